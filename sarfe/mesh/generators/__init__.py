@@ -1,0 +1,1 @@
+"""sarfe.mesh.generators"""
