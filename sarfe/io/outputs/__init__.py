@@ -1,0 +1,42 @@
+"""sarfe.io.outputs — result writers; each a plain function writing into a given path/directory.
+
+    write_summary_json(path, summary: dict) -> Path            strict JSON, NaN/inf → null + note
+    console_table(rows: list[dict], columns=None, formats=None, headers=None, max_rows=None) -> str
+    write_response_h5(path, solutions, *, contacts=None, excitation=None, excitation_dofs=None,
+                      boundary_dofs=None, mode_frequencies_hz=None, erp=None, radiating_nodes=None,
+                      store_displacement=False, store_erp_density_per_harmonic=False,
+                      extra_groups=None, attributes=None) -> Path
+    read_response_h5(path) -> dict
+    write_erp_vtu(path, points, triangles, point_data: dict) -> Path
+    erp_point_data(n_points, erp, normal_displacement, omega, displacement=None,
+                   radiating_nodes=None, contact_marker=None) -> dict
+    contact_markers(n_points, contact_nodes) -> (n_points,) int32
+    write_pvd(path, [(time_or_frequency, vtu_filename), ...]) -> Path
+    write_erp_sweep(directory, points, triangles, point_data_per_frequency, frequencies_hz,
+                    basename="erp") -> Path (.pvd)
+    write_deflection_animation(directory, points, triangles, displacement_harmonics (2H+1, n, 3),
+                               n_frames=24, omega=None, basename="deflection", point_data=None) -> Path (.pvd)
+    plot_erp_sweep(path, frequencies_hz, level_db, stable=None, level_a_db=None, title=None,
+                   linear_level_db=None) -> Path
+    plot_contact_forces(path, force_time (N, n), names=None, omega=None, title=None) -> Path
+    plot_erp_spectrum(path, frequencies_hz (H,), level_db (H,), level_a_db=None, title=None) -> Path
+"""
+from sarfe.io.outputs.plots import plot_contact_forces, plot_erp_spectrum, plot_erp_sweep
+from sarfe.io.outputs.response_h5 import read_response_h5, write_response_h5
+from sarfe.io.outputs.summary import console_table, to_jsonable, write_summary_json
+from sarfe.io.outputs.vtk import (
+    contact_markers,
+    erp_point_data,
+    period_samples,
+    write_deflection_animation,
+    write_erp_sweep,
+    write_erp_vtu,
+    write_pvd,
+)
+
+__all__ = [
+    "write_summary_json", "console_table", "to_jsonable", "write_response_h5", "read_response_h5",
+    "write_erp_vtu", "erp_point_data", "contact_markers", "write_pvd", "write_erp_sweep",
+    "write_deflection_animation", "period_samples", "plot_erp_sweep", "plot_contact_forces",
+    "plot_erp_spectrum",
+]

@@ -1,0 +1,125 @@
+"""``summary.json`` (numpy-safe, strict JSON) and the fixed-width console table of a run."""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict, is_dataclass
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["to_jsonable", "write_summary_json", "console_table", "NULL_NOTE"]
+
+NULL_NOTE = ("null stands for a non-finite number (NaN, +inf or -inf), e.g. the dB level of zero "
+             "power (-inf) or a quantity a contact does not have (NaN); see 'non_finite'")
+
+
+def to_jsonable(value, path: str = "$", replaced: list | None = None):
+    """Plain-Python copy of ``value``: numpy scalars/arrays → numbers/lists, dataclasses → dicts,
+    Paths → str, sets/tuples → lists; NaN/±inf → None, appending ``(json path, repr)`` to ``replaced``.
+    """
+    if replaced is None:
+        replaced = []
+    if is_dataclass(value) and not isinstance(value, type):
+        value = asdict(value)
+    if isinstance(value, dict):
+        return {str(k): to_jsonable(v, f"{path}.{k}", replaced) for k, v in value.items()}
+    if isinstance(value, np.ndarray):
+        value = value.tolist()
+    if isinstance(value, (list, tuple, set)):
+        return [to_jsonable(v, f"{path}[{i}]", replaced) for i, v in enumerate(value)]
+    if isinstance(value, (np.bool_, bool)):
+        return bool(value)
+    if isinstance(value, (np.integer, int)):
+        return int(value)
+    if isinstance(value, (np.floating, float)):
+        value = float(value)
+        if not math.isfinite(value):
+            replaced.append((path, repr(value)))
+            return None
+        return value
+    if isinstance(value, (np.str_, str)):
+        return str(value)
+    if isinstance(value, Path):
+        return str(value)
+    if value is None:
+        return None
+    if isinstance(value, (np.complexfloating, complex)):
+        raise TypeError(f"{path}: complex value {value!r} is not JSON; store real and imaginary parts")
+    raise TypeError(f"{path}: cannot write {type(value).__name__} to JSON")
+
+
+def write_summary_json(path, summary: dict) -> Path:
+    """Write ``summary`` as strict, indented UTF-8 JSON to ``path`` and return the path.
+
+    numpy types are converted; NaN/±inf become ``null`` and, if any were, two keys are added:
+    ``"null_note"`` (:data:`NULL_NOTE`) and ``"non_finite"`` = {json path: "nan" | "inf" | "-inf"}
+    (e.g. ``{"$.erp.level_total_db": "-inf"}``).
+    """
+    path = Path(path)
+    replaced: list = []
+    data = to_jsonable(dict(summary), "$", replaced)
+    if replaced:
+        data["null_note"] = NULL_NOTE
+        data["non_finite"] = {p: r for p, r in replaced}
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(data, indent=2, allow_nan=False, ensure_ascii=False) + "\n",
+                    encoding="utf-8")
+    return path
+
+
+def _format(value, fmt: str | None) -> str:
+    if value is None:
+        return "-"
+    if isinstance(value, (bool, np.bool_)):
+        return "yes" if value else "no"
+    if isinstance(value, (float, np.floating)):
+        value = float(value)
+        if math.isnan(value):
+            return "-"
+        if math.isinf(value):
+            return "-inf" if value < 0 else "inf"
+        if fmt:
+            return format(value, fmt)
+        if value == 0 or 1e-3 <= abs(value) < 1e5:
+            return f"{value:.4g}"
+        return f"{value:.3e}"
+    if fmt and isinstance(value, (int, np.integer)):
+        return format(int(value), fmt)
+    return str(value)
+
+
+def console_table(rows, columns=None, formats=None, headers=None, max_rows: int | None = None) -> str:
+    """Fixed-width text table of ``rows`` (list of dicts) for the end of a run.
+
+    columns : keys to show, in order (default: keys of the first row, then new keys of later rows).
+    formats : {key: format spec}, e.g. ``{"level_total_db": ".1f"}``; floats default to 4
+        significant digits (scientific outside 1e-3…1e5); NaN/None → "-", bools → yes/no.
+    headers : {key: header text} (default: the key).
+    max_rows : show at most this many rows, then a "… (n more)" line.
+    Numbers are right-aligned, text left-aligned. Returns the table (no trailing newline);
+    an empty ``rows`` gives "(no rows)".
+    """
+    rows = list(rows)
+    if not rows:
+        return "(no rows)"
+    if columns is None:
+        columns = []
+        for row in rows:
+            columns += [k for k in row if k not in columns]
+    formats, headers = formats or {}, headers or {}
+    shown = rows if max_rows is None else rows[:max_rows]
+    cells = [[_format(row.get(c), formats.get(c)) for c in columns] for row in shown]
+    numeric = [all(isinstance(row.get(c), (int, float, np.number)) and not isinstance(row.get(c), bool)
+                   or row.get(c) is None for row in shown) for c in columns]
+    head = [str(headers.get(c, c)) for c in columns]
+    widths = [max([len(h)] + [len(r[j]) for r in cells]) for j, h in enumerate(head)]
+
+    def line(parts):
+        return "  ".join(p.rjust(w) if num else p.ljust(w)
+                         for p, w, num in zip(parts, widths, numeric)).rstrip()
+
+    out = [line(head), "  ".join("-" * w for w in widths)] + [line(r) for r in cells]
+    if max_rows is not None and len(rows) > max_rows:
+        out.append(f"... ({len(rows) - max_rows} more)")
+    return "\n".join(out)

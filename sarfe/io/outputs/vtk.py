@@ -1,0 +1,202 @@
+r"""ParaView files: ERP maps (VTU), collections (PVD) and operating-deflection animations.
+
+All VTU files are unstructured grids of the surface triangles with undeformed point coordinates
+[m] and point data only (written with meshio, zlib-compressed binary). PVD files are plain XML
+collections of VTU files referenced by *relative* file names, so a result directory can be moved.
+
+Standard ERP point arrays (:func:`erp_point_data`), n = number of mesh points:
+
+    erp_density_W_m2                (n,)   Σ_k e_k,i, ERP density summed over harmonics [W/m²]
+    erp_density_h<k>_W_m2           (n,)   e_k,i of harmonic k = 1 … H [W/m²]
+    normal_velocity_amplitude_m_s   (n,)   √(Σ_k |v_n,k|²) [m/s], so erp_density = ½ρc·RLF·v²
+    displacement_amplitude_m        (n, 3) per component max_θ |u(θ) − u0| over one period [m]
+    contact_marker                  (n,)   int: 0 = no contact, c+1 = node of contact c
+                                           (ContactSet order; the last contact wins on shared nodes)
+
+Non-radiating points get 0 in the ERP arrays.
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+import meshio
+import numpy as np
+
+__all__ = ["write_erp_vtu", "write_pvd", "write_deflection_animation", "write_erp_sweep",
+           "erp_point_data", "contact_markers", "period_samples"]
+
+
+def period_samples(harmonics, n_samples: int) -> np.ndarray:
+    """u(θ_j) = U0 + Σ_k U_kc cos kθ_j + U_ks sin kθ_j at θ_j = 2πj/n_samples; (2H+1, ...) → (n_samples, ...).
+
+    Direct evaluation (any n_samples ≥ 1, unlike an FFT that needs n_samples ≥ 2H+1).
+    """
+    U = np.asarray(harmonics, dtype=float)
+    H = (U.shape[0] - 1) // 2
+    theta = 2.0 * np.pi * np.arange(int(n_samples)) / int(n_samples)
+    k = np.arange(1, H + 1)
+    phi = np.empty((theta.size, 2 * H + 1))
+    phi[:, 0] = 1.0
+    phi[:, 1::2] = np.cos(np.outer(theta, k))
+    phi[:, 2::2] = np.sin(np.outer(theta, k))
+    return np.tensordot(phi, U, axes=(1, 0))
+
+
+def _check_mesh(points, triangles):
+    points = np.asarray(points, dtype=float)
+    triangles = np.asarray(triangles, dtype=np.int64)
+    if points.ndim != 2 or points.shape[1] != 3:
+        raise ValueError(f"points must be (n, 3) [m], got {points.shape}")
+    if triangles.ndim != 2 or triangles.shape[1] != 3:
+        raise ValueError(f"triangles must be (n_tri, 3), got {triangles.shape}")
+    if triangles.size and (triangles.min() < 0 or triangles.max() >= points.shape[0]):
+        raise ValueError("triangles refer to points that do not exist")
+    return points, triangles
+
+
+def write_erp_vtu(path, points, triangles, point_data: dict) -> Path:
+    """Write one VTU: ``points`` (n, 3) [m], ``triangles`` (n_tri, 3) int, ``point_data``
+    {name: (n,) or (n, 3) array}. Names are kept as given (see the module docstring for the
+    standard ERP names, built by :func:`erp_point_data`). Integer arrays stay integer; float
+    arrays must be finite. Returns the path.
+    """
+    points, triangles = _check_mesh(points, triangles)
+    data = {}
+    for name, values in point_data.items():
+        arr = np.asarray(values)
+        if arr.shape[0] != points.shape[0] or arr.ndim > 2:
+            raise ValueError(f"point_data[{name!r}] must be (n,) or (n, m) with n = "
+                             f"{points.shape[0]}, got {arr.shape}")
+        if arr.dtype.kind == "b":
+            arr = arr.astype(np.int8)
+        elif arr.dtype.kind in "iu":
+            arr = arr.astype(np.int32)
+        else:
+            arr = arr.astype(np.float64)
+            if not np.all(np.isfinite(arr)):
+                raise ValueError(f"point_data[{name!r}] has non-finite values")
+        data[str(name)] = arr
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    meshio.Mesh(points, [("triangle", triangles)], point_data=data).write(path, file_format="vtu")
+    return path
+
+
+def write_pvd(path, entries) -> Path:
+    """Write a ParaView collection: ``entries`` = [(time_or_frequency, vtu_filename), …].
+
+    Filenames are stored relative to the PVD's directory (they should live in it or below).
+    ParaView shows the value as "time": a phase/time for animations, a frequency [Hz] for sweeps.
+    """
+    path = Path(path)
+    lines = ['<?xml version="1.0"?>',
+             '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">',
+             "  <Collection>"]
+    for value, filename in entries:
+        rel = os.path.relpath(Path(path.parent, filename), path.parent).replace(os.sep, "/")
+        lines.append(f'    <DataSet timestep="{float(value)!r}" group="" part="0" '
+                     f"file={quoteattr(rel)}/>")
+    lines += ["  </Collection>", "</VTKFile>", ""]
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text("\n".join(lines), encoding="utf-8")
+    return path
+
+
+def contact_markers(n_points: int, contact_nodes) -> np.ndarray:
+    """(n_points,) int32 marker: 0 everywhere, c+1 on the nodes ``contact_nodes[c]`` of contact c."""
+    marker = np.zeros(int(n_points), dtype=np.int32)
+    for c, nodes in enumerate(contact_nodes):
+        marker[np.asarray(nodes, dtype=int)] = c + 1
+    return marker
+
+
+def erp_point_data(n_points: int, erp, normal_displacement, omega: float, displacement=None,
+                   radiating_nodes=None, contact_marker=None) -> dict:
+    """The standard ERP arrays (module docstring) for :func:`write_erp_vtu`.
+
+    n_points : number of mesh points n.
+    erp : :class:`sarfe.erp.ErpResult` of the radiating nodes (density (H, n_r)).
+    normal_displacement : (2H+1, n_r) [m] harmonics W used for ``erp``.
+    omega : [rad/s].
+    displacement : (2H+1, n, 3) [m] nodal translation harmonics of all points, or None (zeros).
+    radiating_nodes : (n_r,) point indices of the radiating nodes (default: all n points).
+    contact_marker : (n,) int, e.g. from :func:`contact_markers` (default zeros).
+    """
+    from sarfe.erp.erp import normal_velocity_amplitudes
+
+    n = int(n_points)
+    nodes = np.arange(n) if radiating_nodes is None else np.asarray(radiating_nodes, dtype=int)
+    density = np.asarray(erp.density, dtype=float)
+    if density.shape[1] != nodes.size:
+        raise ValueError(f"erp has {density.shape[1]} radiating nodes, radiating_nodes {nodes.size}")
+    data = {}
+    full = np.zeros(n)
+    full[nodes] = erp.density_total
+    data["erp_density_W_m2"] = full
+    for k in range(density.shape[0]):
+        full = np.zeros(n)
+        full[nodes] = density[k]
+        data[f"erp_density_h{k + 1}_W_m2"] = full
+    velocity = normal_velocity_amplitudes(normal_displacement, omega)       # (H, n_r)
+    full = np.zeros(n)
+    full[nodes] = np.sqrt(np.sum(velocity**2, axis=0))
+    data["normal_velocity_amplitude_m_s"] = full
+    if displacement is None:
+        data["displacement_amplitude_m"] = np.zeros((n, 3))
+    else:
+        U = np.asarray(displacement, dtype=float)
+        if U.shape[1:] != (n, 3):
+            raise ValueError(f"displacement must be (2H+1, {n}, 3), got {U.shape}")
+        H = (U.shape[0] - 1) // 2
+        samples = period_samples(U, max(64, 16 * H)) - U[0]
+        data["displacement_amplitude_m"] = np.abs(samples).max(axis=0)
+    data["contact_marker"] = (np.zeros(n, dtype=np.int32) if contact_marker is None
+                              else np.asarray(contact_marker, dtype=np.int32))
+    return data
+
+
+def write_erp_sweep(directory, points, triangles, point_data_per_frequency, frequencies_hz,
+                    basename: str = "erp") -> Path:
+    """One VTU per frequency point (``<basename>_0000.vtu`` …) plus ``<basename>.pvd`` whose
+    "time" is the excitation frequency [Hz]. Returns the PVD path."""
+    directory = Path(directory)
+    entries = []
+    for j, (f, data) in enumerate(zip(frequencies_hz, point_data_per_frequency)):
+        name = f"{basename}_{j:04d}.vtu"
+        write_erp_vtu(directory / name, points, triangles, data)
+        entries.append((f, name))
+    return write_pvd(directory / f"{basename}.pvd", entries)
+
+
+def write_deflection_animation(directory, points, triangles, displacement_harmonics,
+                               n_frames: int = 24, omega: float | None = None,
+                               basename: str = "deflection", point_data=None) -> Path:
+    """Operating deflection over one period as a PVD time series that ParaView plays.
+
+    Frame j (``<basename>_<jjj>.vtu``) holds u(θ_j) = U0 + Σ_k U_kc cos kθ_j + U_ks sin kθ_j,
+    θ_j = 2πj/n_frames, as the point vector ``displacement`` [m] (apply *Warp By Vector*; the
+    coordinates stay undeformed) and its norm ``displacement_magnitude`` [m]. The PVD time is
+    t_j = θ_j/ω [s] when ``omega`` [rad/s] is given, else the period fraction j/n_frames.
+    ``displacement_harmonics`` is (2H+1, n, 3) [m]; ``point_data`` adds constant arrays to every
+    frame (e.g. ``contact_marker``). Returns ``<directory>/<basename>.pvd``.
+    """
+    points, triangles = _check_mesh(points, triangles)
+    U = np.asarray(displacement_harmonics, dtype=float)
+    if U.ndim != 3 or U.shape[1:] != (points.shape[0], 3) or U.shape[0] % 2 == 0:
+        raise ValueError(f"displacement_harmonics must be (2H+1, {points.shape[0]}, 3), got {U.shape}")
+    if int(n_frames) < 2:
+        raise ValueError("n_frames must be >= 2")
+    frames = period_samples(U, int(n_frames))                              # (n_frames, n, 3)
+    directory = Path(directory)
+    entries = []
+    for j, u in enumerate(frames):
+        name = f"{basename}_{j:03d}.vtu"
+        data = dict(point_data or {})
+        data["displacement"] = u
+        data["displacement_magnitude"] = np.linalg.norm(u, axis=1)
+        write_erp_vtu(directory / name, points, triangles, data)
+        phase = j / int(n_frames)
+        entries.append((2.0 * np.pi * phase / omega if omega else phase, name))
+    return write_pvd(directory / f"{basename}.pvd", entries)
