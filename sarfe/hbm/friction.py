@@ -36,3 +36,92 @@ def slider_update(slider_previous, tangential_displacement, slip_radius):
     slider = q + trial * scale[..., None]
     state = np.where(rho <= 0.0, SEPARATED, np.where(slipping, SLIP, STICK)).astype(np.int8)
     return slider, state
+
+
+def compose_clamps(lower, upper):
+    r"""Prefix compositions of the clamps c_j(x) = clip(x, a_j, b_j) along axis 0 (Hillis–Steele).
+
+    The composition of two clamps is a clamp,
+
+        clip(clip(x, a₁, b₁), a₂, b₂) = clip(x, clip(a₁, a₂, b₂), clip(b₁, a₂, b₂)),
+
+    so C_j = c_j ∘ … ∘ c_0 = clip(·, A_j, B_j) for every j follows from log₂N doubling steps, each a
+    vectorized numpy operation over (samples, contacts). lower, upper: (N, ...) with a ≤ b.
+    Returns (A, B) of the same shape; x after sample j is clip(x_start, A_j, B_j).
+    """
+    A = np.array(lower, dtype=float)
+    B = np.array(upper, dtype=float)
+    shift = 1
+    while shift < A.shape[0]:
+        lo, hi = A[shift:], B[shift:]
+        A_new = np.clip(A[:-shift], lo, hi)
+        B_new = np.clip(B[:-shift], lo, hi)
+        A[shift:], B[shift:] = A_new, B_new
+        shift *= 2
+    return A, B
+
+
+def jenkins_periodic_1d(tangential_displacement, slip_radius, slider_start):
+    r"""Periodic steady state of the 1-D Jenkins element over one period, without a sample loop.
+
+    The return map w_j = clip(w_{j−1}, q_j − ρ_j, q_j + ρ_j) is a clamp; the whole period is the
+    composed clamp clip(·, A_{N−1}, B_{N−1}) (:func:`compose_clamps`). A clamp is idempotent, so
+    one period marched from any start w_start lands on the periodic state
+    w_end = clip(w_start, A_{N−1}, B_{N−1}), and the second period w_j = clip(w_end, A_j, B_j) ends
+    on w_end again (it only confirms): 2 passes.
+
+    q: (N, n) [m], ρ = μ λ_n / k_t: (N, n) [m], slider_start: (n,) [m].
+    Returns dict with slider w (N, n), state (N, n) int8, reset (N, n) bool (slip or separation:
+    the history is erased there), sign (N, n) ∈ {+1, −1, 0} with λ_t = sign·μλ_n at a slip sample
+    (+1: w clamped at q − ρ), slider_end (n,), passes = 2.
+    """
+    q = np.asarray(tangential_displacement, dtype=float)
+    rho = np.maximum(np.asarray(slip_radius, dtype=float), 0.0)
+    lower, upper = q - rho, q + rho
+    A, B = compose_clamps(lower, upper)
+    slider_end = np.clip(slider_start, A[-1], B[-1])
+    slider = np.clip(slider_end, A, B)
+    previous = np.concatenate([slider_end[None], slider[:-1]], axis=0)
+    below, above = previous < lower, previous > upper
+    separated = rho <= 0.0
+    sign = np.where(separated, 0, np.where(below, 1, np.where(above, -1, 0))).astype(np.int8)
+    reset = separated | below | above
+    state = np.where(separated, SEPARATED, np.where(below | above, SLIP, STICK)).astype(np.int8)
+    return {"slider": slider, "state": state, "reset": reset, "sign": sign,
+            "slider_end": slider_end, "passes": 2}
+
+
+def last_reset_index(reset):
+    """Index j(i) ≤ i (cyclic) of the last reset sample before or at each sample, along axis 0.
+
+    reset: (N, n) bool. Returns (j (N, n) int, has_reset (n,) bool); j is meaningless where a column
+    never resets. Found by np.maximum.accumulate over two concatenated periods.
+    """
+    N = reset.shape[0]
+    twice = np.concatenate([reset, reset], axis=0)
+    index = np.where(twice, np.arange(2 * N).reshape((-1,) + (1,) * (reset.ndim - 1)), -1)
+    last = np.maximum.accumulate(index, axis=0)[N:]
+    return last % N, reset.any(axis=0)
+
+
+def slider_update_derivatives(slider_previous, tangential_displacement, slip_radius):
+    r"""Return map (as :func:`slider_update`) and its derivatives, vectorized over leading axes.
+
+    Slip: w = q + ρ n, n = t/|t|, t = w_prev − q, so
+        dw = dq + n dρ + (ρ/|t|)(I − n nᵀ)(dw_prev − dq);
+    stick: dw = dw_prev; separation (ρ = 0): dw = dq.
+    Returns (slider (..., 2), state (...), P = ∂w/∂w_prev (..., 2, 2), n_rho = ∂w/∂ρ (..., 2)),
+    with ∂w/∂q = I − P.
+    """
+    slider, state = slider_update(slider_previous, tangential_displacement, slip_radius)
+    trial = np.asarray(slider_previous, dtype=float) - np.asarray(tangential_displacement, dtype=float)
+    norm = np.sqrt(np.sum(trial * trial, axis=-1))
+    rho = np.maximum(np.asarray(slip_radius, dtype=float), 0.0)
+    slipping = (state == SLIP)[..., None, None]
+    unit = trial / np.where(norm > 0, norm, 1.0)[..., None]
+    ratio = (rho / np.where(norm > 0, norm, 1.0))[..., None, None]
+    eye = np.eye(trial.shape[-1])
+    project = ratio * (eye - unit[..., :, None] * unit[..., None, :])
+    P = np.where(slipping, project, np.where((state == STICK)[..., None, None], eye, 0.0))
+    n_rho = np.where((state == SLIP)[..., None], unit, 0.0)
+    return slider, state, P, n_rho

@@ -1,0 +1,101 @@
+r"""Options of the harmonic-balance solver and its result: one periodic solution at one ω.
+
+All fields follow docs/design.md; SI units. Harmonic arrays use the convention of
+:mod:`sarfe.hbm.harmonics` (rows 0, 1c, 1s, …, Hc, Hs).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class SolverOptions:
+    """Newton solver of R(ũ, ω) = S(ω) ũ + f̃_nl(ũ) − f̃_e = 0 at fixed ω.
+
+    tolerance: converged when the residual of the iterated system is ≤ tolerance × its reference
+        (‖f̃_e‖ uncondensed, ‖G S⁻¹ f̃_e‖ when condensed) **and** the residual of the full equation of
+        motion on all DOFs, ‖S ũ + f̃_nl − f̃_e‖ / ‖f̃_e‖, is ≤ ``full_tolerance``.
+    step_tolerance: also converged when the scaled Newton step ‖Δ‖/max(‖x‖, x_ref) falls below it
+        while the residual is ≤ √tolerance (nonsmooth laws can stall at round-off).
+    max_iterations: Newton iteration cap (a point hitting it is returned with converged=False).
+    line_search_steps: backtracking halvings of the step (α = 1, ½, …) on ‖R‖.
+    condensation: 'auto' | True | False. Eliminate the linear DOFs through the dynamic compliance
+        G S_k⁻¹ Gᵀ (Newton on the contact rows only). 'auto' condenses when that system is smaller
+        than the full one and at most ``max_condensed_size`` unknowns.
+    stability: compute Hill stability of the converged solution.
+    friction_tolerance, friction_pass_cap: 2-D slider march, stop when the slider state repeats to
+        friction_tolerance × (max |q| + max ρ), at most friction_pass_cap periods.
+    """
+
+    tolerance: float = 1e-9
+    full_tolerance: float = 1e-6
+    step_tolerance: float = 1e-12
+    max_iterations: int = 50
+    line_search_steps: int = 8
+    condensation: object = "auto"
+    max_condensed_size: int = 2000
+    stability: bool = True
+    stability_tolerance: float = 1e-6
+    friction_tolerance: float = 1e-12
+    friction_pass_cap: int = 50
+
+
+@dataclass(frozen=True)
+class ContinuationOptions:
+    """Pseudo-arclength continuation in ω (scaled arclength s, see :mod:`sarfe.hbm.continuation`).
+
+    Unknowns are scaled as (x / x_scale, ω / |ω_end − ω_start|) with x_scale = ‖x‖ of the first
+    point; the step Δs is a length in those units (Δs = 1 covers the whole range in ω).
+    initial_step, min_step, max_step: Δs bounds. The step grows by ``step_growth`` when the corrector
+    needed ≤ ``target_iterations`` iterations and shrinks by half when it needed more or failed.
+    max_points: cap on the number of points returned (the sweep then stops, last point flagged in
+    its reason). solver: SolverOptions of the correctors.
+    """
+
+    initial_step: float = 0.02
+    min_step: float = 1e-6
+    max_step: float = 0.1
+    step_growth: float = 1.5
+    target_iterations: int = 4
+    max_points: int = 2000
+    solver: SolverOptions = SolverOptions()
+
+
+@dataclass(frozen=True)
+class HarmonicSolution:
+    """One periodic solution at frequency ω (fields as in docs/design.md).
+
+    omega [rad/s]; harmonics H; samples_per_period N;
+    displacement (2H+1, n_dof) [m] on all kept DOFs (recovered after condensation);
+    contact_displacement (2H+1, n_rows) [m] r̃ = G ũ; contact_force (2H+1, n_rows) [N] λ̃;
+    contact_force_time (N, n_rows) [N]; contact_state (N, n_c) int8 (0 open/separated,
+    1 closed-or-stick, 2 slip); converged, reason, iterations,
+    residual_norm = ‖S ũ + Gᵀλ̃ − f̃_e‖ / ‖f̃_e‖ on all DOFs; friction_passes (periods marched by
+    the friction law in the last evaluation); stable (None if not computed); floquet_exponent
+    [1/s] = largest real part of the kept Floquet exponents (nan if not computed).
+    """
+
+    omega: float
+    harmonics: int
+    samples_per_period: int
+    displacement: np.ndarray
+    contact_displacement: np.ndarray
+    contact_force: np.ndarray
+    contact_force_time: np.ndarray
+    contact_state: np.ndarray
+    converged: bool
+    reason: str
+    iterations: int
+    residual_norm: float
+    friction_passes: int = 0
+    stable: object = None
+    floquet_exponent: float = float("nan")
+
+    def amplitude(self, dof: int, harmonic: int = 1) -> float:
+        """Amplitude √(u_kc² + u_ks²) of harmonic k of one DOF [m] (k = 0: the mean)."""
+        if harmonic == 0:
+            return float(abs(self.displacement[0, dof]))
+        return float(np.hypot(self.displacement[2 * harmonic - 1, dof],
+                              self.displacement[2 * harmonic, dof]))
