@@ -1,0 +1,100 @@
+"""``sarfe batch``: run case files and study files, optionally through a Dask cluster.
+
+Exit codes: 0 every variant finished (and the gate passed), 1 some variants failed with an error
+(no gate requested), 2 unusable study/case file, 4 gate failed (``--fail-above-db``: a variant
+above the level, a non-converged one unless ``--allow-nonconverged``, or a failed one).
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+
+HELP = "run many cases or a study (grid / list / Monte Carlo variations) in parallel"
+EPILOG = ("exit codes: 0 all variants finished and the gate passed; 1 some variants failed (no gate); "
+          "2 bad study or case file; 4 gate failed (list of offending variants on stderr)")
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("inputs", nargs="+", metavar="CASE_OR_STUDY",
+                        help="case files (.yaml) and/or study files (with a base_case key)")
+    parser.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                        help="address of a running Dask scheduler, e.g. tcp://10.0.0.5:8786")
+    parser.add_argument("--workers", type=int, default=2, metavar="N",
+                        help="local worker processes when no --scheduler (default 2; 0 = in this process, no Dask)")
+    parser.add_argument("--output", metavar="DIR", default=None,
+                        help="output folder (default results/<study name>); re-running resumes there")
+    parser.add_argument("--fail-above-db", type=float, default=None, metavar="X",
+                        help=f"CI gate: exit 4 if any variant's max ERP level exceeds X dB, "
+                             "did not converge, or failed")
+    parser.add_argument("--allow-nonconverged", action="store_true",
+                        help="non-converged variants do not fail the gate")
+    parser.add_argument("--write-variant-outputs", action="store_true",
+                        help="also write each variant's own output folder (variant_outputs/<id>/)")
+    parser.add_argument("--retry-failed", action="store_true",
+                        help="run variants that failed in an earlier run again")
+    parser.add_argument("--no-cache", action="store_true",
+                        help="do not read/write linear stages in <output>/.cache")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Handler of ``sarfe batch``; returns the exit code."""
+    from sarfe.batch.report import GATE_EXIT_CODE, evaluate_gate
+    from sarfe.batch.runner import default_output_dir, run_study
+    from sarfe.batch.study import StudyError, collect_variants
+
+    if args.workers < 0:
+        print("sarfe batch: --workers must be >= 0", file=sys.stderr)
+        return 2
+    case_errors = _case_error_types()
+    try:
+        output = args.output
+        if output is None:
+            output = default_output_dir(collect_variants(args.inputs))
+        table = run_study(args.inputs, workers=args.workers, scheduler=args.scheduler, output_dir=output,
+                          write_variant_outputs=args.write_variant_outputs, retry_failed=args.retry_failed,
+                          cache_linear_stages=not args.no_cache, progress=True)
+    except (StudyError, *case_errors) as error:
+        print(f"sarfe batch: {error}", file=sys.stderr)
+        return 2
+    summary = table.attrs.get("summary", {})
+    print(_summary_line(summary, output))
+    gate = evaluate_gate(table, args.fail_above_db, args.allow_nonconverged)
+    if args.fail_above_db is not None or not gate.passed:
+        print(f"sarfe batch: {gate.message}", file=sys.stderr if not gate.passed else sys.stdout)
+    if args.fail_above_db is not None:
+        return 0 if gate.passed else GATE_EXIT_CODE
+    return 1 if summary.get("failed") else 0
+
+
+def _case_error_types() -> tuple:
+    try:
+        from sarfe.io.errors import CaseError
+    except ImportError:
+        return ()
+    return (CaseError,)
+
+
+def _summary_line(summary: dict, output) -> str:
+    run = summary.get("run", {})
+    level = summary.get("max_erp_db", {})
+    text = (f"{summary.get('variants', 0)} variants: {summary.get('ok', 0)} ok, "
+            f"{summary.get('nonconverged', 0)} non-converged, {summary.get('failed', 0)} failed "
+            f"({run.get('skipped', 0)} from an earlier run); "
+            f"linear stages built {run.get('linear_stages_built', 0)}, cached {run.get('linear_stages_from_cache', 0)}")
+    if level.get("count"):
+        text += f"; max ERP {level['min']:.1f}…{level['max']:.1f} dB (median {level['median']:.1f})"
+    return text + f"; results in {output}"
+
+
+def register(subparsers) -> argparse.ArgumentParser:
+    """Add the ``batch`` subcommand to ``sarfe``'s subparsers (handler in defaults ``func``)."""
+    parser = subparsers.add_parser("batch", help=HELP, description=HELP + ".", epilog=EPILOG)
+    add_arguments(parser)
+    parser.set_defaults(func=run, handler=run)
+    return parser
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="sarfe batch", description=HELP + ".", epilog=EPILOG)
+    add_arguments(parser)
+    return run(parser.parse_args(argv))

@@ -1,0 +1,250 @@
+"""Batch summary: per-variant maxima, statistics (summary.json), plots, and the CI gate.
+
+Reads the merged table of ``sarfe.batch.store.records_table``. Per variant the level is the maximum
+over its frequency points of the ERP level [dB] (and A-weighted [dB(A)]).
+"""
+from __future__ import annotations
+
+import json
+import math
+import pathlib
+from dataclasses import asdict, dataclass
+
+import numpy as np
+import pandas as pd
+
+from sarfe.batch import store
+
+GATE_EXIT_CODE = 4
+_ERP_DB = ("erp_db", "erp_level_db", "erp_dB", "erp_total_db", "erp_max_db")
+_ERP_DBA = ("erp_dba", "erp_db_a", "erp_dBA", "erp_level_dba", "erp_total_dba")
+_FREQUENCY = ("frequency_hz", "frequency_Hz", "frequency", "freq_hz")
+
+
+def _find(table: pd.DataFrame, names, contains=None, exclude=()):
+    for name in names:
+        if name in table.columns:
+            return name
+    if contains:
+        for column in table.columns:
+            low = column.lower()
+            if all(c in low for c in contains) and not any(e in low for e in exclude):
+                return column
+    return None
+
+
+def erp_column(table):
+    return _find(table, _ERP_DB, ("erp", "db"), ("dba", "db_a", "dba_"))
+
+
+def erp_a_column(table):
+    return _find(table, _ERP_DBA, ("erp", "dba"))
+
+
+def frequency_column(table):
+    return _find(table, _FREQUENCY, ("freq",))
+
+
+def parameter_columns(table) -> list[str]:
+    """Varied-input columns: between the variant columns and the result columns."""
+    return [c for c in table.columns if c not in store.VARIANT_COLUMNS and ("." in c or "[" in c)]
+
+
+def rattle_columns(table) -> dict[str, str]:
+    """{contact name: boolean/number column that says the contact rattles (impacts/opens)}."""
+    found = {}
+    for column in table.columns:
+        low = column.lower()
+        for suffix in ("_rattles", "_rattle", "_impact", "_opens"):
+            if low.endswith(suffix) and low != suffix.strip("_"):
+                found.setdefault(column[: -len(suffix)], column)
+    return found
+
+
+def variant_levels(table: pd.DataFrame) -> pd.DataFrame:
+    """One row per variant: status, error, varied inputs, max ERP dB / dB(A) and where."""
+    erp, erp_a, freq = erp_column(table), erp_a_column(table), frequency_column(table)
+    keep = ["variant_index", "variant_id", "source", "status", "error"] + parameter_columns(table)
+    levels = table.groupby("variant_index", sort=True)[keep].first().reset_index(drop=True)
+    if erp is not None:
+        values = pd.to_numeric(table[erp], errors="coerce")
+        levels["max_erp_db"] = values.groupby(table["variant_index"]).max().to_numpy()
+        if freq is not None:
+            where = values.fillna(-np.inf).groupby(table["variant_index"]).idxmax()
+            levels["frequency_at_max_hz"] = table.loc[where.to_numpy(), freq].to_numpy()
+    if erp_a is not None:
+        values = pd.to_numeric(table[erp_a], errors="coerce")
+        levels["max_erp_dba"] = values.groupby(table["variant_index"]).max().to_numpy()
+    for contact, column in rattle_columns(table).items():
+        flags = pd.to_numeric(table[column], errors="coerce").fillna(0) > 0
+        levels[f"{contact}_rattles"] = flags.groupby(table["variant_index"]).any().to_numpy()
+    return levels
+
+
+def _stats(values) -> dict:
+    values = np.asarray(pd.to_numeric(pd.Series(values), errors="coerce").dropna(), float)
+    if values.size == 0:
+        return {"count": 0}
+    p5, p50, p95 = np.percentile(values, [5, 50, 95])
+    return {"count": int(values.size), "mean": float(values.mean()), "std": float(values.std(ddof=0)),
+            "min": float(values.min()), "p5": float(p5), "median": float(p50), "p95": float(p95),
+            "max": float(values.max())}
+
+
+@dataclass(frozen=True)
+class GateResult:
+    passed: bool
+    threshold_db: float | None
+    offenders: list            # [{variant_id, reason, ...}]
+    message: str               # readable, one line per offending variant
+
+
+def _describe(row, parameters) -> str:
+    values = ", ".join(f"{p}={_short_value(row[p])}" for p in parameters if not _missing(row[p]))
+    return f"{row['variant_id']} [{row['source']}]" + (f" {values}" if values else "")
+
+
+def _missing(value) -> bool:
+    return value is None or (isinstance(value, float) and math.isnan(value))
+
+
+def _short_value(value) -> str:
+    return f"{value:.6g}" if isinstance(value, float) else str(value)
+
+
+def evaluate_gate(table: pd.DataFrame, fail_above_db: float | None = None,
+                  allow_nonconverged: bool = False) -> GateResult:
+    """CI gate: a variant fails when its max ERP level > ``fail_above_db`` [dB], when it did not
+    converge (unless ``allow_nonconverged``), or when it failed with an error.
+    Exit code of a failed gate: ``GATE_EXIT_CODE`` (4)."""
+    levels = variant_levels(table) if len(table) else pd.DataFrame()
+    parameters = parameter_columns(table)
+    offenders, lines = [], []
+    for _, row in levels.iterrows():
+        reason = None
+        if row["status"] == "failed":
+            reason = f"failed: {row['error']}"
+        elif row["status"] == "nonconverged" and not allow_nonconverged:
+            reason = "did not converge (use --allow-nonconverged to accept)"
+        elif fail_above_db is not None and "max_erp_db" in row and row["max_erp_db"] > fail_above_db:
+            at = f" at {row['frequency_at_max_hz']:.6g} Hz" if "frequency_at_max_hz" in row else ""
+            reason = f"ERP {row['max_erp_db']:.2f} dB{at} > {fail_above_db:g} dB"
+        if reason is not None:
+            offenders.append({"variant_id": row["variant_id"], "variant_index": int(row["variant_index"]),
+                              "reason": reason})
+            lines.append(f"  {_describe(row, parameters)}: {reason}")
+    total = len(levels)
+    if offenders:
+        head = f"gate failed: {len(offenders)} of {total} variants"
+        if fail_above_db is not None:
+            head += f" (threshold {fail_above_db:g} dB)"
+        message = "\n".join([head + ":"] + lines)
+    else:
+        message = f"gate passed: {total} variants" + (f" at or below {fail_above_db:g} dB" if fail_above_db is not None else "")
+    return GateResult(passed=not offenders, threshold_db=fail_above_db, offenders=offenders, message=message)
+
+
+def rattle_probability(levels: pd.DataFrame, gap_column: str, bins: int = 8) -> pd.DataFrame:
+    """P(contact rattles) per gap value (grid/list) or gap bin (Monte Carlo).
+
+    Columns: gap_low, gap_high, gap_mid [m], count, then one probability column per contact.
+    """
+    flags = [c for c in levels.columns if c.endswith("_rattles")]
+    data = levels[levels["status"] != "failed"]
+    gaps = pd.to_numeric(data[gap_column], errors="coerce")
+    data, gaps = data[gaps.notna()], gaps[gaps.notna()]
+    unique = np.unique(gaps.dropna())
+    if unique.size == 0:
+        return pd.DataFrame(columns=["gap_low", "gap_high", "gap_mid", "count"])
+    if unique.size <= bins:
+        labels = np.searchsorted(unique, gaps)
+        low, high = unique, unique
+    else:
+        edges = np.linspace(unique[0], unique[-1], bins + 1)
+        labels = np.clip(np.searchsorted(edges, gaps, side="right") - 1, 0, bins - 1)
+        low, high = edges[:-1], edges[1:]
+    out = []
+    for label, members in data.groupby(np.asarray(labels)):
+        out.append({"gap_low": float(low[label]), "gap_high": float(high[label]),
+                    "gap_mid": 0.5 * float(low[label] + high[label]), "count": int(len(members)),
+                    **{f[: -len("_rattles")]: float(members[f].mean()) for f in flags}})
+    return pd.DataFrame(out)
+
+
+def _plots(levels: pd.DataFrame, output: pathlib.Path) -> list[str]:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    written = []
+    if "max_erp_db" in levels and levels["max_erp_db"].notna().any():
+        figure, axis = plt.subplots(figsize=(6, 4))
+        axis.hist(levels["max_erp_db"].dropna(), bins=min(30, max(5, len(levels) // 4)), color="tab:blue")
+        axis.set_xlabel("max ERP level per variant [dB]")
+        axis.set_ylabel("variants")
+        axis.set_title(f"ERP level over {int(levels['max_erp_db'].notna().sum())} variants")
+        figure.tight_layout()
+        figure.savefig(output / "erp_histogram.png", dpi=110)
+        plt.close(figure)
+        written.append("erp_histogram.png")
+    gaps = [c for c in levels.columns if "gap" in c.lower() and ("." in c or "[" in c)]
+    has_flags = any(c.endswith("_rattles") for c in levels.columns)
+    if gaps and has_flags:
+        figure, axis = plt.subplots(figsize=(6, 4))
+        for gap in gaps:
+            table = rattle_probability(levels, gap)
+            for contact in [c for c in table.columns if c not in ("gap_low", "gap_high", "gap_mid", "count")]:
+                axis.plot(table["gap_mid"] * 1e3, table[contact], "o-", label=f"{contact} vs {gap}")
+        axis.set_xlabel("gap [mm]")
+        axis.set_ylabel("probability that the contact rattles")
+        axis.set_ylim(-0.02, 1.02)
+        axis.legend(fontsize=7)
+        figure.tight_layout()
+        figure.savefig(output / "rattle_probability_vs_gap.png", dpi=110)
+        plt.close(figure)
+        written.append("rattle_probability_vs_gap.png")
+    return written
+
+
+def summarize(table: pd.DataFrame, stats=None) -> dict:
+    """Statistics of a merged batch table (the content of summary.json)."""
+    levels = variant_levels(table) if len(table) else pd.DataFrame(columns=["status"])
+    counts = levels["status"].value_counts().to_dict() if len(levels) else {}
+    summary = {
+        "variants": int(len(levels)),
+        "ok": int(counts.get("ok", 0)),
+        "nonconverged": int(counts.get("nonconverged", 0)),
+        "failed": int(counts.get("failed", 0)),
+        "rows": int(len(table)),
+        "columns": {"erp_db": erp_column(table), "erp_dba": erp_a_column(table),
+                    "frequency": frequency_column(table), "parameters": parameter_columns(table)},
+    }
+    if "max_erp_db" in levels:
+        summary["max_erp_db"] = _stats(levels["max_erp_db"])
+    if "max_erp_dba" in levels:
+        summary["max_erp_dba"] = _stats(levels["max_erp_dba"])
+    flags = [c for c in levels.columns if c.endswith("_rattles")]
+    ok = levels[levels["status"] != "failed"] if len(levels) else levels
+    if flags and len(ok):
+        summary["rattle_probability"] = {f[: -len("_rattles")]: float(ok[f].mean()) for f in flags}
+    for parameter in parameter_columns(table):
+        values = pd.to_numeric(levels[parameter], errors="coerce") if parameter in levels else pd.Series([], dtype=float)
+        if values.notna().any():
+            summary.setdefault("parameters", {})[parameter] = _stats(values)
+    summary["failures"] = [{"variant_id": r["variant_id"], "error": r["error"]}
+                           for _, r in levels.iterrows() if r["status"] == "failed"]
+    if stats is not None:
+        summary["run"] = asdict(stats)
+    return summary
+
+
+def write_report(table: pd.DataFrame, output, stats=None) -> dict:
+    """Write summary.json, variants.csv (one row per variant) and the PNGs; return the summary."""
+    output = pathlib.Path(output)
+    summary = summarize(table, stats)
+    if len(table):
+        levels = variant_levels(table)
+        store.atomic_write(output / "variants.csv", levels.to_csv(index=False).encode())
+        summary["plots"] = _plots(levels, output)
+    store.atomic_write(output / "summary.json", json.dumps(summary, indent=2, default=str).encode())
+    return summary
