@@ -1,0 +1,55 @@
+"""Shared steps of the gmsh generators: mesh options, groups, embedded nodes, output."""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from ..gmsh_model import mesh_from_gmsh
+from ..mesh import PanelMesh
+
+
+def set_mesh_size(gmsh, mesh_size: float) -> None:
+    """Uniform target edge length `mesh_size` [m], Frontal-Delaunay triangles, deterministic."""
+    if not mesh_size > 0:
+        raise ValueError(f"mesh_size must be positive, got {mesh_size}")
+    gmsh.option.setNumber("Mesh.MeshSizeMax", mesh_size)
+    gmsh.option.setNumber("Mesh.MeshSizeMin", 0.3 * mesh_size)
+    gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+    gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+    gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+    gmsh.option.setNumber("Mesh.Algorithm", 6)
+    gmsh.option.setNumber("Mesh.ElementOrder", 1)
+    gmsh.option.setNumber("Mesh.Optimize", 0)
+
+
+def add_group(gmsh, dim: int, tags, name: str) -> None:
+    """Named physical group of the entities `tags` of dimension `dim`."""
+    tags = [int(t) for t in np.atleast_1d(tags)]
+    if not tags:
+        raise ValueError(f"physical group {name!r} would be empty")
+    gmsh.model.addPhysicalGroup(dim, tags, name=name)
+
+
+def embed_points(gmsh, surface: int, coordinates) -> list[int]:
+    """Add points (k, 3) [m] and embed them in `surface` so they become mesh nodes.
+
+    Must be called after `occ.synchronize()`; the nodes sit exactly at the given coordinates.
+    """
+    tags = [gmsh.model.occ.addPoint(*map(float, xyz)) for xyz in np.atleast_2d(coordinates)]
+    gmsh.model.occ.synchronize()
+    gmsh.model.mesh.embed(0, tags, 2, surface)
+    return tags
+
+
+def finish(gmsh, path=None) -> PanelMesh:
+    """Mesh the surfaces, convert to `PanelMesh`, optionally write a Gmsh 4.1 `.msh` to `path`."""
+    gmsh.model.mesh.generate(2)
+    mesh = mesh_from_gmsh()
+    if path is not None:
+        path = os.fspath(path)
+        os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+        gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+        gmsh.option.setNumber("Mesh.Binary", 0)
+        gmsh.write(path)
+    return mesh

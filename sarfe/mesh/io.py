@@ -1,0 +1,121 @@
+"""Reading shell meshes from files into `PanelMesh`.
+
+* Gmsh ``.msh`` (v2 / v4) through the gmsh API (keeps z; scikit-fem's loader drops it):
+  named physical groups → node groups (all dims) and element groups (surface groups).
+* Nastran ``.bdf`` / ``.nas`` / ``.dat`` through meshio: one element group and node group per
+  shell property id, named ``pid_<n>``.
+* Abaqus ``.inp`` through meshio: ``*NSET`` → node groups, ``*ELSET`` → element groups
+  (element sets of non-shell elements keep only their nodes as a node group).
+
+Only shell triangles (quadrilaterals split in two, higher-order elements reduced to their
+corners) and optional tetrahedra are kept; nodes used by no kept element are dropped and all
+indices remapped.  Coordinates are scaled from `length_unit` to metres.
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from .gmsh_model import assemble_mesh, gmsh_session, mesh_from_gmsh, split_quads
+from .mesh import PanelMesh
+
+LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "in": 0.0254}
+
+_FORMATS = {".msh": "gmsh", ".bdf": "nastran", ".nas": "nastran", ".dat": "nastran",
+            ".fem": "nastran", ".inp": "abaqus"}
+_MESHIO_TRIANGLES = ("triangle", "triangle6", "triangle7")
+_MESHIO_QUADS = ("quad", "quad8", "quad9")
+_MESHIO_TETS = ("tetra", "tetra10")
+
+
+class MeshError(ValueError):
+    """A mesh file is missing, of unknown type or unreadable (one-line message)."""
+
+
+def load_mesh(path, length_unit: str = "m") -> PanelMesh:
+    """Read a shell mesh (`.msh`, `.bdf`/`.nas`/`.dat`, `.inp`) into a `PanelMesh` in metres.
+
+    length_unit: unit of the file's coordinates, one of 'm', 'mm', 'cm', 'in'.
+    Raises `MeshError` for a missing, unreadable or element-less file or an unknown unit.
+    """
+    path = Path(path)
+    if length_unit not in LENGTH_UNITS:
+        raise MeshError(f"unknown length unit {length_unit!r}; use one of {', '.join(LENGTH_UNITS)}")
+    if not path.is_file():
+        raise MeshError(f"mesh file not found: {path}")
+    fmt = _FORMATS.get(path.suffix.lower())
+    if fmt is None:
+        raise MeshError(f"unknown mesh file type {path.suffix!r} of {path}; "
+                        f"use one of {', '.join(sorted(_FORMATS))}")
+    try:
+        mesh = _read_gmsh(path) if fmt == "gmsh" else _read_meshio(path, fmt)
+    except MeshError:
+        raise
+    except Exception as error:  # reader-specific exceptions → one line
+        message = " ".join(str(error).split()) or type(error).__name__
+        raise MeshError(f"cannot read {fmt} mesh {path}: {message}") from error
+    if mesh.n_triangles == 0 and mesh.tetrahedra is None:
+        raise MeshError(f"no shell triangles/quadrilaterals or tetrahedra in {path}")
+    scale = LENGTH_UNITS[length_unit]
+    return mesh if scale == 1.0 else mesh.scaled(scale)
+
+
+def _read_gmsh(path: Path) -> PanelMesh:
+    with gmsh_session() as gmsh:
+        gmsh.merge(os.fspath(path))
+        return mesh_from_gmsh()
+
+
+def _read_meshio(path: Path, fmt: str) -> PanelMesh:
+    import meshio
+
+    data = meshio.read(os.fspath(path), file_format=fmt)
+    triangle_blocks, tetra_blocks = [], []
+    # per meshio cell block: rows of its kept elements in the concatenated triangle list
+    block_rows, offset = [], 0
+    for block in data.cells:
+        if block.type in _MESHIO_TRIANGLES:
+            triangle_blocks.append(block.data[:, :3])
+            block_rows.append(offset + np.arange(len(block.data))[:, None])
+            offset += len(block.data)
+        elif block.type in _MESHIO_QUADS:
+            triangle_blocks.append(block.data[:, :4])
+            block_rows.append(offset + split_quads(np.arange(len(block.data))).reshape(-1, 2))
+            offset += 2 * len(block.data)
+        else:
+            if block.type in _MESHIO_TETS:
+                tetra_blocks.append(block.data)
+            block_rows.append(None)
+
+    node_groups, element_groups = {}, {}
+    for name, rows in data.point_sets.items():
+        node_groups[name] = np.asarray(rows, dtype=np.int64)
+
+    def add_cells(name, per_block):
+        rows, nodes = [], []
+        for block, index, kept in zip(data.cells, per_block, block_rows):
+            index = np.asarray(index, dtype=np.int64)
+            if index.size == 0:
+                continue
+            nodes.append(np.asarray(block.data)[index].ravel())
+            if kept is not None:
+                rows.append(kept[index].ravel())
+        if rows:
+            element_groups[name] = np.concatenate(rows)
+        if nodes and name not in node_groups:
+            node_groups[name] = np.unique(np.concatenate(nodes))
+
+    for name, per_block in data.cell_sets.items():
+        if name.startswith("gmsh:"):
+            continue
+        add_cells(name, per_block)
+    if fmt == "nastran" and "nastran:ref" in data.cell_data:
+        refs = [np.asarray(r, dtype=np.int64) for r in data.cell_data["nastran:ref"]]
+        pids = np.unique(np.concatenate([r for r, k in zip(refs, block_rows) if k is not None]
+                                        or [np.zeros(0, dtype=np.int64)]))
+        for pid in pids:
+            add_cells(f"pid_{pid}", [np.flatnonzero(r == pid) if k is not None else []
+                                     for r, k in zip(refs, block_rows)])
+    return assemble_mesh(data.points, triangle_blocks, tetra_blocks, node_groups, element_groups)

@@ -1,0 +1,112 @@
+"""Parametric gmsh generators at coarse sizes: topology, groups, contact pairs, determinism."""
+import importlib
+
+import numpy as np
+import pytest
+
+from sarfe.mesh import (connected_components, load_mesh, nodal_areas, node_normals,
+                        orphan_nodes, triangle_areas)
+
+# generator → (coarse mesh size [m], extra parameters, bodies: element groups forming one body,
+#              required groups, geometric gap of the contact pairs [m])
+CASES = {
+    "rattle_rig": (0.01, {}, [["part_beam"], ["part_plate"]],
+                   ["clamp_beam", "clamp_plate", "contact_tip_a", "contact_tip_b", "excite_beam",
+                    "skin", "part_beam", "part_plate"], 0.5e-3),
+}
+
+_CACHE = {}
+
+
+def generated(name):
+    if name not in _CACHE:
+        size, params, *_ = CASES[name]
+        module = importlib.import_module(f"sarfe.mesh.generators.{name}")
+        _CACHE[name] = module.generate(mesh_size=size, **params)
+    return _CACHE[name]
+
+
+@pytest.mark.parametrize("name", list(CASES))
+def test_topology_and_groups(name):
+    mesh = generated(name)
+    _, _, bodies, required, _ = CASES[name]
+    assert len(orphan_nodes(mesh.n_nodes, mesh.triangles)) == 0
+    for group in required:
+        assert group in mesh.node_groups or group in mesh.element_groups, group
+        size = len(mesh.node_groups.get(group, mesh.element_groups.get(group, [])))
+        assert size > 0, group
+    # every triangle in exactly one part; each body is one connected component
+    parts = [g for g in mesh.element_groups if g.startswith("part_")]
+    owner = np.concatenate([mesh.element_groups[g] for g in parts])
+    assert np.array_equal(np.sort(owner), np.arange(mesh.n_triangles))
+    count, labels = connected_components(mesh.n_nodes, mesh.triangles)
+    assert count == len(bodies)
+    for body in bodies:
+        tris = mesh.triangles[np.concatenate([mesh.element_group(g) for g in body])]
+        assert len(np.unique(labels[tris])) == 1, body
+        for group in body:  # each part is itself connected
+            sub = mesh.part(group)
+            assert connected_components(sub.n_nodes, sub.triangles)[0] == 1, group
+    # supports and excitation points are nodes of the mesh
+    for group in mesh.group_names("clip_") + mesh.group_names("clamp_") + mesh.group_names("excite_"):
+        assert len(mesh.node_group(group)) > 0
+
+
+@pytest.mark.parametrize("name", list(CASES))
+def test_contact_pairs(name):
+    mesh = generated(name)
+    gap = CASES[name][4]
+    pairs = mesh.contact_pairs()
+    assert pairs
+    # contact a/b nodes lie on different bodies
+    _, labels = connected_components(mesh.n_nodes, mesh.triangles)
+    for pair, (a, b) in pairs.items():
+        assert len(a) == len(b) == 1, pair
+        distance = np.linalg.norm(mesh.points[a] - mesh.points[b], axis=1)
+        assert distance == pytest.approx(gap, rel=1e-9, abs=1e-12), pair
+        assert labels[a[0]] != labels[b[0]], pair
+        # node normals at both ends parallel to the pair direction
+        d = (mesh.points[b] - mesh.points[a])[0]
+        for node, body_tris in ((a[0], labels[mesh.triangles[:, 0]] == labels[a[0]]),
+                                (b[0], labels[mesh.triangles[:, 0]] == labels[b[0]])):
+            n = node_normals(mesh.points, mesh.triangles[body_tris & _touching(mesh, node)])[node]
+            assert abs(n @ d) / np.linalg.norm(d) > 0.98, pair
+
+
+def _touching(mesh, node):
+    return np.any(mesh.triangles == node, axis=1)
+
+
+@pytest.mark.parametrize("name", list(CASES))
+def test_normals_unit_and_areas(name):
+    mesh = generated(name)
+    skin = mesh.triangles[mesh.element_group("skin")]
+    normals = node_normals(mesh.points, skin)
+    used = np.unique(skin)
+    assert np.allclose(np.linalg.norm(normals[used], axis=1), 1.0)
+    assert nodal_areas(mesh.points, skin).sum() == pytest.approx(triangle_areas(mesh.points, skin).sum(),
+                                                                  rel=1e-12)
+
+
+def test_rattle_plate_area_exact():
+    mesh = generated("rattle_rig")
+    plate = mesh.triangles[mesh.element_group("part_plate")]
+    assert nodal_areas(mesh.points, plate).sum() == pytest.approx(0.15 ** 2, rel=1e-12)
+    assert np.allclose(node_normals(mesh.points, plate)[np.unique(plate)], [0, 0, 1])
+
+
+@pytest.mark.parametrize("name", ["rattle_rig"])
+def test_determinism_and_msh_round_trip(name, tmp_path):
+    size, params, *_ = CASES[name]
+    module = importlib.import_module(f"sarfe.mesh.generators.{name}")
+    first = module.generate(mesh_size=size, path=tmp_path / "a.msh", **params)
+    second = module.generate(mesh_size=size, **params)
+    assert first.points.tobytes() == second.points.tobytes()
+    assert np.array_equal(first.triangles, second.triangles)
+    loaded = load_mesh(tmp_path / "a.msh")
+    assert np.allclose(loaded.points, first.points, rtol=0, atol=1e-15)
+    assert np.array_equal(loaded.triangles, first.triangles)
+    for group, idx in first.node_groups.items():
+        assert np.array_equal(loaded.node_group(group), idx), group
+    for group, idx in first.element_groups.items():
+        assert np.array_equal(loaded.element_group(group), idx), group
