@@ -13,6 +13,9 @@ CASES = {
     "rattle_rig": (0.01, {}, [["part_beam"], ["part_plate"]],
                    ["clamp_beam", "clamp_plate", "contact_tip_a", "contact_tip_b", "excite_beam",
                     "skin", "part_beam", "part_plate"], 0.5e-3),
+    "squeak_rig": (0.01, {"gap": 0.2e-3}, [["part_beam", "part_bump"], ["part_plate"]],
+                   ["clamp_beam", "clamp_plate", "contact_rub_a", "contact_rub_b", "excite_beam",
+                    "skin", "part_beam", "part_bump", "part_plate"], 0.2e-3),
 }
 
 _CACHE = {}
@@ -95,7 +98,7 @@ def test_rattle_plate_area_exact():
     assert np.allclose(node_normals(mesh.points, plate)[np.unique(plate)], [0, 0, 1])
 
 
-@pytest.mark.parametrize("name", ["rattle_rig"])
+@pytest.mark.parametrize("name", ["rattle_rig", "squeak_rig"])
 def test_determinism_and_msh_round_trip(name, tmp_path):
     size, params, *_ = CASES[name]
     module = importlib.import_module(f"sarfe.mesh.generators.{name}")
@@ -110,3 +113,13 @@ def test_determinism_and_msh_round_trip(name, tmp_path):
         assert np.array_equal(loaded.node_group(group), idx), group
     for group, idx in first.element_groups.items():
         assert np.array_equal(loaded.element_group(group), idx), group
+
+
+def test_squeak_pad_touches_plate_by_default():
+    from sarfe.mesh.generators import squeak_rig
+
+    mesh = squeak_rig.generate(mesh_size=0.01)
+    (a,), (b,) = mesh.contact_pairs()["rub"]
+    assert np.array_equal(mesh.points[a], mesh.points[b]) and a != b
+    _, labels = connected_components(mesh.n_nodes, mesh.triangles)
+    assert labels[a] != labels[b]

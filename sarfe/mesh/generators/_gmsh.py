@@ -23,6 +23,20 @@ def set_mesh_size(gmsh, mesh_size: float) -> None:
     gmsh.option.setNumber("Mesh.Optimize", 0)
 
 
+def refine_ball(gmsh, centre, radius: float, size_in: float, size_out: float) -> None:
+    """Target edge length `size_in` inside a ball (`centre`, `radius`), `size_out` elsewhere."""
+    field = gmsh.model.mesh.field
+    tag = field.add("Ball")
+    field.setNumber(tag, "XCenter", centre[0])
+    field.setNumber(tag, "YCenter", centre[1])
+    field.setNumber(tag, "ZCenter", centre[2])
+    field.setNumber(tag, "Radius", radius)
+    field.setNumber(tag, "Thickness", radius)
+    field.setNumber(tag, "VIn", size_in)
+    field.setNumber(tag, "VOut", size_out)
+    field.setAsBackgroundMesh(tag)
+
+
 def add_group(gmsh, dim: int, tags, name: str) -> None:
     """Named physical group of the entities `tags` of dimension `dim`."""
     tags = [int(t) for t in np.atleast_1d(tags)]
