@@ -1,0 +1,246 @@
+r"""Craig–Bampton reduction of (K, M) to boundary DOFs + fixed-interface modes.
+
+Partition the free DOFs into boundary b (kept physically: contact, excitation, response points)
+and interior i. With u_b = q_b and
+
+    u_i = Ψ q_b + Φ q_m,     Ψ = −K_ii⁻¹ K_ib  (constraint modes, static condensation),
+                             K_ii Φ = M_ii Φ Ω²,  Φᵀ M_ii Φ = I  (fixed-interface normal modes),
+
+the transformation u = T q, T = [[I, 0], [Ψ, Φ]], gives K_r = Tᵀ K T and M_r = Tᵀ M T:
+
+    K_r = [[K_bb + K_bi Ψ, 0], [0, Ω²]]
+    M_r = [[M_bb + M_bi Ψ + Ψᵀ M_ib + Ψᵀ M_ii Ψ, (M_bi + Ψᵀ M_ii) Φ], [sym, I]]
+
+K_ii is factorized once (``sarfe.reduction.linear_solvers.factorize``) and that factor serves Ψ
+(one block solve with n_b right-hand sides) and the shift-invert Lanczos iteration for Φ
+(``scipy.sparse.linalg.eigsh`` with sigma = 0 and OPinv = K_ii⁻¹). For a cutoff frequency the
+modes are found in blocks: each new block runs on the operator deflated of the modes already
+found, (I − Φ Φᵀ M_ii) K_ii⁻¹, until the highest frequency found exceeds the cutoff.
+
+Reduced coordinates q = [q_b (n_b, physical, in ``boundary_dofs`` order), q_m (n_m, modal)].
+Units: K [N/m], M [kg], frequencies [Hz].
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from .linear_solvers import factorize
+
+_MODE_BLOCK = 24  # fixed-interface modes requested per Lanczos run when searching up to a cutoff
+
+
+@dataclass(frozen=True)
+class ReducedModel:
+    """Craig–Bampton model on q = [q_b, q_m] (n_r = n_b + n_m).
+
+    mass, stiffness: (n_r, n_r) dense [kg], [N/m]; damping: (n_r, n_r) [N s/m] or None.
+    boundary_dofs: (n_b,) positions of the boundary DOFs in the free-DOF vector (length
+    ``full_dof_count``); interior_dofs: (n_i,) the others, in increasing order.
+    interior_basis: (n_i, n_r) = [Ψ, Φ], the interior rows of T (u_i = interior_basis @ q).
+    mode_frequencies_hz: (n_m,) fixed-interface natural frequencies.
+    free_dofs: (full_dof_count,) original (unconstrained) DOF number of each free DOF, or None if the
+    free-DOF vector is the original one; total_dof_count: length of the original DOF vector.
+    timings: seconds per stage (factorization, constraint_modes, normal_modes, projection).
+    """
+
+    mass: np.ndarray
+    stiffness: np.ndarray
+    boundary_dofs: np.ndarray
+    interior_dofs: np.ndarray
+    interior_basis: np.ndarray
+    mode_frequencies_hz: np.ndarray
+    full_dof_count: int
+    damping: np.ndarray | None = None
+    free_dofs: np.ndarray | None = None
+    total_dof_count: int | None = None
+    solver: str = ""
+    timings: dict = field(default_factory=dict, compare=False)
+
+    @property
+    def boundary_count(self) -> int:
+        return len(self.boundary_dofs)
+
+    @property
+    def mode_count(self) -> int:
+        return len(self.mode_frequencies_hz)
+
+    @property
+    def reduced_dof_count(self) -> int:
+        return self.boundary_count + self.mode_count
+
+    @property
+    def constraint_modes(self) -> np.ndarray:
+        """Ψ (n_i, n_b): interior response to unit boundary displacements."""
+        return self.interior_basis[:, : self.boundary_count]
+
+    @property
+    def fixed_interface_modes(self) -> np.ndarray:
+        """Φ (n_i, n_m), mass-normalized on M_ii."""
+        return self.interior_basis[:, self.boundary_count:]
+
+    @property
+    def size_reduction(self) -> dict:
+        """Free DOFs, reduced DOFs, boundary DOFs, modes and the ratio free/reduced."""
+        return {"free_dofs": self.full_dof_count, "reduced_dofs": self.reduced_dof_count,
+                "boundary_dofs": self.boundary_count, "modes": self.mode_count,
+                "ratio": self.full_dof_count / max(self.reduced_dof_count, 1)}
+
+
+def free_dofs_system(stiffness, mass, fixed_dofs):
+    """Remove fixed (clamped) DOFs: K_ff, M_ff (CSR) and free_dofs (n_f,) original DOF numbers.
+
+    fixed_dofs: original DOF numbers held at zero (duplicates allowed).
+    """
+    n = stiffness.shape[0]
+    keep = np.ones(n, dtype=bool)
+    keep[np.asarray(fixed_dofs, dtype=int)] = False
+    free = np.flatnonzero(keep)
+    stiffness, mass = sp.csr_matrix(stiffness), sp.csr_matrix(mass)
+    return stiffness[free][:, free].tocsr(), mass[free][:, free].tocsr(), free
+
+
+def free_dof_positions(dofs, free_dofs, total_dof_count=None):
+    """Positions in the free-DOF vector of original DOF numbers ``dofs``. Raises if one is fixed."""
+    dofs = np.asarray(dofs, dtype=int)
+    if free_dofs is None:
+        return dofs
+    total = int(total_dof_count if total_dof_count is not None else free_dofs.max() + 1)
+    position = np.full(max(total, dofs.max(initial=-1) + 1), -1, dtype=int)
+    position[free_dofs] = np.arange(len(free_dofs))
+    out = position[dofs]
+    if np.any(out < 0):
+        raise ValueError(f"DOFs {dofs[out < 0][:5].tolist()} are fixed, not free")
+    return out
+
+
+def node_dofs(nodes, components=(0, 1, 2), dofs_per_node: int = 6) -> np.ndarray:
+    """Original DOF numbers dofs_per_node*node + component, node-major, e.g. translations only."""
+    nodes = np.asarray(nodes, dtype=int)
+    return (dofs_per_node * nodes[:, None] + np.asarray(components, dtype=int)[None, :]).ravel()
+
+
+def _fixed_interface_modes(stiffness_ii, mass_ii, operator, mode_count, cutoff_hz, progress, seed=0):
+    """Lowest modes of K_ii φ = ω² M_ii φ via shift-invert (σ = 0) Lanczos, in blocks when cut off.
+
+    operator(y) = K_ii⁻¹ y. Returns ω² (n_m,) ascending and Φ (n_i, n_m) with Φᵀ M_ii Φ = I.
+    """
+    n = mass_ii.shape[0]
+    rng = np.random.default_rng(seed)
+    eigenvalues = np.empty(0)
+    modes = np.empty((n, 0))
+    target = mode_count if mode_count is not None else np.inf
+    cutoff_omega2 = (2 * np.pi * cutoff_hz) ** 2 if cutoff_hz is not None else np.inf
+    while True:
+        want = int(min(target - len(eigenvalues), _MODE_BLOCK if cutoff_hz is not None else target,
+                       n - len(eigenvalues) - 2))
+        if want <= 0:
+            break
+        found = modes
+
+        def deflated(y, found=found):
+            x = operator(y)
+            if found.shape[1]:
+                x = x - found @ (found.T @ (mass_ii @ x))  # project out found modes (M-orthogonal)
+            return x
+
+        opinv = spla.LinearOperator((n, n), matvec=deflated, dtype=float)
+        start = rng.standard_normal(n)
+        if found.shape[1]:
+            start -= found @ (found.T @ (mass_ii @ start))
+        values, vectors = spla.eigsh(stiffness_ii, k=want, M=mass_ii, sigma=0.0, OPinv=opinv, which="LM", v0=start)
+        # with OPinv given, eigsh only uses A for its shape; eigenvalues are λ = σ + 1/ν of OP = OPinv M
+        order = np.argsort(values)
+        values, vectors = values[order], vectors[:, order]
+        scale = np.sqrt(np.einsum("ij,ij->j", vectors, mass_ii @ vectors))
+        eigenvalues = np.concatenate([eigenvalues, values])
+        modes = np.hstack([modes, vectors / scale])
+        if progress is not None:
+            progress(len(eigenvalues), mode_count)
+        if cutoff_hz is None or values[-1] > cutoff_omega2:
+            break
+    order = np.argsort(eigenvalues)
+    eigenvalues, modes = eigenvalues[order], modes[:, order]
+    if cutoff_hz is not None:
+        keep = eigenvalues <= cutoff_omega2
+        if mode_count is not None:
+            keep &= np.arange(len(eigenvalues)) < mode_count
+        eigenvalues, modes = eigenvalues[keep], modes[:, keep]
+    return eigenvalues, modes
+
+
+def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=None, solver="auto",
+                  progress=None, free_dofs=None, total_dof_count=None) -> ReducedModel:
+    """Craig–Bampton reduction (see module docstring for the equations).
+
+    stiffness, mass: (n, n) sparse K [N/m], M [kg] on the free DOFs (fixed DOFs removed, see
+    :func:`free_dofs_system`); K_ii must be positive definite.
+    boundary_dofs: (n_b,) positions in the free-DOF vector kept physically (the caller picks
+    components, e.g. translations only via :func:`node_dofs` + :func:`free_dof_positions`).
+    mode_count: number of fixed-interface modes; cutoff_hz: keep all modes up to this frequency
+    [Hz] (both given: at most mode_count below the cutoff; neither: only static condensation).
+    solver: backend for K_ii (see ``linear_solvers``). progress: optional callable(done, total|None)
+    called after each mode block. free_dofs/total_dof_count: stored for recovery on the original
+    DOF numbering (``free_dofs_system``'s third output).
+    """
+    stiffness, mass = sp.csr_matrix(stiffness), sp.csr_matrix(mass)
+    n = stiffness.shape[0]
+    boundary = np.asarray(boundary_dofs, dtype=int)
+    if len(np.unique(boundary)) != len(boundary) or boundary.min(initial=0) < 0 or boundary.max(initial=-1) >= n:
+        raise ValueError("boundary_dofs must be distinct positions in [0, n)")
+    if mode_count is not None and mode_count < 0:
+        raise ValueError("mode_count must be >= 0")
+    is_interior = np.ones(n, dtype=bool)
+    is_interior[boundary] = False
+    interior = np.flatnonzero(is_interior)
+    timings = {}
+
+    clock = time.perf_counter()
+    k_ii = stiffness[interior][:, interior]
+    m_ii = mass[interior][:, interior].tocsr()
+    k_ib = stiffness[interior][:, boundary].toarray()
+    m_ib = mass[interior][:, boundary].toarray()
+    k_bb = stiffness[boundary][:, boundary].toarray()
+    m_bb = mass[boundary][:, boundary].toarray()
+    timings["partition"] = time.perf_counter() - clock
+
+    clock = time.perf_counter()
+    factor = factorize(k_ii, solver=solver, structure="spd")
+    timings["factorization"] = time.perf_counter() - clock
+
+    clock = time.perf_counter()
+    psi = -factor.solve(k_ib) if len(boundary) else np.empty((len(interior), 0))
+    timings["constraint_modes"] = time.perf_counter() - clock
+
+    clock = time.perf_counter()
+    if (mode_count or 0) > 0 or (cutoff_hz is not None and mode_count is None):
+        omega2, phi = _fixed_interface_modes(k_ii, m_ii, factor.solve, mode_count, cutoff_hz, progress)
+    else:
+        omega2, phi = np.empty(0), np.empty((len(interior), 0))
+    timings["normal_modes"] = time.perf_counter() - clock
+
+    clock = time.perf_counter()
+    m_ii_psi = m_ii @ psi
+    k_rbb = k_bb + k_ib.T @ psi
+    m_rbb = m_bb + m_ib.T @ psi + psi.T @ m_ib + psi.T @ m_ii_psi
+    m_rbm = (m_ib + m_ii_psi).T @ phi
+    n_b, n_m = len(boundary), len(omega2)
+    stiffness_r = np.zeros((n_b + n_m, n_b + n_m))
+    mass_r = np.zeros_like(stiffness_r)
+    stiffness_r[:n_b, :n_b] = 0.5 * (k_rbb + k_rbb.T)
+    stiffness_r[n_b:, n_b:] = np.diag(omega2)
+    mass_r[:n_b, :n_b] = 0.5 * (m_rbb + m_rbb.T)
+    mass_r[:n_b, n_b:] = m_rbm
+    mass_r[n_b:, :n_b] = m_rbm.T
+    mass_r[n_b:, n_b:] = np.eye(n_m)
+    timings["projection"] = time.perf_counter() - clock
+
+    return ReducedModel(
+        mass=mass_r, stiffness=stiffness_r, boundary_dofs=boundary, interior_dofs=interior,
+        interior_basis=np.hstack([psi, phi]), mode_frequencies_hz=np.sqrt(np.maximum(omega2, 0)) / (2 * np.pi),
+        full_dof_count=n, free_dofs=None if free_dofs is None else np.asarray(free_dofs, dtype=int),
+        total_dof_count=total_dof_count, solver=factor.name, timings=timings)

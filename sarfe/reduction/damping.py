@@ -1,0 +1,41 @@
+r"""Modal damping on a reduced model.
+
+Solve the reduced eigenproblem K_r x_j = ω_j² M_r x_j with X ᵀ M_r X = I and set
+
+    D_r = M_r X diag(2 ζ_j ω_j) Xᵀ M_r       [N s/m]
+
+so that every mode of the reduced model (boundary DOFs free) has damping ratio ζ_j. Zero-frequency
+(rigid-body) modes get no damping.
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import scipy.linalg as sla
+
+from .craig_bampton import ReducedModel
+
+
+def reduced_modal_damping(mass, stiffness, zeta) -> np.ndarray:
+    """D_r (n_r, n_r) from dense M_r [kg], K_r [N/m] and ζ (scalar or (n_r,), ascending modes)."""
+    mass = np.asarray(mass, dtype=float)
+    stiffness = np.asarray(stiffness, dtype=float)
+    omega2, modes = sla.eigh(0.5 * (stiffness + stiffness.T), 0.5 * (mass + mass.T))
+    omega = np.sqrt(np.clip(omega2, 0.0, None))
+    zeta = np.broadcast_to(np.asarray(zeta, dtype=float), omega.shape)
+    if np.any(zeta < 0):
+        raise ValueError("damping ratios must be >= 0")
+    weighted = mass @ modes
+    damping = (weighted * (2.0 * zeta * omega)) @ weighted.T
+    return 0.5 * (damping + damping.T)
+
+
+def with_modal_damping(reduced: ReducedModel, zeta) -> ReducedModel:
+    """A copy of ``reduced`` with D_r = :func:`reduced_modal_damping` (M_r, K_r, ζ)."""
+    return dataclasses.replace(reduced, damping=reduced_modal_damping(reduced.mass, reduced.stiffness, zeta))
+
+
+def with_rayleigh_damping(reduced: ReducedModel, alpha: float, beta: float) -> ReducedModel:
+    """A copy with D_r = α M_r + β K_r (= Tᵀ (α M + β K) T exactly) [α 1/s, β s]."""
+    return dataclasses.replace(reduced, damping=alpha * reduced.mass + beta * reduced.stiffness)
