@@ -74,10 +74,12 @@ def test_erp_vtu_reads_back(tmp_path):
     np.testing.assert_allclose(amp[:, 2], 1e-6 * peak * np.abs(shape), rtol=2e-3, atol=1e-15)
 
 
-def test_vtu_rejects_nan_and_bad_shapes(tmp_path):
+def test_vtu_zeroes_nan_and_rejects_bad_shapes(tmp_path):
     points, triangles = plate(1, 1)
-    with pytest.raises(ValueError, match="non-finite"):
-        write_erp_vtu(tmp_path / "x.vtu", points, triangles, {"a": np.full(4, np.nan)})
+    with pytest.warns(RuntimeWarning, match="non-finite"):
+        path = write_erp_vtu(tmp_path / "x.vtu", points, triangles,
+                             {"a": np.array([np.nan, 1.0, np.inf, 2.0])})
+    np.testing.assert_array_equal(pv.read(path).point_data["a"], [0.0, 1.0, 0.0, 2.0])
     with pytest.raises(ValueError, match="point_data"):
         write_erp_vtu(tmp_path / "x.vtu", points, triangles, {"a": np.zeros(3)})
 

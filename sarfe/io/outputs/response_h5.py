@@ -65,8 +65,8 @@ UNITS = ("SI: m, N, s, Hz, rad/s, W, W/m^2; levels in dB re 1e-12 W, A-weighted 
 _STR = h5py.string_dtype("utf-8")
 
 
-def _put(group, name, data, units=None, compress=False):
-    arr = np.asarray(data)
+def _put(group, name, data, units=None, compress=False, text=False):
+    arr = np.asarray(data, dtype=str) if text else np.asarray(data)
     if arr.dtype.kind in "OUS":
         ds = group.create_dataset(name, data=np.asarray([str(s) for s in arr.ravel()], dtype=object)
                                   .reshape(arr.shape), dtype=_STR)
@@ -158,12 +158,12 @@ def write_response_h5(
         _put(status, "iterations", [int(getattr(s, "iterations", 0)) for s in solutions])
         _put(status, "residual_norm", [float(getattr(s, "residual_norm", np.nan)) for s in solutions])
         _put(status, "friction_passes", [int(getattr(s, "friction_passes", 0)) for s in solutions])
-        _put(status, "reason", [str(getattr(s, "reason", "")) for s in solutions])
+        _put(status, "reason", [str(getattr(s, "reason", "")) for s in solutions], text=True)
 
         group = f.create_group("contacts")
         if contacts is not None:
-            _put(group, "names", list(contacts.names))
-            _put(group, "kind", [str(k) for k in contacts.kind])
+            _put(group, "names", list(contacts.names), text=True)
+            _put(group, "kind", [str(k) for k in contacts.kind], text=True)
             _put(group, "normal_row", np.asarray(contacts.normal_row, dtype=np.int64))
             _put(group, "tangent_rows", np.asarray(contacts.tangent_rows, dtype=np.int64))
             _put(group, "gap_m", contacts.gap, "m")

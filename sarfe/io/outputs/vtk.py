@@ -18,6 +18,7 @@ Non-radiating points get 0 in the ERP arrays.
 from __future__ import annotations
 
 import os
+import warnings
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
@@ -59,8 +60,9 @@ def _check_mesh(points, triangles):
 def write_erp_vtu(path, points, triangles, point_data: dict) -> Path:
     """Write one VTU: ``points`` (n, 3) [m], ``triangles`` (n_tri, 3) int, ``point_data``
     {name: (n,) or (n, 3) array}. Names are kept as given (see the module docstring for the
-    standard ERP names, built by :func:`erp_point_data`). Integer arrays stay integer; float
-    arrays must be finite. Returns the path.
+    standard ERP names, built by :func:`erp_point_data`). Integer arrays stay integer (int32),
+    booleans become int8; non-finite float values (NaN/inf, e.g. of a point that did not
+    converge) are written as 0 with a RuntimeWarning, so files never hold NaN. Returns the path.
     """
     points, triangles = _check_mesh(points, triangles)
     data = {}
@@ -75,8 +77,11 @@ def write_erp_vtu(path, points, triangles, point_data: dict) -> Path:
             arr = arr.astype(np.int32)
         else:
             arr = arr.astype(np.float64)
-            if not np.all(np.isfinite(arr)):
-                raise ValueError(f"point_data[{name!r}] has non-finite values")
+            bad = ~np.isfinite(arr)
+            if np.any(bad):  # e.g. a point that did not converge: keep the run's files readable
+                warnings.warn(f"point_data[{name!r}]: {int(bad.sum())} non-finite values written as 0",
+                              RuntimeWarning, stacklevel=2)
+                arr = np.where(bad, 0.0, arr)
         data[str(name)] = arr
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
