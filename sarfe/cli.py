@@ -1,0 +1,191 @@
+"""Command line: ``sarfe solve | verify | validate CASE.yaml`` and ``sarfe --version``.
+
+Exit codes: 0 success; 2 a problem in the case file (one line on stderr naming the key, no
+traceback unless ``--debug``); 3 the run finished but some frequency point did not converge (see
+summary.json ``non_converged_points``); 1 an unexpected internal error; 130 interrupted.
+Subcommands from ``sarfe.study.cli`` / ``sarfe.batch.cli`` (a ``register(subparsers)`` function) are
+added when those modules exist.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+import time
+import traceback
+
+from sarfe import __version__
+from sarfe.io.errors import EXIT_CASE_ERROR, EXIT_NOT_CONVERGED, CaseError
+
+EXTENSION_MODULES = ("sarfe.study.cli", "sarfe.batch.cli")
+
+
+def _say(args, text):
+    if not getattr(args, "quiet", False):
+        print(text, flush=True)
+
+
+def cmd_solve(args) -> int:
+    from sarfe.pipeline import load_case, results_table, solve_case
+
+    case = load_case(args.case)
+    clock = time.perf_counter()
+    _say(args, f"sarfe {__version__}: solving {case.name} ({args.case})")
+    result = solve_case(case, output_dir=args.output, progress=not args.quiet)
+    summary = result.summary
+    if not args.quiet:
+        model = summary["model"]
+        if model.get("kind") == "fe":
+            print(f"model: {model['nodes']} nodes, {model['free_dofs']} free DOFs → "
+                  f"{model['reduced_dofs']} reduced ({model['boundary_dofs']} boundary + "
+                  f"{model['modes']} modes)")
+        print(results_table(result.rows))
+        worst = summary.get("worst") or {}
+        if worst:
+            print(f"loudest point: {worst['erp_level_dba']:.1f} dB(A) "
+                  f"({worst['erp_level_db']:.1f} dB re 1 pW) at {worst['frequency_hz']:.2f} Hz")
+        print(f"results: {result.output_dir}  ({time.perf_counter() - clock:.1f} s)")
+    if result.exit_code == EXIT_NOT_CONVERGED:
+        print(f"sarfe: {len(summary['non_converged_points'])} point(s) did not converge: "
+              f"{summary['non_converged_points']} (see summary.json)", file=sys.stderr)
+    return result.exit_code
+
+
+def cmd_validate(args) -> int:
+    from sarfe.pipeline import check_mesh, load_case
+
+    case = load_case(args.case)
+    info = check_mesh(case)
+    text = f"{args.case}: valid"
+    if info:
+        pairs = ", ".join(f"{k} ({v} pairs)" for k, v in info["contact_pairs"].items())
+        text += f" ({info['nodes']} nodes, {info['triangles']} triangles; contacts: {pairs or 'none'})"
+    _say(args, text)
+    return 0
+
+
+def cmd_verify(args) -> int:
+    """Time integration of one point against the harmonic balance (first-harmonic amplitudes)."""
+    import numpy as np
+
+    from sarfe.hbm.time_integration import integrate_time
+    from sarfe.pipeline import build_linear_model, load_case, nonlinear_model
+    from sarfe.pipeline import adapters
+
+    if not args.frequency_hz > 0:
+        raise CaseError(f"--frequency-hz must be > 0, got {args.frequency_hz}", source=args.case)
+    case = load_case(args.case)
+    stage = build_linear_model(case, progress=not args.quiet)
+    nl = nonlinear_model(case, stage)
+    solver = case.data["solver"]
+    H, N = solver["harmonics"], solver["samples_per_period"]
+    omega = 2 * np.pi * args.frequency_hz
+    engine = adapters.hbm_engine()
+    if engine is None:
+        raise CaseError("the harmonic-balance engine (sarfe.hbm.solve_frequency) is not installed")
+    hbm = engine[0](nl.model, nl.contacts, nl.excitation, omega, H, N)
+    steps = max(512, 4 * N)
+    tim = integrate_time(nl.model, nl.contacts, nl.excitation, omega, H, steps_per_period=steps,
+                         initial=hbm if hbm.converged else None)
+    U_h, U_t = np.asarray(hbm.displacement), np.asarray(tim.displacement_harmonics)
+    amp_h, amp_t = np.hypot(U_h[1], U_h[2]), np.hypot(U_t[1], U_t[2])
+    rows = []
+    for name, _, idx in nl.groups:
+        nr = nl.contacts.normal_row[idx]
+        nr = nr[nr >= 0]
+        if nr.size:
+            G = nl.contacts.gap_map[nr]
+            a_h = np.hypot(G @ U_h[1], G @ U_h[2]).max()
+            a_t = np.hypot(G @ U_t[1], G @ U_t[2]).max()
+            rows.append((f"contact {name} (normal)", a_h, a_t))
+    j = int(np.argmax(amp_h))
+    rows.append((f"largest DOF ({j})", amp_h[j], amp_t[j]))
+    print(f"verify {case.name} at {args.frequency_hz:g} Hz: HBM (H={H}, N={N}, "
+          f"converged={hbm.converged}) vs time integration ({steps} steps/period, "
+          f"{tim.periods} periods, steady={tim.steady})")
+    width = max(len(r[0]) for r in rows)
+    print(f"{'first-harmonic amplitude [m]':<{width}}  {'HBM':>11}  {'time int.':>11}  {'diff':>7}")
+    worst = 0.0
+    for label, a_h, a_t in rows:
+        diff = abs(a_h - a_t) / max(abs(a_t), 1e-300)
+        worst = max(worst, diff if a_t > 1e-15 else 0.0)
+        print(f"{label:<{width}}  {a_h:11.4e}  {a_t:11.4e}  {100 * diff:6.2f}%")
+    agree = worst <= args.tolerance
+    print(f"{'agree' if agree else 'DIFFER'}: largest difference {100 * worst:.2f} % "
+          f"(tolerance {100 * args.tolerance:g} %)")
+    return 0 if agree and hbm.converged else EXIT_NOT_CONVERGED
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="sarfe", description="Squeak & rattle noise of car interior panels: FE + "
+        "Craig–Bampton + harmonic balance with contact + equivalent radiated power.",
+        epilog="exit codes: 0 ok, 2 case-file error, 3 a point did not converge, 1 internal error")
+    parser.add_argument("--version", action="version", version=f"sarfe {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+
+    def common(p):
+        p.add_argument("case", metavar="CASE.yaml", help="case file")
+        p.add_argument("--debug", action="store_true", help="show tracebacks")
+        p.add_argument("--quiet", action="store_true", help="no progress bars or table")
+
+    p = sub.add_parser("solve", help="solve a case and write results")
+    common(p)
+    p.add_argument("--output", "-o", metavar="DIR", default=None,
+                   help="result directory (default: output.directory of the case, results/<name>)")
+    p.set_defaults(func=cmd_solve)
+    p = sub.add_parser("verify", help="compare HBM with time integration at one frequency")
+    common(p)
+    p.add_argument("--frequency-hz", type=float, required=True, metavar="F")
+    p.add_argument("--tolerance", type=float, default=0.05,
+                   help="relative amplitude difference accepted (default 0.05)")
+    p.set_defaults(func=cmd_verify)
+    p = sub.add_parser("validate", help="check a case file (schema, mesh groups, contact pairing)")
+    common(p)
+    p.set_defaults(func=cmd_validate)
+
+    for name in EXTENSION_MODULES:  # optional subcommands (study, batch)
+        try:
+            module = importlib.import_module(name)
+        except ImportError as exc:
+            if exc.name and name.startswith(exc.name):
+                continue
+            raise
+        register = getattr(module, "register", None)
+        if callable(register):
+            register(sub)
+    return parser
+
+
+def main(argv=None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "func", None):
+        parser.print_help()
+        return EXIT_CASE_ERROR
+    debug = getattr(args, "debug", False)
+    try:
+        return int(args.func(args) or 0)
+    except CaseError as exc:
+        if debug:
+            traceback.print_exc()
+        message = str(exc)
+        case_file = getattr(args, "case", None)
+        if case_file and exc.source is None:
+            message = f"{case_file}: {message}"
+        print(f"sarfe: error: {message}", file=sys.stderr)
+        return EXIT_CASE_ERROR
+    except KeyboardInterrupt:
+        print("sarfe: interrupted", file=sys.stderr)
+        return 130
+    except Exception as exc:  # an internal error: one line unless --debug
+        if debug:
+            traceback.print_exc()
+        else:
+            print(f"sarfe: internal error: {type(exc).__name__}: {exc} (rerun with --debug for "
+                  "the traceback)", file=sys.stderr)
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

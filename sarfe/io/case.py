@@ -1,0 +1,486 @@
+"""Case files: read YAML (line numbers kept), validate against the JSON schema, apply defaults.
+
+    load_case(path_or_dict) -> Case      # raises CaseError with one line: file: key.path: problem
+
+The reference of every key is docs/case-file.md; the schema is :data:`sarfe.io.schema.CASE_SCHEMA`.
+Checks that need the mesh (node groups, contact pairing) live in :mod:`sarfe.pipeline`.
+"""
+from __future__ import annotations
+
+import copy
+import difflib
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import jsonschema
+import yaml
+
+from sarfe.io.errors import CaseError, format_key_path
+from sarfe.io.schema import CASE_SCHEMA
+
+_VALIDATOR = jsonschema.Draft202012Validator(CASE_SCHEMA)
+MESH_SUFFIXES = (".msh", ".bdf", ".nas", ".inp")
+MATRIX_SUFFIXES = (".npz", ".npy", ".mtx")
+DEFAULT_ZETA = 0.02
+
+
+@dataclass(frozen=True)
+class Case:
+    """A validated case with every default filled in (``data``), SI units except mesh coordinates.
+
+    ``source``: the YAML file (None for a dict), ``base_dir``: directory that relative file names in
+    the case refer to, ``lines``: {key path tuple: line} for error messages.
+    """
+
+    name: str
+    data: dict
+    source: str | None = None
+    base_dir: Path = Path(".")
+    lines: dict = field(default_factory=dict, compare=False, repr=False)
+
+    @property
+    def is_fe(self) -> bool:
+        return "fe" in self.data["model"]
+
+    def error(self, message, key_path=()) -> CaseError:
+        """A CaseError located in this case file (with the line of the deepest known key)."""
+        path = tuple(key_path) if not isinstance(key_path, str) else ()
+        return CaseError(message, key_path, self.source, _line_of(self.lines, path))
+
+    def resolve(self, file_name) -> Path:
+        """A file named in the case, relative to the case file's directory."""
+        path = Path(file_name).expanduser()
+        return path if path.is_absolute() else self.base_dir / path
+
+
+# ----------------------------------------------------------------------------------- YAML reading
+class CaseLoader(yaml.SafeLoader):
+    """SafeLoader that also reads 2.1e9 / 1e-3 as numbers (YAML 1.1 wants '2.1e+9', '1.0e-3')."""
+
+
+CaseLoader.add_implicit_resolver(
+    "tag:yaml.org,2002:float",
+    re.compile(r"""^(?:[-+]?(?:[0-9][0-9_]*)\.[0-9_]*(?:[eE][-+]?[0-9]+)?
+                  |[-+]?(?:[0-9][0-9_]*)(?:[eE][-+]?[0-9]+)
+                  |\.[0-9_]+(?:[eE][-+]?[0-9]+)?
+                  |[-+]?\.(?:inf|Inf|INF)
+                  |\.(?:nan|NaN|NAN))$""", re.X),
+    list("-+0123456789."))
+
+
+def _node_lines(node, path=(), lines=None, source=None):
+    """Walk a composed YAML node: {key path: 1-based line}; duplicate keys are errors."""
+    lines = {} if lines is None else lines
+    lines[path] = node.start_mark.line + 1
+    if isinstance(node, yaml.MappingNode):
+        seen = set()
+        for key_node, value_node in node.value:
+            key = key_node.value
+            if key in seen:
+                raise CaseError(f"duplicate key '{key}'", path + (key,), source,
+                                key_node.start_mark.line + 1)
+            seen.add(key)
+            _node_lines(value_node, path + (key,), lines, source)
+            lines[path + (key,)] = key_node.start_mark.line + 1
+    elif isinstance(node, yaml.SequenceNode):
+        for index, item in enumerate(node.value):
+            _node_lines(item, path + (index,), lines, source)
+    return lines
+
+
+def _line_of(lines, path):
+    path = tuple(path)
+    while path and path not in lines:
+        path = path[:-1]
+    return lines.get(path) if path else None
+
+
+def read_yaml(path):
+    """Parse a YAML case file → (data, lines). Malformed YAML → CaseError with line and column."""
+    source = str(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise CaseError("case file not found", source=source) from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise CaseError(f"cannot read case file: {exc}", source=source) from None
+    try:
+        node = yaml.compose(text, Loader=CaseLoader)
+        data = yaml.load(text, Loader=CaseLoader)  # noqa: S506 (a SafeLoader)
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        problem = exc.problem or exc.context or "syntax error"
+        raise CaseError(f"malformed YAML{where}: {problem}", source=source) from None
+    except yaml.YAMLError as exc:
+        raise CaseError(f"malformed YAML: {exc}", source=source) from None
+    if node is None:
+        raise CaseError("the case file is empty", source=source)
+    lines = _node_lines(node, source=source)
+    return data, lines
+
+
+# ------------------------------------------------------------------------------ schema messages
+_TYPE_NAMES = {"number": "a number", "integer": "an integer", "string": "a string",
+               "array": "a list", "object": "a mapping", "boolean": "true/false", "null": "null"}
+_PATTERN_HINTS = {
+    "^[-+]?[xyz]$": "must be 'x', 'y', 'z' (optionally signed) or a vector [x, y, z]",
+    "^ground$": "must be a node/DOF index or 'ground'",
+    "^auto$": "must be 'auto' or a vector [x, y, z]",
+    "^[A-Za-z0-9_.-]+$": "may contain only letters, digits, '_', '.' and '-'",
+}
+
+
+def _describe(value) -> str:
+    if isinstance(value, (dict, list)):
+        kind = "a mapping" if isinstance(value, dict) else "a list"
+        return kind
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def _schema_message(error):
+    """(key path tuple, one-line message) for a jsonschema ValidationError."""
+    path = tuple(error.absolute_path)
+    v, value, inst = error.validator, error.validator_value, error.instance
+    if v == "additionalProperties":
+        allowed = sorted(error.schema.get("properties", {}))
+        extra = sorted(set(inst) - set(allowed))
+        key = extra[0]
+        close = difflib.get_close_matches(str(key), allowed, n=1)
+        hint = f"did you mean '{close[0]}'? " if close else ""
+        return path + (key,), f"unknown key ({hint}allowed: {', '.join(allowed)})"
+    if v == "required":
+        missing = [k for k in value if k not in inst]
+        return path + (missing[0],), "missing required key"
+    if v == "type":
+        types = [value] if isinstance(value, str) else value
+        wanted = " or ".join(_TYPE_NAMES.get(t, t) for t in types)
+        return path, f"expected {wanted}, got {_describe(inst)}"
+    if v in ("minimum", "exclusiveMinimum", "maximum", "exclusiveMaximum"):
+        op = {"minimum": ">=", "exclusiveMinimum": ">", "maximum": "<=", "exclusiveMaximum": "<"}[v]
+        return path, f"must be {op} {value:g}, got {inst!r}"
+    if v == "enum":
+        return path, f"must be one of {', '.join(map(repr, value))}, got {_describe(inst)}"
+    if v == "pattern":
+        return path, f"{_PATTERN_HINTS.get(value, 'must match ' + value)}, got {inst!r}"
+    if v == "minItems":
+        return path, f"needs at least {value} item{'s' if value > 1 else ''}, got {len(inst)}"
+    if v == "maxItems":
+        return path, f"takes at most {value} item{'s' if value > 1 else ''}, got {len(inst)}"
+    if v == "minLength":
+        return path, "must not be empty"
+    if v in ("minProperties", "maxProperties"):
+        props = error.schema.get("properties")
+        if props and value == 1:
+            return path, f"give exactly one of {' or '.join(map(repr, props))}"
+        return path, f"needs {'at least' if v == 'minProperties' else 'at most'} {value} entries"
+    if v == "uniqueItems":
+        return path, "has duplicate entries"
+    return path, error.message
+
+
+def _relevance(error):
+    # report the first problem in document order, deepest first at equal position
+    return (-len(error.absolute_path),)
+
+
+def validate_schema(data, source=None, lines=None):
+    """Raise CaseError for the first schema violation (document order)."""
+    lines = lines or {}
+    if not isinstance(data, dict):
+        raise CaseError(f"a case file must be a mapping of sections, got {_describe(data)}",
+                        source=source)
+    errors = list(_VALIDATOR.iter_errors(data))
+    if not errors:
+        return
+    def order(error):
+        return (_line_of(lines, error.absolute_path) or 0, -len(error.absolute_path))
+    error = min(errors, key=order)
+    # descend into the most specific sub-error of a combinator
+    while error.context:
+        error = jsonschema.exceptions.best_match(error.context)
+    path, message = _schema_message(error)
+    raise CaseError(message, path, source, _line_of(lines, path))
+
+
+# ---------------------------------------------------------------------------------- normalizing
+def _only_one(case, section, path, keys, required=True):
+    given = [k for k in keys if k in section]
+    if len(given) > 1:
+        raise case.error(f"give only one of {' or '.join(map(repr, keys))}", path + (given[1],))
+    if required and not given:
+        raise case.error(f"give one of {' or '.join(map(repr, keys))}", path)
+    return given[0] if given else None
+
+
+def _not_allowed(case, section, path, keys, reason):
+    for key in keys:
+        if key in section:
+            raise case.error(f"not allowed {reason}", path + (key,))
+
+
+def direction_vector(case, value, path):
+    """'x' | '-y' | [x, y, z] → unit vector (list of 3 floats)."""
+    if isinstance(value, str):
+        sign = -1.0 if value.startswith("-") else 1.0
+        axis = "xyz".index(value[-1])
+        vector = [0.0, 0.0, 0.0]
+        vector[axis] = sign
+        return vector
+    norm = math.sqrt(sum(float(x) ** 2 for x in value))
+    if norm == 0.0 or not math.isfinite(norm):
+        raise case.error("direction vector must be non-zero and finite", path)
+    return [float(x) / norm for x in value]
+
+
+def _normalize_model(case, data):
+    model = data["model"]
+    if "fe" in model:
+        fe = model["fe"]
+        p = ("model", "fe")
+        source = _only_one(case, fe, p, ("mesh", "generator"))
+        fe.setdefault("mesh_units", "m")
+        if source == "mesh":
+            mesh = case.resolve(fe["mesh"])
+            if mesh.suffix.lower() not in MESH_SUFFIXES:
+                raise case.error(f"mesh file must be one of {', '.join(MESH_SUFFIXES)}, got "
+                                 f"'{mesh.name}'", p + ("mesh",))
+            if not mesh.is_file():
+                raise case.error(f"mesh file not found: {mesh}", p + ("mesh",))
+        else:
+            fe["generator"].setdefault("params", {})
+            if "mesh_units" in fe and fe["mesh_units"] != "m":
+                raise case.error("generated meshes are in metres; mesh_units must be 'm'",
+                                 p + ("mesh_units",))
+    else:
+        mat = model["matrices"]
+        p = ("model", "matrices")
+        for key in ("mass", "stiffness", "damping"):
+            if isinstance(mat.get(key), str):
+                path = case.resolve(mat[key])
+                if path.suffix.lower() not in MATRIX_SUFFIXES:
+                    raise case.error(f"matrix file must be one of {', '.join(MATRIX_SUFFIXES)}, "
+                                     f"got '{path.name}'", p + (key,))
+                if not path.is_file():
+                    raise case.error(f"matrix file not found: {path}", p + (key,))
+        if "damping" in mat and "damping" in data:
+            raise case.error("give either model.matrices.damping or a damping section, not both",
+                             ("damping",))
+        _not_allowed(case, data, (), ("reduction",), "with model.matrices (no reduction)")
+
+
+def _normalize_damping(case, data):
+    if "damping" not in data:
+        if "matrices" in data["model"] and "damping" in data["model"]["matrices"]:
+            data["damping"] = {}
+            return
+        data["damping"] = {"modal_zeta": DEFAULT_ZETA}
+        return
+    damping = data["damping"]
+    _only_one(case, damping, ("damping",), ("modal_zeta", "rayleigh"))
+    zeta = damping.get("modal_zeta")
+    if isinstance(zeta, list):
+        for i, entry in enumerate(zeta):
+            first, last = entry["modes"]
+            if last < first:
+                raise case.error(f"mode range must be [first, last] with first <= last, got "
+                                 f"{entry['modes']}", ("damping", "modal_zeta", i, "modes"))
+
+
+def _normalize_contacts(case, data):
+    contacts = data.setdefault("contacts", [])
+    fe = case.is_fe
+    names = set()
+    for i, contact in enumerate(contacts):
+        p = ("contacts", i)
+        if contact["name"] in names:
+            raise case.error(f"duplicate contact name '{contact['name']}'", p + ("name",))
+        names.add(contact["name"])
+        squeak = contact["type"] == "squeak"
+        if fe:
+            _not_allowed(case, contact, p, ("normal_dof", "tangential_dofs"),
+                         "with model.fe (use 'between' node groups)")
+            if "between" not in contact and "pairs" not in contact:
+                raise case.error("missing required key (node groups [a, b] or [a, ground], "
+                                 "or explicit node 'pairs')", p + ("between",))
+            if "between" in contact and "pairs" in contact:
+                raise case.error("give only one of 'between' or 'pairs'", p + ("pairs",))
+            if "between" in contact and contact["between"][0] == "ground":
+                raise case.error("the first group cannot be 'ground'", p + ("between", 0))
+            contact.setdefault("pairing_tolerance_m", 1e-3)
+            contact.setdefault("normal", "auto")
+            has_normal = True
+        else:
+            _not_allowed(case, contact, p, ("between", "pairs", "normal", "pairing_tolerance_m"),
+                         "with model.matrices (use 'normal_dof' / 'tangential_dofs')")
+            has_normal = "normal_dof" in contact
+            if not squeak and not has_normal:
+                raise case.error("missing required key (a rattle contact needs a normal DOF)",
+                                 p + ("normal_dof",))
+            if squeak and "tangential_dofs" not in contact:
+                raise case.error("missing required key (a squeak contact needs a tangential DOF)",
+                                 p + ("tangential_dofs",))
+            for key in ("normal_dof",):
+                if isinstance(contact.get(key), int):
+                    contact[key] = {"dof": contact[key]}
+            if "tangential_dofs" in contact:
+                contact["tangential_dofs"] = [{"dof": t} if isinstance(t, int) else t
+                                              for t in contact["tangential_dofs"]]
+            for ref in ([contact["normal_dof"]] if has_normal else []) + contact.get(
+                    "tangential_dofs", []):
+                ref.setdefault("relative_to", "ground")
+                ref.setdefault("sign", 1)
+        if not squeak:
+            _not_allowed(case, contact, p, ("tangential_stiffness_N_m", "friction_coefficient",
+                                            "tangential_dofs"), "for a rattle contact")
+        if has_normal and "normal_stiffness_N_m" not in contact:
+            raise case.error("missing required key", p + ("normal_stiffness_N_m",))
+        if not has_normal:
+            _not_allowed(case, contact, p, ("normal_stiffness_N_m", "gap_m"),
+                         "without a normal DOF (the normal load is the constant preload_N)")
+            if "preload_N" not in contact:
+                raise case.error("missing required key (normal load of a friction contact "
+                                 "without normal DOF)", p + ("preload_N",))
+        if squeak:
+            for key in ("tangential_stiffness_N_m", "friction_coefficient"):
+                if key not in contact:
+                    raise case.error("missing required key", p + (key,))
+        _only_one(case, contact, p, ("gap_m", "preload_N"), required=False)
+        if has_normal and "preload_N" not in contact:
+            contact.setdefault("gap_m", 0.0)
+        contact.setdefault("tolerance_m", 0.0)
+
+
+def _normalize_excitation(case, data):
+    exc = data["excitation"]
+    p = ("excitation",)
+    kind = _only_one(case, exc, p, ("forces", "base_acceleration"))
+    _only_one(case, exc, p, ("frequency_hz", "sweep"))
+    if isinstance(exc.get("frequency_hz"), (int, float)):
+        exc["frequency_hz"] = [exc["frequency_hz"]]
+    if "sweep" in exc and exc["sweep"]["start_hz"] == exc["sweep"]["end_hz"]:
+        raise case.error("end_hz must differ from start_hz", p + ("sweep", "end_hz"))
+    fe = case.is_fe
+    if kind == "forces":
+        for i, load in enumerate(exc["forces"]):
+            q = p + ("forces", i)
+            if fe:
+                _not_allowed(case, load, q, ("dof",), "with model.fe (use 'group')")
+                for key in ("group", "direction"):
+                    if key not in load:
+                        raise case.error("missing required key", q + (key,))
+                load["direction"] = direction_vector(case, load["direction"], q + ("direction",))
+            else:
+                _not_allowed(case, load, q, ("group", "direction"),
+                             "with model.matrices (use 'dof')")
+                if "dof" not in load:
+                    raise case.error("missing required key", q + ("dof",))
+            load.setdefault("phase_deg", 0.0)
+    else:
+        base = exc["base_acceleration"]
+        q = p + ("base_acceleration",)
+        if fe:
+            _not_allowed(case, base, q, ("influence",), "with model.fe (use 'direction')")
+            if "direction" not in base:
+                raise case.error("missing required key", q + ("direction",))
+            base["direction"] = direction_vector(case, base["direction"], q + ("direction",))
+        else:
+            _not_allowed(case, base, q, ("direction",), "with model.matrices (use 'influence')")
+        base.setdefault("phase_deg", 0.0)
+
+
+def _normalize_solver(case, data):
+    solver = data.setdefault("solver", {})
+    H = solver.setdefault("harmonics", 5)
+    N = solver.setdefault("samples_per_period", max(64, 2 ** math.ceil(math.log2(16 * H))))
+    if N < 2 * H + 1:
+        raise case.error(f"must be >= 2H+1 = {2 * H + 1} for harmonics H = {H}, got {N}",
+                         ("solver", "samples_per_period"))
+    solver.setdefault("tolerance", 1e-9)
+    solver.setdefault("max_iterations", 50)
+    solver.setdefault("stability", True)
+    cont = solver.setdefault("continuation", {})
+    cont.setdefault("initial_step", 0.02)
+    cont.setdefault("min_step", 1e-6)
+    cont.setdefault("max_step", 0.1)
+    cont.setdefault("max_points", 2000)
+    if cont["min_step"] > cont["max_step"]:
+        raise case.error("must be <= max_step", ("solver", "continuation", "min_step"))
+    if not cont["min_step"] <= cont["initial_step"] <= cont["max_step"]:
+        raise case.error("must lie between min_step and max_step",
+                         ("solver", "continuation", "initial_step"))
+
+
+def _normalize_reduction(case, data):
+    if not case.is_fe:
+        return
+    red = data.setdefault("reduction", {})
+    _only_one(case, red, ("reduction",), ("mode_count", "cutoff_hz"), required=False)
+    red.setdefault("cutoff_margin", 1.5)
+
+
+def _normalize_erp(case, data):
+    erp = data.setdefault("erp", {})
+    p = ("erp",)
+    if case.is_fe:
+        _not_allowed(case, erp, p, ("dofs", "areas_m2"), "with model.fe (use 'surface')")
+    else:
+        _not_allowed(case, erp, p, ("surface",), "with model.matrices (use 'dofs' and 'areas_m2')")
+        if ("dofs" in erp) != ("areas_m2" in erp):
+            raise case.error("give both 'dofs' and 'areas_m2'", p)
+        if "dofs" in erp and len(erp["dofs"]) != len(erp["areas_m2"]):
+            raise case.error(f"needs one area per DOF in erp.dofs ({len(erp['dofs'])}), got "
+                             f"{len(erp['areas_m2'])}", p + ("areas_m2",))
+    erp.setdefault("rho_kg_m3", 1.204)
+    erp.setdefault("c_m_s", 343.2)
+    erp.setdefault("radiation_loss_factor", 1.0)
+    erp.setdefault("reference_power_W", 1e-12)
+
+
+def _normalize_output(case, data):
+    out = data.setdefault("output", {})
+    out.setdefault("directory", str(Path("results") / data["name"]))
+    default = ["summary", "response", "plots", "table"] + (["erp_vtu"] if case.is_fe else [])
+    out.setdefault("files", default)
+    if "summary" not in out["files"]:
+        out["files"] = ["summary"] + list(out["files"])
+
+
+def normalize(case: Case) -> Case:
+    """Cross-key rules and defaults; returns a Case whose ``data`` has every key filled in."""
+    data = case.data
+    _normalize_model(case, data)
+    _normalize_damping(case, data)
+    _normalize_contacts(case, data)
+    _normalize_excitation(case, data)
+    _normalize_solver(case, data)
+    _normalize_reduction(case, data)
+    _normalize_erp(case, data)
+    _normalize_output(case, data)
+    return case
+
+
+def load_case(path_or_dict, base_dir=None) -> Case:
+    """Read (a YAML file) or take (a dict), validate and fill defaults → :class:`Case`.
+
+    Raises CaseError (a ValueError) with one line ``file: key.path: problem (line n)``.
+    """
+    if isinstance(path_or_dict, Case):
+        return path_or_dict
+    if isinstance(path_or_dict, dict):
+        data, lines, source = copy.deepcopy(path_or_dict), {}, None
+        base = Path(base_dir) if base_dir else Path.cwd()
+    else:
+        source = str(path_or_dict)
+        data, lines = read_yaml(path_or_dict)
+        base = Path(base_dir) if base_dir else Path(path_or_dict).resolve().parent
+    validate_schema(data, source, lines)
+    case = Case(name=data["name"], data=data, source=source, base_dir=base, lines=lines)
+    return normalize(case)
+
+
+__all__ = ["Case", "CaseError", "load_case", "read_yaml", "validate_schema", "normalize",
+           "direction_vector", "format_key_path"]

@@ -1,0 +1,174 @@
+"""JSON schema (Draft 2020-12) of a sarfe case file; the reference text is docs/case-file.md.
+
+Every object has ``additionalProperties: false`` so a misspelt key is an error. Physical ranges
+(E > 0, 0 ≤ μ, −1 < ν < 0.5, f > 0, H ≥ 1 …) are checked here; cross-key rules (exactly one of
+two keys, node groups present in the mesh, pairing within tolerance) are checked in
+:mod:`sarfe.io.case`. Defaults are applied in :func:`sarfe.io.case.normalize`.
+"""
+from __future__ import annotations
+
+
+def _object(properties, required=(), **extra):
+    return {"type": "object", "additionalProperties": False, "properties": properties,
+            "required": list(required), **extra}
+
+
+POSITIVE = {"type": "number", "exclusiveMinimum": 0}
+NON_NEGATIVE = {"type": "number", "minimum": 0}
+NUMBER = {"type": "number"}
+NAME = {"type": "string", "minLength": 1}
+INDEX = {"type": "integer", "minimum": 0}
+VECTOR3 = {"type": "array", "items": NUMBER, "minItems": 3, "maxItems": 3}
+# 'x', '-y', '+z' or a vector [x, y, z] (normalized by the case layer)
+DIRECTION = {"type": ["string", "array"], "pattern": "^[-+]?[xyz]$",
+             "items": NUMBER, "minItems": 3, "maxItems": 3}
+# a DOF of a matrices model: an index, or {dof, relative_to, sign}: r = sign·(u[dof] − u[relative_to])
+DOF_REFERENCE = {
+    "type": ["integer", "object"], "minimum": 0,
+    "additionalProperties": False, "required": ["dof"],
+    "properties": {
+        "dof": INDEX,
+        "relative_to": {"type": ["integer", "string"], "minimum": 0, "pattern": "^ground$"},
+        "sign": {"enum": [1, -1]},
+    },
+}
+# a matrix: inline rows, or a file (.npz, .npy, .mtx) relative to the case file
+MATRIX = {"type": ["string", "array"], "minLength": 1, "minItems": 1,
+          "items": {"type": "array", "minItems": 1, "items": NUMBER}}
+MATERIAL = _object({
+    "E_Pa": POSITIVE,
+    "nu": {"type": "number", "exclusiveMinimum": -1, "exclusiveMaximum": 0.5},
+    "rho_kg_m3": POSITIVE,
+}, required=("E_Pa", "nu", "rho_kg_m3"))
+
+FE_MODEL = _object({
+    "mesh": NAME,
+    "generator": _object({
+        "name": {"enum": ["door_trim", "instrument_panel", "squeak_rig", "rattle_rig"]},
+        "mesh_size_m": POSITIVE,
+        "params": {"type": "object"},
+    }, required=("name", "mesh_size_m")),
+    "mesh_units": {"enum": ["m", "mm"]},
+    "materials": {"type": "object", "minProperties": 1, "additionalProperties": MATERIAL},
+    "thickness_m": {"type": "object", "minProperties": 1, "additionalProperties": POSITIVE},
+    "fixed": {"type": "array", "items": NAME, "minItems": 1},
+}, required=("materials", "thickness_m", "fixed"))
+
+MATRICES_MODEL = _object({
+    "mass": MATRIX,
+    "stiffness": MATRIX,
+    "damping": MATRIX,
+}, required=("mass", "stiffness"))
+
+DAMPING = _object({
+    "modal_zeta": {
+        "type": ["number", "array"], "minimum": 0, "exclusiveMaximum": 1, "minItems": 1,
+        "items": _object({
+            "modes": {"type": "array", "items": {"type": "integer", "minimum": 1},
+                      "minItems": 2, "maxItems": 2},
+            "zeta": {"type": "number", "minimum": 0, "exclusiveMaximum": 1},
+        }, required=("modes", "zeta")),
+    },
+    "rayleigh": _object({"alpha_1_s": NON_NEGATIVE, "beta_s": NON_NEGATIVE},
+                        required=("alpha_1_s", "beta_s")),
+})
+
+REDUCTION = _object({
+    "mode_count": {"type": "integer", "minimum": 1},
+    "cutoff_hz": POSITIVE,
+    "cutoff_margin": {"type": "number", "minimum": 1},
+})
+
+CONTACT = _object({
+    "name": {"type": "string", "pattern": "^[A-Za-z0-9_.-]+$"},
+    "type": {"enum": ["rattle", "squeak"]},
+    # FE models: node groups
+    "between": {"type": "array", "items": NAME, "minItems": 2, "maxItems": 2},
+    "pairing_tolerance_m": NON_NEGATIVE,
+    "pairs": {"type": "array", "minItems": 1,
+              "items": {"type": "array", "minItems": 2, "maxItems": 2,
+                        "items": {"type": ["integer", "string"], "minimum": 0,
+                                  "pattern": "^ground$"}}},
+    "normal": {"type": ["string", "array"], "pattern": "^auto$",
+               "items": NUMBER, "minItems": 3, "maxItems": 3},
+    # matrices models: DOFs
+    "normal_dof": DOF_REFERENCE,
+    "tangential_dofs": {"type": "array", "items": DOF_REFERENCE, "minItems": 1, "maxItems": 2},
+    # law
+    "gap_m": NUMBER,
+    "preload_N": NON_NEGATIVE,
+    "normal_stiffness_N_m": POSITIVE,
+    "tangential_stiffness_N_m": POSITIVE,
+    "friction_coefficient": NON_NEGATIVE,
+    "tolerance_m": NON_NEGATIVE,
+}, required=("name", "type"))
+
+LOAD = _object({
+    "group": NAME,
+    "dof": INDEX,
+    "direction": DIRECTION,
+    "force_N": NUMBER,
+    "phase_deg": NUMBER,
+}, required=("force_N",))
+
+EXCITATION = _object({
+    "forces": {"type": "array", "items": LOAD, "minItems": 1},
+    "base_acceleration": _object({
+        "direction": DIRECTION,
+        "amplitude_m_s2": NUMBER,
+        "phase_deg": NUMBER,
+        "influence": {"type": "array", "items": NUMBER, "minItems": 1},
+    }, required=("amplitude_m_s2",)),
+    "frequency_hz": {"type": ["number", "array"], "exclusiveMinimum": 0, "minItems": 1,
+                     "items": POSITIVE},
+    "sweep": _object({"start_hz": POSITIVE, "end_hz": POSITIVE}, required=("start_hz", "end_hz")),
+})
+
+SOLVER = _object({
+    "harmonics": {"type": "integer", "minimum": 1, "maximum": 200},
+    "samples_per_period": {"type": "integer", "minimum": 3},
+    "tolerance": {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1},
+    "max_iterations": {"type": "integer", "minimum": 1},
+    "stability": {"type": "boolean"},
+    "continuation": _object({
+        "initial_step": {"type": "number", "exclusiveMinimum": 0, "maximum": 1},
+        "min_step": {"type": "number", "exclusiveMinimum": 0, "maximum": 1},
+        "max_step": {"type": "number", "exclusiveMinimum": 0, "maximum": 1},
+        "max_points": {"type": "integer", "minimum": 2},
+    }),
+})
+
+ERP = _object({
+    "surface": NAME,
+    "dofs": {"type": "array", "items": INDEX, "minItems": 1},
+    "areas_m2": {"type": "array", "items": POSITIVE, "minItems": 1},
+    "rho_kg_m3": POSITIVE,
+    "c_m_s": POSITIVE,
+    "radiation_loss_factor": {"type": "number", "exclusiveMinimum": 0, "maximum": 10},
+    "reference_power_W": POSITIVE,
+})
+
+OUTPUT_FILES = ["summary", "response", "erp_vtu", "animation", "plots", "table"]
+OUTPUT = _object({
+    "directory": NAME,
+    "files": {"type": "array", "items": {"enum": OUTPUT_FILES}, "uniqueItems": True},
+})
+
+CASE_SCHEMA = {
+    "$schema": "https://json-schema.org/draft/2020-12/schema",
+    "$id": "https://sarfe.example/case.schema.json",
+    "title": "sarfe case file",
+    **_object({
+        "name": {"type": "string", "pattern": "^[A-Za-z0-9_.-]+$"},
+        "description": {"type": "string"},
+        "model": _object({"fe": FE_MODEL, "matrices": MATRICES_MODEL},
+                         minProperties=1, maxProperties=1),
+        "damping": DAMPING,
+        "reduction": REDUCTION,
+        "contacts": {"type": "array", "items": CONTACT},
+        "excitation": EXCITATION,
+        "solver": SOLVER,
+        "erp": ERP,
+        "output": OUTPUT,
+    }, required=("name", "model", "excitation")),
+}

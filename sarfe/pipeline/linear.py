@@ -1,0 +1,553 @@
+r"""The linear stage of a case: model → (reduced) M, K on the kept DOFs, contact geometry in those
+DOFs, unit excitation vectors and the ERP recovery map. Everything here is independent of the
+contact law parameters, damping, force amplitudes and frequencies, so a batch over those reuses it.
+
+FE path: mesh → shell K, M (per-triangle thickness/material) → remove fixed (clip/clamp) DOFs →
+Craig–Bampton with boundary = translations of contact and excitation nodes:
+
+    u = T q,  q = [q_b, q_m],  M_r = Tᵀ M T,  K_r = Tᵀ K T,  f_r = Tᵀ f,
+
+contact rows w = n·(u_a − u_b), q_i = t_i·(u_a − u_b) touch boundary coordinates only, and the
+radiating-surface normal displacement is w_s = N q (N = ``normal_velocity_basis``).
+Matrices path: M, K (and D) as given, no reduction.
+"""
+from __future__ import annotations
+
+import fnmatch
+import hashlib
+import json
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import scipy.io
+import scipy.sparse as sp
+
+from sarfe.io.case import Case, load_case
+from sarfe.io.errors import CaseError
+from sarfe.pipeline import adapters
+
+
+@dataclass(frozen=True)
+class ContactGeometry:
+    """Node pairs of one named contact (FE) and their local frames.
+
+    nodes_a, nodes_b (n_p,) mesh node indices (b = −1 for ground); frames (n_p, 3, 3) rows
+    [normal, tangent 1, tangent 2] (unit, normal from a towards b); coords_a, coords_b (n_p, 3)
+    reduced coordinate of each translation ux, uy, uz (−1 where fixed or ground).
+    """
+
+    name: str
+    nodes_a: np.ndarray
+    nodes_b: np.ndarray
+    frames: np.ndarray
+    coords_a: np.ndarray
+    coords_b: np.ndarray
+    distances: np.ndarray      # (n_p,) [m] |x_b − x_a| (0 for ground)
+
+
+@dataclass(frozen=True)
+class LinearStage:
+    """Picklable linear part of a case (see module docstring). n_r kept DOFs, SI units.
+
+    mass, stiffness (n_r, n_r) [kg], [N/m] dense or sparse; damping (n_r, n_r) [N s/m] or None (the
+    matrices path's own D; FE damping is applied per case in :func:`solve_case`).
+    load_vectors (n_loads, n_r): force on q per 1 N of each ``excitation.forces`` entry (direction
+    included); base_vector (n_r,) or None: −Tᵀ M ι per 1 m/s² base acceleration.
+    contacts: {name: ContactGeometry} (FE) — matrices contacts are built from the case directly.
+    erp_map (n_s, n_r): normal displacement of the radiating nodes w_s = erp_map q; erp_areas (n_s,)
+    [m²]; erp_nodes (n_s,) mesh nodes (FE) or DOFs (matrices).
+    """
+
+    key: str
+    kind: str
+    mass: object
+    stiffness: object
+    damping: object
+    load_vectors: np.ndarray
+    base_vector: np.ndarray | None
+    contacts: dict
+    erp_map: np.ndarray
+    erp_areas: np.ndarray
+    erp_nodes: np.ndarray
+    mesh: object = None
+    reduced: object = None
+    mode_frequencies_hz: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    info: dict = field(default_factory=dict)
+    timings: dict = field(default_factory=dict)
+
+    @property
+    def dof_count(self) -> int:
+        return self.mass.shape[0]
+
+
+# -------------------------------------------------------------------------------------- hashing
+def _file_digest(path: Path) -> str:
+    digest = hashlib.sha256()
+    with open(path, "rb") as handle:
+        for block in iter(lambda: handle.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def default_cutoff_hz(case: Case) -> float:
+    """Reduction cutoff when none is given: margin · H · f_max (margin 1.5 by default)."""
+    exc = case.data["excitation"]
+    f_max = max(exc["frequency_hz"]) if "frequency_hz" in exc else max(
+        exc["sweep"]["start_hz"], exc["sweep"]["end_hz"])
+    return case.data["reduction"]["cutoff_margin"] * case.data["solver"]["harmonics"] * f_max
+
+
+def linear_model_key(case) -> str:
+    """SHA-256 of everything the linear stage depends on (mesh bytes or generator parameters,
+    materials, thicknesses, fixed groups, reduction, contact node sets and normals, excitation
+    DOFs/groups and directions, ERP surface). Same key → :func:`build_linear_model` is reusable.
+    """
+    case = load_case(case)
+    data = case.data
+    model = json.loads(json.dumps(data["model"]))
+    for section in model.values():
+        for key in ("mesh", "mass", "stiffness", "damping"):
+            if isinstance(section.get(key), str):
+                section[key] = {"file_sha256": _file_digest(case.resolve(section[key]))}
+    exc = data["excitation"]
+    parts = {
+        "model": model,
+        "reduction": dict(data.get("reduction", {}), effective_cutoff_hz=default_cutoff_hz(case))
+        if case.is_fe else None,
+        "contacts": [{k: c.get(k) for k in ("name", "between", "pairs", "pairing_tolerance_m",
+                                            "normal", "normal_dof", "tangential_dofs")}
+                     for c in data["contacts"]],
+        "forces": [{k: f.get(k) for k in ("group", "dof", "direction")}
+                   for f in exc.get("forces", [])],
+        "base": {k: v for k, v in exc["base_acceleration"].items() if k in ("direction", "influence")}
+        if "base_acceleration" in exc else None,
+        "erp": {k: data["erp"].get(k) for k in ("surface", "dofs", "areas_m2")},
+        "sarfe_linear_stage": 1,
+    }
+    text = json.dumps(parts, sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+# ------------------------------------------------------------------------------- matrices path
+def _read_matrix(case: Case, key):
+    path_key = ("model", "matrices", key)
+    value = case.data["model"]["matrices"][key]
+    if not isinstance(value, str):
+        rows = [len(r) for r in value]
+        if any(n != len(value) for n in rows):
+            raise case.error(f"must be a square matrix (list of {len(value)} rows of "
+                             f"{len(value)} numbers)", path_key)
+        return np.asarray(value, dtype=float)
+    path = case.resolve(value)
+    try:
+        suffix = path.suffix.lower()
+        if suffix == ".mtx":
+            matrix = sp.csr_matrix(scipy.io.mmread(str(path)))
+        elif suffix == ".npy":
+            matrix = np.load(path, allow_pickle=False)
+        else:
+            try:
+                matrix = sp.load_npz(path).tocsr()
+            except (ValueError, KeyError, OSError):
+                with np.load(path, allow_pickle=False) as archive:
+                    names = list(archive.files)
+                    name = key if key in names else (names[0] if len(names) == 1 else None)
+                    if name is None:
+                        raise CaseError(f"{path.name} holds arrays {names}; none is named '{key}'")
+                    matrix = archive[name]
+    except CaseError as exc:
+        raise case.error(exc.message, path_key) from None
+    except Exception as exc:  # unreadable file of any kind
+        raise case.error(f"cannot read matrix file {path}: {exc}", path_key) from None
+    if matrix.ndim != 2 or matrix.shape[0] != matrix.shape[1]:
+        raise case.error(f"must be a square matrix, file holds shape {matrix.shape}", path_key)
+    return matrix
+
+
+def _check_dof(case, dof, n, path):
+    if dof != "ground" and not 0 <= dof < n:
+        raise case.error(f"DOF {dof} out of range (the model has {n} DOFs: 0…{n - 1})", path)
+
+
+def _build_matrices(case: Case, progress=False) -> dict:
+    data = case.data
+    mass = _read_matrix(case, "mass")
+    stiffness = _read_matrix(case, "stiffness")
+    damping = _read_matrix(case, "damping") if "damping" in data["model"]["matrices"] else None
+    n = mass.shape[0]
+    for key, matrix in (("stiffness", stiffness), ("damping", damping)):
+        if matrix is not None and matrix.shape != (n, n):
+            raise case.error(f"has shape {matrix.shape}, mass has ({n}, {n})",
+                             ("model", "matrices", key))
+    from sarfe.hbm.model import make_linear_model
+    try:
+        make_linear_model(mass, damping, stiffness)
+    except ValueError as exc:
+        word = str(exc).split()[0]
+        key = word if word in ("mass", "stiffness", "damping") else "mass"
+        raise case.error(str(exc), ("model", "matrices", key)) from None
+    for i, contact in enumerate(data["contacts"]):
+        refs = ([("normal_dof", contact["normal_dof"])] if "normal_dof" in contact else []) + [
+            (("tangential_dofs", j), t) for j, t in enumerate(contact.get("tangential_dofs", []))]
+        for key, ref in refs:
+            key = key if isinstance(key, tuple) else (key,)
+            _check_dof(case, ref["dof"], n, ("contacts", i) + key + ("dof",))
+            _check_dof(case, ref["relative_to"], n, ("contacts", i) + key + ("relative_to",))
+            if ref["relative_to"] == ref["dof"]:
+                raise case.error("a DOF cannot be relative to itself",
+                                 ("contacts", i) + key + ("relative_to",))
+    exc = data["excitation"]
+    loads = np.zeros((len(exc.get("forces", [])), n))
+    for i, load in enumerate(exc.get("forces", [])):
+        _check_dof(case, load["dof"], n, ("excitation", "forces", i, "dof"))
+        loads[i, load["dof"]] = 1.0
+    base = None
+    if "base_acceleration" in exc:
+        influence = np.asarray(exc["base_acceleration"].get("influence", np.ones(n)), dtype=float)
+        if influence.shape != (n,):
+            raise case.error(f"needs {n} entries (one per DOF), got {len(influence)}",
+                             ("excitation", "base_acceleration", "influence"))
+        base = -(mass @ influence)
+    erp = data["erp"]
+    dofs = np.asarray(erp.get("dofs", []), dtype=int)
+    for j, dof in enumerate(dofs):
+        _check_dof(case, int(dof), n, ("erp", "dofs", j))
+    erp_map = np.zeros((len(dofs), n))
+    erp_map[np.arange(len(dofs)), dofs] = 1.0
+    return dict(kind="matrices", mass=mass, stiffness=stiffness, damping=damping,
+                load_vectors=loads, base_vector=base, contacts={}, erp_map=erp_map,
+                erp_areas=np.asarray(erp.get("areas_m2", []), dtype=float), erp_nodes=dofs,
+                info={"dofs": n})
+
+
+# ------------------------------------------------------------------------------------- FE path
+def load_case_mesh(case: Case):
+    """The case's PanelMesh (file or generator), in metres; errors name model.fe.mesh/generator."""
+    fe = case.data["model"]["fe"]
+    if "mesh" in fe:
+        path = case.resolve(fe["mesh"])
+        try:
+            mesh = adapters.load_mesh_file(path, fe["mesh_units"])
+        except CaseError as exc:
+            raise case.error(exc.message, ("model", "fe", "mesh")) from None
+        except Exception as exc:
+            raise case.error(f"cannot read mesh file {path}: {exc}", ("model", "fe", "mesh")) from None
+        where = ("model", "fe", "mesh_units")
+    else:
+        gen = fe["generator"]
+        try:
+            mesh = adapters.generate_mesh(gen["name"], gen["mesh_size_m"], gen["params"])
+        except CaseError as exc:
+            raise case.error(exc.message, ("model", "fe", "generator", "name")) from None
+        except TypeError as exc:
+            raise case.error(f"generator rejected a parameter: {exc}",
+                             ("model", "fe", "generator", "params")) from None
+        except ValueError as exc:
+            raise case.error(str(exc), ("model", "fe", "generator")) from None
+        where = ("model", "fe", "generator")
+    if mesh.n_triangles == 0:
+        raise case.error("the mesh has no shell triangles", where[:3])
+    extent = float(np.linalg.norm(np.ptp(mesh.points, axis=0)))
+    if extent > 20.0:
+        raise case.error(f"the mesh spans {extent:.3g} m — are its coordinates in mm? "
+                         "(set mesh_units: mm)", where)
+    if extent < 5e-3:
+        raise case.error(f"the mesh spans only {extent:.3g} m — are its coordinates in metres "
+                         "while mesh_units says mm?", where)
+    return mesh
+
+
+def _available(names):
+    names = sorted(names)
+    text = ", ".join(names[:30]) + (", …" if len(names) > 30 else "")
+    return text or "none"
+
+
+def resolve_node_group(case, mesh, name, path, allow_elements=True):
+    """Node indices of a node group (or the nodes of an element group); glob patterns allowed."""
+    matches = [g for g in mesh.node_groups if fnmatch.fnmatchcase(g, name)]
+    nodes = [mesh.node_groups[g] for g in matches]
+    if not matches and allow_elements:
+        elems = [g for g in mesh.element_groups if fnmatch.fnmatchcase(g, name)]
+        nodes = [np.unique(mesh.triangles[mesh.element_groups[g]]) for g in elems]
+        matches = elems
+    if not matches:
+        raise case.error(f"node group '{name}' not in mesh (available: "
+                         f"{_available(mesh.node_groups)})", path)
+    result = np.unique(np.concatenate(nodes)) if nodes else np.zeros(0, int)
+    if result.size == 0:
+        raise case.error(f"node group '{name}' is empty", path)
+    return result
+
+
+def _per_triangle(case, mesh, mapping, key):
+    """Index into list(mapping) per triangle; later keys override earlier ones."""
+    owner = np.full(mesh.n_triangles, -1)
+    for j, name in enumerate(mapping):
+        if name == "*":
+            owner[:] = j
+            continue
+        groups = [g for g in mesh.element_groups if fnmatch.fnmatchcase(g, name)]
+        if not groups:
+            raise case.error(f"element group '{name}' not in mesh (available: "
+                             f"{_available(mesh.element_groups)}, or '*' for all)",
+                             ("model", "fe", key, name))
+        for g in groups:
+            owner[mesh.element_groups[g]] = j
+    missing = np.count_nonzero(owner < 0)
+    if missing:
+        raise case.error(f"{missing} of {mesh.n_triangles} triangles belong to no listed element "
+                         f"group (add '*' for a default; groups: {_available(mesh.element_groups)})",
+                         ("model", "fe", key))
+    return owner
+
+
+def frame_from_normal(normals):
+    """Rows [n, t1, t2] (…, 3, 3) of right-handed orthonormal frames around unit normals (…, 3)."""
+    n = np.asarray(normals, dtype=float)
+    axis = np.eye(3)[np.argmin(np.abs(n), axis=-1)]
+    t1 = np.cross(n, axis)
+    t1 /= np.linalg.norm(t1, axis=-1, keepdims=True)
+    t2 = np.cross(n, t1)
+    return np.stack([n, t1, t2], axis=-2)
+
+
+def pair_contact(case, mesh, index, normals_all):
+    """Node pairs and frames of contacts[index] (nearest-node pairing or explicit pairs)."""
+    from scipy.spatial import cKDTree
+
+    contact = case.data["contacts"][index]
+    p = ("contacts", index)
+    points = mesh.points
+    if "pairs" in contact:
+        pairs = contact["pairs"]
+        a = np.array([q[0] for q in pairs])
+        for j, (na, nb) in enumerate(pairs):
+            for k, node in enumerate((na, nb)):
+                if node == "ground":
+                    if k == 0:
+                        raise case.error("the first node cannot be 'ground'", p + ("pairs", j, 0))
+                    continue
+                if not 0 <= node < mesh.n_nodes:
+                    raise case.error(f"node {node} out of range (mesh has {mesh.n_nodes} nodes)",
+                                     p + ("pairs", j, k))
+        a = np.array([q[0] for q in pairs], dtype=int)
+        b = np.array([-1 if q[1] == "ground" else q[1] for q in pairs], dtype=int)
+    else:
+        group_a, group_b = contact["between"]
+        a = resolve_node_group(case, mesh, group_a, p + ("between", 0))
+        if group_b == "ground":
+            b = np.full(len(a), -1)
+        else:
+            nodes_b = resolve_node_group(case, mesh, group_b, p + ("between", 1))
+            distance, nearest = cKDTree(points[nodes_b]).query(points[a])
+            tolerance = contact["pairing_tolerance_m"]
+            far = distance > tolerance * (1 + 1e-9) + 1e-12
+            if np.any(far):
+                worst = int(np.argmax(distance))
+                raise case.error(
+                    f"{np.count_nonzero(far)} of {len(a)} nodes of '{group_a}' have no node of "
+                    f"'{group_b}' within pairing_tolerance_m = {tolerance:g} m (farthest: node "
+                    f"{a[worst]} at {distance[worst]:.3g} m)", p + ("between",))
+            b = nodes_b[nearest]
+    offset = np.where(b[:, None] >= 0, points[np.maximum(b, 0)] - points[a], 0.0)
+    distance = np.linalg.norm(offset, axis=1)
+    if contact["normal"] == "auto":
+        normal = normals_all[a].copy()
+        if np.any(np.linalg.norm(normal, axis=1) < 0.5):
+            raise case.error("node(s) with no surface normal (not on any shell triangle); give "
+                             "normal: [x, y, z]", p + ("normal",))
+        apart = distance > 1e-9
+        flip = apart & (np.einsum("ij,ij->i", normal, offset) < 0)
+        normal[flip] *= -1.0
+    else:
+        vector = np.asarray(contact["normal"], dtype=float)
+        length = np.linalg.norm(vector)
+        if length == 0 or not np.isfinite(length):
+            raise case.error("normal vector must be non-zero", p + ("normal",))
+        normal = np.broadcast_to(vector / length, (len(a), 3))
+    return a, b, frame_from_normal(normal), distance
+
+
+def _build_fe(case: Case, progress=False) -> dict:
+    from sarfe.erp import nodal_areas, nodal_normals
+    from sarfe.fe.shell import shell_matrices
+    from sarfe.reduction.craig_bampton import craig_bampton, free_dofs_system
+    from sarfe.reduction.recovery import normal_velocity_basis
+
+    data, fe = case.data, case.data["model"]["fe"]
+    timings = {}
+    clock = time.perf_counter()
+    mesh = load_case_mesh(case)
+    timings["mesh_s"] = time.perf_counter() - clock
+    n_nodes = mesh.n_nodes
+
+    # groups and pairing first: cheap, and the errors a user is most likely to make
+    fixed_nodes = np.unique(np.concatenate([
+        resolve_node_group(case, mesh, g, ("model", "fe", "fixed", i), allow_elements=False)
+        for i, g in enumerate(fe["fixed"])]))
+    normals_all = nodal_normals(mesh.points, mesh.triangles)
+    paired = {c["name"]: pair_contact(case, mesh, i, normals_all)
+              for i, c in enumerate(data["contacts"])}
+    exc = data["excitation"]
+    load_nodes = [resolve_node_group(case, mesh, f["group"], ("excitation", "forces", i, "group"))
+                  for i, f in enumerate(exc.get("forces", []))]
+    if "surface" in data["erp"]:
+        surface = data["erp"]["surface"]
+        if surface in mesh.element_groups:
+            radiating_triangles = mesh.triangles[mesh.element_groups[surface]]
+        else:
+            nodes = resolve_node_group(case, mesh, surface, ("erp", "surface"))
+            inside = np.zeros(n_nodes, bool)
+            inside[nodes] = True
+            radiating_triangles = mesh.triangles[inside[mesh.triangles].all(axis=1)]
+            if len(radiating_triangles) == 0:
+                raise case.error(f"node group '{surface}' contains no whole triangle",
+                                 ("erp", "surface"))
+    elif "skin" in mesh.element_groups:
+        radiating_triangles = mesh.triangles[mesh.element_groups["skin"]]
+    else:
+        radiating_triangles = mesh.triangles
+
+    # assembly
+    clock = time.perf_counter()
+    materials, thickness = fe["materials"], fe["thickness_m"]
+    mat_owner = _per_triangle(case, mesh, materials, "materials")
+    thick_owner = _per_triangle(case, mesh, thickness, "thickness_m")
+    mats = list(materials.values())
+    young = np.array([m["E_Pa"] for m in mats])[mat_owner]
+    poisson = np.array([m["nu"] for m in mats])[mat_owner]
+    density = np.array([m["rho_kg_m3"] for m in mats])[mat_owner]
+    t = np.array(list(thickness.values()), dtype=float)[thick_owner]
+    extent = float(np.linalg.norm(np.ptp(mesh.points, axis=0)))
+    if t.max() > 0.2 * extent:
+        raise case.error(f"thickness {t.max():g} m is not small against the mesh size "
+                         f"{extent:.3g} m (thickness_m is in metres)", ("model", "fe", "thickness_m"))
+    stiffness, mass = shell_matrices(mesh.points, mesh.triangles, t, young, poisson, density)
+    timings["assembly_s"] = time.perf_counter() - clock
+
+    # constraints: fixed nodes (6 DOFs) and nodes on no triangle
+    used = np.zeros(n_nodes, bool)
+    used[mesh.triangles.ravel()] = True
+    held = np.union1d(fixed_nodes, np.flatnonzero(~used))
+    fixed_dofs = (6 * held[:, None] + np.arange(6)).ravel()
+    k_ff, m_ff, free = free_dofs_system(stiffness, mass, fixed_dofs)
+    position = np.full(6 * n_nodes, -1)
+    position[free] = np.arange(len(free))
+
+    # boundary = translations of contact and excitation nodes (free ones)
+    boundary_nodes = [g[0] for g in paired.values()] + [g[1][g[1] >= 0] for g in paired.values()]
+    boundary_nodes = np.unique(np.concatenate(boundary_nodes + load_nodes + [np.zeros(0, int)]))
+    boundary_positions = position[(6 * boundary_nodes[:, None] + np.arange(3)).ravel()]
+    boundary_positions = boundary_positions[boundary_positions >= 0]
+
+    clock = time.perf_counter()
+    red = data["reduction"]
+    cutoff = red.get("cutoff_hz", None if "mode_count" in red else default_cutoff_hz(case))
+    bar = _bar(progress, "reduction", None)
+    try:
+        reduced = craig_bampton(k_ff, m_ff, boundary_positions, mode_count=red.get("mode_count"),
+                                cutoff_hz=cutoff, progress=(lambda done, total: bar.update(1))
+                                if bar else None, free_dofs=free, total_dof_count=6 * n_nodes)
+    except (RuntimeError, ValueError, np.linalg.LinAlgError) as exc:
+        raise case.error(f"the structure is not held (singular stiffness: {exc}); check the "
+                         "fixed groups", ("model", "fe", "fixed")) from None
+    finally:
+        if bar:
+            bar.close()
+    timings["reduction_s"] = time.perf_counter() - clock
+    n_b, n_r = reduced.boundary_count, reduced.reduced_dof_count
+
+    # reduced coordinate of every translational DOF (−1 when fixed / not boundary)
+    coord = np.full(6 * n_nodes, -1)
+    coord[free[reduced.boundary_dofs]] = np.arange(n_b)
+
+    def coords_of(nodes):
+        nodes = np.asarray(nodes)
+        out = np.full((len(nodes), 3), -1)
+        ok = nodes >= 0
+        out[ok] = coord[6 * nodes[ok, None] + np.arange(3)]
+        return out
+
+    contacts = {}
+    for name, (a, b, frames, distance) in paired.items():
+        contacts[name] = ContactGeometry(name, a, b, frames, coords_of(a), coords_of(b), distance)
+
+    loads = np.zeros((len(load_nodes), n_r))
+    for i, (nodes, load) in enumerate(zip(load_nodes, exc.get("forces", []))):
+        c = coords_of(nodes)
+        direction = np.asarray(load["direction"])
+        for comp in range(3):
+            ok = c[:, comp] >= 0
+            np.add.at(loads[i], c[ok, comp], direction[comp] / len(nodes))
+    base = None
+    if "base_acceleration" in exc:
+        iota = np.zeros(6 * n_nodes)
+        for comp in range(3):
+            iota[6 * np.arange(n_nodes) + comp] = exc["base_acceleration"]["direction"][comp]
+        f = -(m_ff @ iota[free])
+        base = np.zeros(n_r)
+        base[:n_b] = f[reduced.boundary_dofs]
+        base += reduced.interior_basis.T @ f[reduced.interior_dofs]
+
+    erp_nodes = np.unique(radiating_triangles)
+    areas = nodal_areas(mesh.points, radiating_triangles)[erp_nodes]
+    normals = nodal_normals(mesh.points, radiating_triangles)[erp_nodes]
+    erp_map = normal_velocity_basis(reduced, normals, erp_nodes)
+
+    info = {"nodes": int(n_nodes), "triangles": int(mesh.n_triangles),
+            "total_dofs": int(6 * n_nodes), "free_dofs": int(len(free)),
+            "fixed_nodes": int(len(fixed_nodes)), "boundary_dofs": int(n_b),
+            "modes": int(reduced.mode_count), "reduced_dofs": int(n_r),
+            "cutoff_hz": None if cutoff is None else float(cutoff),
+            "radiating_nodes": int(len(erp_nodes)), "radiating_area_m2": float(areas.sum()),
+            "linear_solver": reduced.solver}
+    return dict(kind="fe", mass=reduced.mass, stiffness=reduced.stiffness, damping=None,
+                load_vectors=loads, base_vector=base, contacts=contacts, erp_map=erp_map,
+                erp_areas=areas, erp_nodes=erp_nodes, mesh=mesh, reduced=reduced,
+                mode_frequencies_hz=reduced.mode_frequencies_hz, info=info, timings=timings)
+
+
+def _bar(progress, description, total):
+    if not progress:
+        return None
+    import sys
+
+    from tqdm import tqdm
+    return tqdm(total=total, desc=description, unit="block", leave=False,
+                disable=not sys.stderr.isatty())
+
+
+def check_mesh(case) -> dict:
+    """Validation that needs the mesh but no assembly: groups exist, contacts pair. Returns info."""
+    case = load_case(case)
+    if not case.is_fe:
+        _build_matrices(case)
+        return {}
+    mesh = load_case_mesh(case)
+    fe = case.data["model"]["fe"]
+    for i, g in enumerate(fe["fixed"]):
+        resolve_node_group(case, mesh, g, ("model", "fe", "fixed", i), allow_elements=False)
+    _per_triangle(case, mesh, fe["materials"], "materials")
+    _per_triangle(case, mesh, fe["thickness_m"], "thickness_m")
+    from sarfe.erp import nodal_normals
+    normals = nodal_normals(mesh.points, mesh.triangles)
+    pairs = {c["name"]: len(pair_contact(case, mesh, i, normals)[0])
+             for i, c in enumerate(case.data["contacts"])}
+    for i, f in enumerate(case.data["excitation"].get("forces", [])):
+        resolve_node_group(case, mesh, f["group"], ("excitation", "forces", i, "group"))
+    if "surface" in case.data["erp"] and case.data["erp"]["surface"] not in mesh.element_groups:
+        resolve_node_group(case, mesh, case.data["erp"]["surface"], ("erp", "surface"))
+    return {"nodes": mesh.n_nodes, "triangles": mesh.n_triangles, "contact_pairs": pairs}
+
+
+def build_linear_model(case, progress=False) -> LinearStage:
+    """Linear stage of a case (module docstring); raises CaseError for mesh/group/file problems."""
+    case = load_case(case)
+    clock = time.perf_counter()
+    parts = _build_fe(case, progress) if case.is_fe else _build_matrices(case, progress)
+    timings = dict(parts.pop("timings", {}))
+    timings["linear_stage_s"] = time.perf_counter() - clock
+    return LinearStage(key=linear_model_key(case), timings=timings, **parts)
