@@ -50,7 +50,8 @@ def test_erp_vtu_reads_back(tmp_path):
     assert mesh.n_points == n and mesh.n_cells == triangles.shape[0]
     np.testing.assert_allclose(mesh.points, points)
     expected = {"erp_density_W_m2", "erp_density_h1_W_m2", "erp_density_h2_W_m2",
-                "normal_velocity_amplitude_m_s", "displacement_amplitude_m", "contact_marker"}
+                "normal_velocity_amplitude_m_s", "normal_displacement_amplitude_m",
+                "displacement_amplitude_m", "contact_marker"}
     assert expected <= set(mesh.point_data.keys())
     for name in expected:
         assert not np.any(np.isnan(mesh.point_data[name]))
@@ -72,6 +73,9 @@ def test_erp_vtu_reads_back(tmp_path):
     peak = np.abs(2 * np.cos(theta) + np.sin(2 * theta)).max()
     shape = U[1, :, 2] / 2e-6
     np.testing.assert_allclose(amp[:, 2], 1e-6 * peak * np.abs(shape), rtol=2e-3, atol=1e-15)
+    # flat plate in z: normal amplitude = |u_z| amplitude
+    np.testing.assert_allclose(mesh.point_data["normal_displacement_amplitude_m"], amp[:, 2],
+                               rtol=2e-3, atol=1e-15)
 
 
 def test_vtu_zeroes_nan_and_rejects_bad_shapes(tmp_path):

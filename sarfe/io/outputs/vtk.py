@@ -9,7 +9,9 @@ Standard ERP point arrays (:func:`erp_point_data`), n = number of mesh points:
     erp_density_W_m2                (n,)   Σ_k e_k,i, ERP density summed over harmonics [W/m²]
     erp_density_h<k>_W_m2           (n,)   e_k,i of harmonic k = 1 … H [W/m²]
     normal_velocity_amplitude_m_s   (n,)   √(Σ_k |v_n,k|²) [m/s], so erp_density = ½ρc·RLF·v²
+    normal_displacement_amplitude_m (n,)   max_θ |w(θ) − w0| of the surface-normal displacement [m]
     displacement_amplitude_m        (n, 3) per component max_θ |u(θ) − u0| over one period [m]
+                                           (zeros if the caller passes no nodal displacement)
     contact_marker                  (n,)   int: 0 = no contact, c+1 = node of contact c
                                            (ContactSet order; the last contact wins on shared nodes)
 
@@ -125,7 +127,8 @@ def erp_point_data(n_points: int, erp, normal_displacement, omega: float, displa
     erp : :class:`sarfe.erp.ErpResult` of the radiating nodes (density (H, n_r)).
     normal_displacement : (2H+1, n_r) [m] harmonics W used for ``erp``.
     omega : [rad/s].
-    displacement : (2H+1, n, 3) [m] nodal translation harmonics of all points, or None (zeros).
+    displacement : (2H+1, n, 3) [m] nodal translation harmonics of all points, or None (then
+        ``displacement_amplitude_m`` is all zeros; ``normal_displacement_amplitude_m`` is always set).
     radiating_nodes : (n_r,) point indices of the radiating nodes (default: all n points).
     contact_marker : (n,) int, e.g. from :func:`contact_markers` (default zeros).
     """
@@ -148,6 +151,10 @@ def erp_point_data(n_points: int, erp, normal_displacement, omega: float, displa
     full = np.zeros(n)
     full[nodes] = np.sqrt(np.sum(velocity**2, axis=0))
     data["normal_velocity_amplitude_m_s"] = full
+    W = np.asarray(normal_displacement, dtype=float)
+    full = np.zeros(n)
+    full[nodes] = np.abs(period_samples(W, max(64, 8 * velocity.shape[0])) - W[0]).max(axis=0)
+    data["normal_displacement_amplitude_m"] = full
     if displacement is None:
         data["displacement_amplitude_m"] = np.zeros((n, 3))
     else:
