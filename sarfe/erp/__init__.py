@@ -4,6 +4,7 @@
                               density=1.204, sound_speed=343.2, radiation_loss_factor=1.0,
                               reference_power=1e-12) -> ErpResult
     a_weighting_db(f), db_sum(levels), a_weighted_total_db(levels, f)
+    baffled_radiated_power(points, areas, v̂, omega), radiation_efficiency(...)  (Rayleigh reference)
     nodal_areas(points, triangles), nodal_normals(points, triangles),
     normal_displacement(U (2H+1, n, 3), normals (n, 3)), nodal_translations(U (2H+1, n_dof), nodes)
 """
@@ -16,6 +17,7 @@ from sarfe.erp.erp import (
     normal_velocity_amplitudes,
     power_level_db,
 )
+from sarfe.erp.rayleigh import baffled_radiated_power, radiation_efficiency
 from sarfe.erp.surface import (
     nodal_areas,
     nodal_normals,
@@ -29,5 +31,6 @@ __all__ = [
     "AIR_DENSITY", "SOUND_SPEED", "REFERENCE_POWER", "ErpResult", "equivalent_radiated_power",
     "normal_velocity_amplitudes", "power_level_db", "nodal_areas", "nodal_normals",
     "nodal_translations", "normal_displacement", "triangle_area_vectors", "a_weighting_db",
-    "db_sum", "a_weighted_levels_db", "a_weighted_total_db",
+    "db_sum", "a_weighted_levels_db", "a_weighted_total_db", "baffled_radiated_power",
+    "radiation_efficiency",
 ]
