@@ -21,7 +21,7 @@ from sarfe.io.errors import CaseError, format_key_path
 from sarfe.io.schema import CASE_SCHEMA
 
 _VALIDATOR = jsonschema.Draft202012Validator(CASE_SCHEMA)
-MESH_SUFFIXES = (".msh", ".bdf", ".nas", ".inp")
+MESH_SUFFIXES = (".msh", ".bdf", ".nas", ".dat", ".inp")
 MATRIX_SUFFIXES = (".npz", ".npy", ".mtx")
 DEFAULT_ZETA = 0.02
 
@@ -349,8 +349,8 @@ def _normalize_contacts(case, data):
                 if key not in contact:
                     raise case.error("missing required key", p + (key,))
         _only_one(case, contact, p, ("gap_m", "preload_N"), required=False)
-        if has_normal and "preload_N" not in contact:
-            contact.setdefault("gap_m", 0.0)
+        if has_normal and "preload_N" not in contact and not fe:
+            contact.setdefault("gap_m", 0.0)  # FE: default = geometric gap of each node pair
         contact.setdefault("tolerance_m", 0.0)
 
 
@@ -420,6 +420,7 @@ def _normalize_reduction(case, data):
     red = data.setdefault("reduction", {})
     _only_one(case, red, ("reduction",), ("mode_count", "cutoff_hz"), required=False)
     red.setdefault("cutoff_margin", 1.5)
+    red.setdefault("min_mode_count", 10)
 
 
 def _normalize_erp(case, data):

@@ -77,6 +77,7 @@ REDUCTION = _object({
     "mode_count": {"type": "integer", "minimum": 1},
     "cutoff_hz": POSITIVE,
     "cutoff_margin": {"type": "number", "minimum": 1},
+    "min_mode_count": {"type": "integer", "minimum": 0},
 })
 
 CONTACT = _object({

@@ -44,7 +44,7 @@ class ContactGeometry:
     frames: np.ndarray
     coords_a: np.ndarray
     coords_b: np.ndarray
-    distances: np.ndarray      # (n_p,) [m] |x_b − x_a| (0 for ground)
+    distances: np.ndarray      # (n_p,) [m] n·(x_b − x_a), the geometric gap (0 for ground)
 
 
 @dataclass(frozen=True)
@@ -353,13 +353,13 @@ def pair_contact(case, mesh, index, normals_all):
                     f"{a[worst]} at {distance[worst]:.3g} m)", p + ("between",))
             b = nodes_b[nearest]
     offset = np.where(b[:, None] >= 0, points[np.maximum(b, 0)] - points[a], 0.0)
-    distance = np.linalg.norm(offset, axis=1)
+    separation = np.linalg.norm(offset, axis=1)
     if contact["normal"] == "auto":
         normal = normals_all[a].copy()
         if np.any(np.linalg.norm(normal, axis=1) < 0.5):
             raise case.error("node(s) with no surface normal (not on any shell triangle); give "
                              "normal: [x, y, z]", p + ("normal",))
-        apart = distance > 1e-9
+        apart = separation > 1e-9
         flip = apart & (np.einsum("ij,ij->i", normal, offset) < 0)
         normal[flip] *= -1.0
     else:
@@ -368,6 +368,8 @@ def pair_contact(case, mesh, index, normals_all):
         if length == 0 or not np.isfinite(length):
             raise case.error("normal vector must be non-zero", p + ("normal",))
         normal = np.broadcast_to(vector / length, (len(a), 3))
+    # geometric gap along the normal (the default gap of the pair; 0 for coincident nodes)
+    distance = np.einsum("ij,ij->i", normal, offset)
     return a, b, frame_from_normal(normal), distance
 
 
@@ -448,9 +450,15 @@ def _build_fe(case: Case, progress=False) -> dict:
     cutoff = red.get("cutoff_hz", None if "mode_count" in red else default_cutoff_hz(case))
     bar = _bar(progress, "reduction", None)
     try:
-        reduced = craig_bampton(k_ff, m_ff, boundary_positions, mode_count=red.get("mode_count"),
-                                cutoff_hz=cutoff, progress=(lambda done, total: bar.update(1))
-                                if bar else None, free_dofs=free, total_dof_count=6 * n_nodes)
+        def reduce(mode_count, cutoff_hz):
+            return craig_bampton(k_ff, m_ff, boundary_positions, mode_count=mode_count,
+                                 cutoff_hz=cutoff_hz, progress=(lambda done, total: bar.update(1))
+                                 if bar else None, free_dofs=free, total_dof_count=6 * n_nodes)
+        reduced = reduce(red.get("mode_count"), cutoff)
+        if "mode_count" not in red and reduced.mode_count < red["min_mode_count"]:
+            # a cutoff below the first fixed-interface modes leaves only static condensation
+            reduced = reduce(min(red["min_mode_count"], len(free) - len(boundary_positions) - 1),
+                             None)
     except (RuntimeError, ValueError, np.linalg.LinAlgError) as exc:
         raise case.error(f"the structure is not held (singular stiffness: {exc}); check the "
                          "fixed groups", ("model", "fe", "fixed")) from None

@@ -126,14 +126,17 @@ def build_contacts(case: Case, stage: LinearStage):
             tangent_rows.append((t + [-1, -1])[:2])
             share = 1.0
         stiffness = contact.get("normal_stiffness_N_m", 0.0)
-        if has_normal:
-            g = contact["gap_m"] if "gap_m" in contact else -contact["preload_N"] / stiffness
-            load = 0.0
-        else:
-            g, load = 0.0, contact["preload_N"]
-        for _ in range(pairs):
+        if not has_normal:
+            g, load = np.zeros(pairs), contact["preload_N"]
+        elif "gap_m" in contact:
+            g, load = np.full(pairs, float(contact["gap_m"])), 0.0
+        elif "preload_N" in contact:
+            g, load = np.full(pairs, -contact["preload_N"] / stiffness), 0.0
+        else:  # FE default: the geometric gap of each node pair along its normal
+            g, load = np.asarray(stage.contacts[name].distances, dtype=float), 0.0
+        for p in range(pairs):
             kind.append(contact["type"])
-            gap.append(g)
+            gap.append(g[p])
             k_n.append(stiffness * share)
             k_t.append(contact.get("tangential_stiffness_N_m", 0.0) * share)
             mu.append(contact.get("friction_coefficient", 0.0))
@@ -323,6 +326,14 @@ def solve_points(case, nl: NonlinearModel, progress=False):
             if engine is not None:
                 solution = engine[0](nl.model, contacts, nl.excitation, float(omega), H, N,
                                      initial=previous, options=options)
+                if not solution.converged and contacts.count:
+                    # retry once from the periodic state found by time integration
+                    guess = adapters.time_integration_point(nl.model, contacts, nl.excitation,
+                                                            float(omega), H, N)
+                    retry = engine[0](nl.model, contacts, nl.excitation, float(omega), H, N,
+                                      initial=guess.displacement, options=options)
+                    if retry.converged:
+                        solution = retry
             else:
                 solution = adapters.time_integration_point(nl.model, contacts, nl.excitation,
                                                            float(omega), H, N)
