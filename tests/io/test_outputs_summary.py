@@ -35,9 +35,9 @@ def test_summary_json_is_strict_and_numpy_safe(tmp_path):
     assert data["erp"]["level_total_db"] is None
     assert data["point"] == {"x": 1.0, "tag": "a"} and data["nested"]["t"] == [0.5, None]
     assert "null" in data["null_note"]
-    assert data["non_finite"]["$.levels[1]"] == "nan"
-    assert data["non_finite"]["$.levels[2]"] == "inf"
-    assert data["non_finite"]["$.erp.level_total_db"] == "-inf"
+    assert data["non_finite"]["$.levels[*]"] == {"values": ["nan", "inf"], "count": 2}
+    assert data["non_finite"]["$.erp.level_total_db"] == {"values": ["-inf"], "count": 1}
+    assert data["non_finite"]["$.erp.level_db[*]"] == {"values": ["-inf"], "count": 1}
 
 
 def test_summary_json_without_non_finite_has_no_note(tmp_path):

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from dataclasses import asdict, is_dataclass
 from pathlib import Path
 
@@ -53,15 +54,22 @@ def write_summary_json(path, summary: dict) -> Path:
     """Write ``summary`` as strict, indented UTF-8 JSON to ``path`` and return the path.
 
     numpy types are converted; NaN/±inf become ``null`` and, if any were, two keys are added:
-    ``"null_note"`` (:data:`NULL_NOTE`) and ``"non_finite"`` = {json path: "nan" | "inf" | "-inf"}
-    (e.g. ``{"$.erp.level_total_db": "-inf"}``).
+    ``"null_note"`` (:data:`NULL_NOTE`) and ``"non_finite"``, which says where the nulls are, with
+    list indices collapsed to ``[*]``: {json path: {"values": ["-inf", …], "count": n}}, e.g.
+    ``{"$.points[*].erp.harmonics.level_db[*]": {"values": ["-inf"], "count": 12}}``.
     """
     path = Path(path)
     replaced: list = []
     data = to_jsonable(dict(summary), "$", replaced)
     if replaced:
+        grouped: dict = {}
+        for where, what in replaced:
+            entry = grouped.setdefault(re.sub(r"\[\d+\]", "[*]", where), {"values": [], "count": 0})
+            if what not in entry["values"]:
+                entry["values"].append(what)
+            entry["count"] += 1
         data["null_note"] = NULL_NOTE
-        data["non_finite"] = {p: r for p, r in replaced}
+        data["non_finite"] = grouped
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(data, indent=2, allow_nan=False, ensure_ascii=False) + "\n",
                     encoding="utf-8")
