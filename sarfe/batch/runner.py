@@ -223,6 +223,7 @@ def _local_client(workers: int):
         os.environ.setdefault(name, value)
     cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                            dashboard_address=None, host="127.0.0.1", silence_logs=logging.ERROR,
+                           scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # metrics only, loopback
                            env=dict(_BLAS_ENV))
     return Client(cluster), cluster
 

@@ -125,7 +125,9 @@ def read_yaml(path) -> dict:
     except OSError as error:
         raise StudyError(f"{path}: cannot read ({error.strerror})") from None
     except yaml.YAMLError as error:
-        raise StudyError(f"{path}: not valid YAML ({' '.join(str(error).split())})") from None
+        hint = ("; quote parameter paths inside {…} or [...], e.g. {'contacts[0].gap_m': 1.0e-4}"
+                if "flow" in str(error) else "")
+        raise StudyError(f"{path}: not valid YAML ({' '.join(str(error).split())}){hint}") from None
     if not isinstance(data, dict):
         raise StudyError(f"{path}: expected a mapping at the top level")
     return data

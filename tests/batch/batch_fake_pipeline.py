@@ -87,7 +87,7 @@ def solve_case(case: Case, linear_stage=None, output_dir=None, progress=False) -
         omega = 2 * math.pi * hz
         amplitude = force / abs(complex(linear_stage.stiffness - linear_stage.mass * omega**2, linear_stage.damping * omega))
         velocity = amplitude * omega
-        row = {"frequency_hz": hz, "converged": force <= 10.0, "stable": True,
+        row = {"frequency_hz": hz, "converged": not data.get("nonconverged", False), "stable": True,
                "erp_db": 20 * math.log10(velocity / 1e-9), "erp_dba": 20 * math.log10(velocity / 1e-9) - 5.0}
         for contact in data.get("contacts", []):
             penetration = max(amplitude - contact["gap_m"], 0.0)
