@@ -16,7 +16,15 @@ CASES = {
     "squeak_rig": (0.01, {"gap": 0.2e-3}, [["part_beam", "part_bump"], ["part_plate"]],
                    ["clamp_beam", "clamp_plate", "contact_rub_a", "contact_rub_b", "excite_beam",
                     "skin", "part_beam", "part_bump", "part_plate"], 0.2e-3),
+    "door_trim": (0.03, {}, [["part_carrier", "part_ribs", "part_bosses"], ["part_map_pocket"]],
+                  [f"clip_{i}" for i in range(1, 11)] + [f"clip_pocket_{i}" for i in range(1, 5)]
+                  + [f"contact_{s}_{e}" for s in ("lower_1", "lower_2", "lower_3", "upper_1",
+                                                  "side_left", "side_right") for e in "ab"]
+                  + ["excite_carrier", "excite_pocket", "skin", "part_carrier", "part_ribs",
+                     "part_bosses", "part_map_pocket"], 0.5e-3),
 }
+# parts made of several disjoint pieces (each welded to the carrier skin)
+SCATTERED = {"part_bosses"}
 
 _CACHE = {}
 
@@ -47,7 +55,7 @@ def test_topology_and_groups(name):
     for body in bodies:
         tris = mesh.triangles[np.concatenate([mesh.element_group(g) for g in body])]
         assert len(np.unique(labels[tris])) == 1, body
-        for group in body:  # each part is itself connected
+        for group in set(body) - SCATTERED:  # each part is itself connected
             sub = mesh.part(group)
             assert connected_components(sub.n_nodes, sub.triangles)[0] == 1, group
     # supports and excitation points are nodes of the mesh
@@ -68,12 +76,13 @@ def test_contact_pairs(name):
         distance = np.linalg.norm(mesh.points[a] - mesh.points[b], axis=1)
         assert distance == pytest.approx(gap, rel=1e-9, abs=1e-12), pair
         assert labels[a[0]] != labels[b[0]], pair
-        # node normals at both ends parallel to the pair direction
+        # node normals at both ends parallel to the pair direction (b: the flat or smooth
+        # partner, strict; a: a coarse mesh of a bulged part may tilt its node normal)
         d = (mesh.points[b] - mesh.points[a])[0]
-        for node, body_tris in ((a[0], labels[mesh.triangles[:, 0]] == labels[a[0]]),
-                                (b[0], labels[mesh.triangles[:, 0]] == labels[b[0]])):
-            n = node_normals(mesh.points, mesh.triangles[body_tris & _touching(mesh, node)])[node]
-            assert abs(n @ d) / np.linalg.norm(d) > 0.98, pair
+        for node, limit in ((b[0], 0.995), (a[0], 0.9)):
+            body = labels[mesh.triangles[:, 0]] == labels[node]
+            n = node_normals(mesh.points, mesh.triangles[body & _touching(mesh, node)])[node]
+            assert abs(n @ d) / np.linalg.norm(d) > limit, pair
 
 
 def _touching(mesh, node):
@@ -98,7 +107,7 @@ def test_rattle_plate_area_exact():
     assert np.allclose(node_normals(mesh.points, plate)[np.unique(plate)], [0, 0, 1])
 
 
-@pytest.mark.parametrize("name", ["rattle_rig", "squeak_rig"])
+@pytest.mark.parametrize("name", ["rattle_rig", "squeak_rig", "door_trim"])
 def test_determinism_and_msh_round_trip(name, tmp_path):
     size, params, *_ = CASES[name]
     module = importlib.import_module(f"sarfe.mesh.generators.{name}")
