@@ -22,6 +22,12 @@ CASES = {
                                                   "side_left", "side_right") for e in "ab"]
                   + ["excite_carrier", "excite_pocket", "skin", "part_carrier", "part_ribs",
                      "part_bosses", "part_map_pocket"], 0.5e-3),
+    "instrument_panel": (0.03, {}, [["part_carrier", "part_ribs", "part_bosses"], ["part_trim_strip"]],
+                         [f"clip_{i}" for i in range(1, 11)] + [f"clip_strip_{i}" for i in range(1, 5)]
+                         + [f"contact_{s}_{e}" for s in ("front_1", "front_2", "rear_1", "end_left",
+                                                         "end_right") for e in "ab"]
+                         + ["excite_carrier", "excite_strip", "skin", "part_carrier", "part_ribs",
+                            "part_bosses", "part_trim_strip"], 0.5e-3),
 }
 # parts made of several disjoint pieces (each welded to the carrier skin)
 SCATTERED = {"part_bosses"}
