@@ -5,7 +5,8 @@ Solve the reduced eigenproblem K_r x_j = ω_j² M_r x_j with X ᵀ M_r X = I and
     D_r = M_r X diag(2 ζ_j ω_j) Xᵀ M_r       [N s/m]
 
 so that every mode of the reduced model (boundary DOFs free) has damping ratio ζ_j. Zero-frequency
-(rigid-body) modes get no damping.
+(rigid-body) modes get no damping. ``sarfe.fe.damping.modal_damping`` implements the same formula;
+it is used when importable, the local version below is the fallback.
 """
 from __future__ import annotations
 
@@ -19,6 +20,14 @@ from .craig_bampton import ReducedModel
 
 def reduced_modal_damping(mass, stiffness, zeta) -> np.ndarray:
     """D_r (n_r, n_r) from dense M_r [kg], K_r [N/m] and ζ (scalar or (n_r,), ascending modes)."""
+    try:
+        from sarfe.fe.damping import modal_damping
+    except ImportError:
+        return _modal_damping(mass, stiffness, zeta)
+    return modal_damping(mass, stiffness, zeta)
+
+
+def _modal_damping(mass, stiffness, zeta):
     mass = np.asarray(mass, dtype=float)
     stiffness = np.asarray(stiffness, dtype=float)
     omega2, modes = sla.eigh(0.5 * (stiffness + stiffness.T), 0.5 * (mass + mass.T))
