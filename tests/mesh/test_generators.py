@@ -122,7 +122,7 @@ def test_determinism_and_msh_round_trip(name, tmp_path):
     assert first.points.tobytes() == second.points.tobytes()
     assert np.array_equal(first.triangles, second.triangles)
     loaded = load_mesh(tmp_path / "a.msh")
-    assert np.allclose(loaded.points, first.points, rtol=0, atol=1e-15)
+    assert loaded.points.tobytes() == first.points.tobytes()
     assert np.array_equal(loaded.triangles, first.triangles)
     for group, idx in first.node_groups.items():
         assert np.array_equal(loaded.node_group(group), idx), group
@@ -138,3 +138,38 @@ def test_squeak_pad_touches_plate_by_default():
     assert np.array_equal(mesh.points[a], mesh.points[b]) and a != b
     _, labels = connected_components(mesh.n_nodes, mesh.triangles)
     assert labels[a] != labels[b]
+
+
+def test_cached_mesh_equals_generated(tmp_path):
+    from sarfe.mesh.cache import cached_mesh
+
+    fresh = cached_mesh("rattle_rig", 0.01, cache_dir=tmp_path, gap=1e-3)
+    files = list(tmp_path.glob("rattle_rig-*.msh"))
+    assert len(files) == 1
+    again = cached_mesh("rattle_rig", 0.01, cache_dir=tmp_path, gap=1e-3)
+    assert again.points.tobytes() == fresh.points.tobytes()
+    assert np.array_equal(again.triangles, fresh.triangles)
+    assert again.node_groups.keys() == fresh.node_groups.keys()
+    cached_mesh("rattle_rig", 0.01, cache_dir=tmp_path, gap=2e-3)
+    assert len(list(tmp_path.glob("rattle_rig-*.msh"))) == 2
+
+
+def test_mm_scaling_of_generated_file(tmp_path):
+    from sarfe.mesh.generators import rattle_rig
+
+    mesh = rattle_rig.generate(mesh_size=0.02, path=tmp_path / "rig.msh")
+    scaled = load_mesh(tmp_path / "rig.msh", length_unit="mm")
+    assert np.allclose(scaled.points, mesh.points * 1e-3, rtol=1e-15, atol=0)
+
+
+@pytest.mark.parametrize("name", ["rattle_rig", "squeak_rig"])
+def test_shipped_rig_meshes_are_current(name):
+    """meshes/<rig>.msh must equal a fresh generation (rerun meshes/generate.py if not)."""
+    import pathlib
+
+    module = importlib.import_module(f"sarfe.mesh.generators.{name}")
+    shipped = load_mesh(pathlib.Path(__file__).resolve().parents[2] / "meshes" / f"{name}.msh")
+    fresh = module.generate(mesh_size=0.005)
+    assert shipped.points.tobytes() == fresh.points.tobytes()
+    assert np.array_equal(shipped.triangles, fresh.triangles)
+    assert sorted(shipped.node_groups) == sorted(fresh.node_groups)

@@ -57,13 +57,13 @@ def embed_points(gmsh, surface: int, coordinates) -> list[int]:
 
 
 def finish(gmsh, path=None) -> PanelMesh:
-    """Mesh the surfaces, convert to `PanelMesh`, optionally write a Gmsh 4.1 `.msh` to `path`."""
+    """Mesh the surfaces, convert to `PanelMesh`, optionally write a binary Gmsh 4.1 `.msh` to `path`."""
     gmsh.model.mesh.generate(2)
     mesh = mesh_from_gmsh()
     if path is not None:
         path = os.fspath(path)
         os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
         gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
-        gmsh.option.setNumber("Mesh.Binary", 0)
+        gmsh.option.setNumber("Mesh.Binary", 1)  # exact doubles: loading gives the same mesh
         gmsh.write(path)
     return mesh
