@@ -103,6 +103,14 @@ def test_pvd_lists_files_and_sweep(tmp_path):
     reader.set_active_time_value(150.0)
     mesh = reader.read()[0]
     np.testing.assert_allclose(mesh.point_data["erp_density_W_m2"], 1.0)
+    assert mesh.field_data["frequency_hz"][0] == 150.0 and mesh.field_data["point_index"][0] == 1
+    # a continuation through a fold visits 150 Hz twice: time = point index, frequency in field data
+    fold = write_erp_sweep(tmp_path / "fold", points, triangles, datasets * 2,
+                           [100.0, 150.0, 200.0, 180.0, 150.0, 220.0])
+    reader = pv.get_reader(str(fold))
+    np.testing.assert_allclose(reader.time_values, np.arange(6))
+    reader.set_active_time_value(4)
+    assert reader.read()[0].field_data["frequency_hz"][0] == 150.0
     # plain write_pvd with files in a subfolder stays relative
     other = write_pvd(tmp_path / "vtk" / "all.pvd", [(0.0, "sub/a.vtu")])
     assert 'file="sub/a.vtu"' in other.read_text()
@@ -131,6 +139,8 @@ def test_deflection_animation_over_one_period(tmp_path):
         np.testing.assert_allclose(mesh.point_data["displacement_magnitude"],
                                    np.linalg.norm(expected, axis=1), atol=1e-18)
         assert "contact_marker" in mesh.point_data
+        assert mesh.point_data.active_vectors_name == "displacement"
+        assert mesh.field_data["phase"][0] == pytest.approx(j / 12)
     # without omega the "time" is the period fraction
     pvd2 = write_deflection_animation(tmp_path / "anim2", points, triangles, U, n_frames=4)
     np.testing.assert_allclose(pv.get_reader(str(pvd2)).time_values, [0, 0.25, 0.5, 0.75])

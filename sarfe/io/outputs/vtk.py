@@ -1,7 +1,7 @@
 r"""ParaView files: ERP maps (VTU), collections (PVD) and operating-deflection animations.
 
 All VTU files are unstructured grids of the surface triangles with undeformed point coordinates
-[m] and point data only (written with meshio, zlib-compressed binary). PVD files are plain XML
+[m], point data and a little field data (written with pyvista, zlib-compressed binary XML). PVD files are plain XML
 collections of VTU files referenced by *relative* file names, so a result directory can be moved.
 
 Standard ERP point arrays (:func:`erp_point_data`), n = number of mesh points:
@@ -24,7 +24,6 @@ import warnings
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
-import meshio
 import numpy as np
 
 __all__ = ["write_erp_vtu", "write_pvd", "write_deflection_animation", "write_erp_sweep",
@@ -59,18 +58,24 @@ def _check_mesh(points, triangles):
     return points, triangles
 
 
-def write_erp_vtu(path, points, triangles, point_data: dict) -> Path:
+def write_erp_vtu(path, points, triangles, point_data: dict, field_data: dict | None = None,
+                  active_vectors: str | None = None) -> Path:
     """Write one VTU: ``points`` (n, 3) [m], ``triangles`` (n_tri, 3) int, ``point_data``
-    {name: (n,) or (n, 3) array}. Names are kept as given (see the module docstring for the
+    {name: (n,) or (n, m) array}. Names are kept as given (see the module docstring for the
     standard ERP names, built by :func:`erp_point_data`). Integer arrays stay integer (int32),
     booleans become int8; non-finite float values (NaN/inf, e.g. of a point that did not
-    converge) are written as 0 with a RuntimeWarning, so files never hold NaN. Returns the path.
+    converge) are written as 0 with a RuntimeWarning, so files never hold NaN.
+    ``field_data`` {name: scalar | array | str} is stored as VTK field data (e.g. the frequency);
+    ``active_vectors`` names a (n, 3) array ParaView offers first (e.g. to Warp By Vector).
+    Written with pyvista (zlib-compressed binary XML). Returns the path.
     """
+    import pyvista as pv
+
     points, triangles = _check_mesh(points, triangles)
-    data = {}
+    grid = pv.UnstructuredGrid({pv.CellType.TRIANGLE: triangles}, points)
     for name, values in point_data.items():
         arr = np.asarray(values)
-        if arr.shape[0] != points.shape[0] or arr.ndim > 2:
+        if arr.shape[:1] != (points.shape[0],) or arr.ndim > 2:
             raise ValueError(f"point_data[{name!r}] must be (n,) or (n, m) with n = "
                              f"{points.shape[0]}, got {arr.shape}")
         if arr.dtype.kind == "b":
@@ -84,10 +89,14 @@ def write_erp_vtu(path, points, triangles, point_data: dict) -> Path:
                 warnings.warn(f"point_data[{name!r}]: {int(bad.sum())} non-finite values written as 0",
                               RuntimeWarning, stacklevel=2)
                 arr = np.where(bad, 0.0, arr)
-        data[str(name)] = arr
+        grid.point_data[str(name)] = arr
+    for name, value in (field_data or {}).items():
+        grid.field_data[str(name)] = [value] if isinstance(value, str) else np.atleast_1d(value)
+    if active_vectors is not None:
+        grid.point_data.active_vectors_name = active_vectors
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    meshio.Mesh(points, [("triangle", triangles)], point_data=data).write(path, file_format="vtu")
+    grid.save(str(path), binary=True)
     return path
 
 
@@ -171,14 +180,25 @@ def erp_point_data(n_points: int, erp, normal_displacement, omega: float, displa
 
 def write_erp_sweep(directory, points, triangles, point_data_per_frequency, frequencies_hz,
                     basename: str = "erp") -> Path:
-    """One VTU per frequency point (``<basename>_0000.vtu`` …) plus ``<basename>.pvd`` whose
-    "time" is the excitation frequency [Hz]. Returns the PVD path."""
+    """One VTU per frequency point (``<basename>_0000.vtu`` …, in sweep order) plus
+    ``<basename>.pvd``. Each VTU carries field data ``frequency_hz`` and ``point_index``.
+
+    The PVD "time" is the frequency [Hz] when all frequencies differ; a continuation that turns
+    back through a fold visits a frequency more than once, and then the time is the point index
+    0, 1, … (ParaView sorts and merges equal times). Returns the PVD path.
+    """
     directory = Path(directory)
+    frequencies = np.asarray(frequencies_hz, dtype=float)
+    data = list(point_data_per_frequency)
+    if len(data) != frequencies.size:
+        raise ValueError(f"{len(data)} point-data sets for {frequencies.size} frequencies")
+    unique = np.unique(frequencies).size == frequencies.size
     entries = []
-    for j, (f, data) in enumerate(zip(frequencies_hz, point_data_per_frequency)):
+    for j, (f, values) in enumerate(zip(frequencies, data)):
         name = f"{basename}_{j:04d}.vtu"
-        write_erp_vtu(directory / name, points, triangles, data)
-        entries.append((f, name))
+        write_erp_vtu(directory / name, points, triangles, values,
+                      field_data={"frequency_hz": float(f), "point_index": j})
+        entries.append((f if unique else j, name))
     return write_pvd(directory / f"{basename}.pvd", entries)
 
 
@@ -208,7 +228,8 @@ def write_deflection_animation(directory, points, triangles, displacement_harmon
         data = dict(point_data or {})
         data["displacement"] = u
         data["displacement_magnitude"] = np.linalg.norm(u, axis=1)
-        write_erp_vtu(directory / name, points, triangles, data)
         phase = j / int(n_frames)
+        write_erp_vtu(directory / name, points, triangles, data, active_vectors="displacement",
+                      field_data={"phase": phase})
         entries.append((2.0 * np.pi * phase / omega if omega else phase, name))
     return write_pvd(directory / f"{basename}.pvd", entries)
