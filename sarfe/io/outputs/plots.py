@@ -63,13 +63,15 @@ def _plot_branches(ax, x, y, category, color, label_prefix=""):
 
 
 def plot_erp_sweep(path, frequencies_hz, level_db, stable=None, level_a_db=None, title=None,
-                   linear_level_db=None) -> Path:
+                   linear_level_db=None, dynamic_range_db: float = 80.0) -> Path:
     """ERP level vs excitation frequency for a sweep, in sweep (continuation) order.
 
     frequencies_hz : (n_f,) [Hz]; level_db : (n_f,) total ERP level [dB re 1 pW];
     stable : (n_f,) True/False/None per point (None = not assessed); level_a_db : optional
     (n_f,) A-weighted total [dB(A)]; linear_level_db : optional (n_f,) linear baseline (thin grey).
-    Non-finite levels are left out. Returns the PNG path.
+    The y axis shows at most ``dynamic_range_db`` below the highest level (a panel that barely
+    moves has levels of −200 dB that would squash the plot). Non-finite levels are left out.
+    Returns the PNG path.
     """
     x = np.asarray(frequencies_hz, dtype=float)
     category = _categories(stable, x.size)
@@ -81,6 +83,13 @@ def plot_erp_sweep(path, frequencies_hz, level_db, stable=None, level_a_db=None,
     if linear_level_db is not None:
         ax.plot(x, np.asarray(linear_level_db, dtype=float), color="0.5", linewidth=0.8,
                 label="linear (no contact)")
+    shown = [np.asarray(v, dtype=float) for v in (level_db, level_a_db, linear_level_db)
+             if v is not None]
+    finite = np.concatenate([v[np.isfinite(v)] for v in shown])
+    if finite.size:
+        top, low = float(finite.max()), float(finite.min())
+        margin = 0.05 * max(min(top - low, dynamic_range_db), 1.0)
+        ax.set_ylim(max(low, top - dynamic_range_db) - margin, top + margin)
     ax.set_xlabel("excitation frequency [Hz]")
     ax.set_ylabel("ERP level [dB re 1 pW]" + (" / [dB(A)]" if level_a_db is not None else ""))
     ax.grid(True, alpha=0.3)
