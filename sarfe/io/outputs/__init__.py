@@ -1,5 +1,8 @@
 """sarfe.io.outputs — result writers; each a plain function writing into a given path/directory.
 
+File layouts and array names are documented in the modules: summary.py (summary.json),
+response_h5.py (response.h5), vtk.py (VTU/PVD arrays), plots.py (PNGs).
+
     write_summary_json(path, summary: dict) -> Path            strict JSON, NaN/inf → null + note
     console_table(rows: list[dict], columns=None, formats=None, headers=None, max_rows=None) -> str
     write_response_h5(path, solutions, *, contacts=None, excitation=None, excitation_dofs=None,
@@ -7,7 +10,7 @@
                       store_displacement=False, store_erp_density_per_harmonic=False,
                       extra_groups=None, attributes=None) -> Path
     read_response_h5(path) -> dict
-    write_erp_vtu(path, points, triangles, point_data: dict) -> Path
+    write_erp_vtu(path, points, triangles, point_data: dict, field_data=None, active_vectors=None) -> Path
     erp_point_data(n_points, erp, normal_displacement, omega, displacement=None,
                    radiating_nodes=None, contact_marker=None) -> dict
     contact_markers(n_points, contact_nodes) -> (n_points,) int32
@@ -17,7 +20,7 @@
     write_deflection_animation(directory, points, triangles, displacement_harmonics (2H+1, n, 3),
                                n_frames=24, omega=None, basename="deflection", point_data=None) -> Path (.pvd)
     plot_erp_sweep(path, frequencies_hz, level_db, stable=None, level_a_db=None, title=None,
-                   linear_level_db=None) -> Path
+                   linear_level_db=None, dynamic_range_db=80.0) -> Path
     plot_contact_forces(path, force_time (N, n), names=None, omega=None, title=None) -> Path
     plot_erp_spectrum(path, frequencies_hz (H,), level_db (H,), level_a_db=None, title=None) -> Path
 """
