@@ -1,0 +1,72 @@
+"""DOF numbering, sparse assembly and support (fixed-DOF) sets for 6-DOF shell nodes.
+
+DOF order is node-major: dof = 6·node + c with c = 0..5 ↔ [ux, uy, uz, rx, ry, rz].
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+__all__ = ["element_dofs", "assemble", "fixed_dofs", "free_dofs", "COMPONENTS"]
+
+#: component letters of the 6 nodal DOFs
+COMPONENTS = ("ux", "uy", "uz", "rx", "ry", "rz")
+
+_NAMED = {
+    "all": (0, 1, 2, 3, 4, 5),
+    "translations": (0, 1, 2),
+    "rotations": (3, 4, 5),
+}
+
+
+def element_dofs(triangles, dofs_per_node=6):
+    """Global DOF numbers of each element, (n_el, 3·dofs_per_node), node-major."""
+    triangles = np.asarray(triangles, dtype=np.int64)
+    return (dofs_per_node * triangles[:, :, None] + np.arange(dofs_per_node)).reshape(
+        triangles.shape[0], -1
+    )
+
+
+def assemble(element_matrices, dofs, n_dof):
+    """Sum element matrices (n_el, k, k) into a CSR (n_dof, n_dof) in one coo → csr pass."""
+    k = dofs.shape[1]
+    rows = np.broadcast_to(dofs[:, :, None], (dofs.shape[0], k, k)).ravel()
+    cols = np.broadcast_to(dofs[:, None, :], (dofs.shape[0], k, k)).ravel()
+    matrix = sp.coo_matrix((element_matrices.ravel(), (rows, cols)), shape=(n_dof, n_dof))
+    return matrix.tocsr()
+
+
+def _components(components):
+    if isinstance(components, str):
+        if components in _NAMED:
+            return np.array(_NAMED[components])
+        names = [c.strip() for c in components.replace(",", " ").split()]
+        if not names or any(c not in COMPONENTS for c in names):
+            raise ValueError(
+                f"components {components!r}: use 'all', 'translations', 'rotations', "
+                f"names from {COMPONENTS} or integers 0..5"
+            )
+        return np.array([COMPONENTS.index(c) for c in names])
+    comps = np.asarray(components, dtype=np.int64).ravel()
+    if comps.size == 0 or comps.min() < 0 or comps.max() > 5:
+        raise ValueError(f"components must be integers in 0..5, got {components!r}")
+    return comps
+
+
+def fixed_dofs(nodes, components="all"):
+    """Sorted unique DOF numbers 6·node + c of a clamped/supported node set.
+
+    nodes: node indices (any shape); components: 'all' (clamped), 'translations'
+    (pinned), 'rotations', a string of names like 'ux uy uz' or integers 0..5.
+    """
+    nodes = np.asarray(nodes, dtype=np.int64).ravel()
+    comps = _components(components)
+    return np.unique(6 * nodes[:, None] + comps[None, :])
+
+
+def free_dofs(n_dof, fixed):
+    """Complement of ``fixed`` in range(n_dof), sorted."""
+    mask = np.ones(n_dof, dtype=bool)
+    mask[np.asarray(fixed, dtype=np.int64)] = False
+    return np.flatnonzero(mask)
