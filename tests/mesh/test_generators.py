@@ -173,3 +173,26 @@ def test_shipped_rig_meshes_are_current(name):
     assert shipped.points.tobytes() == fresh.points.tobytes()
     assert np.array_equal(shipped.triangles, fresh.triangles)
     assert sorted(shipped.node_groups) == sorted(fresh.node_groups)
+
+
+@pytest.mark.parametrize("name,attached,rib_height", [("door_trim", "part_map_pocket", 0.015),
+                                                      ("instrument_panel", "part_trim_strip", 0.02)])
+def test_panel_layers(name, attached, rib_height):
+    """Ribs and bosses lie behind the skin, the attached part in front of it, ribs vertical."""
+    mesh = generated(name)
+    f = importlib.import_module(f"sarfe.mesh.generators.{name}").spec().height
+    p, t = mesh.points, mesh.triangles
+
+    def offset(group):
+        nodes = np.unique(t[mesh.element_group(group)])
+        return p[nodes, 2] - f(p[nodes, 0], p[nodes, 1])
+
+    skin_error = np.abs(offset("part_carrier")).max()
+    assert skin_error < 1e-3  # B-spline skin follows f(x, y)
+    ribs = offset("part_ribs")
+    assert ribs.min() == pytest.approx(-rib_height, abs=1e-6) and ribs.max() < skin_error
+    assert offset("part_bosses").max() < skin_error
+    assert offset(attached).min() > 0  # never behind the carrier skin
+    rib_normals = node_normals(p, t[mesh.element_group("part_ribs")])
+    used = np.unique(t[mesh.element_group("part_ribs")])
+    assert np.abs(rib_normals[used, 2]).max() < 1e-6

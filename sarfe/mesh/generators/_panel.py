@@ -178,15 +178,14 @@ def build(spec: PanelSpec, mesh_size: float, path=None) -> PanelMesh:
 def _strip(occ, xs, ys, f, depth):
     """Planar vertical rib face over the straight plan-view line (xs, ys).
 
-    Top edge: a straight line `_LIFT` above the highest skin point (cut away after
-    fragmentation); bottom edge: spline through (x, y, f − depth), coplanar hence planar.
+    Top edge: spline through (x, y, f + `_LIFT`) (the sliver in front of the skin is cut away
+    after fragmentation); bottom edge: spline through (x, y, f − depth).  All points lie in one
+    vertical plane, so both splines and the face are planar.
     """
-    top = float(np.max(f(xs, ys))) + _LIFT
+    top = [occ.addPoint(x, y, float(f(x, y)) + _LIFT) for x, y in zip(xs, ys)]
     bottom = [occ.addPoint(x, y, float(f(x, y)) - depth) for x, y in zip(xs, ys)]
-    top_start = occ.addPoint(xs[0], ys[0], top)
-    top_end = occ.addPoint(xs[-1], ys[-1], top)
-    curves = [occ.addLine(top_start, top_end), occ.addLine(top_end, bottom[-1]),
-              occ.addSpline(bottom[::-1]), occ.addLine(bottom[0], top_start)]
+    curves = [occ.addSpline(top), occ.addLine(top[-1], bottom[-1]),
+              occ.addSpline(bottom[::-1]), occ.addLine(bottom[0], top[0])]
     return occ.addPlaneSurface([occ.addCurveLoop(curves)])
 
 
