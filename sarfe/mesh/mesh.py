@@ -23,7 +23,7 @@ class GroupError(KeyError):
 
 
 def _index_array(values, name: str) -> np.ndarray:
-    array = np.asarray(values, dtype=np.int64).reshape(-1)
+    array = np.array(values, dtype=np.int64).reshape(-1)
     if array.size and array.min() < 0:
         raise ValueError(f"group {name!r} has negative indices")
     return array
@@ -47,16 +47,16 @@ class PanelMesh:
     tetrahedra: np.ndarray | None = None
 
     def __post_init__(self):
-        points = np.ascontiguousarray(self.points, dtype=np.float64)
+        points = np.array(self.points, dtype=np.float64)  # own copy: frozen and read-only
         if points.ndim != 2 or points.shape[1] != 3:
             raise ValueError(f"points must have shape (n, 3), got {points.shape}")
-        triangles = np.ascontiguousarray(self.triangles, dtype=np.int64).reshape(-1, 3)
+        triangles = np.array(self.triangles, dtype=np.int64).reshape(-1, 3)
         n = len(points)
         if triangles.size and (triangles.min() < 0 or triangles.max() >= n):
             raise ValueError("triangles reference nodes outside points")
         tets = self.tetrahedra
         if tets is not None:
-            tets = np.ascontiguousarray(tets, dtype=np.int64)
+            tets = np.array(tets, dtype=np.int64)
             if tets.ndim != 2 or tets.shape[1] not in (4, 10):
                 raise ValueError(f"tetrahedra must have shape (n, 4|10), got {tets.shape}")
             if tets.size and (tets.min() < 0 or tets.max() >= n):

@@ -85,3 +85,23 @@ def test_errors(tmp_path):
         load_mesh(tmp_path / "x.stl")
     with pytest.raises(MeshError, match="unknown length unit"):
         load_mesh(bad, length_unit="furlong")
+
+
+def test_tetrahedra_kept_and_shells_split(tmp_path):
+    points = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]], dtype=float)
+    path = tmp_path / "solid.inp"
+    meshio.write(path, meshio.Mesh(points, [("tetra", np.array([[0, 1, 2, 3]])),
+                                            ("triangle", np.array([[1, 2, 4]]))]),
+                 file_format="abaqus")
+    mesh = load_mesh(path)
+    assert np.array_equal(mesh.tetrahedra, [[0, 1, 2, 3]])
+    assert np.array_equal(mesh.triangles, [[1, 2, 4]])
+
+
+def test_panel_mesh_copies_inputs():
+    from sarfe.mesh import PanelMesh
+
+    points = np.zeros((3, 3))
+    mesh = PanelMesh(points, [[0, 1, 2]])
+    points[0, 0] = 1.0  # caller's array stays writable and independent
+    assert mesh.points[0, 0] == 0.0
