@@ -158,7 +158,14 @@ def _schema_message(error):
     if v == "type":
         types = [value] if isinstance(value, str) else value
         wanted = " or ".join(_TYPE_NAMES.get(t, t) for t in types)
-        return path, f"expected {wanted}, got {_describe(inst)}"
+        hint = ""
+        if isinstance(inst, str) and ("number" in types or "integer" in types):
+            try:
+                float(inst)
+                hint = " (a number written as text; plain PyYAML reads 2.0e4 as text, use 2.0e+4)"
+            except ValueError:
+                pass
+        return path, f"expected {wanted}, got {_describe(inst)}{hint}"
     if v in ("minimum", "exclusiveMinimum", "maximum", "exclusiveMaximum"):
         op = {"minimum": ">=", "exclusiveMinimum": ">", "maximum": "<=", "exclusiveMaximum": "<"}[v]
         return path, f"must be {op} {value:g}, got {inst!r}"

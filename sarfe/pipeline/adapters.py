@@ -58,14 +58,15 @@ def make_options(cls, values: dict):
 
 
 def time_integration_point(model, contacts, excitation, omega, harmonics, samples_per_period,
-                           initial=None):
-    """A HarmonicSolution look-alike from time integration (fallback when no HBM engine)."""
+                           initial=None, max_periods=400):
+    """A HarmonicSolution look-alike from time integration (fallback when no HBM engine, and the
+    start guess of a retry: then ``max_periods`` is small and the state need not be steady)."""
     from sarfe.hbm.harmonics import harmonic_coefficients
     from sarfe.hbm.time_integration import integrate_time
 
     steps = max(int(samples_per_period), 256)
     response = integrate_time(model, contacts, excitation, omega, harmonics,
-                              steps_per_period=steps, max_periods=400, initial=initial)
+                              steps_per_period=steps, max_periods=max_periods, initial=initial)
     return SimpleNamespace(
         omega=float(omega), harmonics=int(harmonics), samples_per_period=steps,
         displacement=response.displacement_harmonics,

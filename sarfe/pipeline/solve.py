@@ -329,7 +329,7 @@ def solve_points(case, nl: NonlinearModel, progress=False):
                 if not solution.converged and contacts.count:
                     # retry once from the periodic state found by time integration
                     guess = adapters.time_integration_point(nl.model, contacts, nl.excitation,
-                                                            float(omega), H, N)
+                                                            float(omega), H, N, max_periods=40)
                     retry = engine[0](nl.model, contacts, nl.excitation, float(omega), H, N,
                                       initial=guess.displacement, options=options)
                     if retry.converged:
