@@ -88,13 +88,17 @@ def get_path(data: dict, path: str) -> list:
 
 
 def set_path(data: dict, path: str, value) -> dict:
-    """Copy of ``data`` with ``value`` written at every place ``path`` matches."""
+    """Copy of ``data`` with ``value`` written at every place ``path`` matches (``None`` removes
+    the key, e.g. ``excitation.sweep: null`` to give ``excitation.frequency_hz`` instead)."""
     steps = parse_path(path)
     if steps[-1].selector is not None:
         raise PathError(f"parameter path {path!r}: the last step must be a plain key")
     out = copy.deepcopy(data)
     for node in _parents(out, steps, path):
-        node[steps[-1].key] = value
+        if value is None:
+            node.pop(steps[-1].key, None)
+        else:
+            node[steps[-1].key] = value
     return out
 
 

@@ -45,20 +45,26 @@ def frequency_column(table):
     return _find(table, _FREQUENCY, ("freq",))
 
 
+_CASE_SECTIONS = ("name", "description", "model", "damping", "reduction", "contacts", "excitation",
+                  "solver", "erp", "output")
+# per-contact columns of CaseResult.rows: "<contact>.<quantity>"; maxima over frequency per variant
+CONTACT_MAXIMA = ("max_penetration_m", "peak_normal_force_N", "peak_friction_force_N")
+RATTLE_COLUMN = "max_penetration_m"  # a contact rattles when it closes: penetration > 0
+
+
 def parameter_columns(table) -> list[str]:
-    """Varied-input columns: between the variant columns and the result columns."""
-    return [c for c in table.columns if c not in store.VARIANT_COLUMNS and ("." in c or "[" in c)]
+    """Varied-input columns (``table.attrs['parameters']``, else paths into a case section)."""
+    if "parameters" in table.attrs:
+        return [c for c in table.attrs["parameters"] if c in table.columns]
+    return [c for c in table.columns if c not in store.VARIANT_COLUMNS
+            and ("[" in c or c.split(".")[0] in _CASE_SECTIONS and "." in c)]
 
 
-def rattle_columns(table) -> dict[str, str]:
-    """{contact name: boolean/number column that says the contact rattles (impacts/opens)}."""
-    found = {}
-    for column in table.columns:
-        low = column.lower()
-        for suffix in ("_rattles", "_rattle", "_impact", "_opens"):
-            if low.endswith(suffix) and low != suffix.strip("_"):
-                found.setdefault(column[: -len(suffix)], column)
-    return found
+def contact_columns(table, quantity: str) -> dict[str, str]:
+    """{contact name: column} of ``<contact>.<quantity>`` result columns."""
+    parameters = set(parameter_columns(table))
+    suffix = "." + quantity
+    return {c[: -len(suffix)]: c for c in table.columns if c.endswith(suffix) and c not in parameters}
 
 
 def variant_levels(table: pd.DataFrame) -> pd.DataFrame:
@@ -66,6 +72,7 @@ def variant_levels(table: pd.DataFrame) -> pd.DataFrame:
     erp, erp_a, freq = erp_column(table), erp_a_column(table), frequency_column(table)
     keep = ["variant_index", "variant_id", "source", "status", "error"] + parameter_columns(table)
     levels = table.groupby("variant_index", sort=True)[keep].first().reset_index(drop=True)
+    levels.attrs["parameters"] = parameter_columns(table)
     if erp is not None:
         values = pd.to_numeric(table[erp], errors="coerce")
         levels["max_erp_db"] = values.groupby(table["variant_index"]).max().to_numpy()
@@ -75,9 +82,14 @@ def variant_levels(table: pd.DataFrame) -> pd.DataFrame:
     if erp_a is not None:
         values = pd.to_numeric(table[erp_a], errors="coerce")
         levels["max_erp_dba"] = values.groupby(table["variant_index"]).max().to_numpy()
-    for contact, column in rattle_columns(table).items():
-        flags = pd.to_numeric(table[column], errors="coerce").fillna(0) > 0
-        levels[f"{contact}_rattles"] = flags.groupby(table["variant_index"]).any().to_numpy()
+    for quantity in CONTACT_MAXIMA:
+        for contact, column in contact_columns(table, quantity).items():
+            values = pd.to_numeric(table[column], errors="coerce")
+            levels[column] = values.groupby(table["variant_index"]).max().to_numpy()
+    for contact, column in contact_columns(table, RATTLE_COLUMN).items():
+        values = pd.to_numeric(table[column], errors="coerce")
+        if values.notna().any():  # contacts without a normal direction (pure squeak) have NaN
+            levels[f"{contact}.rattles"] = (values.fillna(0) > 0).groupby(table["variant_index"]).any().to_numpy()
     return levels
 
 
@@ -149,7 +161,7 @@ def rattle_probability(levels: pd.DataFrame, gap_column: str, bins: int = 8) -> 
 
     Columns: gap_low, gap_high, gap_mid [m], count, then one probability column per contact.
     """
-    flags = [c for c in levels.columns if c.endswith("_rattles")]
+    flags = [c for c in levels.columns if c.endswith(".rattles")]
     data = levels[levels["status"] != "failed"]
     gaps = pd.to_numeric(data[gap_column], errors="coerce")
     data, gaps = data[gaps.notna()], gaps[gaps.notna()]
@@ -167,30 +179,29 @@ def rattle_probability(levels: pd.DataFrame, gap_column: str, bins: int = 8) -> 
     for label, members in data.groupby(np.asarray(labels)):
         out.append({"gap_low": float(low[label]), "gap_high": float(high[label]),
                     "gap_mid": 0.5 * float(low[label] + high[label]), "count": int(len(members)),
-                    **{f[: -len("_rattles")]: float(members[f].mean()) for f in flags}})
+                    **{f[: -len(".rattles")]: float(members[f].mean()) for f in flags}})
     return pd.DataFrame(out)
 
 
 def _plots(levels: pd.DataFrame, output: pathlib.Path) -> list[str]:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure  # no pyplot: no GUI backend, no global state
 
     written = []
     if "max_erp_db" in levels and levels["max_erp_db"].notna().any():
-        figure, axis = plt.subplots(figsize=(6, 4))
+        figure = Figure(figsize=(6, 4))
+        axis = figure.add_subplot()
         axis.hist(levels["max_erp_db"].dropna(), bins=min(30, max(5, len(levels) // 4)), color="tab:blue")
         axis.set_xlabel("max ERP level per variant [dB]")
         axis.set_ylabel("variants")
         axis.set_title(f"ERP level over {int(levels['max_erp_db'].notna().sum())} variants")
         figure.tight_layout()
         figure.savefig(output / "erp_histogram.png", dpi=110)
-        plt.close(figure)
         written.append("erp_histogram.png")
-    gaps = [c for c in levels.columns if "gap" in c.lower() and ("." in c or "[" in c)]
-    has_flags = any(c.endswith("_rattles") for c in levels.columns)
+    gaps = [c for c in parameter_columns(levels) if "gap" in c.lower()]
+    has_flags = any(c.endswith(".rattles") for c in levels.columns)
     if gaps and has_flags:
-        figure, axis = plt.subplots(figsize=(6, 4))
+        figure = Figure(figsize=(6, 4))
+        axis = figure.add_subplot()
         for gap in gaps:
             table = rattle_probability(levels, gap)
             for contact in [c for c in table.columns if c not in ("gap_low", "gap_high", "gap_mid", "count")]:
@@ -201,7 +212,6 @@ def _plots(levels: pd.DataFrame, output: pathlib.Path) -> list[str]:
         axis.legend(fontsize=7)
         figure.tight_layout()
         figure.savefig(output / "rattle_probability_vs_gap.png", dpi=110)
-        plt.close(figure)
         written.append("rattle_probability_vs_gap.png")
     return written
 
@@ -223,10 +233,10 @@ def summarize(table: pd.DataFrame, stats=None) -> dict:
         summary["max_erp_db"] = _stats(levels["max_erp_db"])
     if "max_erp_dba" in levels:
         summary["max_erp_dba"] = _stats(levels["max_erp_dba"])
-    flags = [c for c in levels.columns if c.endswith("_rattles")]
+    flags = [c for c in levels.columns if c.endswith(".rattles")]
     ok = levels[levels["status"] != "failed"] if len(levels) else levels
     if flags and len(ok):
-        summary["rattle_probability"] = {f[: -len("_rattles")]: float(ok[f].mean()) for f in flags}
+        summary["rattle_probability"] = {f[: -len(".rattles")]: float(ok[f].mean()) for f in flags}
     for parameter in parameter_columns(table):
         values = pd.to_numeric(levels[parameter], errors="coerce") if parameter in levels else pd.Series([], dtype=float)
         if values.notna().any():

@@ -65,7 +65,7 @@ def build_stage(variant: Variant, pipeline_name: str = PIPELINE):
 
 def _converged(result) -> bool:
     summary = getattr(result, "summary", None) or {}
-    if summary.get("converged") is False:
+    if summary.get("all_converged", summary.get("converged")) is False:
         return False
     return all(row.get("converged", True) is not False for row in (result.rows or []))
 
@@ -84,10 +84,15 @@ def solve_variant(variant: Variant, linear_stage, pipeline_name: str = PIPELINE,
     try:
         pipeline = _pipeline(pipeline_name)
         case = load_variant_case(pipeline, variant)
-        result = pipeline.solve_case(case, linear_stage=linear_stage, output_dir=variant_output, progress=False)
+        options = {}
+        if "write" in inspect.signature(pipeline.solve_case).parameters:
+            options["write"] = variant_output is not None  # no files per variant unless asked
+        result = pipeline.solve_case(case, linear_stage=linear_stage, output_dir=variant_output,
+                                     progress=False, **options)
+        summary = {k: v for k, v in (getattr(result, "summary", None) or {}).items() if k != "points"}
         record.update(status="ok" if _converged(result) else "nonconverged",
-                      exit_code=getattr(result, "exit_code", None),
-                      summary=dict(getattr(result, "summary", None) or {}), rows=list(result.rows or []))
+                      exit_code=getattr(result, "exit_code", None), summary=summary,
+                      rows=list(result.rows or []))
     except Exception as error:  # recorded, the batch goes on
         record.update(error=_error_text(error), traceback=traceback.format_exc(limit=8))
     record["elapsed_s"] = time.perf_counter() - start

@@ -129,8 +129,9 @@ def records_table(variants: list[Variant], records: dict[str, dict]) -> pd.DataF
             rows.append(row)
     table = pd.DataFrame(rows)
     if table.empty:
-        return pd.DataFrame(columns=VARIANT_COLUMNS + parameter_names)
+        table = pd.DataFrame(columns=VARIANT_COLUMNS + parameter_names)
     table["exit_code"] = table["exit_code"].astype("Int64")
+    table.attrs["parameters"] = parameter_names
     return table
 
 

@@ -244,11 +244,24 @@ def draw(rng: np.random.Generator, spec: dict, samples: int) -> np.ndarray:
     if kind == "lognormal":
         return rng.lognormal(math.log(spec["median"]), spec["log_std"], samples)
     if kind == "truncated_normal":
-        from scipy.stats import truncnorm
-        mean, std = spec["mean"], spec["std"]
-        a, b = (spec["low"] - mean) / std, (spec["high"] - mean) / std
-        return truncnorm.ppf(rng.uniform(0.0, 1.0, samples), a, b, loc=mean, scale=std)
+        return _truncated_normal(rng.uniform(0.0, 1.0, samples), spec["mean"], spec["std"], spec["low"], spec["high"])
     raise StudyError(f"unknown distribution {kind!r}")
+
+
+def _truncated_normal(u, mean, std, low, high):
+    """Inverse CDF of N(mean, std²) restricted to [low, high] at probabilities ``u``.
+
+    x = mean + std Φ⁻¹(Φ(a) + u (Φ(b) − Φ(a))), a, b = (low, high − mean)/std; for a > 0 the
+    mirrored form with Φ(−·) keeps the precision of the far tail.
+    """
+    from scipy.special import ndtr, ndtri
+
+    a, b = (low - mean) / std, (high - mean) / std
+    if a > 0:
+        x = mean - std * ndtri(ndtr(-a) - u * (ndtr(-a) - ndtr(-b)))
+    else:
+        x = mean + std * ndtri(ndtr(a) + u * (ndtr(b) - ndtr(a)))
+    return np.clip(x, low, high)
 
 
 def parameter_sets(study: Study) -> list[dict]:

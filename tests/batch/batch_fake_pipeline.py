@@ -91,9 +91,9 @@ def solve_case(case: Case, linear_stage=None, output_dir=None, progress=False) -
                "erp_db": 20 * math.log10(velocity / 1e-9), "erp_dba": 20 * math.log10(velocity / 1e-9) - 5.0}
         for contact in data.get("contacts", []):
             penetration = max(amplitude - contact["gap_m"], 0.0)
-            row[f"{contact['name']}_max_force_N"] = contact["normal_stiffness_N_m"] * penetration
-            row[f"{contact['name']}_rattles"] = penetration > 0
-        impact = sum(v for k, v in row.items() if k.endswith("_max_force_N"))
+            row[f"{contact['name']}.max_penetration_m"] = penetration
+            row[f"{contact['name']}.peak_normal_force_N"] = contact["normal_stiffness_N_m"] * penetration
+        impact = sum(v for k, v in row.items() if k.endswith(".peak_normal_force_N"))
         row["erp_db"] += 10 * math.log10(1.0 + impact)
         rows.append(row)
     if output_dir is not None:
@@ -101,5 +101,5 @@ def solve_case(case: Case, linear_stage=None, output_dir=None, progress=False) -
         with open(os.path.join(output_dir, "summary.json"), "w") as stream:
             json.dump({"points": len(rows)}, stream)
     converged = all(r["converged"] for r in rows)
-    return CaseResult(summary={"converged": converged, "max_erp_db": max(r["erp_db"] for r in rows)},
+    return CaseResult(summary={"all_converged": converged, "max_erp_db": max(r["erp_db"] for r in rows)},
                       rows=rows, exit_code=0 if converged else 3)

@@ -37,7 +37,7 @@ def test_same_results_in_process_one_and_two_workers(tmp_path, fake_log, dask_cl
     pd.testing.assert_frame_equal(in_process, one)
     assert len(in_process) == 8 * 3 and in_process["variant_id"].nunique() == 8
     assert set(in_process["status"]) == {"ok"}
-    assert {"contacts[name=pocket_1].gap_m", "erp_db", "erp_dba", "pocket_1_max_force_N"} <= set(in_process.columns)
+    assert {"contacts[name=pocket_1].gap_m", "erp_db", "erp_dba", "pocket_1.peak_normal_force_N"} <= set(in_process.columns)
     assert two.attrs["summary"]["run"]["mode"] == "dask" and two.attrs["summary"]["run"]["workers"] == 2
     for folder in ("p", "w2"):
         out = tmp_path / folder
