@@ -88,6 +88,10 @@ def build(spec: PanelSpec, mesh_size: float, path=None) -> PanelMesh:
     f = spec.height
     carrier_points = {f"contact_{k}_b": v for k, v in part.contacts.items()} | dict(spec.excite)
     _check_clearance(spec, carrier_points, 2e-3)
+    for i, (cx, cy) in enumerate(spec.clips, start=1):
+        d = min([abs(cy - r) for r in spec.ribs_along_x] + [abs(cx - r) for r in spec.ribs_along_y])
+        if d < spec.boss_radius + 5e-3:
+            raise ValueError(f"clip_{i} boss at ({cx}, {cy}) is {d * 1e3:.1f} mm from a rib")
     with gmsh_session() as gmsh:
         occ = gmsh.model.occ
         set_mesh_size(gmsh, mesh_size)

@@ -56,7 +56,6 @@ def generate(mesh_size: float = 0.005, path=None, plate_size: float = 0.1,
         out, out_map = occ.fragment([(2, strip)], [(2, t) for t in cap])
         occ.synchronize()
         strip_pieces = [t for d, t in out_map[0] if d == 2]
-        cap = [t for d, t in out if d == 2 and t not in strip_pieces] or cap
         inner = [t for t in strip_pieces if occ.getMass(2, t) < 2 * math.pi * r * r]
         beam = [t for t in strip_pieces if t not in inner]
         cap = [t for d, t in out if d == 2 and t not in strip_pieces]
@@ -65,6 +64,8 @@ def generate(mesh_size: float = 0.005, path=None, plate_size: float = 0.1,
         apex_tag = [t for d, t in gmsh.model.getBoundary([(2, t) for t in cap], combined=False,
                                                          oriented=False, recursive=True)
                     if d == 0 and abs(gmsh.model.getValue(0, t, [])[2] - gap) < 1e-9]
+        if len(beam) != 1 or len(apex_tag) != 1:
+            raise RuntimeError("squeak_rig: welding the pad into the strip failed")
         (tip_b,) = embed_points(gmsh, plate, [(pad_x, pad_y, 0.0)])
         (excite,) = embed_points(gmsh, beam[0], [(x_clamp + excite_fraction * beam_length, pad_y, z_beam)])
         eps = 1e-6
