@@ -55,7 +55,7 @@ _DISTRIBUTIONS = {
     "truncated_normal": {"mean": _NUMBER, "std": _POSITIVE, "low": _NUMBER, "high": _NUMBER},
 }
 _SCALAR = {"type": ["number", "string", "boolean"]}
-_VALUE = {"anyOf": [_SCALAR, {"type": "array"}, {"type": "object"}]}
+_VALUE = {"anyOf": [_SCALAR, {"type": "array"}, {"type": "object"}, {"type": "null"}]}  # null removes the key
 
 STUDY_SCHEMA = {
     "$schema": "https://json-schema.org/draft/2020-12/schema",

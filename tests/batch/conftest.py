@@ -36,8 +36,9 @@ def fake_log(fake_log_file):
     return count
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def dask_client(fake_log_file):
+    """One two-worker LocalCluster for all batch tests (starting one costs seconds)."""
     distributed = pytest.importorskip("distributed")
     from sarfe.batch.runner import _local_client
 
