@@ -4,6 +4,7 @@
 `sarfe.mesh.generators.<rattle_rig|squeak_rig|door_trim|instrument_panel>.generate(...)`.
 """
 from .geometry import (
+    contact_frames,
     connected_components,
     facet_normals,
     nodal_areas,
@@ -17,6 +18,6 @@ from .mesh import GroupError, PanelMesh
 
 __all__ = [
     "PanelMesh", "GroupError", "MeshError", "load_mesh", "LENGTH_UNITS",
-    "connected_components", "facet_normals", "nodal_areas", "node_normals",
+    "contact_frames", "connected_components", "facet_normals", "nodal_areas", "node_normals",
     "orient_triangles", "orphan_nodes", "triangle_areas",
 ]

@@ -180,3 +180,32 @@ def orphan_nodes(n_nodes: int, triangles, tetrahedra=None) -> np.ndarray:
     if tetrahedra is not None:
         used[np.asarray(tetrahedra, dtype=np.int64).ravel()] = True
     return np.flatnonzero(~used)
+
+
+def contact_frames(mesh, tolerance: float = 1e-12) -> dict:
+    """Local frame and geometric gap of every contact pair `contact_<pair>_a` / `_b` of `mesh`.
+
+    Returns {pair: (normal (k, 3), tangents (k, 2, 3), gap (k,))} with k node pairs:
+    normal n = (x_b − x_a)/|x_b − x_a| points from node a to node b, gap g = |x_b − x_a| [m];
+    for coincident nodes (g ≤ tolerance) n is b's node normal on the triangles touching b,
+    turned away from the triangles touching a.  Tangents t₁, t₂ complete a right-handed
+    orthonormal frame (t₁ × t₂ = n).  The pair closes when (u_a − u_b)·n reaches g.
+    """
+    points = mesh.points
+    frames = {}
+    for pair, (a, b) in mesh.contact_pairs().items():
+        delta = points[b] - points[a]
+        gap = np.linalg.norm(delta, axis=1)
+        normal = np.divide(delta, gap[:, None], out=np.zeros_like(delta), where=gap[:, None] > tolerance)
+        for i in np.flatnonzero(gap <= tolerance):  # rare: only coincident pairs
+            near_b = np.any(mesh.triangles == b[i], axis=1)
+            near_a = np.any(mesh.triangles == a[i], axis=1)
+            n = node_normals(points, mesh.triangles[near_b])[b[i]]
+            side = points[mesh.triangles[near_a]].mean(axis=(0, 1)) - points[b[i]]
+            normal[i] = -n if n @ side > 0 else n
+        helper = np.eye(3)[np.argmin(np.abs(normal), axis=1)]
+        t1 = np.cross(helper, normal)
+        t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
+        t2 = np.cross(normal, t1)
+        frames[pair] = (normal, np.stack([t1, t2], axis=1), gap)
+    return frames

@@ -196,3 +196,18 @@ def test_panel_layers(name, attached, rib_height):
     rib_normals = node_normals(p, t[mesh.element_group("part_ribs")])
     used = np.unique(t[mesh.element_group("part_ribs")])
     assert np.abs(rib_normals[used, 2]).max() < 1e-6
+
+
+def test_contact_frames():
+    from sarfe.mesh import contact_frames
+
+    normal, tangents, gap = contact_frames(generated("rattle_rig"))["tip"]
+    assert np.allclose(normal, [[0, 0, -1]]) and gap == pytest.approx([0.5e-3], rel=1e-12)
+    frame = np.concatenate([tangents[0], normal], axis=0)  # rows t1, t2, n
+    assert np.allclose(frame @ frame.T, np.eye(3)) and np.linalg.det(frame) == pytest.approx(1.0)
+    from sarfe.mesh.generators import squeak_rig
+
+    normal, _, gap = contact_frames(squeak_rig.generate(mesh_size=0.01))["rub"]
+    assert gap[0] == 0.0 and np.allclose(normal, [[0, 0, -1]])  # from the pad down into the plate
+    for pair, (normal, _, gap) in contact_frames(generated("door_trim")).items():
+        assert gap == pytest.approx(0.5e-3, rel=1e-9) and normal[0, 2] < -0.9, pair
