@@ -8,7 +8,12 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["rectangle_triangles", "cylindrical_panel_triangles", "boundary_nodes"]
+__all__ = [
+    "rectangle_triangles",
+    "cylindrical_panel_triangles",
+    "cylindrical_panel_solid",
+    "boundary_nodes",
+]
 
 
 def rectangle_triangles(length_x, length_y, nx, ny, pattern="alternating", distortion=0.0, seed=0):
@@ -57,6 +62,31 @@ def cylindrical_panel_triangles(radius, angle, length, n_arc, n_axial, pattern="
         [radius * np.sin(theta), points[:, 1], radius * (np.cos(theta) - 1.0)]
     )
     return mapped, triangles
+
+
+def cylindrical_panel_solid(radius, angle, length, thickness, n_arc, n_axial, layers,
+                            kind="hex2"):
+    """The same panel as a curved quadratic scikit-fem solid mesh, ``layers`` elements through
+    the thickness (radius ± thickness/2). kind: 'hex2' (MeshHex2) or 'tet2' (MeshTet2,
+    six tetrahedra per cell). Every geometry node is mapped exactly onto the cylinder.
+    """
+    import skfem
+
+    cells = skfem.MeshHex1.init_tensor(
+        np.linspace(-angle / 2.0, angle / 2.0, n_arc + 1),
+        np.linspace(0.0, length, n_axial + 1),
+        np.linspace(-thickness / 2.0, thickness / 2.0, layers + 1),
+    )
+    if kind == "hex2":
+        cls, quadratic = skfem.MeshHex2, skfem.MeshHex2.from_mesh(cells)
+    elif kind == "tet2":
+        cls, quadratic = skfem.MeshTet2, skfem.MeshTet2.from_mesh(cells.to_meshtet())
+    else:
+        raise ValueError(f"kind must be 'hex2' or 'tet2', got {kind!r}")
+    theta, y, offset = quadratic.doflocs
+    r = radius + offset
+    doflocs = np.vstack([r * np.sin(theta), y, r * np.cos(theta) - radius])
+    return cls(doflocs=doflocs, t=quadratic.t)
 
 
 def boundary_nodes(triangles):
