@@ -271,8 +271,11 @@ def _jenkins_2d(q, rho, drho_dw, k_t, start, H, N, jacobian, tolerance, pass_cap
     return force, state, w_start, passes, J
 
 
-def jacobian_matrix(blocks, n_rows: int, harmonics: int) -> sp.csr_matrix:
-    """Assemble ∂λ̃/∂r̃ blocks into a sparse ((2H+1) n_rows)² matrix, harmonic-major ordering."""
+def jacobian_matrix(blocks, n_rows: int, harmonics: int, dense: bool = False):
+    """Assemble ∂λ̃/∂r̃ blocks into a ((2H+1) n_rows)² matrix, harmonic-major ordering.
+
+    Sparse CSR by default; a dense ndarray when ``dense`` (small condensed systems).
+    """
     P = 2 * int(harmonics) + 1
     size = P * n_rows
     I, Jc, V = [], [], []
@@ -284,6 +287,11 @@ def jacobian_matrix(blocks, n_rows: int, harmonics: int) -> sp.csr_matrix:
         I.append(np.broadcast_to(local[:, :, None], block.shape)[mask])
         Jc.append(np.broadcast_to(local[:, None, :], block.shape)[mask])
         V.append(block[mask])
+    if dense:
+        out = np.zeros((size, size))
+        for i, j, v in zip(I, Jc, V):
+            np.add.at(out, (i, j), v)
+        return out
     if not I:
         return sp.csr_matrix((size, size))
     return sp.csr_matrix((np.concatenate(V), (np.concatenate(I), np.concatenate(Jc))),

@@ -118,7 +118,7 @@ def contact_mix():
 def test_jacobian_matches_finite_differences_all_states():
     rng = np.random.default_rng(3)
     contacts = contact_mix()
-    H, N = 4, 256
+    H, N = 3, 128
     X = random_state(rng, H, 11)
     for row, gap in ((0, 0.3), (1, -0.2), (2, 0.1), (4, 0.0)):   # normal rows cross their gap
         X[0, row], X[1, row] = gap, 0.6

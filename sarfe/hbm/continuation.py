@@ -1,0 +1,156 @@
+r"""Frequency sweep by pseudo-arclength continuation of R(x, ω) = 0, through folds.
+
+Scaled unknowns z = (x / x_s, ω / ω_s), x_s = ‖x‖ of the first point, ω_s = |ω_end − ω_start|.
+From a solution z_i with unit tangent t_i (null vector of ∂R/∂z, found from the bordered system
+
+    [[∂R/∂x · x_s, ∂R/∂ω · ω_s], [t_{i−1}ᵀ]] t = [0, 1],   t ← t / ‖t‖,
+
+oriented like t_{i−1}, so the tangent stays defined at folds where ∂R/∂x is singular):
+
+    predictor  z_p = z_i + Δs t_i
+    corrector  R(z) = 0,  t_iᵀ (z − z_p) = 0     (Newton on the bordered system, line search)
+
+Δs adapts: ×``step_growth`` when the corrector needed ≤ ``target_iterations`` iterations, ×½ when
+it needed more or failed (retry), stop below ``min_step``. A corrector that lands farther than 3 Δs
+from z_i (branch jumping) counts as failed. The last point is solved at exactly ω_end. x is the
+condensed contact-row vector or all DOFs (see :mod:`sarfe.hbm.solve`); the linear solution with
+contacts linearized at u = 0 is the first guess.
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import scipy.sparse as sp
+
+from .newton import SingularJacobian, newton, solve_linear
+from .residual import Evaluation
+from .solution import ContinuationOptions
+from .solve import (_check_omega, _solve, finalize, initial_slider, linearized_guess,
+                    make_evaluator, make_problem, slider_acceptor, wants_condensation)
+
+
+def _bordered(jacobian, d_omega, x_scale, omega_scale, row, row_scale=1.0):
+    """[[J x_s, ∂R/∂ω ω_s], [row · row_scale]] (dense or sparse like J)."""
+    if sp.issparse(jacobian):
+        return sp.bmat([[jacobian * x_scale, sp.csc_matrix(d_omega[:, None] * omega_scale)],
+                        [sp.csr_matrix(row[None] * row_scale), None]], format="csc")
+    return np.block([[jacobian * x_scale, d_omega[:, None] * omega_scale],
+                     [row[None] * row_scale]])
+
+
+def tangent(evaluation, x_scale, omega_scale, previous):
+    """Unit tangent of the solution curve in scaled unknowns, oriented like ``previous``."""
+    A = _bordered(evaluation.jacobian, evaluation.omega_derivative, x_scale, omega_scale, previous)
+    rhs = np.zeros(A.shape[0])
+    rhs[-1] = 1.0
+    t = solve_linear(A, rhs)
+    t /= np.linalg.norm(t)
+    return t if t @ previous >= 0 else -t
+
+
+def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
+                 samples_per_period, options=None, progress=None):
+    """Sweep ω from ω_start to ω_end [rad/s] (either direction) → list of HarmonicSolution.
+
+    progress(done, total): called after each point with done = covered fraction of the range
+    (0…1) and total = 1.0. Points are in continuation order (ω is not monotonic past folds).
+    A failed sweep returns the points found so far; the last one's ``reason`` says why it stopped.
+    """
+    options = options or ContinuationOptions()
+    so = options.solver
+    corrector = replace(so, max_iterations=min(so.max_iterations, options.corrector_iterations))
+    problem = make_problem(model, contacts, excitation, harmonics, samples_per_period, so)
+    _check_omega(omega_start, "omega_start")
+    _check_omega(omega_end, "omega_end")
+    if omega_start == omega_end:
+        raise ValueError("omega_start and omega_end must differ")
+    direction = np.sign(omega_end - omega_start)
+    span = abs(omega_end - omega_start)
+    state = {"slider": None}
+    first = _solve(problem, omega_start, linearized_guess(problem, omega_start), so, homotopy=True)
+    solutions = [first]
+    if not first.converged:
+        return solutions
+    condensed = wants_condensation(problem, so)
+    evaluate, to_x, to_displacement = make_evaluator(problem, condensed)
+    state["slider"] = initial_slider(problem, first.displacement)
+    accept = slider_acceptor(state)
+    x, omega = to_x(first.displacement), float(omega_start)
+    x_scale = max(np.linalg.norm(x), 1e-300)
+    z = np.append(x / x_scale, omega / span)
+    previous = np.zeros_like(z)
+    previous[-1] = direction
+    step = options.initial_step
+
+    inner = {}
+
+    def evaluate_z(zz, jacobian):
+        e = evaluate(zz[:-1] * x_scale, zz[-1] * span, jacobian, state["slider"])
+        if jacobian:
+            inner["z"], inner["ev"] = zz, e
+        return e
+
+    def stop(reason):
+        last = solutions[-1]
+        solutions[-1] = replace(last, reason=f"{last.reason}; sweep stopped: {reason}")
+        return solutions
+
+    while True:
+        try:
+            ev = inner["ev"] if inner.get("z") is z else evaluate_z(z, True)
+            t = tangent(ev, x_scale, span, previous)
+        except SingularJacobian:
+            if condensed:   # S_k(ω) singular on the way: continue on all DOFs
+                condensed = False
+                evaluate, to_x, to_displacement = make_evaluator(problem, False)
+                x = to_x(solutions[-1].displacement)
+                x_scale = max(np.linalg.norm(x), 1e-300)
+                z = np.append(x / x_scale, solutions[-1].omega / span)
+                continue
+            return stop("singular bordered Jacobian (tangent)")
+        while True:
+            predicted = z + step * t
+
+            def augmented(zz, jacobian, predicted=predicted, t=t):
+                e = evaluate_z(zz, jacobian)
+                residual = np.append(e.residual, e.reference * (t @ (zz - predicted)))
+                J = (_bordered(e.jacobian, e.omega_derivative, x_scale, span, t, e.reference)
+                     if jacobian else None)
+                return Evaluation(residual, J, None, e.forces, e.reference)
+
+            try:
+                result = newton(augmented, predicted, corrector, x_scale=1.0, accept=accept)
+                ok = result.converged and np.linalg.norm(result.x - z) <= 3 * step
+            except SingularJacobian:
+                ok = False
+            if ok:
+                break
+            step *= 0.5
+            if step < options.min_step:
+                return stop(f"step below min_step {options.min_step:g} near ω = {z[-1] * span:.6g}")
+        z_new = result.x
+        omega_new = z_new[-1] * span
+        U_new = to_displacement(z_new[:-1] * x_scale, omega_new, result.evaluation)
+        if direction * (omega_new - omega_end) >= 0:      # passed the end: solve at ω_end exactly
+            fraction = (omega_end - z[-1] * span) / (omega_new - z[-1] * span)
+            U_prev = solutions[-1].displacement
+            guess = U_prev + fraction * (U_new - U_prev)
+            solutions.append(_solve(problem, omega_end, guess, so, state["slider"]))
+            if progress is not None:
+                progress(1.0, 1.0)
+            return solutions
+        solutions.append(finalize(problem, omega_new, U_new, True, "converged", result.iterations,
+                                  state["slider"], so))
+        if progress is not None:
+            progress(float(np.clip(direction * (omega_new - omega_start) / span, 0, 1)), 1.0)
+        if len(solutions) >= options.max_points:
+            return stop(f"max_points {options.max_points} reached")
+        if direction * (omega_new - omega_start) < -span:
+            return stop("the branch turned back beyond omega_start")
+        previous, z = t, z_new
+        if result.iterations <= options.target_iterations:
+            step = min(step * options.step_growth, options.max_step)
+        else:
+            step = max(step * 0.5, options.min_step)
+

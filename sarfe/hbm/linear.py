@@ -1,0 +1,188 @@
+r"""Linear part of the harmonic balance: S(ω) per harmonic, dynamic compliance condensation, recovery.
+
+Per harmonic k the linear operator acts on (u_kc, u_ks) as
+
+    S_k(ω) = [[K − k²ω²M,  kωD],
+              [−kωD,        K − k²ω²M]],        S_0 = K,
+
+(from u = u_c cos kθ + u_s sin kθ, u̇ = kω(−u_c sin kθ + u_s cos kθ), ü = −k²ω² u). It is applied
+harmonic by harmonic; the (2H+1)n Kronecker product is never formed densely. Equivalently, with the
+complex amplitude z = u_c − i u_s (u = Re(z e^{ikθ})), S_k becomes the complex dynamic stiffness
+
+    Z_k(ω) = K − k²ω²M + i kωD,      Z_k z = f_c − i f_s,
+
+which halves the cost of each solve.
+
+Condensation: the linear DOFs are eliminated exactly through the dynamic compliance at the
+contact rows, C_k = G Z_k⁻¹ Gᵀ (n_rows × n_rows), so that r̃ = G ũ satisfies
+
+    R_c(r̃) = r̃ − r̃_lin + C λ̃(r̃) = 0,    r̃_lin = G S⁻¹ f̃_e,
+
+with (2H+1) n_rows unknowns instead of (2H+1) n. The DOFs are recovered afterwards from
+ũ_k = Z_k⁻¹ (f̃_k − Gᵀ λ̃_k). Z_k is factorized once per harmonic and frequency (dense LU, or
+SuperLU when the model is sparse). A singular Z_k (undamped resonance, free-floating structure at
+k = 0) makes :func:`condense` return None so that the caller falls back to the full residual.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from .harmonics import derivative_matrix
+
+
+def apply_dynamic_stiffness(model, omega: float, U: np.ndarray) -> np.ndarray:
+    """S(ω) Ũ for Ũ (2H+1, n) [m] → (2H+1, n) [N], harmonic by harmonic (3 matrix products)."""
+    U = np.asarray(U, dtype=float)
+    H = (U.shape[0] - 1) // 2
+    KU = np.asarray(model.stiffness @ U.T).T
+    MU = np.asarray(model.mass @ U.T).T
+    DU = np.asarray(model.damping @ U.T).T
+    k = np.arange(1, H + 1)[:, None]
+    out = KU.copy()
+    out[1::2] += -(k * omega) ** 2 * MU[1::2] + k * omega * DU[2::2]
+    out[2::2] += -(k * omega) ** 2 * MU[2::2] - k * omega * DU[1::2]
+    return out
+
+
+def apply_dynamic_stiffness_derivative(model, omega: float, U: np.ndarray) -> np.ndarray:
+    """∂S/∂ω Ũ (2H+1, n): cos rows −2k²ωM u_c + kD u_s, sin rows −2k²ωM u_s − kD u_c."""
+    U = np.asarray(U, dtype=float)
+    H = (U.shape[0] - 1) // 2
+    MU = np.asarray(model.mass @ U.T).T
+    DU = np.asarray(model.damping @ U.T).T
+    k = np.arange(1, H + 1)[:, None]
+    out = np.zeros_like(U)
+    out[1::2] = -2 * k**2 * omega * MU[1::2] + k * DU[2::2]
+    out[2::2] = -2 * k**2 * omega * MU[2::2] - k * DU[1::2]
+    return out
+
+
+def dynamic_stiffness_matrix(model, omega: float, harmonics: int) -> sp.csr_matrix:
+    """Sparse block-diagonal S(ω) of size (2H+1)n, harmonic-major (for the uncondensed Newton).
+
+    S = I⊗K − ω² diag(k²)⊗M + ω ∇⊗D  (∇ = :func:`derivative_matrix`, sparse Kronecker products).
+    """
+    K, M, D = (sp.csr_matrix(a) for a in (model.stiffness, model.mass, model.damping))
+    P = 2 * harmonics + 1
+    orders = np.concatenate(([0], np.repeat(np.arange(1, harmonics + 1), 2)))
+    return (sp.kron(sp.identity(P), K) - omega**2 * sp.kron(sp.diags(orders**2.0), M)
+            + omega * sp.kron(sp.csr_matrix(derivative_matrix(harmonics)), D)).tocsr()
+
+
+def hill_matrices(model, omega: float, harmonics: int):
+    """(M̃, D̃) of the Hill problem s² M̃ + s D̃ + ∂R/∂ũ: M̃ = I⊗M, D̃ = I⊗D + 2ω ∇⊗M (sparse)."""
+    P = 2 * harmonics + 1
+    M, D = sp.csr_matrix(model.mass), sp.csr_matrix(model.damping)
+    Mt = sp.kron(sp.identity(P), M, format="csr")
+    Dt = sp.kron(sp.identity(P), D, format="csr") + 2 * omega * sp.kron(
+        sp.csr_matrix(derivative_matrix(harmonics)), M, format="csr")
+    return Mt, Dt
+
+
+def _factorize(Z):
+    """solve(b) with a sparse LU of one complex Z_k, or None when it is singular."""
+    try:
+        lu = spla.splu(sp.csc_matrix(Z))
+    except RuntimeError:
+        return None
+    diag = np.abs(lu.U.diagonal())
+    if diag.min() <= 1e-13 * diag.max():
+        return None
+    return lu.solve
+
+
+def to_complex(F):
+    """Complex amplitudes (H+1, ...) f_c − i f_s of harmonic arrays F (2H+1, ...) (row 0: mean)."""
+    return np.concatenate([F[:1].astype(complex), F[1::2] - 1j * F[2::2]], axis=0)
+
+
+def from_complex(Z):
+    """Inverse of :func:`to_complex`: (H+1, ...) complex → (2H+1, ...) real."""
+    out = np.empty((2 * Z.shape[0] - 1,) + Z.shape[1:])
+    out[0] = Z[0].real
+    out[1::2], out[2::2] = Z[1:].real, -Z[1:].imag
+    return out
+
+
+@dataclass(frozen=True)
+class Condensation:
+    """Dynamic compliance of the contact rows at one ω (see module docstring).
+
+    compliance: C (P, P) real, P = (2H+1) n_rows, harmonic-major, block diagonal over harmonics
+    [m/N]; linear_response: r̃_lin (2H+1, n_rows) [m]; admittance: Y_k = Z_k⁻¹ Gᵀ (H+1, n, n_rows)
+    complex; forced: y_k = Z_k⁻¹ f_k (H+1, n) complex.
+    """
+
+    omega: float
+    compliance: np.ndarray
+    linear_response: np.ndarray
+    admittance: np.ndarray
+    forced: np.ndarray
+
+
+def condense(model, gap_map, excitation: np.ndarray, omega: float) -> Condensation | None:
+    """Solve Z_k(ω) [Gᵀ, f_k], k = 0…H, build C = G Z⁻¹ Gᵀ and r̃_lin; None if a Z_k is singular.
+
+    Dense models: one batched LAPACK solve over the H+1 harmonics (singularity judged by the
+    condition number for n ≤ 64, by LAPACK otherwise); sparse models: one SuperLU per harmonic.
+    """
+    F = np.asarray(excitation, dtype=float)
+    H = (F.shape[0] - 1) // 2
+    G = sp.csr_matrix(gap_map)
+    n_rows, n = G.shape
+    k = np.arange(H + 1)
+    rhs = np.concatenate([np.broadcast_to(G.T.toarray(), (H + 1, n, n_rows)),
+                          to_complex(F)[:, :, None]], axis=2).astype(complex)
+    if sp.issparse(model.stiffness):
+        solution = np.empty_like(rhs)
+        K, M, D = (sp.csc_matrix(a, dtype=complex)
+                   for a in (model.stiffness, model.mass, model.damping))
+        for order in k:
+            Z = K - (order * omega) ** 2 * M + 1j * order * omega * D
+            solve = _factorize(Z)
+            if solve is None:
+                return None
+            solution[order] = solve(rhs[order])
+    else:
+        K, M, D = (np.asarray(a, dtype=float) for a in (model.stiffness, model.mass, model.damping))
+        Z = K - ((k * omega) ** 2)[:, None, None] * M + 1j * (k * omega)[:, None, None] * D
+        if n <= 64 and np.any(np.linalg.cond(Z) > 1e13):
+            return None
+        try:
+            solution = np.linalg.solve(Z, rhs)
+        except np.linalg.LinAlgError:
+            return None
+    if not np.all(np.isfinite(solution)):
+        return None
+    Y, y = solution[:, :, :n_rows], solution[:, :, n_rows]
+    Gd = G.toarray()
+    Ck = np.einsum("rn,knm->krm", Gd, Y)                  # (H+1, n_rows, n_rows)
+    C = np.zeros((2 * H + 1, n_rows, 2 * H + 1, n_rows))
+    C[0, :, 0, :] = Ck[0].real
+    c, s = 2 * k[1:] - 1, 2 * k[1:]
+    C[c, :, c, :], C[c, :, s, :] = Ck[1:].real, Ck[1:].imag
+    C[s, :, c, :], C[s, :, s, :] = -Ck[1:].imag, Ck[1:].real
+    r_lin = from_complex(y @ Gd.T)
+    P = (2 * H + 1) * n_rows
+    return Condensation(float(omega), C.reshape(P, P), r_lin, Y, y)
+
+
+def recover_displacement(condensation: Condensation, contact_force: np.ndarray) -> np.ndarray:
+    """ũ (2H+1, n) from λ̃ (2H+1, n_rows): ũ_k = Z_k⁻¹ (f̃_k − Gᵀ λ̃_k) = y_k − Y_k λ̃_k."""
+    L = to_complex(np.asarray(contact_force, dtype=float))
+    return from_complex(condensation.forced - np.einsum("knm,km->kn", condensation.admittance, L))
+
+
+def condensed_omega_derivative(model, condensation: Condensation, U: np.ndarray) -> np.ndarray:
+    """∂R_c/∂ω = G Z⁻¹ (∂Z/∂ω) ũ = Yᵀ Z' ũ (Z symmetric), Z'_k = −2k²ωM + i kD; (2H+1, n_rows)."""
+    H = (U.shape[0] - 1) // 2
+    k = np.arange(H + 1)[:, None]
+    z = to_complex(U)
+    dz = (-2 * k**2 * condensation.omega * np.asarray(model.mass @ z.T).T
+          + 1j * k * np.asarray(model.damping @ z.T).T)
+    return from_complex(np.einsum("knm,kn->km", condensation.admittance, dz))

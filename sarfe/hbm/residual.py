@@ -1,0 +1,112 @@
+r"""Harmonic-balance residual and its analytic Jacobian, full or condensed to the contact rows.
+
+Full (all kept DOFs, unknowns x = ũ.ravel(), (2H+1) n of them):
+
+    R(ũ, ω) = S(ω) ũ + f̃_nl(ũ) − f̃_e,      f̃_nl = Gᵀ λ̃(G ũ)   (per harmonic)
+    ∂R/∂ũ = S(ω) + (I⊗G)ᵀ ∂λ̃/∂r̃ (I⊗G)      (sparse),    ∂R/∂ω = (∂S/∂ω) ũ
+
+Condensed (unknowns x = r̃.ravel(), (2H+1) n_rows of them, see :mod:`sarfe.hbm.linear`):
+
+    R_c(r̃, ω) = r̃ − r̃_lin(ω) + C(ω) λ̃(r̃),    ∂R_c/∂r̃ = I + C ∂λ̃/∂r̃ (dense),
+    ∂R_c/∂ω = G Z⁻¹ Z' ũ(r̃)
+
+The contact laws are displacement-only and rate-independent, so ∂f̃_nl/∂ω = 0.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from .aft import ContactForces, contact_forces, jacobian_matrix
+from .linear import (apply_dynamic_stiffness, apply_dynamic_stiffness_derivative,
+                     condensed_omega_derivative, dynamic_stiffness_matrix, recover_displacement)
+
+
+@dataclass(frozen=True)
+class Problem:
+    """The data of one harmonic-balance problem: model (M, D, K), contacts, f̃_e (2H+1, n) [N], H, N."""
+
+    model: object
+    contacts: object
+    excitation: np.ndarray
+    harmonics: int
+    samples_per_period: int
+    friction_tolerance: float = 1e-12
+    friction_pass_cap: int = 50
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """Residual R (P,), Jacobian ∂R/∂x (dense or sparse, or None), ∂R/∂ω (P,), forces, reference."""
+
+    residual: np.ndarray
+    jacobian: object
+    omega_derivative: np.ndarray
+    forces: ContactForces
+    reference: float
+
+
+def _gap_blocks(contacts, harmonics):
+    return sp.kron(sp.identity(2 * harmonics + 1), contacts.gap_map, format="csr")
+
+
+def nonlinear_force(contacts, U, samples_per_period, slider_start=None, jacobian=True):
+    """f̃_nl = Gᵀ λ̃(G ũ) (2H+1, n) [N], ∂f̃_nl/∂ũ (sparse, harmonic-major) and the ContactForces."""
+    U = np.asarray(U, dtype=float)
+    H = (U.shape[0] - 1) // 2
+    G = contacts.gap_map
+    R = np.asarray(G @ U.T).T
+    forces = contact_forces(contacts, R, samples_per_period, slider_start, jacobian)
+    f = np.asarray(G.T @ forces.force.T).T
+    jac = None
+    if jacobian:
+        GG = _gap_blocks(contacts, H)
+        jac = (GG.T @ jacobian_matrix(forces.blocks, G.shape[0], H) @ GG).tocsr()
+    return f, jac, forces
+
+
+def full_residual(problem: Problem, x, omega, slider_start=None, jacobian=True) -> Evaluation:
+    """R(ũ, ω) on all DOFs; x = ũ.ravel() (harmonic-major). Reference ‖f̃_e‖."""
+    n = problem.model.dof_count
+    U = np.asarray(x, dtype=float).reshape(-1, n)
+    G = problem.contacts.gap_map
+    forces = contact_forces(problem.contacts, np.asarray(G @ U.T).T, problem.samples_per_period,
+                            slider_start, jacobian, problem.friction_tolerance,
+                            problem.friction_pass_cap)
+    f_nl = np.asarray(G.T @ forces.force.T).T
+    R = apply_dynamic_stiffness(problem.model, omega, U) + f_nl - problem.excitation
+    J = dR = None
+    if jacobian:
+        GG = _gap_blocks(problem.contacts, problem.harmonics)
+        J_nl = GG.T @ jacobian_matrix(forces.blocks, G.shape[0], problem.harmonics) @ GG
+        J = (dynamic_stiffness_matrix(problem.model, omega, problem.harmonics) + J_nl).tocsc()
+        dR = apply_dynamic_stiffness_derivative(problem.model, omega, U).ravel()
+    return Evaluation(R.ravel(), J, dR, forces, _reference(np.linalg.norm(problem.excitation)))
+
+
+def condensed_residual(problem: Problem, condensation, x, slider_start=None,
+                       jacobian=True) -> Evaluation:
+    """R_c(r̃, ω) at the ω of ``condensation``; x = r̃.ravel(). Reference ‖r̃_lin‖."""
+    n_rows = problem.contacts.row_count
+    Rr = np.asarray(x, dtype=float).reshape(-1, n_rows)
+    forces = contact_forces(problem.contacts, Rr, problem.samples_per_period, slider_start,
+                            jacobian, problem.friction_tolerance, problem.friction_pass_cap)
+    C = condensation.compliance
+    R = x - condensation.linear_response.ravel() + C @ forces.force.ravel()
+    J = dR = None
+    if jacobian:
+        dense = C.shape[0] <= 600
+        J_lam = jacobian_matrix(forces.blocks, n_rows, problem.harmonics, dense=dense)
+        J = C @ J_lam if dense else np.asarray((J_lam.T @ C.T).T)
+        J[np.diag_indices_from(J)] += 1.0
+        U = recover_displacement(condensation, forces.force)
+        dR = condensed_omega_derivative(problem.model, condensation, U).ravel()
+    reference = _reference(np.linalg.norm(condensation.linear_response), np.linalg.norm(x))
+    return Evaluation(R, J, dR, forces, reference)
+
+
+def _reference(*values):
+    value = max(values)
+    return value if value > 0 else 1.0

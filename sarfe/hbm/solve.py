@@ -1,0 +1,220 @@
+r"""Periodic solution at one frequency: R(ũ, ω) = S(ω) ũ + f̃_nl(ũ) − f̃_e = 0 by Newton.
+
+Steps of :func:`solve_frequency`:
+1. validate the inputs (shapes, H, N; the model and contacts were validated when built);
+2. first guess: the linear response with every contact linearized at u = 0 (closed contacts as
+   springs k_n with their preload, squeak tangents stuck as springs k_t), unless ``initial`` is given;
+   if Newton fails from it, a homotopy in the excitation level (f̃_e·s, s stepped 0 → 1 with
+   adaptive steps, each solve warm-started by the previous) provides the start;
+3. Newton on the contact rows only (dynamic compliance condensation, :mod:`sarfe.hbm.linear`) when
+   that system is smaller, else — or when some S_k(ω) is singular — on all DOFs (sparse LU);
+4. recovery of all DOFs, the residual of the full equation of motion relative to ‖f̃_e‖, Hill
+   stability (:mod:`sarfe.hbm.stability`).
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import scipy.sparse as sp
+
+from .aft import default_slider_start
+from .harmonics import check_harmonics, time_samples
+from .linear import condense, dynamic_stiffness_matrix, recover_displacement
+from .newton import SingularJacobian, newton, solve_linear
+from .residual import Problem, condensed_residual, full_residual
+from .solution import HarmonicSolution, SolverOptions
+from .stability import hill_stability
+
+
+def make_problem(model, contacts, excitation, harmonics, samples_per_period, options=None):
+    """Validate and bundle the inputs (raises ValueError naming the parameter)."""
+    options = options or SolverOptions()
+    check_harmonics(harmonics, samples_per_period)
+    n = model.dof_count
+    F = np.asarray(excitation, dtype=float)
+    if F.shape != (2 * harmonics + 1, n):
+        raise ValueError(f"excitation must have shape (2H+1, n_dof) = ({2 * harmonics + 1}, {n}), "
+                         f"got {F.shape}")
+    if not np.all(np.isfinite(F)):
+        raise ValueError("excitation has non-finite entries")
+    if contacts.gap_map.shape[1] != n:
+        raise ValueError(f"contacts.gap_map has {contacts.gap_map.shape[1]} columns, "
+                         f"the model has {n} DOFs")
+    return Problem(model, contacts, F, int(harmonics), int(samples_per_period),
+                   options.friction_tolerance, options.friction_pass_cap)
+
+
+def _check_omega(omega, name="omega"):
+    if not np.isfinite(omega) or omega <= 0:
+        raise ValueError(f"{name} must be a finite frequency > 0 [rad/s], got {omega!r}")
+
+
+def condensed_size(problem):
+    return (2 * problem.harmonics + 1) * problem.contacts.row_count
+
+
+def wants_condensation(problem, options) -> bool:
+    """'auto': condense when n_rows < n_dof and (2H+1) n_rows ≤ max_condensed_size."""
+    if options.condensation == "auto":
+        return (problem.contacts.row_count < problem.model.dof_count
+                and condensed_size(problem) <= options.max_condensed_size)
+    return bool(options.condensation)
+
+
+def linearized_guess(problem, omega) -> np.ndarray:
+    """ũ of the linear system with the contacts linearized at u = 0 (see module docstring)."""
+    c, H, n = problem.contacts, problem.harmonics, problem.model.dof_count
+    rows_k = np.zeros(c.row_count)
+    preload = np.zeros(c.row_count)
+    closed = (c.normal_row >= 0) & (c.gap <= 0)
+    rows_k[c.normal_row[closed]] = c.normal_stiffness[closed]
+    preload[c.normal_row[closed]] = -c.normal_stiffness[closed] * c.gap[closed]
+    has_n = c.normal_row >= 0
+    preload[c.normal_row[has_n]] += np.where(np.asarray(c.kind)[has_n] == "squeak",
+                                             c.normal_load[has_n], 0.0)
+    for col in range(2):
+        present = c.tangent_rows[:, col] >= 0
+        rows_k[c.tangent_rows[present, col]] = c.tangential_stiffness[present]
+    G = c.gap_map
+    GG = sp.kron(sp.identity(2 * H + 1), G, format="csr")
+    A = dynamic_stiffness_matrix(problem.model, omega, H) + GG.T @ sp.diags(
+        np.tile(rows_k, 2 * H + 1)) @ GG
+    F = problem.excitation.copy()
+    F[0] -= G.T @ preload
+    try:
+        return solve_linear(A, F.ravel()).reshape(2 * H + 1, n)
+    except SingularJacobian:
+        return np.zeros((2 * H + 1, n))
+
+
+def make_evaluator(problem, condensed):
+    """evaluate(x, ω, jacobian, slider) for the condensed or full residual; condensation cached per ω.
+
+    Returns (evaluate, to_x, to_displacement) where to_x maps ũ → x and to_displacement maps an
+    evaluation at ω to ũ (2H+1, n). None if condensation was asked but S_k(ω) is singular at ω.
+    """
+    n = problem.model.dof_count
+    G = problem.contacts.gap_map
+    if not condensed:
+        def evaluate(x, omega, jacobian, slider):
+            return full_residual(problem, x, omega, slider, jacobian)
+
+        def to_displacement(x, omega, evaluation):
+            return np.asarray(x).reshape(-1, n)
+
+        return evaluate, lambda U: np.asarray(U).ravel(), to_displacement
+    cache = {}
+
+    def condensation(omega):
+        if omega not in cache:
+            cache.clear()
+            cache[omega] = condense(problem.model, G, problem.excitation, omega)
+        if cache[omega] is None:
+            raise SingularJacobian(f"S_k(ω) singular at ω = {omega:g}")
+        return cache[omega]
+
+    def evaluate(x, omega, jacobian, slider):
+        return condensed_residual(problem, condensation(omega), x, slider, jacobian)
+
+    def to_displacement(x, omega, evaluation):
+        return recover_displacement(condensation(omega), evaluation.forces.force)
+
+    return evaluate, lambda U: np.asarray(G @ np.asarray(U).T).T.ravel(), to_displacement
+
+
+def initial_slider(problem, U):
+    r = np.asarray(problem.contacts.gap_map @ U.T).T
+    return default_slider_start(problem.contacts, time_samples(r, problem.samples_per_period))
+
+
+def slider_acceptor(state):
+    """accept(evaluation) for Newton: warm-start the slider at the last periodic state."""
+    def accept(evaluation):
+        new = evaluation.forces.slider_end
+        old = state["slider"]
+        changed = not np.allclose(np.nan_to_num(new), np.nan_to_num(old), rtol=0, atol=0)
+        state["slider"] = new
+        return changed
+    return accept
+
+
+def finalize(problem, omega, U, converged, reason, iterations, slider, options) -> HarmonicSolution:
+    """Full residual on all DOFs, contact fields, Hill stability → HarmonicSolution."""
+    with np.errstate(all="ignore"):
+        ev = full_residual(problem, U.ravel(), omega, slider, jacobian=options.stability)
+    residual = float(np.linalg.norm(ev.residual) / ev.reference)
+    if not np.isfinite(residual):
+        converged, reason = False, "non-finite residual"
+    elif converged and residual > options.full_tolerance:
+        converged = False
+        reason = f"full residual {residual:.3g} above full_tolerance {options.full_tolerance:g}"
+    stable, exponent = None, float("nan")
+    if converged and options.stability:
+        stable, exponent = hill_stability(problem.model, omega, problem.harmonics, ev.jacobian,
+                                          options.stability_tolerance)
+    G = problem.contacts.gap_map
+    return HarmonicSolution(
+        omega=float(omega), harmonics=problem.harmonics,
+        samples_per_period=problem.samples_per_period, displacement=U,
+        contact_displacement=np.asarray(G @ U.T).T, contact_force=ev.forces.force,
+        contact_force_time=ev.forces.force_time, contact_state=ev.forces.state,
+        converged=bool(converged), reason=reason, iterations=int(iterations),
+        residual_norm=residual, friction_passes=int(ev.forces.friction_passes),
+        stable=stable, floquet_exponent=exponent)
+
+
+def solve_frequency(model, contacts, excitation, omega, harmonics, samples_per_period,
+                    initial=None, options=None) -> HarmonicSolution:
+    """Periodic solution at one ω [rad/s] (see module docstring).
+
+    excitation f̃_e (2H+1, n_dof) [N]; initial: a HarmonicSolution or ũ (2H+1, n_dof) [m].
+    The returned solution has converged=False and a ``reason`` when Newton did not converge.
+    """
+    options = options or SolverOptions()
+    problem = make_problem(model, contacts, excitation, harmonics, samples_per_period, options)
+    _check_omega(omega)
+    if initial is None:
+        return _solve(problem, omega, linearized_guess(problem, omega), options, homotopy=True)
+    U0 = np.asarray(getattr(initial, "displacement", initial), dtype=float)
+    if U0.shape != problem.excitation.shape:
+        raise ValueError(f"initial displacement must have shape {problem.excitation.shape}")
+    return _solve(problem, omega, U0, options)
+
+
+def _solve(problem, omega, U0, options, slider=None, homotopy=False):
+    """Newton from U0 (condensed when useful, full as fallback); with ``homotopy``, a failed
+    start is retried by stepping the excitation f̃_e·s, s: 0 → 1 (adaptive, each step warm-started)."""
+    U, result, slider = _newton(problem, omega, U0, options, slider)
+    if homotopy and not result.converged:
+        scale, step, current, current_slider = 0.0, 0.25, linearized_guess(
+            replace(problem, excitation=0 * problem.excitation), omega), None
+        steps = replace(options, max_iterations=min(options.max_iterations, 20))
+        while scale < 1.0 and step >= 1e-3:
+            target = min(1.0, scale + step)
+            trial = replace(problem, excitation=target * problem.excitation)
+            U_t, result_t, slider_t = _newton(trial, omega, current, steps, current_slider)
+            if result_t.converged:
+                scale, current, current_slider = target, U_t, slider_t
+                step *= 1.5
+            else:
+                step *= 0.5
+        if scale == 1.0:
+            U, result, slider = _newton(problem, omega, current, options, current_slider)
+    return finalize(problem, omega, U, result.converged, result.reason, result.iterations,
+                    slider, options)
+
+
+def _newton(problem, omega, U0, options, slider=None):
+    state = {"slider": initial_slider(problem, U0) if slider is None else slider}
+    accept = slider_acceptor(state)
+    result = None
+    for condensed in ((True, False) if wants_condensation(problem, options) else (False,)):
+        evaluate, to_x, to_displacement = make_evaluator(problem, condensed)
+        try:
+            result = newton(lambda x, jac: evaluate(x, omega, jac, state["slider"]), to_x(U0),
+                            options, x_scale=np.linalg.norm(to_x(U0)), accept=accept)
+        except SingularJacobian:
+            continue            # S_k(ω) singular: fall back to the full residual
+        break
+    return to_displacement(result.x, omega, result.evaluation), result, state["slider"]
