@@ -273,9 +273,29 @@ class _Propagator:
         return self.lu.solve(self.M @ (c0 * u + c1 * v + a) + self.D @ (c2 * u + v)) + self.g[j]
 
 
+def _extrapolation_weights(steps):
+    """Reduced-rank extrapolation: γ minimizing ‖Σ γ_i Δ_i‖ with Σ γ_i = 1 (None if degenerate).
+
+    For a period map x₊ = A x + b the fixed point is Σ γ_i x_{i+1} once the Δ_i span the transient.
+    """
+    gram = steps @ steps.T
+    scale = np.trace(gram)
+    if not np.isfinite(scale) or scale <= 0:
+        return None
+    y = np.linalg.lstsq(gram / scale + 1e-13 * np.eye(len(gram)), np.ones(len(gram)), rcond=None)[0]
+    if abs(y.sum()) < 1e-300:
+        return None
+    return y / y.sum()
+
+
 def _run(model, contacts, forcing, omega, N, u, v, slider, max_periods, steady_tolerance,
-         output_dofs, harmonics, progress, period_offset):
-    """Integrate whole periods from (u, v, slider) at t = 0 until periodic; returns a dict."""
+         accelerate, progress, period_offset):
+    """Integrate whole periods from (u, v, slider) at t = 0 until periodic; returns a dict.
+
+    With ``accelerate``, every few periods the period-start states are extrapolated to the fixed
+    point of the period map (reduced-rank extrapolation); a jump that does not lower the
+    periodicity error is undone, and the next try waits longer (off after 4 failures).
+    """
     n = u.size
     h = 2.0 * np.pi / (omega * N)
     G = contacts.gap_map.toarray() if contacts is not None else np.zeros((0, n))
@@ -298,24 +318,37 @@ def _run(model, contacts, forcing, omega, N, u, v, slider, max_periods, steady_t
             r = r - (0.5 * step if it > 30 else step)  # damp if cycling between active sets
         return lam, new_slider, state, r, it
 
-    if law is not None:
-        r0 = G @ u
-        lam, slider, state = law.forces(r0, slider)
-    else:
-        lam, state = np.zeros(0), np.zeros(0, dtype=np.int8)
     Md = M.toarray() if sp.issparse(M) else np.asarray(M)
-    a = np.linalg.solve(Md, forcing[0] - K @ u - D @ v - G.T @ lam) if n <= DENSE_LIMIT else \
-        spla.spsolve(sp.csc_matrix(M), forcing[0] - K @ u - D @ v - G.T @ lam)
+    dense = n <= DENSE_LIMIT
 
+    def restart(u, v, slider):
+        """Contact forces and the consistent acceleration M a = f − K u − D v − Gᵀλ at t = 0."""
+        if law is not None:
+            lam, slider, state = law.forces(G @ u, slider)
+        else:
+            lam, state = np.zeros(0), np.zeros(0, dtype=np.int8)
+        rhs = forcing[0] - K @ u - D @ v - G.T @ lam
+        a = np.linalg.solve(Md, rhs) if dense else spla.spsolve(sp.csc_matrix(M), rhs)
+        return a, slider, lam, state
+
+    def pack(u, v, slider):
+        return np.concatenate((u, v / omega, slider.ravel()))
+
+    def unpack(x):
+        return x[:n], omega * x[n:2 * n], x[2 * n:].reshape(-1, 2)
+
+    a, slider, lam, state = restart(u, v, slider)
     u_samples = np.empty((N, n))
     v_samples = np.empty((N, n))
     r_samples = np.empty((N, n_rows))
     lam_samples = np.empty((N, n_rows))
     state_samples = np.empty((N, n_c), dtype=np.int8)
     error, steady, periods, worst_iterations = np.inf, False, 0, 0
-    r_prev = G @ u
+    window = min(2 * n + slider.size, 12)
+    history, jumped, failures, wait = [], None, 0, 0
     while periods < max_periods:
-        start = np.concatenate((u, v / omega, slider.ravel()))
+        start = pack(u, v, slider)
+        r_prev = G @ u
         input_work = damping_work = 0.0
         contact_work = np.zeros(n_rows)
         for j in range(N):
@@ -342,7 +375,7 @@ def _run(model, contacts, forcing, omega, N, u, v, slider, max_periods, steady_t
                 contact_work += (r_new - r_prev) * 0.5 * (lam + lam_new)
             u, v, lam, r_prev = u_new, v_new, lam_new, r_new
         periods += 1
-        end = np.concatenate((u, v / omega, slider.ravel()))
+        end = pack(u, v, slider)
         amplitude = max(np.abs(u_samples).max(), np.abs(v_samples).max() / omega, 1e-300)
         error = np.abs(end - start).max() / amplitude
         if progress is not None:
@@ -350,6 +383,32 @@ def _run(model, contacts, forcing, omega, N, u, v, slider, max_periods, steady_t
         if error <= steady_tolerance:
             steady = True
             break
+        if not accelerate or periods >= max_periods:
+            continue
+        if jumped is not None:  # judge the last extrapolation by the period that followed it
+            before, error_before = jumped
+            jumped = None
+            if error > error_before:  # it made things worse: undo, wait longer before the next try
+                failures += 1
+                accelerate = failures < 4
+                wait = periods + window * 2**failures
+                u, v, slider = unpack(before)
+                a, slider, lam, state = restart(u, v, slider)
+                continue
+        if periods < wait:
+            continue
+        history.append(start)
+        if len(history) > window:
+            states = np.array(history[1:] + [end])              # x_1 … x_m
+            steps = np.diff(np.array(history + [end]), axis=0)  # Δ_i = x_{i+1} − x_i
+            shrinking = np.abs(steps[-1]).max() < 0.5 * np.abs(steps[0]).max()
+            # extrapolate only a decaying transient: RRE would also find unstable orbits
+            weight = _extrapolation_weights(steps) if shrinking else None
+            if weight is not None:
+                jumped = (end, error)
+                u, v, slider = unpack(weight @ states)
+                a, slider, lam, state = restart(u, v, slider)
+            history = []
     per_contact = np.zeros(n_c)
     if n_c:
         owner = np.full(n_rows, -1)
@@ -368,7 +427,7 @@ def _run(model, contacts, forcing, omega, N, u, v, slider, max_periods, steady_t
 
 def integrate_time(model, contacts, excitation, omega, harmonics, steps_per_period=512,
                    max_periods=1000, steady_tolerance=1e-7, initial=None, *, output_dofs=None,
-                   richardson=False, progress=None) -> TimeResponse:
+                   richardson=False, accelerate=True, progress=None) -> TimeResponse:
     """Periodic steady state of M ü + D u̇ + K u + Gᵀλ = f_e(t) by Newmark time integration.
 
     model: :class:`LinearModel` (n_dof); contacts: :class:`ContactSet` or None; excitation: force
@@ -382,6 +441,8 @@ def integrate_time(model, contacts, excitation, omega, harmonics, steps_per_peri
     output_dofs: DOF indices kept in the time samples (default all).
     richardson: also run with 2N steps and extrapolate the harmonics, (4 U_2N − U_N)/3 (the scheme's
     error is O(h²)); all other fields come from the 2N run.
+    accelerate: extrapolate the period-start states to the periodic orbit every few periods
+    (reduced-rank extrapolation of the period map; a jump that does not help is undone).
     progress: optional callable(periods_done, None).
     """
     F = np.asarray(excitation, dtype=float)
@@ -413,7 +474,7 @@ def integrate_time(model, contacts, excitation, omega, harmonics, steps_per_peri
     def one_run(N_run, u, v, slider, offset):
         forcing = time_samples(F, N_run)
         return _run(model, contacts, forcing, omega, N_run, u, v, slider, max_periods,
-                    steady_tolerance, output_dofs, harmonics, progress, offset)
+                    steady_tolerance, accelerate, progress, offset)
 
     u0, v0 = _state_at_zero(U_init, omega, N)
     G = contacts.gap_map if contacts is not None else None
