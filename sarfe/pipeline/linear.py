@@ -453,7 +453,7 @@ def _build_fe(case: Case, progress=False) -> dict:
         def reduce(mode_count, cutoff_hz):
             return craig_bampton(k_ff, m_ff, boundary_positions, mode_count=mode_count,
                                  cutoff_hz=cutoff_hz, progress=(lambda done, total: bar.update(1))
-                                 if bar else None, free_dofs=free, total_dof_count=6 * n_nodes)
+                                 if bar is not None else None, free_dofs=free, total_dof_count=6 * n_nodes)
         reduced = reduce(red.get("mode_count"), cutoff)
         if "mode_count" not in red and reduced.mode_count < red["min_mode_count"]:
             # a cutoff below the first fixed-interface modes leaves only static condensation
@@ -463,7 +463,7 @@ def _build_fe(case: Case, progress=False) -> dict:
         raise case.error(f"the structure is not held (singular stiffness: {exc}); check the "
                          "fixed groups", ("model", "fe", "fixed")) from None
     finally:
-        if bar:
+        if bar is not None:
             bar.close()
     timings["reduction_s"] = time.perf_counter() - clock
     n_b, n_r = reduced.boundary_count, reduced.reduced_dof_count

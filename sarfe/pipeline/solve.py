@@ -145,10 +145,41 @@ def build_contacts(case: Case, stage: LinearStage):
         names += [name] if pairs == 1 else [f"{name}[{p}]" for p in range(pairs)]
         groups.append((name, contact["type"], np.arange(start, len(kind))))
     G = sp.csr_matrix(np.array(rows).reshape(len(rows), n))
+    gap = np.array(gap, dtype=float)
+    preloaded = [(idx, c["preload_N"]) for c, (_, _, idx) in zip(case.data["contacts"], groups)
+                 if "preload_N" in c and "gap_m" not in c and np.all(np.array(normal_row)[idx] >= 0)]
+    if preloaded:
+        gap = preload_gaps(stage.stiffness, G, np.array(normal_row), gap, np.array(k_n), preloaded)
     contacts = make_contact_set(G, np.array(kind, dtype=object), np.array(normal_row, dtype=int),
                                 np.array(tangent_rows, dtype=int).reshape(-1, 2), gap, k_n, k_t,
                                 mu, n0, names)
     return contacts, groups, np.array(tolerance, dtype=float)
+
+
+def preload_gaps(stiffness, gap_map, normal_row, gap, normal_stiffness, preloaded):
+    r"""Overclosures g that make the static solution carry the requested preloads.
+
+    Static equilibrium with the preloaded contacts closed: K u + G_nᵀ λ = 0 → w = G_n u = −C λ with
+    the static compliance C = G_n K⁻¹ G_nᵀ between the paired DOFs, and λ = k_n (w − g), so
+
+        g = −(λ / k_n + C λ),    λ_i = P / n_p  for the n_p node pairs of a contact with preload P.
+
+    Only the preloaded contacts are assumed closed (the others open) and all are solved together.
+    A singular K (a free-floating matrices model) falls back to g = −λ / k_n.
+    """
+    contacts = np.concatenate([idx for idx, _ in preloaded])
+    force = np.concatenate([np.full(len(idx), load / len(idx)) for idx, load in preloaded])
+    rows = gap_map[normal_row[contacts]].toarray()
+    K = stiffness.toarray() if sp.issparse(stiffness) else np.asarray(stiffness, dtype=float)
+    gap = gap.copy()
+    try:
+        compliance = rows @ np.linalg.solve(K, rows.T)
+        if not np.all(np.isfinite(compliance)):
+            raise np.linalg.LinAlgError("singular")
+    except np.linalg.LinAlgError:
+        compliance = np.zeros((len(contacts), len(contacts)))
+    gap[contacts] = -(force / normal_stiffness[contacts] + compliance @ force)
+    return gap
 
 
 def excitation_amplitude(case: Case, stage: LinearStage) -> np.ndarray:
@@ -298,6 +329,40 @@ def _bar(progress, total, description):
                 disable=not sys.stderr.isatty())
 
 
+def _solve_one(engine, nl, omega, H, N, options, previous):
+    """One HBM point; on failure retry once from a short time integration (its end state).
+
+    An engine exception or a point that still fails is returned with ``converged=False`` and the
+    reason (the time-integration state stands in when the engine raised), never dropped.
+    """
+    contacts = nl.contacts
+    if engine is None:
+        return adapters.time_integration_point(nl.model, contacts, nl.excitation, omega, H, N)
+    error = None
+    try:
+        solution = engine[0](nl.model, contacts, nl.excitation, omega, H, N, initial=previous,
+                             options=options)
+    except Exception as exc:  # an engine failure must not lose the other points
+        solution, error = None, exc
+    if solution is not None and (solution.converged or not contacts.count):
+        return solution
+    guess = adapters.time_integration_point(nl.model, contacts, nl.excitation, omega, H, N,
+                                            max_periods=40)
+    try:
+        retry = engine[0](nl.model, contacts, nl.excitation, omega, H, N,
+                          initial=guess.displacement, options=options)
+        if retry.converged:
+            return retry
+    except Exception:
+        pass
+    if solution is None:
+        guess.converged = False
+        guess.reason = (f"HBM engine failed ({type(error).__name__}: {error}); values are the "
+                        "time-integration state after 40 periods")
+        return guess
+    return solution
+
+
 def solve_points(case, nl: NonlinearModel, progress=False):
     """HarmonicSolution per frequency point (listed frequencies in order, or a continuation)."""
     solver, exc = case.data["solver"], case.data["excitation"]
@@ -311,11 +376,16 @@ def solve_points(case, nl: NonlinearModel, progress=False):
             try:
                 return list(engine[1](nl.model, contacts, nl.excitation, start, end, H, N,
                                       options=cont_options,
-                                      progress=(lambda done, total: bar.update(1)) if bar else None))
+                                      progress=(lambda done, total: bar.update(1))
+                                      if bar is not None else None))
+            except Exception as error:  # fall back to a point-by-point sweep
+                import warnings
+                warnings.warn(f"continuation failed ({type(error).__name__}: {error}); "
+                              "sweeping point by point instead", RuntimeWarning, stacklevel=2)
             finally:
-                if bar:
+                if bar is not None:
                     bar.close()
-        count = max(2, int(round(1.0 / solver["continuation"]["initial_step"])) + 1)
+        count = min(max(2, int(round(1.0 / solver["continuation"]["initial_step"])) + 1), 101)
         omegas = np.linspace(start, end, count)
     else:
         omegas = 2 * np.pi * np.asarray(exc["frequency_hz"], dtype=float)
@@ -323,26 +393,14 @@ def solve_points(case, nl: NonlinearModel, progress=False):
     bar = _bar(progress, len(omegas), "frequencies")
     try:
         for omega in omegas:
-            if engine is not None:
-                solution = engine[0](nl.model, contacts, nl.excitation, float(omega), H, N,
-                                     initial=previous, options=options)
-                if not solution.converged and contacts.count:
-                    # retry once from the periodic state found by time integration
-                    guess = adapters.time_integration_point(nl.model, contacts, nl.excitation,
-                                                            float(omega), H, N, max_periods=40)
-                    retry = engine[0](nl.model, contacts, nl.excitation, float(omega), H, N,
-                                      initial=guess.displacement, options=options)
-                    if retry.converged:
-                        solution = retry
-            else:
-                solution = adapters.time_integration_point(nl.model, contacts, nl.excitation,
-                                                           float(omega), H, N)
+            solution = _solve_one(engine, nl, float(omega), H, N, options, previous)
             solutions.append(solution)
-            previous = solution if getattr(solution, "converged", False) else None
-            if bar:
+            previous = solution if getattr(solution, "converged", False) and not isinstance(
+                solution, adapters.SimpleNamespace) else None
+            if bar is not None:
                 bar.update(1)
     finally:
-        if bar:
+        if bar is not None:
             bar.close()
     return solutions
 
