@@ -63,6 +63,12 @@ def build_stage(variant: Variant, pipeline_name: str = PIPELINE):
     return pipeline.build_linear_model(load_variant_case(pipeline, variant), progress=False)
 
 
+def _timed_build(variant: Variant, pipeline_name: str = PIPELINE):
+    start = time.perf_counter()
+    stage = build_stage(variant, pipeline_name)
+    return stage, time.perf_counter() - start
+
+
 def _converged(result) -> bool:
     summary = getattr(result, "summary", None) or {}
     if summary.get("all_converged", summary.get("converged")) is False:
@@ -115,9 +121,12 @@ class RunStats:
     linear_models: int = 0           # distinct linear_model_key among variants run now
     linear_stages_built: int = 0
     linear_stages_from_cache: int = 0
+    linear_build_s: float = 0.0      # summed wall time of the linear builds (on the workers)
     linear_model_keys: list = field(default_factory=list)
     mode: str = "in-process"
     workers: int = 0
+    cluster_start_s: float = 0.0     # starting the LocalCluster / connecting to the scheduler
+    solve_phase_s: float = 0.0       # linear builds + variants (wall), without start-up and report
     wall_time_s: float = 0.0
 
 
@@ -162,12 +171,13 @@ def _run_in_process(groups, output, stats, finish, pipeline_name, write_outputs,
             stats.linear_stages_from_cache += 1
         else:
             try:
-                stage = build_stage(members[0], pipeline_name)
+                stage, seconds = _timed_build(members[0], pipeline_name)
             except Exception as error:
                 for variant in members:
                     finish(failed_record(variant, f"linear model: {_error_text(error)}"))
                 continue
             stats.linear_stages_built += 1
+            stats.linear_build_s += seconds
             if cache:
                 store.save_stage(output, key, stage)
         for variant in members:
@@ -195,7 +205,7 @@ def _run_dask(client, groups, output, stats, finish, pipeline_name, write_output
             stats.linear_stages_from_cache += 1
             submit_group(key, stage)
             continue
-        future = client.submit(build_stage, members[0], pipeline_name, retries=1, pure=False,
+        future = client.submit(_timed_build, members[0], pipeline_name, retries=1, pure=False,
                                key=f"sarfe-linear-{key[:16]}-{time.time_ns()}")
         task_of[future.key] = ("linear", key)
         pending.add(future)
@@ -213,7 +223,9 @@ def _run_dask(client, groups, output, stats, finish, pipeline_name, write_output
                 for variant in groups[item]:
                     finish(failed_record(variant, f"linear model: {message}"))
                 continue
+            value, seconds = value
             stats.linear_stages_built += 1
+            stats.linear_build_s += seconds
             if cache:
                 store.save_stage(output, item, value)
             submit_group(item, value)
@@ -285,8 +297,11 @@ def run_study(study_or_cases, workers: int = 2, scheduler: str | None = None, ou
             stats.linear_models = len(groups)
             stats.linear_model_keys = list(groups)
             if client is None and scheduler is None and workers == 0:
+                clock = time.perf_counter()
                 _run_in_process(groups, output, stats, finish, pipeline, write_variant_outputs, cache_linear_stages)
+                stats.solve_phase_s = time.perf_counter() - clock
             else:
+                clock = time.perf_counter()
                 if client is None:
                     if scheduler is not None:
                         from distributed import Client
@@ -296,7 +311,10 @@ def run_study(study_or_cases, workers: int = 2, scheduler: str | None = None, ou
                         client = own_client
                 stats.mode = "dask"
                 stats.workers = len(client.scheduler_info()["workers"])
+                stats.cluster_start_s = time.perf_counter() - clock
+                clock = time.perf_counter()
                 _run_dask(client, groups, output, stats, finish, pipeline, write_variant_outputs, cache_linear_stages)
+                stats.solve_phase_s = time.perf_counter() - clock
     finally:
         bar.close()
         if own_client is not None:
