@@ -59,7 +59,8 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
     """
     options = options or ContinuationOptions()
     so = options.solver
-    corrector = replace(so, max_iterations=min(so.max_iterations, options.corrector_iterations))
+    corrector = replace(so, max_iterations=min(so.max_iterations, options.corrector_iterations),
+                        line_search_steps=min(so.line_search_steps, 3))
     problem = make_problem(model, contacts, excitation, harmonics, samples_per_period, so)
     _check_omega(omega_start, "omega_start")
     _check_omega(omega_end, "omega_end")

@@ -52,7 +52,8 @@ class ContinuationOptions:
     needed ≤ ``target_iterations`` iterations and shrinks by half when it needed more or failed.
     max_points: cap on the number of points returned (the sweep then stops, last point flagged in
     its reason). corrector_iterations: Newton cap of one corrector (a failed corrector halves Δs,
-    so a low cap is cheaper than a long struggle). solver: SolverOptions of the correctors.
+    so a low cap is cheaper than a long struggle; the corrector also uses at most 3 line-search
+    halvings). solver: SolverOptions of the correctors.
     """
 
     initial_step: float = 0.02
@@ -61,7 +62,7 @@ class ContinuationOptions:
     step_growth: float = 1.5
     target_iterations: int = 4
     max_points: int = 2000
-    corrector_iterations: int = 12
+    corrector_iterations: int = 8
     solver: SolverOptions = SolverOptions()
 
 

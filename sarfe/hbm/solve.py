@@ -55,10 +55,16 @@ def condensed_size(problem):
 
 
 def wants_condensation(problem, options) -> bool:
-    """'auto': condense when n_rows < n_dof and (2H+1) n_rows ≤ max_condensed_size."""
+    """'auto': condense when the dense condensed system is clearly smaller than the full one:
+    P_c = (2H+1) n_rows ≤ max_condensed_size and n_rows < n_dof (dense model), or P_c ≤ ¼ of the
+    full size (sparse model, whose full Jacobian is sparse and cheap to factorize)."""
     if options.condensation == "auto":
-        return (problem.contacts.row_count < problem.model.dof_count
-                and condensed_size(problem) <= options.max_condensed_size)
+        size = condensed_size(problem)
+        if size > options.max_condensed_size:
+            return False
+        if sp.issparse(problem.model.stiffness):
+            return 4 * problem.contacts.row_count <= problem.model.dof_count
+        return problem.contacts.row_count < problem.model.dof_count
     return bool(options.condensation)
 
 
