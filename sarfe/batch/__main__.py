@@ -3,4 +3,5 @@ import sys
 
 from sarfe.batch.cli import main
 
-sys.exit(main())
+if __name__ == "__main__":  # guarded: Dask's spawned workers import the main module again
+    sys.exit(main())

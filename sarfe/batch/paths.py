@@ -87,6 +87,12 @@ def get_path(data: dict, path: str) -> list:
     return [node[steps[-1].key] for node in _parents(data, steps, path) if steps[-1].key in node]
 
 
+def count_matches(data: dict, path: str) -> int:
+    """Number of places ``path`` would be written (0: a selector matches no list item)."""
+    steps = parse_path(path)
+    return len(_parents(data, steps, path)) if steps[-1].selector is None else 0
+
+
 def set_path(data: dict, path: str, value) -> dict:
     """Copy of ``data`` with ``value`` written at every place ``path`` matches (``None`` removes
     the key, e.g. ``excitation.sweep: null`` to give ``excitation.frequency_hz`` instead)."""

@@ -39,7 +39,7 @@ import jsonschema
 import numpy as np
 import yaml
 
-from sarfe.batch.paths import PathError, apply_parameters, get_path, parse_path
+from sarfe.batch.paths import PathError, apply_parameters, count_matches, parse_path
 
 
 class StudyError(ValueError):
@@ -199,9 +199,8 @@ def load_study(path) -> Study:
     for parameter_path in _parameter_paths(study):
         try:
             parse_path(parameter_path)
-            if not get_path(base, parameter_path) and "[" in parameter_path:
+            if count_matches(base, parameter_path) == 0:
                 raise PathError(f"parameter path {parameter_path!r} matches nothing in the base case")
-            apply_parameters(base, {parameter_path: 0.0})
         except PathError as error:
             raise StudyError(f"{path}: variations: {error}") from None
     if kind == "monte_carlo":

@@ -88,6 +88,17 @@ variations:
 """
 
 
+def test_selected_key_missing_in_base_case_is_added(tmp_path):
+    path = write(tmp_path, """
+base_case: case.yaml
+variations:
+  grid:
+    contacts[name=pocket_2].tolerance_m: [1.0e-5]
+""")
+    (variant,) = collect_variants(path)
+    assert variant.case["contacts"][1]["tolerance_m"] == 1e-5 and "tolerance_m" not in variant.case["contacts"][0]
+
+
 def test_monte_carlo_is_deterministic_with_seed(tmp_path):
     a = collect_variants(write(tmp_path, MC.format(seed=7)))
     b = collect_variants(write(tmp_path, MC.format(seed=7)))
