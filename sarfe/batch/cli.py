@@ -1,17 +1,22 @@
 """``sarfe batch``: run case files and study files, optionally through a Dask cluster.
 
-Exit codes: 0 every variant finished (and the gate passed), 1 some variants failed with an error
-(no gate requested), 2 unusable study/case file, 4 gate failed (``--fail-above-db``: a variant
-above the level, a non-converged one unless ``--allow-nonconverged``, or a failed one).
+Exit codes (as ``sarfe solve`` where they overlap): 0 every variant finished and converged, or
+the gate passed; 2 unusable study/case file (nothing run); 3 no gate asked and some variant did not
+converge (unless ``--allow-nonconverged``); 4 gate failed (``--fail-above-db``: a variant above the
+level, a non-converged one unless ``--allow-nonconverged``, or a failed one); 5 no gate asked and
+some variants failed with an error (each recorded in the table); 1 internal error.
 """
 from __future__ import annotations
 
 import argparse
 import sys
 
+EXIT_NOT_CONVERGED = 3  # = sarfe.io.errors.EXIT_NOT_CONVERGED
+EXIT_VARIANTS_FAILED = 5
 HELP = "run many cases or a study (grid / list / Monte Carlo variations) in parallel"
-EPILOG = ("exit codes: 0 all variants finished and the gate passed; 1 some variants failed (no gate); "
-          "2 bad study or case file; 4 gate failed (list of offending variants on stderr)")
+EPILOG = ("exit codes: 0 all variants finished and converged, or the gate passed; 2 bad study or case "
+          "file; 3 some variant did not converge (no gate); 4 gate failed (offending variants listed on "
+          "stderr); 5 some variants failed with an error (no gate); 1 internal error")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -63,7 +68,9 @@ def run(args: argparse.Namespace) -> int:
         print(f"sarfe batch: {gate.message}", file=sys.stderr if not gate.passed else sys.stdout)
     if args.fail_above_db is not None:
         return 0 if gate.passed else GATE_EXIT_CODE
-    return 1 if summary.get("failed") else 0
+    if summary.get("failed"):
+        return EXIT_VARIANTS_FAILED
+    return EXIT_NOT_CONVERGED if summary.get("nonconverged") and not args.allow_nonconverged else 0
 
 
 def _case_error_types() -> tuple:

@@ -67,6 +67,8 @@ def test_failing_variants_are_recorded_and_others_finish(tmp_path, fake_log, mod
     summary = table.attrs["summary"]
     assert summary["failed"] == 3 and len(summary["failures"]) == 3
     assert (table[table.status == "ok"].groupby("variant_index").size() == 3).all()
+    if mode == "in-process":  # the CLI on the finished folder: exit 5, failures listed
+        assert main(["--workers", "0", "--output", str(tmp_path / "out"), str(tmp_path / "study.yaml")]) == 5
 
 
 def cli(capsys, *argv):
@@ -103,6 +105,8 @@ def test_gate_exit_code_and_message(tmp_path, fake_log, capsys):
     code, stdout, _ = cli(capsys, "--workers", 0, "--output", out, "--fail-above-db", max(levels) + 1,
                           "--allow-nonconverged", path)
     assert code == 0 and "gate passed" in stdout
+    assert cli(capsys, "--workers", 0, "--output", out, path)[0] == 3  # no gate: non-converged → 3
+    assert cli(capsys, "--workers", 0, "--output", out, "--allow-nonconverged", path)[0] == 0
 
 
 def test_cli_bad_study_is_exit_2_and_register_adds_subcommand(tmp_path, capsys):
