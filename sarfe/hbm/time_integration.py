@@ -246,7 +246,7 @@ def _slider_from_initial(law, r0, initial_force):
 class _Propagator:
     """Linear part of one Newmark step: u_lin = K_eff⁻¹ (f₊ + M(c₀u + c₁v + a) + D(c₂u + v))."""
 
-    def __init__(self, model, h, gap_map_dense, forcing):
+    def __init__(self, model, h, gap_map, forcing):
         M, D, K = model.mass, model.damping, model.stiffness
         c0, c1, c2 = 4.0 / h**2, 4.0 / h, 2.0 / h
         n = M.shape[0]
@@ -262,9 +262,10 @@ class _Propagator:
             solve = lu.solve
             self.M, self.D, self.lu, self.c = Ms, Ds, lu, (c0, c1, c2)
         self.g = solve(forcing.T).T if forcing.shape[0] else forcing      # K_eff⁻¹ f_j, (N, n)
-        self.B = solve(gap_map_dense.T) if gap_map_dense.shape[0] else np.zeros((n, 0))
+        rows_t = gap_map.T.toarray() if sp.issparse(gap_map) else gap_map.T
+        self.B = solve(rows_t) if gap_map.shape[0] else np.zeros((n, 0))
         self.B = self.B.reshape(n, -1)
-        self.C = gap_map_dense @ self.B                                   # contact compliance
+        self.C = np.asarray(gap_map @ self.B)                             # contact compliance
 
     def linear(self, u, v, a, j):
         if self.dense:
@@ -298,7 +299,11 @@ def _run(model, contacts, forcing, omega, N, u, v, slider, max_periods, steady_t
     """
     n = u.size
     h = 2.0 * np.pi / (omega * N)
-    G = contacts.gap_map.toarray() if contacts is not None else np.zeros((0, n))
+    dense = n <= DENSE_LIMIT
+    if contacts is None:
+        G = np.zeros((0, n))
+    else:  # dense rows for small (reduced) models, sparse matvecs for big ones
+        G = contacts.gap_map.toarray() if dense else sp.csr_matrix(contacts.gap_map)
     law = _ContactLaw(contacts) if contacts is not None and contacts.count else None
     n_rows, n_c = G.shape[0], (contacts.count if contacts is not None else 0)
     prop = _Propagator(model, h, G, forcing)
@@ -318,8 +323,7 @@ def _run(model, contacts, forcing, omega, N, u, v, slider, max_periods, steady_t
             r = r - (0.5 * step if it > 30 else step)  # damp if cycling between active sets
         return lam, new_slider, state, r, it
 
-    Md = M.toarray() if sp.issparse(M) else np.asarray(M)
-    dense = n <= DENSE_LIMIT
+    Md = (M.toarray() if sp.issparse(M) else np.asarray(M)) if dense else None
 
     def restart(u, v, slider):
         """Contact forces and the consistent acceleration M a = f − K u − D v − Gᵀλ at t = 0."""
