@@ -255,3 +255,46 @@ def test_input_validation():
         integrate_time(model, None, F, 10.0, 8, steps_per_period=10)
     with pytest.raises(ValueError, match="initial"):
         integrate_time(model, None, F, 10.0, 1, initial=np.zeros((3, 5)))
+
+
+def test_many_contacts_vectorized_equals_separate_copies():
+    """Two uncoupled copies of a rattle + squeak system, contacts and rows shuffled: each copy
+    responds exactly like the system alone (checks the vectorized contact bookkeeping)."""
+    M = np.diag([1.0, 0.3, 0.3])
+    K = np.array([[2e4, -1e4, 0.0], [-1e4, 1e4, 0.0], [0.0, 0.0, 2e4]])
+    D = 2e-4 * K + 8.0 * M
+    F1 = np.zeros((3, 3))
+    F1[1, 0], F1[1, 2], F1[2, 2] = 15.0, 3.0, 1.0
+    omega, N = 2 * np.pi * 12.0, 64
+    squeak = dict(tangential_stiffness=3e4, friction_coefficient=0.4, normal_load=2.0)
+    # single system: rows [w (x2), q (x1), rattle on x0]
+    G1 = np.array([[0, 0, 1.0], [0, 1.0, 0], [1.0, 0, 0]])
+    single = make_contact_set(sp.csr_matrix(G1), ["squeak", "rattle"], [0, 2], [[1, -1], [-1, -1]],
+                              gap=[-2e-4, 2e-3], normal_stiffness=[4e4, 2e4],
+                              tangential_stiffness=[3e4, 0], friction_coefficient=[0.4, 0],
+                              normal_load=[2.0, 0])
+    alone = integrate_time(make_linear_model(M, D, K), single, F1, omega, 1, steps_per_period=N,
+                           steady_tolerance=1e-10)
+    assert set(np.unique(alone.contact_state[:, 0])) >= {STICK, SLIP}
+    assert 0 < alone.contact_state[:, 1].mean() < 1
+    Z = np.zeros((3, 3))
+    big = make_linear_model(np.block([[M, Z], [Z, M]]), np.block([[D, Z], [Z, D]]),
+                            np.block([[K, Z], [Z, K]]))
+    # rows of the copy: copy B's rows first, in a shuffled order
+    G2 = np.zeros((6, 6))
+    G2[0, 5] = G2[1, 3] = G2[2, 4] = 1.0                  # copy B: w, rattle, q
+    G2[3, 1] = G2[4, 0] = G2[5, 2] = 1.0                  # copy A: q, rattle, w
+    contacts = make_contact_set(
+        sp.csr_matrix(G2), ["squeak", "rattle", "rattle", "squeak"], [0, 1, 4, 5],
+        [[2, -1], [-1, -1], [-1, -1], [3, -1]], gap=[-2e-4, 2e-3, 2e-3, -2e-4],
+        normal_stiffness=[4e4, 2e4, 2e4, 4e4], tangential_stiffness=[3e4, 0, 0, 3e4],
+        friction_coefficient=[0.4, 0, 0, 0.4], normal_load=[2.0, 0, 0, 2.0])
+    F2 = np.hstack([F1, F1])
+    both = integrate_time(big, contacts, F2, omega, 1, steps_per_period=N, steady_tolerance=1e-10)
+    scale = np.abs(alone.displacement_harmonics).max()
+    for copy in (slice(0, 3), slice(3, 6)):
+        assert np.abs(both.displacement_harmonics[:, copy]
+                      - alone.displacement_harmonics).max() < 1e-8 * scale
+    for columns in ([3, 2], [0, 1]):   # stick/slip exactly at the Coulomb limit may flip by round-off
+        assert np.mean(both.contact_state[:, columns] != alone.contact_state) <= 2 / N
+    assert np.allclose(both.contact_work[[3, 2]], alone.contact_work, rtol=1e-6, atol=1e-12)
