@@ -39,7 +39,8 @@ def cmd_solve(args) -> int:
             print(f"model: {model['nodes']} nodes, {model['free_dofs']} free DOFs → "
                   f"{model['reduced_dofs']} reduced ({model['boundary_dofs']} boundary + "
                   f"{model['modes']} modes)")
-        print(results_table(result.rows))
+        types = {c["name"]: c["type"] for c in summary["contacts"]}
+        print(results_table(result.rows, types))
         worst = summary.get("worst") or {}
         if worst:
             print(f"loudest point: {worst['erp_level_dba']:.1f} dB(A) "

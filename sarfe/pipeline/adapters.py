@@ -89,3 +89,46 @@ def contact_displacement_samples(solution, gap_map, samples):
     if R is None:
         R = np.asarray(solution.displacement) @ gap_map.T.toarray() if gap_map.shape[0] else None
     return time_samples(np.asarray(R), samples)
+
+
+# ------------------------------------------------------------------ ADAPTER: pyFFTW issue #344
+class _FftOnMatrices:
+    """ADAPTER for pyFFTW issue #344 (github.com/pyFFTW/pyFFTW/issues/344): a real FFT along axis 0
+    of an array with two or more further axes can fail with "The data has an uncaught error that
+    led to the planner returning NULL". It sometimes fails for the 4-D Jacobian samples of 2-D
+    friction in ``sarfe.hbm.aft``. This shim folds the trailing axes into one before calling the
+    same backend, so only 1-D and 2-D transforms reach pyFFTW; the numbers are identical. Remove it
+    once ``sarfe.hbm.harmonics`` reshapes by itself.
+    """
+
+    def __init__(self, backend):
+        self.backend = backend
+
+    def rfft(self, u, axis=0, **kwargs):
+        u = np.asarray(u)
+        if axis != 0 or u.ndim <= 2:
+            return self.backend.rfft(u, axis=axis, **kwargs)
+        out = self.backend.rfft(u.reshape(u.shape[0], -1), axis=0, **kwargs)
+        return out.reshape((out.shape[0],) + u.shape[1:])
+
+    def irfft(self, spectrum, n=None, axis=0, **kwargs):
+        spectrum = np.asarray(spectrum)
+        if axis != 0 or spectrum.ndim <= 2:
+            return self.backend.irfft(spectrum, n=n, axis=axis, **kwargs)
+        out = self.backend.irfft(spectrum.reshape(spectrum.shape[0], -1), n=n, axis=0, **kwargs)
+        return out.reshape((out.shape[0],) + spectrum.shape[1:])
+
+    def __getattr__(self, name):
+        return getattr(self.backend, name)
+
+
+def guard_fft_backend():
+    """Install :class:`_FftOnMatrices` around ``sarfe.hbm.harmonics._fft`` (once, pyFFTW only)."""
+    try:
+        from sarfe.hbm import harmonics
+    except ImportError:
+        return
+    backend = getattr(harmonics, "_fft", None)
+    if backend is not None and getattr(harmonics, "FFT_BACKEND", "") == "pyfftw" and not isinstance(
+            backend, _FftOnMatrices):
+        harmonics._fft = _FftOnMatrices(backend)

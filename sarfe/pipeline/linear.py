@@ -382,8 +382,10 @@ def _build_fe(case: Case, progress=False) -> dict:
     data, fe = case.data, case.data["model"]["fe"]
     timings = {}
     clock = time.perf_counter()
+    stages = _bar(progress, "linear stage", 4, unit="step")
     mesh = load_case_mesh(case)
     timings["mesh_s"] = time.perf_counter() - clock
+    _step(stages, "assembly")
     n_nodes = mesh.n_nodes
 
     # groups and pairing first: cheap, and the errors a user is most likely to make
@@ -429,6 +431,7 @@ def _build_fe(case: Case, progress=False) -> dict:
                          f"{extent:.3g} m (thickness_m is in metres)", ("model", "fe", "thickness_m"))
     stiffness, mass = shell_matrices(mesh.points, mesh.triangles, t, young, poisson, density)
     timings["assembly_s"] = time.perf_counter() - clock
+    _step(stages, "reduction")
 
     # constraints: fixed nodes (6 DOFs) and nodes on no triangle
     used = np.zeros(n_nodes, bool)
@@ -448,7 +451,7 @@ def _build_fe(case: Case, progress=False) -> dict:
     clock = time.perf_counter()
     red = data["reduction"]
     cutoff = red.get("cutoff_hz", None if "mode_count" in red else default_cutoff_hz(case))
-    bar = _bar(progress, "reduction", None)
+    bar = _bar(progress, "Craig-Bampton mode blocks", None)
     try:
         def reduce(mode_count, cutoff_hz):
             return craig_bampton(k_ff, m_ff, boundary_positions, mode_count=mode_count,
@@ -466,6 +469,7 @@ def _build_fe(case: Case, progress=False) -> dict:
         if bar is not None:
             bar.close()
     timings["reduction_s"] = time.perf_counter() - clock
+    _step(stages, "contacts, loads, ERP map")
     n_b, n_r = reduced.boundary_count, reduced.reduced_dof_count
 
     # reduced coordinate of every translational DOF (−1 when fixed / not boundary)
@@ -505,6 +509,7 @@ def _build_fe(case: Case, progress=False) -> dict:
     normals = nodal_normals(mesh.points, radiating_triangles)[erp_nodes]
     erp_map = normal_velocity_basis(reduced, normals, erp_nodes)
 
+    _step(stages, None)
     info = {"nodes": int(n_nodes), "triangles": int(mesh.n_triangles),
             "total_dofs": int(6 * n_nodes), "free_dofs": int(len(free)),
             "fixed_nodes": int(len(fixed_nodes)), "boundary_dofs": int(n_b),
@@ -518,14 +523,24 @@ def _build_fe(case: Case, progress=False) -> dict:
                 mode_frequencies_hz=reduced.mode_frequencies_hz, info=info, timings=timings)
 
 
-def _bar(progress, description, total):
-    if not progress:
-        return None
+def _bar(progress, description, total, unit="block"):
+    """A tqdm bar on stderr, or None (no progress wanted, or stderr is not a terminal)."""
     import sys
 
+    if not progress or not sys.stderr.isatty():
+        return None
     from tqdm import tqdm
-    return tqdm(total=total, desc=description, unit="block", leave=False,
-                disable=not sys.stderr.isatty())
+    return tqdm(total=total, desc=description, unit=unit, leave=False)
+
+
+def _step(bar, next_description):
+    if bar is None:
+        return
+    bar.update(1)
+    if next_description is None:
+        bar.close()
+    else:
+        bar.set_description(f"linear stage: {next_description}")
 
 
 def check_mesh(case) -> dict:

@@ -27,6 +27,8 @@ from sarfe.io.errors import EXIT_NOT_CONVERGED, CaseError
 from sarfe.pipeline import adapters
 from sarfe.pipeline.linear import LinearStage, build_linear_model, linear_model_key
 
+adapters.guard_fft_backend()
+
 
 @dataclass
 class CaseResult:
@@ -322,11 +324,10 @@ def _solver_options(case):
 
 
 def _bar(progress, total, description):
-    if not progress:
+    if not progress or not sys.stderr.isatty():
         return None
     from tqdm import tqdm
-    return tqdm(total=total, desc=description, unit="point", leave=False,
-                disable=not sys.stderr.isatty())
+    return tqdm(total=total, desc=description, unit="point", leave=False)
 
 
 def _solve_one(engine, nl, omega, H, N, options, previous):
@@ -462,7 +463,9 @@ def _write_outputs(case, stage, nl, summary, rows, solutions, erps, normal_w, di
     outputs.write_summary_json(directory / "summary.json", summary)
     written["summary"] = "summary.json"
     if "table" in files:
-        (directory / "table.txt").write_text(results_table(rows) + "\n", encoding="utf-8")
+        types = {name: kind for name, kind, _ in nl.groups}
+        (directory / "table.txt").write_text(results_table(rows, types, max_contacts=100) + "\n",
+                                             encoding="utf-8")
         written["table"] = "table.txt"
     if not solutions:
         return written
@@ -527,21 +530,37 @@ def _write_outputs(case, stage, nl, summary, rows, solutions, erps, normal_w, di
     return written
 
 
-def results_table(rows) -> str:
-    """Console table of the frequency points (ERP and convergence)."""
+def results_table(rows, contact_types=None, max_contacts=4) -> str:
+    """Console table of the frequency points: convergence, ERP and, per contact (at most
+    ``max_contacts``), the max penetration of a rattle contact or the slip fraction of a squeak
+    contact. ``contact_types``: {name: 'rattle' | 'squeak'} (default: all rattle)."""
     from sarfe.io.outputs import console_table
 
     columns = ["frequency_hz", "converged", "stable", "iterations", "erp_db", "erp_dba",
                "linear_erp_db"]
-    extra = [k for k in (rows[0] if rows else {}) if k.endswith(".max_penetration_m")
-             or k.endswith(".slip_fraction")]
     headers = {"frequency_hz": "f [Hz]", "erp_db": "ERP [dB]", "erp_dba": "ERP [dB(A)]",
                "linear_erp_db": "linear [dB]", "iterations": "iter"}
-    headers.update({k: k.replace(".max_penetration_m", " pen [m]").replace(".slip_fraction",
-                                                                           " slip")
-                    for k in extra})
     formats = {"frequency_hz": ".2f", "erp_db": ".1f", "erp_dba": ".1f", "linear_erp_db": ".1f"}
-    return console_table(rows, columns=columns + extra[:6], formats=formats, headers=headers)
+    names = [k[: -len(".max_penetration_m")] for k in (rows[0] if rows else {})
+             if k.endswith(".max_penetration_m")]
+    for name in names[:max_contacts]:
+        if (contact_types or {}).get(name) == "squeak":
+            key, header, fmt = f"{name}.slip_fraction", f"{name} slip", ".2f"
+        else:
+            key, header, fmt = f"{name}.max_penetration_m", f"{name} pen [mm]", ".3f"
+        columns.append(key)
+        headers[key] = header
+        formats[key] = fmt
+    shown = [dict(row) for row in rows]
+    for row in shown:  # penetration in mm for reading
+        for name in names:
+            key = f"{name}.max_penetration_m"
+            if isinstance(row.get(key), float) and math.isfinite(row[key]):
+                row[key] = 1e3 * row[key]
+    table = console_table(shown, columns=columns, formats=formats, headers=headers)
+    if len(names) > max_contacts:
+        table += f"\n({len(names) - max_contacts} more contacts in summary.json)"
+    return table
 
 
 def _replace_directory(temporary: Path, target: Path):
