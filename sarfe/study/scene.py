@@ -1,0 +1,307 @@
+r"""Model only what the scene requires: contacts that never switch are solved linearly, and the
+harmonic content of a solution says which harmonics carry nothing.
+
+Contact screening (a cheap linear pass). At every ω of a grid over the sweep, the response of the
+linear model with each contact linearized at u = 0 (what :func:`sarfe.hbm.solve.linearized_guess`
+solves: preloaded contacts as springs k_n with their preload, open ones absent, squeak tangents stuck)
+gives the relative normal motion w(θ) of every contact. With the gap g and a margin m ∈ (0, 1):
+
+- ``open``   (g > 0):  max_{ω,θ} w ≤ (1 − m) g      — never closes: λ ≡ 0, drop the contact;
+- ``closed`` (g < 0, rattle): min_{ω,θ} (w − g) ≥ m |g| — never opens: λ = k_n (w − g) is linear,
+  add k_n gᵣᵀ gᵣ to K and k_n g gᵣᵀ to the static load f̃_e,0 (gᵣ: its row of G; exact while closed);
+- otherwise ``nonlinear`` (kept), with the reason. Squeak contacts with a normal load N0 > 0 are
+  always kept (their slider state is history dependent even when they never slip).
+
+Because the other contacts' nonlinear response can drive a screened contact, :func:`check_pruning`
+re-checks every decision on the nonlinear solution (w of the dropped contacts is still G u); a
+violated decision means: solve again with the full set (:func:`solve_frequency_pruned` does that).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+OPEN, CLOSED, NONLINEAR = "open", "closed", "nonlinear"
+
+
+@dataclass(frozen=True)
+class ContactDecision:
+    """How one contact is modelled. clearance: the screened quantity relative to |g| —
+    open: (g − max w)/g, closed: min(w − g)/|g| (≥ margin for the decision), nan when not screened."""
+
+    index: int
+    name: str
+    kind: str
+    decision: str
+    clearance: float
+    reason: str
+
+
+@dataclass(frozen=True)
+class PrunedProblem:
+    """The problem with screened contacts removed: model (closed contacts' springs added), contacts
+    (kept ones only), excitation (preloads moved to the static row), and the bookkeeping."""
+
+    model: object
+    contacts: object
+    excitation: np.ndarray
+    kept: np.ndarray            # indices of the kept contacts in the full set
+    decisions: tuple
+
+
+def _linear_pass(model, contacts, excitation, omega):
+    from sarfe.hbm.solve import linearized_guess, make_problem
+
+    import warnings
+
+    H = (excitation.shape[0] - 1) // 2
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        problem = make_problem(model, contacts, excitation, H, max(4 * H + 1, 16))
+        return linearized_guess(problem, omega)
+
+
+def screen_contacts(model, contacts, excitation, omegas, margin=0.5, samples=64) -> tuple:
+    """Decisions (one :class:`ContactDecision` per contact) from the linear pass over ``omegas``.
+
+    excitation f̃_e (2H+1, n) [N]; omegas [rad/s] — include the resonances in the band (a grid of a
+    few hundred points, or the grid plus the linear natural frequencies); margin m (module docstring).
+    """
+    from sarfe.hbm.harmonics import time_samples
+
+    F = np.asarray(excitation, dtype=float)
+    c = contacts
+    has = c.normal_row >= 0
+    w_max = np.full(c.count, -np.inf)
+    w_min = np.full(c.count, np.inf)
+    for omega in np.atleast_1d(omegas):
+        U = _linear_pass(model, c, F, float(omega))
+        R = np.asarray(c.gap_map @ U.T).T
+        r = time_samples(R, samples)
+        w = r[:, np.where(has, c.normal_row, 0)]
+        w_max = np.maximum(w_max, np.where(has, w.max(axis=0), -np.inf))
+        w_min = np.minimum(w_min, np.where(has, w.min(axis=0), np.inf))
+    decisions = []
+    for i in range(c.count):
+        name = c.names[i] if i < len(c.names) else f"contact_{i}"
+        kind, g = str(c.kind[i]), float(c.gap[i])
+        nan = float("nan")
+        if not has[i]:
+            decisions.append(ContactDecision(i, name, kind, NONLINEAR, nan,
+                                             "no normal row (constant normal load): kept"))
+            continue
+        if kind == "squeak" and c.normal_load[i] > 0:
+            decisions.append(ContactDecision(i, name, kind, NONLINEAR, nan,
+                                             "friction under a normal load: kept"))
+            continue
+        if g > 0:
+            clearance = (g - w_max[i]) / g
+            if clearance >= margin:
+                decisions.append(ContactDecision(
+                    i, name, kind, OPEN, float(clearance),
+                    f"never closes: max w = {w_max[i]:.3g} m ≤ (1 − {margin:g}) × gap {g:.3g} m"))
+            else:
+                decisions.append(ContactDecision(
+                    i, name, kind, NONLINEAR, float(clearance),
+                    f"closes or comes within {margin:g} × gap (max w = {w_max[i]:.3g} m, gap {g:.3g} m)"))
+        elif g < 0 and kind == "rattle":
+            clearance = (w_min[i] - g) / abs(g)
+            if clearance >= margin:
+                decisions.append(ContactDecision(
+                    i, name, kind, CLOSED, float(clearance),
+                    f"never opens: min (w − g) = {w_min[i] - g:.3g} m ≥ {margin:g} × overlap {-g:.3g} m"))
+            else:
+                decisions.append(ContactDecision(
+                    i, name, kind, NONLINEAR, float(clearance),
+                    f"opens or comes within {margin:g} × overlap (min (w − g) = {w_min[i] - g:.3g} m)"))
+        else:
+            decisions.append(ContactDecision(i, name, kind, NONLINEAR, 0.0,
+                                             "touching (gap 0) or preloaded friction: kept"))
+    return tuple(decisions)
+
+
+def subset_contacts(contacts, indices):
+    """ContactSet with only the contacts ``indices`` (their rows of G re-numbered)."""
+    from sarfe.hbm.contacts import make_contact_set
+
+    idx = np.asarray(indices, dtype=int)
+    c = contacts
+    rows = np.concatenate([c.normal_row[idx], c.tangent_rows[idx].ravel()])
+    rows = np.unique(rows[rows >= 0])
+    new = {int(r): j for j, r in enumerate(rows)}
+    remap = np.vectorize(lambda r: new.get(int(r), -1), otypes=[int])
+    normal = remap(c.normal_row[idx]) if idx.size else np.zeros(0, int)
+    tangent = remap(c.tangent_rows[idx]).reshape(-1, 2) if idx.size else np.zeros((0, 2), int)
+    G = c.gap_map[rows] if rows.size else sp.csr_matrix((0, c.gap_map.shape[1]))
+    names = tuple(c.names[i] for i in idx) if c.names else None
+    return make_contact_set(G, np.asarray(c.kind, dtype=object)[idx], normal, tangent, c.gap[idx],
+                            c.normal_stiffness[idx], c.tangential_stiffness[idx],
+                            c.friction_coefficient[idx], c.normal_load[idx], names)
+
+
+def prune_contacts(model, contacts, excitation, decisions) -> PrunedProblem:
+    """Apply decisions: drop ``open`` contacts, turn ``closed`` rattle contacts into springs.
+
+    Closed: λ = k_n (w − g), w = gᵣ u → K += k_n gᵣᵀ gᵣ and f̃_e,0 += k_n g gᵣᵀ (exact while closed).
+    """
+    from sarfe.hbm.model import make_linear_model
+
+    F = np.asarray(excitation, dtype=float).copy()
+    K = model.stiffness
+    add = None
+    for d in decisions:
+        if d.decision != CLOSED:
+            continue
+        row = contacts.gap_map[contacts.normal_row[d.index]]
+        k_n, g = contacts.normal_stiffness[d.index], contacts.gap[d.index]
+        term = k_n * (row.T @ row)
+        add = term if add is None else add + term
+        F[0] += k_n * g * np.asarray(row.todense()).ravel()
+    if add is not None:
+        K = (sp.csr_matrix(K) + add).tocsr() if sp.issparse(K) else np.asarray(K) + add.toarray()
+    kept = np.array([d.index for d in decisions if d.decision == NONLINEAR], dtype=int)
+    pruned_model = make_linear_model(model.mass, model.damping, K) if add is not None else model
+    return PrunedProblem(pruned_model, subset_contacts(contacts, kept), F, kept, tuple(decisions))
+
+
+def check_pruning(contacts, decisions, displacement, samples=256) -> list:
+    """Decisions violated by a solution ũ (2H+1, n): [(name, what happened)] (empty = all hold)."""
+    from sarfe.hbm.harmonics import time_samples
+
+    U = np.asarray(displacement, dtype=float)
+    violated = []
+    for d in decisions:
+        if d.decision == NONLINEAR:
+            continue
+        row = contacts.gap_map[contacts.normal_row[d.index]]
+        w = time_samples(np.asarray(row @ U.T).ravel(), samples)
+        g = contacts.gap[d.index]
+        if d.decision == OPEN and w.max() > g:
+            violated.append((d.name, f"screened open but closes (max w − g = {w.max() - g:.3g} m)"))
+        if d.decision == CLOSED and w.min() < g:
+            violated.append((d.name, f"screened closed but opens (min w − g = {w.min() - g:.3g} m)"))
+    return violated
+
+
+def restore_solution(solution, model, contacts, excitation, samples_per_period=None):
+    """A HarmonicSolution of the pruned problem re-expressed with the full contact set (contact
+    displacements, forces and states of all contacts; residual on the full equations)."""
+    from dataclasses import replace
+
+    from sarfe.hbm.residual import full_residual
+    from sarfe.hbm.solve import make_problem
+
+    import warnings
+
+    H = int(solution.harmonics)
+    N = int(samples_per_period or solution.samples_per_period)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        problem = make_problem(model, contacts, np.asarray(excitation, dtype=float), H, N)
+    U = np.asarray(solution.displacement)
+    ev = full_residual(problem, U.ravel(), solution.omega, None, jacobian=False)
+    residual = float(np.linalg.norm(ev.residual) / ev.reference)
+    return replace(solution, contact_displacement=np.asarray(contacts.gap_map @ U.T).T,
+                   contact_force=ev.forces.force, contact_force_time=ev.forces.force_time,
+                   contact_state=ev.forces.state, residual_norm=residual)
+
+
+def solve_frequency_pruned(model, contacts, excitation, omega, harmonics, samples_per_period,
+                           decisions, initial=None, options=None):
+    """solve_frequency on the pruned problem, checked; falls back to the full set on a violation.
+
+    Returns (HarmonicSolution with all contacts, report dict {'kept', 'dropped', 'violations',
+    'fallback'}).
+    """
+    from sarfe.hbm.solve import solve_frequency
+
+    pruned = prune_contacts(model, contacts, excitation, decisions)
+    dropped = [d.name for d in decisions if d.decision != NONLINEAR]
+    report = {"kept": [contacts.names[i] for i in pruned.kept], "dropped": dropped,
+              "violations": [], "fallback": False}
+    if pruned.contacts.count == 0:
+        from sarfe.hbm.time_integration import linear_harmonic_response
+
+        U = linear_harmonic_response(pruned.model, pruned.excitation, omega)
+        solution = _linear_solution(U, omega, harmonics, samples_per_period)
+    else:
+        solution = solve_frequency(pruned.model, pruned.contacts, pruned.excitation, omega,
+                                   harmonics, samples_per_period, initial=initial, options=options)
+    report["violations"] = check_pruning(contacts, decisions, solution.displacement)
+    if report["violations"]:
+        report["fallback"] = True
+        full = solve_frequency(model, contacts, excitation, omega, harmonics, samples_per_period,
+                               initial=solution.displacement, options=options)
+        return full, report
+    return restore_solution(solution, model, contacts, excitation, samples_per_period), report
+
+
+def _linear_solution(U, omega, harmonics, samples_per_period):
+    from sarfe.hbm.solution import HarmonicSolution
+
+    z = np.zeros((U.shape[0], 0))
+    return HarmonicSolution(omega=float(omega), harmonics=int(harmonics),
+                            samples_per_period=int(samples_per_period), displacement=U,
+                            contact_displacement=z, contact_force=z,
+                            contact_force_time=np.zeros((samples_per_period, 0)),
+                            contact_state=np.zeros((samples_per_period, 0), np.int8),
+                            converged=True, reason="linear (no nonlinear contact left)",
+                            iterations=0, residual_norm=0.0)
+
+
+# ----------------------------------------------------------------------------- harmonic content
+def harmonic_content(solution, threshold=1e-3) -> dict:
+    """Energy per harmonic order of the contact displacements, forces and all DOFs, and what could
+    be dropped (the engine solves full sets 0…H; this is the estimate and the report).
+
+    Returns {'orders', 'displacement_share', 'contact_displacement_share', 'contact_force_share',
+    'even_share', 'odd_share', 'mean_share', 'needed_harmonics', 'suggestion'}; shares are fractions
+    of the energy of harmonics k ≥ 1 (the mean separately, relative to all). ``needed_harmonics``:
+    smallest K with the energy above K below threshold² (amplitude share < threshold).
+    """
+    from sarfe.study.accuracy import harmonic_energy
+
+    out = {"orders": list(range(int(solution.harmonics) + 1))}
+    groups = {"displacement": solution.displacement,
+              "contact_displacement": solution.contact_displacement,
+              "contact_force": solution.contact_force}
+    total_dyn = None
+    for key, X in groups.items():
+        X = np.asarray(X, dtype=float)
+        e = harmonic_energy(X) if X.size else np.zeros(int(solution.harmonics) + 1)
+        dyn = e[1:].sum()
+        out[f"{key}_share"] = (e / dyn if dyn > 0 else np.zeros_like(e)).tolist()
+        if key == "contact_displacement" and X.size:
+            total_dyn = e
+    e = total_dyn if total_dyn is not None else harmonic_energy(np.asarray(solution.displacement))
+    dyn = e[1:].sum()
+    orders = np.arange(e.size)
+    even = float(e[2::2].sum() / dyn) if dyn > 0 else 0.0
+    odd = float(e[1::2].sum() / dyn) if dyn > 0 else 0.0
+    out["even_share"], out["odd_share"] = even, odd
+    out["mean_share"] = float(e[0] / e.sum()) if e.sum() > 0 else 0.0
+    tail = np.cumsum(e[::-1])[::-1]             # energy of orders ≥ k
+    needed = int(solution.harmonics)
+    if dyn > 0:
+        small = np.flatnonzero((tail[1:] / dyn) < threshold ** 2)
+        needed = int(orders[1:][small[0]] - 1) if small.size else int(solution.harmonics)
+        needed = max(needed, 1)
+    out["needed_harmonics"] = needed
+    hints = []
+    if dyn > 0 and even < threshold ** 2:
+        hints.append("even harmonics carry < threshold: an odd-only set would do (symmetric response)")
+    if dyn > 0 and odd < threshold ** 2:
+        hints.append("odd harmonics carry < threshold")
+    if needed < int(solution.harmonics):
+        hints.append(f"harmonics above {needed} carry < threshold: H = {needed} would do")
+    if not hints:
+        hints.append("all kept harmonics matter")
+    out["suggestion"] = "; ".join(hints)
+    return out
+
+
+__all__ = ["OPEN", "CLOSED", "NONLINEAR", "ContactDecision", "PrunedProblem", "screen_contacts",
+           "subset_contacts", "prune_contacts", "check_pruning", "restore_solution",
+           "solve_frequency_pruned", "harmonic_content"]
