@@ -1,0 +1,56 @@
+"""The ``sarfe`` command: version, help, subcommand hook, validate."""
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import sarfe
+from sarfe import cli
+
+CASES = Path(__file__).resolve().parents[1] / "cases"
+
+
+def test_version(capsys):
+    with pytest.raises(SystemExit) as info:
+        cli.main(["--version"])
+    assert info.value.code == 0
+    assert capsys.readouterr().out.strip() == f"sarfe {sarfe.__version__}"
+
+
+def test_no_command_prints_help_exit_2(capsys):
+    assert cli.main([]) == 2
+    assert "solve" in capsys.readouterr().out
+
+
+def test_console_script_and_module_entry_point():
+    script = Path(sys.executable).with_name("sarfe")
+    command = [str(script)] if script.exists() else [sys.executable, "-m", "sarfe"]
+    proc = subprocess.run(command + ["validate", str(CASES / "lumped_rattle.yaml")],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip().endswith("valid")
+
+
+def test_extension_subcommands_are_registered(monkeypatch):
+    """Modules in EXTENSION_MODULES with register(subparsers) add subcommands; missing ones are
+    skipped."""
+    import types
+
+    module = types.ModuleType("sarfe_fake_ext")
+
+    def register(subparsers):
+        p = subparsers.add_parser("fake", help="a fake extension")
+        p.set_defaults(func=lambda args: 0)
+
+    module.register = register
+    monkeypatch.setitem(sys.modules, "sarfe_fake_ext", module)
+    monkeypatch.setattr(cli, "EXTENSION_MODULES", ("sarfe_fake_ext", "sarfe.not_there.cli"))
+    assert cli.main(["fake"]) == 0
+
+
+def test_validate_reports_pairs(capsys):
+    assert cli.main(["validate", str(CASES / "rattle_rig.yaml")]) == 0
+    assert "tip (1 pairs)" in capsys.readouterr().out
