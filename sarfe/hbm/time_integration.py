@@ -309,11 +309,15 @@ def _run(model, contacts, forcing, omega, N, u, v, slider, max_periods, steady_t
     prop = _Propagator(model, h, G, forcing)
     M, D, K = model.mass, model.damping, model.stiffness
     identity = np.eye(n_rows)
+    if law is not None:  # round-off floor of the contact Newton [m]
+        slip_lengths = contacts.friction_coefficient * contacts.normal_load / np.maximum(
+            contacts.tangential_stiffness, 1e-300)
+        length_floor = 1e-15 * max(np.abs(contacts.gap).max(), slip_lengths.max(), 1e-9)
 
     def contact(r_lin, slider_prev, r_guess):
         """Solve r + C λ(r) = r_lin (semismooth Newton); returns λ, slider, state, r, iterations."""
         r = r_guess
-        tolerance = 1e-12 * max(np.abs(r_lin).max(), np.abs(r).max(), 1e-300)
+        tolerance = 1e-12 * np.abs(r_lin).max() + length_floor
         for it in range(1, 60):
             lam, new_slider, state = law.forces(r, slider_prev)
             residual = r + prop.C @ lam - r_lin
@@ -353,8 +357,6 @@ def _run(model, contacts, forcing, omega, N, u, v, slider, max_periods, steady_t
     while periods < max_periods:
         start = pack(u, v, slider)
         r_prev = G @ u
-        input_work = damping_work = 0.0
-        contact_work = np.zeros(n_rows)
         for j in range(N):
             u_samples[j], v_samples[j] = u, v
             r_samples[j], lam_samples[j] = r_prev, lam
@@ -372,11 +374,6 @@ def _run(model, contacts, forcing, omega, N, u, v, slider, max_periods, steady_t
             du = u_new - u
             v_new = 2.0 / h * du - v
             a = 4.0 / h**2 * (du - h * v) - a
-            # discrete work identity of the trapezoidal rule: Δu·f̄, Δuᵀ D Δu / h, Δr·λ̄
-            input_work += du @ (0.5 * (forcing[j] + forcing[(j + 1) % N]))
-            damping_work += du @ (D @ du) / h
-            if n_rows:
-                contact_work += (r_new - r_prev) * 0.5 * (lam + lam_new)
             u, v, lam, r_prev = u_new, v_new, lam_new, r_new
         periods += 1
         end = pack(u, v, slider)
@@ -413,6 +410,13 @@ def _run(model, contacts, forcing, omega, N, u, v, slider, max_periods, steady_t
                 u, v, slider = unpack(weight @ states)
                 a, slider, lam, state = restart(u, v, slider)
             history = []
+    # work over the last period by the discrete identity of the trapezoidal rule (exact balance):
+    # Δu·f̄, Δuᵀ D Δu / h, Δr·λ̄ per step
+    du = np.diff(np.vstack((u_samples, u)), axis=0)
+    input_work = float(np.sum(du * 0.5 * (forcing + np.roll(forcing, -1, axis=0))))
+    damping_work = float(np.sum(du * (D @ du.T).T) / h)
+    contact_work = np.sum(np.diff(np.vstack((r_samples, r_prev)), axis=0)
+                          * 0.5 * (lam_samples + np.vstack((lam_samples[1:], lam))), axis=0)
     per_contact = np.zeros(n_c)
     if n_c:
         owner = np.full(n_rows, -1)
