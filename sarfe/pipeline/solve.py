@@ -330,6 +330,21 @@ def _bar(progress, total, description):
     return tqdm(total=total, desc=description, unit="point", leave=False)
 
 
+def linear_solution(nl: NonlinearModel, omega, H, N):
+    """The exact periodic solution of a model without contacts, as a HarmonicSolution."""
+    from sarfe.hbm.solution import HarmonicSolution
+    from sarfe.hbm.time_integration import linear_harmonic_response
+
+    U = linear_harmonic_response(nl.model, nl.excitation, omega)
+    rows, count = nl.contacts.row_count, nl.contacts.count
+    return HarmonicSolution(
+        omega=float(omega), harmonics=int(H), samples_per_period=int(N), displacement=U,
+        contact_displacement=np.zeros((2 * H + 1, rows)), contact_force=np.zeros((2 * H + 1, rows)),
+        contact_force_time=np.zeros((N, rows)), contact_state=np.zeros((N, count), dtype=np.int8),
+        converged=True, reason="linear model (no contacts): exact solution", iterations=0,
+        residual_norm=0.0)
+
+
 def _solve_one(engine, nl, omega, H, N, options, previous):
     """One HBM point; on failure retry once from a short time integration (its end state).
 
@@ -337,6 +352,8 @@ def _solve_one(engine, nl, omega, H, N, options, previous):
     reason (the time-integration state stands in when the engine raised), never dropped.
     """
     contacts = nl.contacts
+    if not contacts.count:
+        return linear_solution(nl, omega, H, N)
     if engine is None:
         return adapters.time_integration_point(nl.model, contacts, nl.excitation, omega, H, N)
     error = None
@@ -372,7 +389,7 @@ def solve_points(case, nl: NonlinearModel, progress=False):
     contacts = nl.contacts
     if "sweep" in exc:
         start, end = (2 * np.pi * exc["sweep"][k] for k in ("start_hz", "end_hz"))
-        if engine is not None:
+        if engine is not None and contacts.count:
             bar = _bar(progress, None, "sweep")
             try:
                 return list(engine[1](nl.model, contacts, nl.excitation, start, end, H, N,
@@ -530,7 +547,7 @@ def _write_outputs(case, stage, nl, summary, rows, solutions, erps, normal_w, di
     return written
 
 
-def results_table(rows, contact_types=None, max_contacts=4) -> str:
+def results_table(rows, contact_types=None, max_contacts=6) -> str:
     """Console table of the frequency points: convergence, ERP and, per contact (at most
     ``max_contacts``), the max penetration of a rattle contact or the slip fraction of a squeak
     contact. ``contact_types``: {name: 'rattle' | 'squeak'} (default: all rattle)."""
