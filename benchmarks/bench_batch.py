@@ -98,6 +98,70 @@ def run(folder, study, workers):
     }
 
 
+def compare(first: pd.DataFrame, second: pd.DataFrame) -> dict:
+    """How two result tables of the same study differ: statuses, and the largest ERP difference."""
+    if list(first["variant_id"]) != list(second["variant_id"]):
+        return {"same_rows": False}
+    out = {"same_rows": True, "same_status": bool((first["status"] == second["status"]).all())}
+    for column in ("erp_db", "erp_dba"):
+        if column in first:
+            delta = (pd.to_numeric(first[column]) - pd.to_numeric(second[column])).abs()
+            out[f"max_abs_diff_{column}"] = float(delta.max())
+            out[f"rows_over_0.01dB_{column}"] = int((delta > 0.01).sum())
+    numeric = [c for c in first.columns if pd.api.types.is_float_dtype(first[c])]
+    out["columns_not_bitwise_equal"] = [c for c in numeric if not first[c].equals(second[c])]
+    return out
+
+
+def markdown(report: dict) -> list[str]:
+    """The section of batch.md for one benchmark run."""
+    runs, case, samples = report["runs"], report["case"], report["samples"]
+    lines = [
+        f"## {case}, {samples} variants",
+        "",
+        f"{samples}-variant Monte Carlo tolerance study of **{case}** at {report['frequency_hz']:g} Hz "
+        "(one frequency point per variant; varied: " + ", ".join(f"`{p}`" for p in report["parameters"])
+        + "), LocalCluster with 1 and with 2 worker processes (one thread each), linear-stage disk "
+        "cache off so that each run builds it.",
+        "",
+    ]
+    if report["cases_not_used"]:
+        lines += ["Cases not used: " + "; ".join(f"{k}: {v}" for k, v in report["cases_not_used"].items()), ""]
+    lines += [
+        "| workers | total [s] | cluster start [s] | linear stages built | linear build [s] | variants [s] "
+        "| mean per variant on a worker [s] | failed |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for r in runs:
+        phase = r["solve_phase_s"] - r["linear_build_s"]
+        lines.append(f"| {r['workers']} | {r['wall_s']:.1f} | {r['cluster_start_s']:.1f} | {r['linear_stages_built']} "
+                     f"(of {r['linear_models']} linear model) | {r['linear_build_s']:.1f} | {phase:.1f} "
+                     f"| {r['variant_solve_mean_s']:.3f} | {r['failed']} |")
+    lines += [
+        "",
+        f"- speed-up 1 → 2 workers: **{report['speedup_total']:.2f}×** total, "
+        f"{report['speedup_variant_phase']:.2f}× in the variant phase (after cluster start and linear build)",
+        f"- linear part computed once per run: {all(r['linear_stages_built'] == 1 for r in runs)}",
+        f"- 1-worker and 2-worker tables bitwise identical: {report['tables_identical']}",
+    ]
+    difference = report.get("difference_1_vs_2_workers")
+    if difference and not report["tables_identical"]:
+        lines.append(f"  (same variants and statuses: {difference.get('same_rows')}/{difference.get('same_status')}; "
+                     f"max |ΔERP| {difference.get('max_abs_diff_erp_db', float('nan')):.2e} dB, rows differing by "
+                     f"more than 0.01 dB: {difference.get('rows_over_0.01dB_erp_db')}; the HBM solves are not "
+                     "bitwise reproducible across processes, e.g. FFTW plans depend on array alignment)")
+    if report["erp_db"]:
+        e = report["erp_db"]
+        lines.append(f"- max ERP per variant: {e['min']:.1f} … {e['max']:.1f} dB (median {e['median']:.1f})")
+    lines += [
+        f"- machine: {report['machine']['cpus']} CPUs shared with other jobs; 1-min load average "
+        f"{report['machine']['load_average_1min_before']:.1f} before, {runs[-1]['load_average_1min_at_end']:.1f} "
+        "at the end (on a loaded machine a speed-up well below 2 is expected)",
+        "",
+    ]
+    return lines
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--samples", type=int, default=200)
@@ -131,6 +195,7 @@ def main(argv=None) -> int:
             runs.append(numbers)
             print(json.dumps(numbers), flush=True)
         identical = tables[0].equals(tables[1])
+        difference = compare(tables[0], tables[1])
         levels = tables[0].groupby("variant_id")["erp_db"].max() if "erp_db" in tables[0] else pd.Series([], dtype=float)
 
     speedup = runs[0]["wall_s"] / runs[1]["wall_s"]
@@ -139,50 +204,25 @@ def main(argv=None) -> int:
         "case": case, "cases_not_used": skipped, "samples": args.samples, "frequency_hz": frequency,
         "parameters": parameters, "runs": runs, "speedup_total": speedup,
         "speedup_variant_phase": variant_phase[0] / variant_phase[1],
-        "tables_identical": bool(identical),
+        "tables_identical": bool(identical), "difference_1_vs_2_workers": difference,
         "erp_db": {"min": float(levels.min()), "median": float(levels.median()), "max": float(levels.max())}
         if len(levels) else {},
         "machine": {"cpus": os.cpu_count(), "python": platform.python_version(),
                     "load_average_1min_before": load_before},
     }
-    (results_dir / "batch.json").write_text(json.dumps(report, indent=2))
-    lines = [
-        "# Batch benchmark (`benchmarks/bench_batch.py`)",
-        "",
-        f"{args.samples}-variant Monte Carlo tolerance study of **{case}** at {frequency:g} Hz "
-        f"(one frequency point per variant), LocalCluster with 1 and with 2 worker processes "
-        f"(one thread each), linear-stage disk cache off so each run builds it.",
-        "",
-    ]
-    if skipped:
-        lines += ["Cases not used: " + "; ".join(f"{k}: {v}" for k, v in skipped.items()), ""]
-    lines += [
-        "| workers | total [s] | cluster start [s] | linear stages built | linear build [s] | variants [s] "
-        "| mean per variant on a worker [s] | failed |",
-        "|---|---|---|---|---|---|---|---|",
-    ]
-    for r, phase in zip(runs, variant_phase):
-        lines.append(f"| {r['workers']} | {r['wall_s']:.1f} | {r['cluster_start_s']:.1f} | {r['linear_stages_built']} "
-                     f"(of {r['linear_models']} linear model) | {r['linear_build_s']:.1f} | {phase:.1f} "
-                     f"| {r['variant_solve_mean_s']:.3f} | {r['failed']} |")
-    lines += [
-        "",
-        f"- speed-up 1 → 2 workers: **{speedup:.2f}×** total, {report['speedup_variant_phase']:.2f}× "
-        "in the variant phase (after cluster start and linear build)",
-        f"- linear part computed once per run: {all(r['linear_stages_built'] == 1 for r in runs)}",
-        f"- 1-worker and 2-worker tables identical: {identical}",
-    ]
-    if report["erp_db"]:
-        e = report["erp_db"]
-        lines.append(f"- max ERP per variant: {e['min']:.1f} … {e['max']:.1f} dB (median {e['median']:.1f})")
-    lines += [
-        f"- machine: {os.cpu_count()} CPUs shared with other jobs; 1-min load average "
-        f"{load_before:.1f} before, {runs[-1]['load_average_1min_at_end']:.1f} at the end "
-        "(a speed-up below 2 on a loaded machine is expected)",
-        "",
-    ]
-    (results_dir / "batch.md").write_text("\n".join(lines))
-    print("\n".join(lines))
+    path = results_dir / "batch.json"
+    try:
+        previous = json.loads(path.read_text())
+        reports = ({f"{previous['case']}_{previous['samples']}": previous} if "case" in previous
+                   else previous.get("runs_by_case", {}))
+    except (OSError, ValueError, AttributeError, KeyError):
+        reports = {}
+    reports[f"{case}_{args.samples}"] = report
+    path.write_text(json.dumps({"runs_by_case": reports}, indent=2))
+    text = "\n".join(["# Batch benchmark (`benchmarks/bench_batch.py`)", ""]
+                     + [line for r in reports.values() for line in markdown(r)])
+    (results_dir / "batch.md").write_text(text)
+    print(text)
     return 0
 
 
