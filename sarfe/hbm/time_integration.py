@@ -446,7 +446,9 @@ def integrate_time(model, contacts, excitation, omega, harmonics, steps_per_peri
     initial: start state — None (the scheme's linear periodic solution, contacts ignored), harmonics
     (2H'+1, n_dof) [m], or a :class:`HarmonicSolution` (its ``displacement`` and θ = 0 contact force
     set the slider positions).
-    output_dofs: DOF indices kept in the time samples (default all).
+    output_dofs: DOF indices kept in ``displacement``/``velocity`` samples (default: all DOFs, or
+    only the DOFs the contacts touch when n_dof > DENSE_LIMIT). ``displacement_harmonics`` always
+    covers all DOFs (the last period is held in memory, N × n_dof).
     richardson: also run with 2N steps and extrapolate the harmonics, (4 U_2N − U_N)/3 (the scheme's
     error is O(h²)); all other fields come from the 2N run.
     accelerate: extrapolate the period-start states to the periodic orbit every few periods
@@ -464,7 +466,10 @@ def integrate_time(model, contacts, excitation, omega, harmonics, steps_per_peri
         raise ValueError(f"steps_per_period must be >= 2H+1 = {2 * harmonics + 1}, got {N}")
     if contacts is not None and contacts.gap_map.shape[1] != n:
         raise ValueError(f"contacts.gap_map has {contacts.gap_map.shape[1]} columns, model has {n} DOFs")
-    output_dofs = np.arange(n) if output_dofs is None else np.asarray(output_dofs, dtype=int)
+    if output_dofs is None:  # all DOFs of reduced models; only the contact DOFs of big ones
+        output_dofs = np.arange(n) if n <= DENSE_LIMIT or contacts is None else \
+            np.unique(sp.csr_matrix(contacts.gap_map).indices)
+    output_dofs = np.asarray(output_dofs, dtype=int)
 
     law = _ContactLaw(contacts) if contacts is not None and contacts.count else None
     initial_force = None
