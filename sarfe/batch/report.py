@@ -16,33 +16,20 @@ import pandas as pd
 from sarfe.batch import store
 
 GATE_EXIT_CODE = 4
-_ERP_DB = ("erp_db", "erp_level_db", "erp_dB", "erp_total_db", "erp_max_db")
-_ERP_DBA = ("erp_dba", "erp_db_a", "erp_dBA", "erp_level_dba", "erp_total_dba")
-_FREQUENCY = ("frequency_hz", "frequency_Hz", "frequency", "freq_hz")
-
-
-def _find(table: pd.DataFrame, names, contains=None, exclude=()):
-    for name in names:
-        if name in table.columns:
-            return name
-    if contains:
-        for column in table.columns:
-            low = column.lower()
-            if all(c in low for c in contains) and not any(e in low for e in exclude):
-                return column
-    return None
+# columns of CaseResult.rows (sarfe.pipeline.solve): total ERP level [dB re 1 pW], A-weighted [dB(A)]
+ERP_DB, ERP_DBA, FREQUENCY = "erp_db", "erp_dba", "frequency_hz"
 
 
 def erp_column(table):
-    return _find(table, _ERP_DB, ("erp", "db"), ("dba", "db_a", "dba_"))
+    return ERP_DB if ERP_DB in table.columns else None
 
 
 def erp_a_column(table):
-    return _find(table, _ERP_DBA, ("erp", "dba"))
+    return ERP_DBA if ERP_DBA in table.columns else None
 
 
 def frequency_column(table):
-    return _find(table, _FREQUENCY, ("freq",))
+    return FREQUENCY if FREQUENCY in table.columns else None
 
 
 _CASE_SECTIONS = ("name", "description", "model", "damping", "reduction", "contacts", "excitation",
