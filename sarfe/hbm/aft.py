@@ -212,7 +212,10 @@ def _jenkins_2d(q, rho, drho_dw, k_t, start, H, N, jacobian, tolerance, pass_cap
 
     The disk projection of the slider is not composable like the 1-D clamp, so the march over
     samples is inherent to 2-D hysteresis. Periods are marched from ``start`` until the slider
-    state at θ_0 repeats to ``tolerance`` × (max|q| + max ρ) or ``pass_cap`` periods; a final period
+    state at θ_0 repeats to ``tolerance`` × (max|q| + max ρ) or ``pass_cap`` periods; between passes
+    the start is updated by Newton on the periodicity, w_0 ← w_0 + (I − A)⁻¹ (w_N − w_0) with
+    A = ∂w_N/∂w_0 (where I − A is regular, i.e. the contact slipped), so a few passes suffice even
+    when slip is rare and the plain iteration contracts slowly; a final period
     propagates the consistent tangent: with X = local harmonics (h·3 + l),
         dw_j = (I − P_j) dq_j + n_j dρ_j + P_j dw_{j−1},
     and the periodicity w_N = w_0 gives ∂w_0/∂X = (I − A)⁻¹ B (A = ∂w_N/∂w_0, B = ∂w_N/∂X at
@@ -224,13 +227,24 @@ def _jenkins_2d(q, rho, drho_dw, k_t, start, H, N, jacobian, tolerance, pass_cap
     scale = np.abs(q).max() + rho.max() + 1e-300
     w = np.array(start, dtype=float)
     passes = 0
+    eye = np.eye(2)
     while True:
         w0 = w.copy()
+        A = np.broadcast_to(eye, (n, 2, 2)).copy()        # ∂w_N/∂w_0 over the pass
         for j in range(N):
-            w, _ = slider_update(w, q[j], rho[j])
+            w, _, Pj, _ = slider_update_derivatives(w, q[j], rho[j])
+            A = Pj @ A
         passes += 1
-        if np.abs(w - w0).max() <= tolerance * scale or passes >= pass_cap:
+        residual = w - w0
+        if np.abs(residual).max() <= tolerance * scale or passes >= pass_cap:
+            w = w0 if np.abs(residual).max() <= tolerance * scale else w
             break
+        # Newton on the periodicity w_N(w_0) = w_0 where it is well posed (slip: I − A regular)
+        system = eye - A
+        det = np.linalg.det(system)
+        ok = np.abs(det) > 1e-6
+        if np.any(ok):
+            w[ok] = w0[ok] + np.linalg.solve(system[ok], residual[ok][..., None])[..., 0]
     Phi = _basis(H, N)
     force = np.empty((N, n, 2))
     state = np.empty((N, n), np.int8)
@@ -239,21 +253,20 @@ def _jenkins_2d(q, rho, drho_dw, k_t, start, H, N, jacobian, tolerance, pass_cap
         dw_dw0 = np.broadcast_to(np.eye(2), (n, 2, 2)).copy()
         dforce = np.empty((N, n, 2, 3 * P))
         history = np.empty((N, n, 2, 2))
-        eye = np.eye(2)
+        dq = np.zeros((N, 2, 3 * P))                       # ∂q_j/∂X templates
+        dq[:, 0, 1::3], dq[:, 1, 2::3] = Phi, Phi
+        dn = np.zeros((N, 3 * P))                          # ∂w_j/∂X (normal) template
+        dn[:, 0::3] = Phi
     w_start = w.copy()
     for j in range(N):
         w, st, Pj, n_rho = slider_update_derivatives(w, q[j], rho[j])
         force[j] = k_t[:, None] * (q[j] - w)
         state[j] = st
-        if jacobian:
-            dq = np.zeros((2, 3 * P))
-            dq[0, 1::3], dq[1, 2::3] = Phi[j], Phi[j]
-            drho = np.zeros((n, 3 * P))
-            drho[:, 0::3] = drho_dw[j][:, None] * Phi[j]
-            dw = (np.einsum("cab,bx->cax", eye - Pj, dq) + n_rho[:, :, None] * drho[:, None, :]
-                  + np.einsum("cab,cbx->cax", Pj, dw))
-            dw_dw0 = np.einsum("cab,cbd->cad", Pj, dw_dw0)
-            dforce[j] = k_t[:, None, None] * (dq[None] - dw)
+        if jacobian:      # dw_j = P_j (dw_{j−1} − dq_j) + dq_j + n_j dρ_j
+            dw = Pj @ (dw - dq[j]) + dq[j] + n_rho[:, :, None] * (drho_dw[j][:, None, None]
+                                                                  * dn[j][None, None, :])
+            dw_dw0 = Pj @ dw_dw0
+            dforce[j] = k_t[:, None, None] * (dq[j] - dw)
             history[j] = dw_dw0
     passes += 1
     if not jacobian:

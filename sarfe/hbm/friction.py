@@ -110,18 +110,22 @@ def slider_update_derivatives(slider_previous, tangential_displacement, slip_rad
     Slip: w = q + ρ n, n = t/|t|, t = w_prev − q, so
         dw = dq + n dρ + (ρ/|t|)(I − n nᵀ)(dw_prev − dq);
     stick: dw = dw_prev; separation (ρ = 0): dw = dq.
-    Returns (slider (..., 2), state (...), P = ∂w/∂w_prev (..., 2, 2), n_rho = ∂w/∂ρ (..., 2)),
-    with ∂w/∂q = I − P.
+    Returns (slider (..., m), state (...), P = ∂w/∂w_prev (..., m, m), n_rho = ∂w/∂ρ (..., m)),
+    with ∂w/∂q = I − P. Fused and lean: it runs once per time sample in the 2-D march.
     """
-    slider, state = slider_update(slider_previous, tangential_displacement, slip_radius)
-    trial = np.asarray(slider_previous, dtype=float) - np.asarray(tangential_displacement, dtype=float)
-    norm = np.sqrt(np.sum(trial * trial, axis=-1))
+    w_prev = np.asarray(slider_previous, dtype=float)
+    q = np.asarray(tangential_displacement, dtype=float)
     rho = np.maximum(np.asarray(slip_radius, dtype=float), 0.0)
-    slipping = (state == SLIP)[..., None, None]
-    unit = trial / np.where(norm > 0, norm, 1.0)[..., None]
-    ratio = (rho / np.where(norm > 0, norm, 1.0))[..., None, None]
-    eye = np.eye(trial.shape[-1])
-    project = ratio * (eye - unit[..., :, None] * unit[..., None, :])
-    P = np.where(slipping, project, np.where((state == STICK)[..., None, None], eye, 0.0))
-    n_rho = np.where((state == SLIP)[..., None], unit, 0.0)
-    return slider, state, P, n_rho
+    trial = w_prev - q
+    norm = np.sqrt(np.add.reduce(trial * trial, axis=-1))
+    slipping = norm > rho
+    separated = rho <= 0.0
+    safe = np.where(norm > 0.0, norm, 1.0)
+    ratio = np.where(slipping, rho / safe, 1.0)
+    slider = q + trial * ratio[..., None]
+    unit = trial / safe[..., None]
+    slip_unit = unit * slipping[..., None]
+    coefficient = np.where(separated, 0.0, ratio)
+    P = (np.eye(trial.shape[-1]) - slip_unit[..., :, None] * unit[..., None, :]) * coefficient[..., None, None]
+    state = np.where(separated, SEPARATED, np.where(slipping, SLIP, STICK)).astype(np.int8)
+    return slider, state, P, slip_unit
