@@ -46,9 +46,12 @@ def cmd_solve(args) -> int:
             print(f"loudest point: {worst['erp_level_dba']:.1f} dB(A) "
                   f"({worst['erp_level_db']:.1f} dB re 1 pW) at {worst['frequency_hz']:.2f} Hz")
         print(f"results: {result.output_dir}  ({time.perf_counter() - clock:.1f} s)")
-    if result.exit_code == EXIT_NOT_CONVERGED:
+    if summary["non_converged_points"]:
         print(f"sarfe: {len(summary['non_converged_points'])} point(s) did not converge: "
               f"{summary['non_converged_points']} (see summary.json)", file=sys.stderr)
+    if summary.get("sweep_complete") is False:
+        print(f"sarfe: the sweep stopped at {summary['points'][-1]['frequency_hz']:.2f} Hz before "
+              f"its end ({summary['sweep_stop_reason']})", file=sys.stderr)
     return result.exit_code
 
 

@@ -132,5 +132,5 @@ def test_shipped_lumped_case_cli(tmp_path, capsys):
     summary = json.loads((tmp_path / "res" / "summary.json").read_text())
     assert [c["name"] for c in summary["contacts"]] == ["panel_bracket", "seal"]
     seal = summary["points"][0]["contacts"][1]
-    assert seal["peak_normal_force_N"] == pytest.approx(2.0)   # constant normal load
+    assert seal["peak_normal_force_N"] == pytest.approx(1.0)   # constant normal load
     assert seal["open_fraction"] == 0.0

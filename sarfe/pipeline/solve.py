@@ -9,6 +9,7 @@ equivalent_radiated_power`. Linear baseline: (K − ω² M + iω D) Û = F̂ wit
 """
 from __future__ import annotations
 
+import dataclasses
 import datetime as _dt
 import math
 import os
@@ -381,6 +382,33 @@ def _solve_one(engine, nl, omega, H, N, options, previous):
     return solution
 
 
+def _finish_sweep(engine, nl, solutions, start, end, H, N, options, step):
+    """Complete a continuation that stopped before ``end`` point by point (natural-parameter
+    steps of ``step``·|end − start| from the last converged point). The points it adds carry
+    ``reason`` '… (point-by-point after the continuation stopped)'."""
+    if not solutions:
+        return solutions
+    span = abs(end - start)
+    last = solutions[-1].omega
+    if abs(last - end) <= 1e-3 * span:
+        return solutions
+    if (end - last) * (end - start) < 0:   # past the end (e.g. turned back): nothing to add
+        return solutions
+    count = max(2, int(math.ceil(abs(end - last) / (step * span))) + 1)
+    previous = next((s for s in reversed(solutions) if s.converged), None)
+    for omega in np.linspace(last, end, count)[1:]:
+        solution = _solve_one(engine, nl, float(omega), H, N, options, previous)
+        try:
+            solution = dataclasses.replace(
+                solution, reason=f"{solution.reason} (point-by-point after the continuation stopped)")
+        except TypeError:
+            solution.reason += " (point-by-point after the continuation stopped)"
+        solutions.append(solution)
+        if solution.converged and not isinstance(solution, adapters.SimpleNamespace):
+            previous = solution
+    return solutions
+
+
 def solve_points(case, nl: NonlinearModel, progress=False):
     """HarmonicSolution per frequency point (listed frequencies in order, or a continuation)."""
     solver, exc = case.data["solver"], case.data["excitation"]
@@ -392,10 +420,12 @@ def solve_points(case, nl: NonlinearModel, progress=False):
         if engine is not None and contacts.count:
             bar = _bar(progress, None, "sweep")
             try:
-                return list(engine[1](nl.model, contacts, nl.excitation, start, end, H, N,
-                                      options=cont_options,
-                                      progress=(lambda done, total: bar.update(1))
-                                      if bar is not None else None))
+                solutions = list(engine[1](nl.model, contacts, nl.excitation, start, end, H, N,
+                                           options=cont_options,
+                                           progress=(lambda done, total: bar.update(1))
+                                           if bar is not None else None))
+                return _finish_sweep(engine, nl, solutions, start, end, H, N, options,
+                                     solver["continuation"]["initial_step"])
             except Exception as error:  # fall back to a point-by-point sweep
                 import warnings
                 warnings.warn(f"continuation failed ({type(error).__name__}: {error}); "
@@ -628,7 +658,12 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         normal_w.append(W)
     timings["postprocess_s"] = time.perf_counter() - clock
     not_converged = [p["index"] for p in points if not p["converged"]]
-    exit_code = EXIT_NOT_CONVERGED if not_converged or not points else 0
+    sweep = case.data["excitation"].get("sweep")
+    sweep_complete = None
+    if sweep and points:
+        span = abs(sweep["end_hz"] - sweep["start_hz"])
+        sweep_complete = abs(points[-1]["frequency_hz"] - sweep["end_hz"]) <= 1e-3 * span
+    exit_code = EXIT_NOT_CONVERGED if (not_converged or not points or sweep_complete is False) else 0
     engine = "harmonic balance" if adapters.hbm_engine() else "time integration (no HBM engine)"
     summary = {
         "sarfe_version": __version__,
@@ -638,6 +673,8 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         "exit_code": exit_code,
         "all_converged": not not_converged and bool(points),
         "non_converged_points": not_converged,
+        "sweep_complete": sweep_complete,        # None without a sweep; False → exit code 3
+        "sweep_stop_reason": (points[-1]["reason"] if sweep_complete is False else None),
         "engine": engine,
         "linear_model_key": stage.key,
         "model": dict(stage.info, kind=stage.kind, kept_dofs=int(stage.dof_count),
