@@ -134,3 +134,19 @@ def test_shipped_lumped_case_cli(tmp_path, capsys):
     seal = summary["points"][0]["contacts"][1]
     assert seal["peak_normal_force_N"] == pytest.approx(1.0)   # constant normal load
     assert seal["open_fraction"] == 0.0
+
+
+def test_sweep_linear_limit_matches_closed_form():
+    case = oscillator(20.0)
+    del case["excitation"]["frequency_hz"]
+    case["excitation"]["sweep"] = {"start_hz": 20.0, "end_hz": 40.0}
+    result = solve_case(case, write=False)
+    summary = result.summary
+    assert summary["sweep_complete"] is True and result.exit_code == 0
+    f = [p["frequency_hz"] for p in summary["points"]]
+    assert f[0] == pytest.approx(20.0) and f[-1] == pytest.approx(40.0, abs=0.02)
+    assert len(f) >= 5
+    for point, solution in zip(summary["points"], result.solutions):
+        U = np.asarray(solution.displacement)
+        assert math.hypot(U[1, 0], U[2, 0]) == pytest.approx(
+            closed_form_amplitude(point["frequency_hz"]), rel=1e-5)
