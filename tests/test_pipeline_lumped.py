@@ -150,3 +150,27 @@ def test_sweep_linear_limit_matches_closed_form():
         U = np.asarray(solution.displacement)
         assert math.hypot(U[1, 0], U[2, 0]) == pytest.approx(
             closed_form_amplitude(point["frequency_hz"]), rel=1e-5)
+
+
+def test_matrix_files_npz_mtx_npy(tmp_path):
+    import scipy.io
+    import scipy.sparse as sp
+
+    np.savez(tmp_path / "model.npz", mass=np.diag([M, 1.0]), stiffness=np.diag([K, 1.0e4]))
+    scipy.io.mmwrite(str(tmp_path / "k.mtx"), sp.csr_matrix(np.diag([K, 1.0e4])))
+    sp.save_npz(tmp_path / "m_sparse.npz", sp.csr_matrix(np.diag([M, 1.0])))
+    np.save(tmp_path / "k.npy", np.diag([K, 1.0e4]))
+    reference = solve_case(oscillator([25.0]), write=False).summary["points"][0]["erp"]["power_W"]
+    for mass, stiffness in (("model.npz", "model.npz"), ("m_sparse.npz", "k.mtx"),
+                            ("model.npz", "k.npy")):
+        case = oscillator([25.0])
+        case["model"]["matrices"] = {"mass": mass, "stiffness": stiffness}
+        case = load_case(case, base_dir=tmp_path)
+        power = solve_case(case, write=False).summary["points"][0]["erp"]["power_W"]
+        assert power == pytest.approx(reference, rel=1e-9)
+    (tmp_path / "bad.npz").write_bytes(b"not a zip")
+    case = oscillator([25.0])
+    case["model"]["matrices"]["mass"] = "bad.npz"
+    from sarfe.io.errors import CaseError
+    with pytest.raises(CaseError, match=r"model.matrices.mass: cannot read matrix file"):
+        build_linear_model(load_case(case, base_dir=tmp_path))
