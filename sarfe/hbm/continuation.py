@@ -112,20 +112,13 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
             return stop("singular bordered Jacobian (tangent)")
         while True:
             predicted = z + step * t
-
-            def augmented(zz, jacobian, predicted=predicted, t=t):
-                e = evaluate_z(zz, jacobian)
-                residual = np.append(e.residual, e.reference * (t @ (zz - predicted)))
-                J = (_bordered(e.jacobian, e.omega_derivative, x_scale, span, t, e.reference)
-                     if jacobian else None)
-                return Evaluation(residual, J, None, e.forces, e.reference)
-
-            try:
-                result = newton(augmented, predicted, corrector, x_scale=1.0, accept=accept)
-                ok = result.converged and np.linalg.norm(result.x - z) <= 3 * step
-            except SingularJacobian:
-                ok = False
-            if ok:
+            result = _corrector(evaluate_z, z, predicted, t, step, x_scale, span, corrector, accept)
+            if result is None and step <= 0.01 * options.initial_step:
+                # a corner of the (nonsmooth) branch: the hyperplane may miss it, the sphere
+                # ‖z − z_i‖ = Δs intersects it
+                result = _corrector(evaluate_z, z, predicted, None, step, x_scale, span,
+                                    corrector, accept)
+            if result is not None:
                 break
             step *= 0.5
             if step < options.min_step:
@@ -155,3 +148,28 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
         else:
             step = max(step * 0.5, options.min_step)
 
+
+def _corrector(evaluate_z, z, predicted, t, step, x_scale, span, options, accept):
+    """Newton on R(z) = 0 with t·(z − z_p) = 0 (hyperplane), or ‖z − z_i‖² = Δs² when t is None
+    (sphere). Returns the converged NewtonResult within 3 Δs of z_i, or None."""
+    def augmented(zz, jacobian):
+        e = evaluate_z(zz, jacobian)
+        if t is not None:
+            extra, row = t @ (zz - predicted), t
+        else:
+            d = zz - z
+            extra, row = (d @ d - step**2) / (2 * step), d / step
+        residual = np.append(e.residual, e.reference * extra)
+        J = (_bordered(e.jacobian, e.omega_derivative, x_scale, span, row, e.reference)
+             if jacobian else None)
+        return Evaluation(residual, J, None, e.forces, e.reference)
+
+    try:
+        result = newton(augmented, predicted, options, x_scale=1.0, accept=accept)
+    except SingularJacobian:
+        return None
+    if result.converged and np.linalg.norm(result.x - z) <= 3 * step:
+        if t is None and (result.x - z) @ (predicted - z) <= 0:
+            return None          # the sphere's backward intersection
+        return result
+    return None

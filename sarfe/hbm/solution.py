@@ -58,7 +58,7 @@ class ContinuationOptions:
 
     initial_step: float = 0.02
     min_step: float = 1e-6
-    max_step: float = 0.1
+    max_step: float = 0.25
     step_growth: float = 1.5
     target_iterations: int = 4
     max_points: int = 2000

@@ -23,8 +23,13 @@ import scipy.sparse.linalg as spla
 from .linear import hill_matrices
 
 
-def floquet_exponents(model, omega, harmonics, jacobian, dense_limit=3000):
-    """Kept Floquet exponents s [1/s] (2n,) of a solution, given ∂R/∂ũ (sparse or dense)."""
+def floquet_exponents(model, omega, harmonics, jacobian, dense_limit=3000, max_exponents=120):
+    """Kept Floquet exponents s [1/s] (2n,) of a solution, given ∂R/∂ũ (sparse or dense).
+
+    On the sparse path at most ``max_exponents`` exponents nearest the origin are computed (all 2n
+    representatives lie in the strip |Im s| ≤ ω/2, hence near 0; for 2n > max_exponents only the
+    ones of the lowest modes are checked).
+    """
     n = model.dof_count
     Mt, Dt = hill_matrices(model, omega, harmonics)
     size = Mt.shape[0]
@@ -38,7 +43,8 @@ def floquet_exponents(model, omega, harmonics, jacobian, dense_limit=3000):
     else:
         A = sp.bmat([[None, sp.identity(size)], [-sp.csr_matrix(jacobian), -Dt]], format="csc")
         B = sp.block_diag([sp.identity(size), Mt], format="csc")
-        count = min(2 * size - 2, max(3 * keep, keep + 20))
+        keep = min(keep, max_exponents)
+        count = min(2 * size - 2, keep + max(20, keep // 2))
         values = spla.eigs(A, k=count, M=B, sigma=0.0, which="LM", return_eigenvectors=False)
     values = values[np.isfinite(values)]
     order = np.argsort(np.abs(values.imag), kind="stable")

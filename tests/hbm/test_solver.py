@@ -295,3 +295,26 @@ def test_hill_sparse_shift_invert_matches_dense():
     sparse = floquet_exponents(model, 0.7, H03, J, dense_limit=10)
     key = lambda v: np.sort_complex(np.round(v, 8))  # noqa: E731
     np.testing.assert_allclose(key(dense), key(sparse), atol=1e-7)
+
+
+def test_downward_sweep_and_point_cap():
+    model, contacts, F = example03()
+    options = ContinuationOptions(solver=SolverOptions(stability=False))
+    sols = continuation(model, contacts, F, 0.8, 0.5, H03, N03, options=options)
+    omega = np.array([s.omega for s in sols])
+    assert all(s.converged for s in sols) and omega[-1] == pytest.approx(0.5, abs=1e-12)
+    assert np.any(np.diff(omega) > 0)
+    assert max(s.amplitude(1) for s in sols) == pytest.approx(0.9374, rel=2e-3)
+    capped = continuation(model, contacts, F, 0.8, 0.5, H03, 256,
+                          options=ContinuationOptions(max_points=5,
+                                                      solver=SolverOptions(stability=False)))
+    assert len(capped) == 5 and "max_points" in capped[-1].reason
+
+
+def test_non_converged_point_is_flagged():
+    model, contacts, F = example03()
+    guess = np.zeros_like(F)
+    guess[1, 0] = 3.0
+    s = solve_frequency(model, contacts, F, 0.75, H03, 256, initial=guess,
+                        options=SolverOptions(max_iterations=1, stability=False))
+    assert not s.converged and "max iterations 1 reached" in s.reason and s.stable is None
