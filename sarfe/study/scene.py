@@ -7,7 +7,8 @@ solves: preloaded contacts as springs k_n with their preload, open ones absent, 
 gives the relative normal motion w(θ) of every contact. With the gap g and a margin m ∈ (0, 1):
 
 - ``open``   (g > 0):  max_{ω,θ} w ≤ (1 − m) g      — never closes: λ ≡ 0, drop the contact;
-- ``closed`` (g < 0, rattle): min_{ω,θ} (w − g) ≥ m |g| — never opens: λ = k_n (w − g) is linear,
+- ``closed`` (g < 0, rattle): min_{ω,θ} (w − g) ≥ m (w₀ − g), w₀ the static (mean) closure — the
+  compression never drops below m × its static value, never opens: λ = k_n (w − g) is linear,
   add k_n gᵣᵀ gᵣ to K and k_n g gᵣᵀ to the static load f̃_e,0 (gᵣ: its row of G; exact while closed);
 - otherwise ``nonlinear`` (kept), with the reason. Squeak contacts with a normal load N0 > 0 are
   always kept (their slider state is history dependent even when they never slip).
@@ -29,7 +30,8 @@ OPEN, CLOSED, NONLINEAR = "open", "closed", "nonlinear"
 @dataclass(frozen=True)
 class ContactDecision:
     """How one contact is modelled. clearance: the screened quantity relative to |g| —
-    open: (g − max w)/g, closed: min(w − g)/|g| (≥ margin for the decision), nan when not screened."""
+    open: (g − max w)/g, closed: min(w − g)/(w₀ − g) (≥ margin for the decision), nan when not
+    screened."""
 
     index: int
     name: str
@@ -76,6 +78,7 @@ def screen_contacts(model, contacts, excitation, omegas, margin=0.5, samples=64)
     has = c.normal_row >= 0
     w_max = np.full(c.count, -np.inf)
     w_min = np.full(c.count, np.inf)
+    w_mean = np.zeros(c.count)
     for omega in np.atleast_1d(omegas):
         U = _linear_pass(model, c, F, float(omega))
         R = np.asarray(c.gap_map @ U.T).T
@@ -83,6 +86,7 @@ def screen_contacts(model, contacts, excitation, omegas, margin=0.5, samples=64)
         w = r[:, np.where(has, c.normal_row, 0)]
         w_max = np.maximum(w_max, np.where(has, w.max(axis=0), -np.inf))
         w_min = np.minimum(w_min, np.where(has, w.min(axis=0), np.inf))
+        w_mean = np.where(has, R[0, np.where(has, c.normal_row, 0)], 0.0)   # static: same at every ω
     decisions = []
     for i in range(c.count):
         name = c.names[i] if i < len(c.names) else f"contact_{i}"
@@ -107,15 +111,18 @@ def screen_contacts(model, contacts, excitation, omegas, margin=0.5, samples=64)
                     i, name, kind, NONLINEAR, float(clearance),
                     f"closes or comes within {margin:g} × gap (max w = {w_max[i]:.3g} m, gap {g:.3g} m)"))
         elif g < 0 and kind == "rattle":
-            clearance = (w_min[i] - g) / abs(g)
+            static = w_mean[i] - g
+            clearance = (w_min[i] - g) / static if static > 0 else -np.inf
             if clearance >= margin:
                 decisions.append(ContactDecision(
                     i, name, kind, CLOSED, float(clearance),
-                    f"never opens: min (w − g) = {w_min[i] - g:.3g} m ≥ {margin:g} × overlap {-g:.3g} m"))
+                    f"never opens: min (w − g) = {w_min[i] - g:.3g} m ≥ {margin:g} × static "
+                    f"compression {static:.3g} m"))
             else:
                 decisions.append(ContactDecision(
                     i, name, kind, NONLINEAR, float(clearance),
-                    f"opens or comes within {margin:g} × overlap (min (w − g) = {w_min[i] - g:.3g} m)"))
+                    f"opens or comes within {margin:g} × static compression (min (w − g) = "
+                    f"{w_min[i] - g:.3g} m, static {static:.3g} m)"))
         else:
             decisions.append(ContactDecision(i, name, kind, NONLINEAR, 0.0,
                                              "touching (gap 0) or preloaded friction: kept"))
@@ -233,7 +240,12 @@ def solve_frequency_pruned(model, contacts, excitation, omega, harmonics, sample
     if report["violations"]:
         report["fallback"] = True
         full = solve_frequency(model, contacts, excitation, omega, harmonics, samples_per_period,
-                               initial=solution.displacement, options=options)
+                               initial=initial, options=options)
+        if not full.converged:
+            retry = solve_frequency(model, contacts, excitation, omega, harmonics,
+                                    samples_per_period, initial=solution.displacement,
+                                    options=options)
+            full = retry if retry.converged else full
         return full, report
     return restore_solution(solution, model, contacts, excitation, samples_per_period), report
 

@@ -1,0 +1,104 @@
+"""Model only what the scene requires: contact screening/pruning and harmonic content."""
+import warnings
+
+import numpy as np
+import pytest
+
+from sarfe.hbm import SolverOptions, solve_frequency
+from sarfe.study.scene import (CLOSED, NONLINEAR, OPEN, check_pruning, harmonic_content,
+                               prune_contacts, screen_contacts, solve_frequency_pruned,
+                               subset_contacts)
+from sarfe.study.lumped import lumped_problem
+
+OPTIONS = SolverOptions(stability=False)
+
+
+def scene():
+    """3 masses: DOF 0 rattles (1 mm gap), DOF 1 has a 1 m gap (never closes), DOF 2 is preloaded
+    by 1 kN into its contact (never opens); a friction contact on DOF 1."""
+    return lumped_problem(3, rattle_dofs=(0, 1, 2), gap=[1e-3, 1.0, -1e-2], zeta=0.05, force=10.0,
+                          squeak_dofs=(1,), harmonics=5)
+
+
+def sweep(p):
+    w = p.natural_frequencies_rad_s
+    return np.concatenate([np.linspace(0.5 * w[0], 1.5 * w[-1], 60), w])
+
+
+def test_screen_decisions():
+    p = scene()
+    d = screen_contacts(p.model, p.contacts, p.excitation, sweep(p))
+    assert [x.decision for x in d] == [NONLINEAR, OPEN, CLOSED, NONLINEAR]
+    assert all(x.reason for x in d)
+    assert d[1].clearance > 0.9 and d[2].clearance >= 0.5
+
+
+def test_subset_contacts_keeps_laws():
+    p = scene()
+    sub = subset_contacts(p.contacts, [0, 3])
+    assert sub.count == 2 and sub.row_count == 2
+    assert list(sub.kind) == ["rattle", "squeak"] and sub.names == ("rattle_0", "squeak_1")
+    assert sub.tangent_rows[1, 0] == 1 and sub.normal_row[1] == -1
+
+
+@pytest.mark.timeout(300)
+@pytest.mark.parametrize("omega", [70.0, 150.0, 260.0])
+def test_pruned_solution_is_identical(omega):
+    p = scene()
+    d = screen_contacts(p.model, p.contacts, p.excitation, sweep(p))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        full = solve_frequency(p.model, p.contacts, p.excitation, omega, 5, 128, options=OPTIONS)
+        pruned, report = solve_frequency_pruned(p.model, p.contacts, p.excitation, omega, 5, 128,
+                                                d, options=OPTIONS)
+    assert full.converged and pruned.converged
+    assert report["dropped"] == ["rattle_1", "rattle_2"] and not report["fallback"]
+    scale = np.abs(full.displacement).max()
+    np.testing.assert_allclose(pruned.displacement, full.displacement, atol=1e-8 * scale)
+    np.testing.assert_allclose(pruned.contact_force, full.contact_force,
+                               atol=1e-8 * np.abs(full.contact_force).max())
+    assert pruned.residual_norm < 1e-6
+
+
+def test_violated_decision_falls_back():
+    """A decision taken on a weak excitation does not hold at a strong one: the check catches it."""
+    p = lumped_problem(1, rattle_dofs=(0,), gap=1e-3, force=0.1, harmonics=3)
+    d = screen_contacts(p.model, p.contacts, p.excitation, [90.0])
+    assert d[0].decision == OPEN
+    strong = lumped_problem(1, rattle_dofs=(0,), gap=1e-3, force=10.0, harmonics=3)
+    pruned = prune_contacts(strong.model, strong.contacts, strong.excitation, d)
+    assert pruned.contacts.count == 0
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        s, report = solve_frequency_pruned(strong.model, strong.contacts, strong.excitation, 90.0,
+                                           3, 64, d, options=OPTIONS)
+    assert report["violations"] and report["fallback"]
+    assert s.converged and np.abs(s.contact_force_time).max() > 0
+    assert check_pruning(strong.contacts, d, s.displacement)  # still violated: it does close
+
+
+def test_harmonic_content_symmetric_response():
+    """A symmetric (zero-mean, odd) nonlinearity: two equal gaps on both sides → no even harmonics."""
+    from scipy import sparse as sp
+
+    from sarfe.hbm.contacts import make_contact_set
+    from sarfe.study.lumped import lumped_problem as lp
+
+    p = lp(1, rattle_dofs=(), harmonics=7, force=10.0)
+    G = sp.csr_matrix(np.array([[1.0], [-1.0]]))
+    contacts = make_contact_set(G, np.array(["rattle", "rattle"], dtype=object), [0, 1],
+                                [[-1, -1], [-1, -1]], [1e-3, 1e-3], [1e5, 1e5])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        s = solve_frequency(p.model, contacts, p.excitation, 90.0, 7, 256, options=OPTIONS)
+    assert s.converged
+    report = harmonic_content(s, threshold=1e-6)
+    assert report["even_share"] < 1e-20 and report["odd_share"] == pytest.approx(1.0)
+    assert "odd-only" in report["suggestion"]
+    one_sided = lumped_problem(gap=1e-3, harmonics=7)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        s1 = solve_frequency(one_sided.model, one_sided.contacts, one_sided.excitation, 90.0, 7, 256,
+                             options=OPTIONS)
+    r1 = harmonic_content(s1, threshold=1e-2)
+    assert r1["even_share"] > 1e-4 and 1 <= r1["needed_harmonics"] <= 7
