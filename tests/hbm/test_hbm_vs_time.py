@@ -116,3 +116,46 @@ def test_time_integration_from_rest_finds_the_same_orbit():
     assert coarse.steady and fine.steady
     # O(h²): the 256 → 512 change is ~4/3 of the 256-step error, well below 0.1 %
     assert relative_error(coarse.displacement_harmonics, fine.displacement_harmonics) < 1e-3
+
+
+def chain_model(harmonics, n=8):
+    """n-DOF spring–mass chain (fixed–free) with 3 rattle stops and 2 friction contacts (one with
+    two tangential directions via a pair of DOFs), shaken at the first mass near mode 1."""
+    mass = np.full(n, 0.2)
+    k = 4e4
+    K = np.diag(np.full(n, 2 * k)) - np.diag(np.full(n - 1, k), 1) - np.diag(np.full(n - 1, k), -1)
+    K[-1, -1] = k
+    M = np.diag(mass)
+    model = make_linear_model(M, 1e-4 * K + 6.0 * M, K)
+    rows = []
+    for dof in (n - 1, n - 4, n // 2):                     # rattle stops
+        rows.append(np.eye(n)[dof])
+    rows += [np.eye(n)[n - 2], np.eye(n)[3], np.eye(n)[5] - 0.5 * np.eye(n)[6]]
+    G = sp.csr_matrix(np.array(rows))
+    contacts = make_contact_set(
+        G, ["rattle", "rattle", "rattle", "squeak", "squeak"], [0, 1, 2, -1, -1],
+        [[-1, -1], [-1, -1], [-1, -1], [3, -1], [4, 5]], gap=[2e-3, 1.5e-3, 1e-3, 0, 0],
+        normal_stiffness=[5e4, 5e4, 5e4, 0, 0], tangential_stiffness=[0, 0, 0, 2e4, 2e4],
+        friction_coefficient=[0, 0, 0, 0.5, 0.5], normal_load=[0, 0, 0, 4.0, 3.0])
+    F = np.zeros((2 * harmonics + 1, n))
+    F[1, 0] = 60.0
+    omega = 2 * np.pi * 0.9 * np.sqrt(np.linalg.eigvalsh(np.linalg.solve(M, K))[0]) / (2 * np.pi)
+    return model, contacts, F, omega
+
+
+@needs_engine
+@pytest.mark.slow
+def test_chain_with_several_contacts():
+    """8-DOF chain, 3 rattle stops + 1-D and 2-D friction: H = 15 within 0.1 %, H = 30 closer."""
+    solutions = {}
+    for H in (15, 30):
+        model, contacts, F, omega = chain_model(H)
+        solutions[H] = sarfe.hbm.solve_frequency(model, contacts, F, omega, H, 1024)
+        assert solutions[H].converged
+    reference = integrate_time(model, contacts, F, omega, 30, steps_per_period=1024,
+                               richardson=True, initial=solutions[30])
+    assert reference.steady
+    errors = {H: relative_error(s.displacement, reference.displacement_harmonics)
+              for H, s in solutions.items()}
+    assert errors[15] < 1e-3 and errors[30] < 0.5 * errors[15], errors
+    assert np.all(reference.contact_work[3:] > 0)           # both friction contacts dissipate
