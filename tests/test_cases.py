@@ -88,3 +88,33 @@ def test_shipped_fe_case_runs(name, tmp_path):
     summary = result.summary
     assert len(summary["points"]) >= 1
     assert all(np.isfinite(p["erp"]["power_W"]) for p in summary["points"])
+
+
+def test_fe_contact_geometry_pairs_ground_and_normal():
+    """Nearest-node pairing: normal from striker to plate (−z), default gap = geometric 0.5 mm;
+    a grounded contact with an explicit normal; explicit node pairs give the same rows."""
+    from sarfe.pipeline import build_linear_model, nonlinear_model
+
+    data = load_case(CASES / "rattle_rig.yaml").data
+    data["model"]["fe"]["generator"]["mesh_size_m"] = 0.03
+    data["reduction"] = {"mode_count": 4}
+    stage = build_linear_model(data)
+    tip = stage.contacts["tip"]
+    assert tip.frames[0, 0] == pytest.approx([0.0, 0.0, -1.0], abs=1e-9)
+    nl = nonlinear_model(data, stage)
+    assert nl.contacts.gap[0] == pytest.approx(0.5e-3, rel=1e-9)
+
+    grounded = dict(data["contacts"][0], name="tip_ground", between=["contact_tip_a", "ground"],
+                    normal=[0, 0, -2], gap_m=1e-3)
+    explicit = dict(data["contacts"][0], name="tip_pairs",
+                    pairs=[[int(tip.nodes_a[0]), int(tip.nodes_b[0])]])
+    del explicit["between"]
+    data["contacts"] += [grounded, explicit]
+    stage = build_linear_model(data)
+    nl = nonlinear_model(data, stage)
+    G = nl.contacts.gap_map.toarray()
+    assert np.all(stage.contacts["tip_ground"].coords_b == -1)
+    np.testing.assert_allclose(G[2], G[0])                  # explicit pair = nearest-node pair
+    assert nl.contacts.gap.tolist() == pytest.approx([0.5e-3, 1e-3, 0.5e-3])
+    # the grounded row measures only the striker: w = −u_z(striker)
+    assert np.count_nonzero(G[1]) == 1 and G[1].min() == pytest.approx(-1.0)
