@@ -41,7 +41,7 @@ def example03():
 
 def sweep03(stability):
     model, contacts, F = example03()
-    options = ContinuationOptions(max_step=0.3, solver=SolverOptions(stability=stability))
+    options = ContinuationOptions(solver=SolverOptions(stability=stability))
     start = time.perf_counter()
     sols = continuation(model, contacts, F, 0.5, 0.8, 21, 1024, options=options)
     elapsed = time.perf_counter() - start
@@ -112,7 +112,7 @@ def main():
     lines = ["# HBM engine benchmark", "",
              f"Machine: {results['machine']}, {results['cpu_count']} cores, load average at start "
              f"{results['load_average'][0]:.1f} (shared machine: timings are upper bounds). One BLAS thread.",
-             "", "## NLvib example 03 sweep (H = 21, N = 1024, Ω 0.5 → 0.8, max_step 0.3)", "",
+             "", "## NLvib example 03 sweep (H = 21, N = 1024, Ω 0.5 → 0.8, default ContinuationOptions)", "",
              "| Hill stability | wall time [s] | points | Newton iterations | peak |a₂| | at Ω | unstable points |",
              "|---|---|---|---|---|---|---|"]
     for r in results["example03"]:

@@ -5,6 +5,17 @@
 Modules: harmonics (Fourier convention), contacts (ContactSet), unilateral / friction (laws),
 aft (forces + Jacobian), linear (S(ω), condensation), residual, newton, solve (one ω),
 continuation (pseudo-arclength in ω), stability (Hill), solution (options + result).
+
+Example (NLvib example 03)::
+
+    K = np.array([[1.0, -1.0], [-1.0, 2.0]])
+    model = make_linear_model(np.eye(2), 0.03 * K, K)
+    contacts = make_contact_set(sp.csr_matrix([[1.0, 0.0]]), ["rattle"], [0], [[-1, -1]],
+                                gap=1.0, normal_stiffness=100.0)
+    H, N = 21, 1024
+    force = np.zeros((2 * H + 1, 2)); force[1, 1] = 0.1          # 0.1 cos Ωt on DOF 2
+    branch = continuation(model, contacts, force, 0.5, 0.8, H, N)  # through the folds
+    peak = max(s.amplitude(1) for s in branch)                     # ≈ 0.9374 at Ω ≈ 0.751
 """
 from .contacts import ContactSet, make_contact_set
 from .continuation import continuation

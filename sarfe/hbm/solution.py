@@ -62,7 +62,7 @@ class ContinuationOptions:
     step_growth: float = 1.5
     target_iterations: int = 4
     max_points: int = 2000
-    corrector_iterations: int = 8
+    corrector_iterations: int = 5
     solver: SolverOptions = SolverOptions()
 
 
