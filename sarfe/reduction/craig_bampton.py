@@ -200,17 +200,20 @@ def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, blo
     cutoff_omega2 = (2 * np.pi * cutoff_hz) ** 2 if cutoff_hz is not None else np.inf
     target = mode_count if mode_count is not None else n
     q, mq = _m_orthonormal(operator(mass_ii @ rng.standard_normal((n, block_size))), mass_ii)
-    bases, mass_bases = [q], [mq]
+    capacity = min(n, max(4 * block_size, 2 * min(target, n) + 2 * block_size))
+    store, mass_store = np.empty((n, capacity)), np.empty((n, capacity))  # Q, M Q preallocated
+    m_new = q.shape[1]
+    store[:, :m_new], mass_store[:, :m_new] = q, mq
     projected = np.zeros((0, 0))
     while True:
-        w = operator(mass_bases[-1])
-        basis, mass_basis = np.hstack(bases), np.hstack(mass_bases)
+        w = operator(mass_store[:, projected.shape[0]:m_new])
+        basis, mass_basis = store[:, :m_new], mass_store[:, :m_new]
         coefficients = mass_basis.T @ w
         w = w - basis @ coefficients
         correction = mass_basis.T @ w
         w = w - basis @ correction
         coefficients = coefficients + correction
-        m_old, m_new = projected.shape[0], basis.shape[1]
+        m_old = projected.shape[0]
         grown = np.zeros((m_new, m_new))
         grown[:m_old, :m_old] = projected
         grown[:, m_old:] = coefficients
@@ -234,8 +237,12 @@ def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, blo
         done = leading >= wanted and above_cutoff and (wanted == target or cutoff_hz is not None)
         if done or m_new + q.shape[1] > n - 1 or q.shape[1] == 0:
             break
-        bases.append(q)
-        mass_bases.append(mq)
+        if m_new + q.shape[1] > capacity:
+            capacity = min(n, 2 * capacity)
+            store = np.hstack([store[:, :m_new], np.empty((n, capacity - m_new))])
+            mass_store = np.hstack([mass_store[:, :m_new], np.empty((n, capacity - m_new))])
+        store[:, m_new:m_new + q.shape[1]], mass_store[:, m_new:m_new + q.shape[1]] = q, mq
+        m_new += q.shape[1]
     count = min(wanted, leading) if done else min(wanted, m_new)
     modes = basis @ vectors[:, :count]
     return omega2[:count], modes
