@@ -3,7 +3,8 @@
 Writes benchmarks/results/linear.md and linear.json. Every case runs in a fresh Python process so
 that peak memory (ru_maxrss) belongs to that case alone.
 
-Usage: python benchmarks/bench_linear.py [--quick]   (--quick: 10 mm only, no solver comparison)
+Usage: python benchmarks/bench_linear.py [--quick | --report]
+  --quick: 10 mm only, no solver comparison; --report: rewrite linear.md from linear.json.
 
 Geometry: ``sarfe.mesh.generators.door_trim.generate(mesh_size=...)`` when it exists; otherwise a
 stand-in of the same size class — a cylindrically curved 1.0 m × 0.65 m ABS panel (R = 1.2 m,
@@ -259,6 +260,15 @@ def write_report(cases, quick):
                     f"| {r['one_solve_s']:.3f} ({r['one_solve_cpu_s']:.3f}) "
                     f"| {r['block36_solve_s']:.2f} ({r['per_rhs_in_block_cpu_s']:.4f}) | {entries} "
                     f"| {r['factor_memory_gb']:.2f} | {r['relative_residual']:.1e} | {LICENCES[name]} | {WHEELS[name]} |")
+    lines += ["", "## What dominates", ""]
+    for c in cases:
+        stages = {"mesh (gmsh)": c["mesh_cpu_s"], "assembly": c["assembly_cpu_s"],
+                  **{f"CB {k[:-4].replace('_', ' ').replace('normal modes', 'fixed-interface modes (Lanczos)')}": v for k, v in c["cb_stages_s"].items() if k.endswith("_cpu")}}
+        top = max(stages, key=stages.get)
+        total = sum(stages.values())
+        lines.append(f"- {c['mesh_size_mm']} mm: {top} takes {stages[top]:.1f} of {total:.1f} CPU s "
+                     f"({100 * stages[top] / total:.0f} %); wall time under the shared load was "
+                     f"{c['linear_total_s'] / max(c['linear_total_cpu_s'], 1e-9):.1f}× the CPU time.")
     (HERE / "results").mkdir(exist_ok=True)
     (HERE / "results" / "linear.md").write_text("\n".join(lines) + "\n")
     (HERE / "results" / "linear.json").write_text(json.dumps(cases, indent=1, default=float) + "\n")
@@ -271,6 +281,10 @@ def main():
         return
     if len(sys.argv) >= 2 and sys.argv[1] == "--solver":
         print(json.dumps(run_solver(sys.argv[2], sys.argv[3]), default=float))
+        return
+    if len(sys.argv) >= 2 and sys.argv[1] == "--report":  # rewrite linear.md from linear.json
+        cases = json.loads((HERE / "results" / "linear.json").read_text())
+        write_report(cases, quick=not cases[0].get("solver_comparison"))
         return
     quick = "--quick" in sys.argv
     from sarfe.reduction import available_solvers

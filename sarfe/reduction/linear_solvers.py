@@ -22,7 +22,18 @@ name          library and licence                                        use
 
 ``solver="auto"`` takes, in this order, the first backend that is importable and fits the
 structure: pardiso → cholespy → superlu for ``"spd"``; pardiso → superlu otherwise; superlu for
-complex matrices. The order is the measured speed order on shell stiffness matrices here.
+complex matrices. The order is the measured speed order on the door trim K_ii (CPU seconds, one
+thread; 205,686 DOFs at 5 mm / 55,230 at 10 mm):
+
+    factorize   pardiso 3.6 / 1.2,  cholespy 20.5 / 2.6,  superlu 13.6 / 1.5
+    one solve   pardiso 0.11 / 0.021, cholespy 0.12 / 0.022, superlu 0.18 / 0.030
+    per RHS in a 36-column block  pardiso 0.020 / 0.0047, cholespy 0.038 / 0.0075, superlu 0.082 / 0.019
+    factor memory [GB]  pardiso 0.61 / 0.19, cholespy 0.51 / 0.15, superlu 1.71 / 0.34
+
+PARDISO's SPD solves run without MKL's default two iterative-refinement steps (3× the cost, no
+gain for a Cholesky factor). cholespy factorizes simplicially (no supernodes, reference BLAS),
+hence its slow factorization of large models. SuperLU uses the symmetric MMD(AᵀA+A) ordering
+with diagonal pivots (3.6× less fill than its COLAMD default on these matrices).
 """
 from __future__ import annotations
 
