@@ -74,7 +74,6 @@ def cmd_verify(args) -> int:
 
     from sarfe.hbm.time_integration import integrate_time
     from sarfe.pipeline import build_linear_model, load_case, nonlinear_model
-    from sarfe.pipeline import adapters
 
     if not args.frequency_hz > 0:
         raise CaseError(f"--frequency-hz must be > 0, got {args.frequency_hz}", source=args.case)
@@ -84,13 +83,16 @@ def cmd_verify(args) -> int:
     solver = case.data["solver"]
     H, N = solver["harmonics"], solver["samples_per_period"]
     omega = 2 * np.pi * args.frequency_hz
-    engine = adapters.hbm_engine()
+    from sarfe.pipeline.solve import _solve_one, _solver_options
+
+    engine, options, _ = _solver_options(case)
     if engine is None:
         raise CaseError("the harmonic-balance engine (sarfe.hbm.solve_frequency) is not installed")
-    hbm = engine[0](nl.model, nl.contacts, nl.excitation, omega, H, N)
+    # HBM as in `sarfe solve` (a failed Newton is retried from a short time integration);
+    # the time integration below starts independently from the linear periodic solution.
+    hbm = _solve_one(engine, nl, omega, H, N, options, None)
     steps = max(512, 4 * N)
-    tim = integrate_time(nl.model, nl.contacts, nl.excitation, omega, H, steps_per_period=steps,
-                         initial=hbm if hbm.converged else None)
+    tim = integrate_time(nl.model, nl.contacts, nl.excitation, omega, H, steps_per_period=steps)
     U_h, U_t = np.asarray(hbm.displacement), np.asarray(tim.displacement_harmonics)
     amp_h, amp_t = np.hypot(U_h[1], U_h[2]), np.hypot(U_t[1], U_t[2])
     rows = []
