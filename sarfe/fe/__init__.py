@@ -5,8 +5,9 @@ node) for the trim panels, a scikit-fem quadratic solid for chunky parts and ref
 checks, support DOF sets and linear damping.
 """
 
-from .assembly import assemble, element_dofs, fixed_dofs, free_dofs
+from .assembly import assemble, assemble_pair, element_dofs, fixed_dofs, free_dofs
 from .damping import modal_damping, rayleigh_damping
+from .modes import natural_frequencies
 from .shell import local_frames, shell_element_matrices, shell_matrices
 
 __all__ = [
@@ -14,6 +15,8 @@ __all__ = [
     "shell_element_matrices",
     "local_frames",
     "assemble",
+    "assemble_pair",
+    "natural_frequencies",
     "element_dofs",
     "fixed_dofs",
     "free_dofs",

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-__all__ = ["element_dofs", "assemble", "fixed_dofs", "free_dofs", "COMPONENTS"]
+__all__ = ["element_dofs", "assemble", "assemble_pair", "fixed_dofs", "free_dofs", "COMPONENTS"]
 
 #: component letters of the 6 nodal DOFs
 COMPONENTS = ("ux", "uy", "uz", "rx", "ry", "rz")
@@ -28,13 +28,41 @@ def element_dofs(triangles, dofs_per_node=6):
     )
 
 
+def _coo_indices(dofs, n_dof):
+    index_type = np.int32 if n_dof < 2**31 - 1 else np.int64
+    dofs = np.asarray(dofs, dtype=index_type)
+    n_el, k = dofs.shape
+    rows = np.broadcast_to(dofs[:, :, None], (n_el, k, k)).ravel()
+    cols = np.broadcast_to(dofs[:, None, :], (n_el, k, k)).ravel()
+    return rows, cols
+
+
 def assemble(element_matrices, dofs, n_dof):
     """Sum element matrices (n_el, k, k) into a CSR (n_dof, n_dof) in one coo → csr pass."""
-    k = dofs.shape[1]
-    rows = np.broadcast_to(dofs[:, :, None], (dofs.shape[0], k, k)).ravel()
-    cols = np.broadcast_to(dofs[:, None, :], (dofs.shape[0], k, k)).ravel()
+    rows, cols = _coo_indices(dofs, n_dof)
     matrix = sp.coo_matrix((element_matrices.ravel(), (rows, cols)), shape=(n_dof, n_dof))
     return matrix.tocsr()
+
+
+def assemble_pair(element_stiffness, element_mass, dofs, n_dof):
+    """Assemble two matrices with the same element DOFs (K and M) in a single pass.
+
+    The pair is summed as one complex matrix K + iM (coo → csr sums duplicates in both
+    parts at once), then split into real CSR matrices with identical sparsity patterns.
+    element_stiffness / element_mass: (n_el, k, k) real, or pass a complex (n_el, k, k)
+    array as element_stiffness and None as element_mass.
+    """
+    if element_mass is None:
+        combined = np.asarray(element_stiffness)
+    else:
+        combined = element_stiffness + 1j * element_mass
+    rows, cols = _coo_indices(dofs, n_dof)
+    matrix = sp.coo_matrix((combined.ravel(), (rows, cols)), shape=(n_dof, n_dof)).tocsr()
+    pattern = (matrix.indices, matrix.indptr)
+    stiffness = sp.csr_matrix((matrix.data.real.copy(), *pattern), shape=matrix.shape)
+    mass = sp.csr_matrix((matrix.data.imag.copy(), matrix.indices.copy(), matrix.indptr.copy()),
+                         shape=matrix.shape)
+    return stiffness, mass
 
 
 def _components(components):

@@ -12,6 +12,7 @@ __all__ = [
     "rectangle_triangles",
     "cylindrical_panel_triangles",
     "cylindrical_panel_solid",
+    "gmsh_rectangle_triangles",
     "boundary_nodes",
 ]
 
@@ -87,6 +88,38 @@ def cylindrical_panel_solid(radius, angle, length, thickness, n_arc, n_axial, la
     r = radius + offset
     doflocs = np.vstack([r * np.sin(theta), y, r * np.cos(theta) - radius])
     return cls(doflocs=doflocs, t=quadratic.t)
+
+
+def gmsh_rectangle_triangles(length_x, length_y, size, algorithm=6):
+    """Unstructured Gmsh triangle mesh of [0, length_x] × [0, length_y] (z = 0), target
+    element size ``size`` [m]; algorithm 6 = Frontal-Delaunay. Returns points, triangles."""
+    import gmsh
+
+    started = gmsh.isInitialized()
+    if not started:
+        gmsh.initialize(["-noenv"], readConfigFiles=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("sarfe_fe_rectangle")
+        gmsh.model.occ.addRectangle(0.0, 0.0, 0.0, length_x, length_y)
+        gmsh.model.occ.synchronize()
+        gmsh.option.setNumber("Mesh.MeshSizeMin", size)
+        gmsh.option.setNumber("Mesh.MeshSizeMax", size)
+        gmsh.option.setNumber("Mesh.Algorithm", algorithm)
+        gmsh.model.mesh.generate(2)
+        tags, coords, _ = gmsh.model.mesh.getNodes()
+        _, _, connectivity = gmsh.model.mesh.getElements(2)
+        gmsh.model.remove()
+    finally:
+        if not started:
+            gmsh.finalize()
+    index = np.zeros(int(tags.max()) + 1, dtype=np.int64)
+    index[tags.astype(np.int64)] = np.arange(len(tags))
+    triangles = index[np.asarray(connectivity[0], dtype=np.int64).reshape(-1, 3)]
+    used = np.unique(triangles)  # drop geometry-only nodes, renumber compactly
+    compact = np.full(len(tags), -1, dtype=np.int64)
+    compact[used] = np.arange(len(used))
+    return coords.reshape(-1, 3)[used], compact[triangles]
 
 
 def boundary_nodes(triangles):

@@ -78,3 +78,15 @@ def test_modal_damping_diagonalises_with_requested_ratios():
     assert np.abs(d @ rigid).max() < 1e-8 * np.abs(d).max()
     with pytest.raises(ValueError):
         modal_damping(mass, stiffness, np.ones(3))
+
+
+def test_natural_frequencies_free_free_and_modes_mass_normalised():
+    from sarfe.fe import natural_frequencies
+
+    points, triangles = rectangle_triangles(0.1, 0.08, 4, 4)
+    k, m = shell_matrices(points, triangles, 2e-3, E, NU, RHO)
+    f, modes = natural_frequencies(k, m, 8, return_modes=True)
+    dense = sl.eigh(k.toarray(), m.toarray(), eigvals_only=True)[:8]
+    assert np.all(f[:6] < 1e-3 * f[6])
+    assert np.allclose(f[6:], np.sqrt(dense[6:]) / (2 * np.pi), rtol=1e-8)
+    assert np.allclose(modes.T @ (m @ modes), np.eye(8), atol=1e-8)
