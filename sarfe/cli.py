@@ -83,14 +83,14 @@ def cmd_verify(args) -> int:
     solver = case.data["solver"]
     H, N = solver["harmonics"], solver["samples_per_period"]
     omega = 2 * np.pi * args.frequency_hz
-    from sarfe.pipeline.solve import _solve_one, _solver_options
+    from sarfe.pipeline.points import solve_point, solver_options
 
-    engine, options, _ = _solver_options(case)
+    engine, options, _ = solver_options(case)
     if engine is None:
         raise CaseError("the harmonic-balance engine (sarfe.hbm.solve_frequency) is not installed")
     # HBM as in `sarfe solve` (a failed Newton is retried from a short time integration);
     # the time integration below starts independently from the linear periodic solution.
-    hbm = _solve_one(engine, nl, omega, H, N, options, None)
+    hbm = solve_point(engine, nl, omega, H, N, options, None)
     steps = max(512, 4 * N)
     tim = integrate_time(nl.model, nl.contacts, nl.excitation, omega, H, steps_per_period=steps)
     U_h, U_t = np.asarray(hbm.displacement), np.asarray(tim.displacement_harmonics)

@@ -31,7 +31,7 @@ def oscillator(frequencies, gap=GAP, **solver):
 
 
 def closed_form_amplitude(f):
-    w, wn = 2 * math.pi * f, math.sqrt(K / M)
+    w = 2 * math.pi * f
     c = 2 * ZETA * math.sqrt(K * M)
     return F / abs(K - M * w * w + 1j * c * w)
 
@@ -116,7 +116,6 @@ def test_linear_stage_key_and_pickle():
 
 
 def test_shipped_lumped_case_cli(tmp_path, capsys):
-    import shutil
     from pathlib import Path
 
     source = Path(__file__).resolve().parents[1] / "cases" / "lumped_rattle.yaml"

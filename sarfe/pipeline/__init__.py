@@ -1,5 +1,10 @@
 """sarfe.pipeline — one case from YAML to results: the case layer's public functions.
 
+Modules: linear (mesh → reduced model, contact geometry, load and ERP maps; the reusable linear
+stage), nonlinear (damping, ContactSet, excitation harmonics), points (HBM per frequency or
+continuation, with fallbacks), postprocess (ERP, contact indicators, linear risk baseline),
+outputs (result files, console table), solve (solve_case), adapters (calls into other parts).
+
     load_case(path_or_dict) -> Case                         schema-validated, defaults filled
     linear_model_key(case) -> str                           SHA-256 of the linear stage's inputs
     build_linear_model(case, progress=False) -> LinearStage picklable reduced model + maps
@@ -14,7 +19,9 @@ from sarfe.pipeline.linear import (
     check_mesh,
     linear_model_key,
 )
-from sarfe.pipeline.solve import CaseResult, nonlinear_model, results_table, solve_case
+from sarfe.pipeline.nonlinear import nonlinear_model
+from sarfe.pipeline.outputs import results_table
+from sarfe.pipeline.solve import CaseResult, solve_case
 
 __all__ = ["Case", "CaseError", "CaseResult", "ContactGeometry", "LinearStage", "load_case",
            "linear_model_key", "build_linear_model", "check_mesh", "solve_case",

@@ -1,0 +1,160 @@
+"""Frequency points of a case: the HBM engine per listed frequency or a continuation sweep,
+with the fallbacks that keep every point reported (exact linear solution without contacts; a
+retry from a short time integration; a stopped continuation completed point by point).
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import sys
+
+import numpy as np
+
+from sarfe.pipeline import adapters
+from sarfe.pipeline.nonlinear import NonlinearModel
+
+adapters.guard_fft_backend()
+
+
+def solver_options(case):
+    solver = case.data["solver"]
+    engine = adapters.hbm_engine()
+    if engine is None:
+        return None, None, None
+    _, _, SolverOptions, ContinuationOptions = engine
+    values = {"tolerance": solver["tolerance"], "max_iterations": solver["max_iterations"],
+              "stability": solver["stability"]}
+    options = adapters.make_options(SolverOptions, values)
+    cont = solver["continuation"]
+    cvalues = dict(initial_step=cont["initial_step"], min_step=cont["min_step"],
+                   max_step=cont["max_step"], max_points=cont["max_points"], solver=options)
+    return engine, options, adapters.make_options(ContinuationOptions, cvalues)
+
+
+def _bar(progress, total, description):
+    if not progress or not sys.stderr.isatty():
+        return None
+    from tqdm import tqdm
+    return tqdm(total=total, desc=description, unit="point", leave=False)
+
+
+def linear_solution(nl: NonlinearModel, omega, H, N):
+    """The exact periodic solution of a model without contacts, as a HarmonicSolution."""
+    from sarfe.hbm.solution import HarmonicSolution
+    from sarfe.hbm.time_integration import linear_harmonic_response
+
+    U = linear_harmonic_response(nl.model, nl.excitation, omega)
+    rows, count = nl.contacts.row_count, nl.contacts.count
+    return HarmonicSolution(
+        omega=float(omega), harmonics=int(H), samples_per_period=int(N), displacement=U,
+        contact_displacement=np.zeros((2 * H + 1, rows)), contact_force=np.zeros((2 * H + 1, rows)),
+        contact_force_time=np.zeros((N, rows)), contact_state=np.zeros((N, count), dtype=np.int8),
+        converged=True, reason="linear model (no contacts): exact solution", iterations=0,
+        residual_norm=0.0)
+
+
+def solve_point(engine, nl, omega, H, N, options, previous):
+    """One HBM point; on failure retry once from a short time integration (its end state).
+
+    An engine exception or a point that still fails is returned with ``converged=False`` and the
+    reason (the time-integration state stands in when the engine raised), never dropped.
+    """
+    contacts = nl.contacts
+    if not contacts.count:
+        return linear_solution(nl, omega, H, N)
+    if engine is None:
+        return adapters.time_integration_point(nl.model, contacts, nl.excitation, omega, H, N)
+    error = None
+    try:
+        solution = engine[0](nl.model, contacts, nl.excitation, omega, H, N, initial=previous,
+                             options=options)
+    except Exception as exc:  # an engine failure must not lose the other points
+        solution, error = None, exc
+    if solution is not None and (solution.converged or not contacts.count):
+        return solution
+    guess = adapters.time_integration_point(nl.model, contacts, nl.excitation, omega, H, N,
+                                            max_periods=40)
+    try:
+        retry = engine[0](nl.model, contacts, nl.excitation, omega, H, N,
+                          initial=guess.displacement, options=options)
+        if retry.converged:
+            return retry
+    except Exception:
+        pass
+    if solution is None:
+        guess.converged = False
+        guess.reason = (f"HBM engine failed ({type(error).__name__}: {error}); values are the "
+                        "time-integration state after 40 periods")
+        return guess
+    return solution
+
+
+def finish_sweep(engine, nl, solutions, start, end, H, N, options, step):
+    """Complete a continuation that stopped before ``end`` point by point (natural-parameter
+    steps of ``step``·|end − start| from the last converged point). The points it adds carry
+    ``reason`` '… (point-by-point after the continuation stopped)'."""
+    if not solutions:
+        return solutions
+    span = abs(end - start)
+    last = solutions[-1].omega
+    if abs(last - end) <= 1e-3 * span:
+        return solutions
+    if (end - last) * (end - start) < 0:   # past the end (e.g. turned back): nothing to add
+        return solutions
+    count = max(2, int(math.ceil(abs(end - last) / (step * span))) + 1)
+    previous = next((s for s in reversed(solutions) if s.converged), None)
+    for omega in np.linspace(last, end, count)[1:]:
+        solution = solve_point(engine, nl, float(omega), H, N, options, previous)
+        try:
+            solution = dataclasses.replace(
+                solution, reason=f"{solution.reason} (point-by-point after the continuation stopped)")
+        except TypeError:
+            solution.reason += " (point-by-point after the continuation stopped)"
+        solutions.append(solution)
+        if solution.converged and not isinstance(solution, adapters.SimpleNamespace):
+            previous = solution
+    return solutions
+
+
+def solve_points(case, nl: NonlinearModel, progress=False):
+    """HarmonicSolution per frequency point (listed frequencies in order, or a continuation)."""
+    solver, exc = case.data["solver"], case.data["excitation"]
+    H, N = solver["harmonics"], solver["samples_per_period"]
+    engine, options, cont_options = solver_options(case)
+    contacts = nl.contacts
+    if "sweep" in exc:
+        start, end = (2 * np.pi * exc["sweep"][k] for k in ("start_hz", "end_hz"))
+        if engine is not None and contacts.count:
+            bar = _bar(progress, None, "sweep")
+            try:
+                solutions = list(engine[1](nl.model, contacts, nl.excitation, start, end, H, N,
+                                           options=cont_options,
+                                           progress=(lambda done, total: bar.update(1))
+                                           if bar is not None else None))
+                return finish_sweep(engine, nl, solutions, start, end, H, N, options,
+                                     solver["continuation"]["initial_step"])
+            except Exception as error:  # fall back to a point-by-point sweep
+                import warnings
+                warnings.warn(f"continuation failed ({type(error).__name__}: {error}); "
+                              "sweeping point by point instead", RuntimeWarning, stacklevel=2)
+            finally:
+                if bar is not None:
+                    bar.close()
+        count = min(max(2, int(round(1.0 / solver["continuation"]["initial_step"])) + 1), 101)
+        omegas = np.linspace(start, end, count)
+    else:
+        omegas = 2 * np.pi * np.asarray(exc["frequency_hz"], dtype=float)
+    solutions, previous = [], None
+    bar = _bar(progress, len(omegas), "frequencies")
+    try:
+        for omega in omegas:
+            solution = solve_point(engine, nl, float(omega), H, N, options, previous)
+            solutions.append(solution)
+            previous = solution if getattr(solution, "converged", False) and not isinstance(
+                solution, adapters.SimpleNamespace) else None
+            if bar is not None:
+                bar.update(1)
+    finally:
+        if bar is not None:
+            bar.close()
+    return solutions

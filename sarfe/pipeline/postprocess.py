@@ -1,0 +1,157 @@
+r"""Per-point results: ERP of the HBM solution, contact indicators, linear risk baseline.
+
+ERP: w_s = N ũ (radiating-node normal displacement harmonics) → :func:`sarfe.erp.
+equivalent_radiated_power`. Linear baseline: (K − ω² M + iω D) Û = F̂ without contacts →
+:func:`sarfe.risk.linear_risk_from_contacts` and its ERP.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import scipy.sparse as sp
+
+from sarfe.pipeline.nonlinear import NonlinearModel
+
+
+def _erp(case, stage, displacement, omega):
+    """ErpResult of displacement harmonics (2H+1, n) at ω (zero power without radiating nodes)."""
+    from sarfe.erp import equivalent_radiated_power
+
+    erp = case.data["erp"]
+    W = np.asarray(displacement) @ stage.erp_map.T
+    if W.shape[1] == 0:  # no radiating surface: a zero-area node keeps the shapes valid
+        W, areas = np.zeros((W.shape[0], 1)), np.zeros(1)
+    else:
+        areas = stage.erp_areas
+    result = equivalent_radiated_power(W, omega, areas, density=erp["rho_kg_m3"],
+                                       sound_speed=erp["c_m_s"],
+                                       radiation_loss_factor=erp["radiation_loss_factor"],
+                                       reference_power=erp["reference_power_W"])
+    return result, W
+
+
+def _erp_dict(result):
+    return {"power_W": float(result.power_total), "level_db": float(result.level_total_db),
+            "level_dba": float(result.level_total_a_db),
+            "harmonics": {"frequency_hz": result.frequencies_hz, "power_W": result.power,
+                          "level_db": result.level_db, "level_dba": result.level_a_db}}
+
+
+def contact_indicators(solution, nl: NonlinearModel) -> list[dict]:
+    """Per named contact: max penetration, peak normal/friction force, open/stick/slip fractions."""
+    from sarfe.hbm.harmonics import time_samples
+
+    cs = nl.contacts
+    R = np.asarray(solution.contact_displacement)
+    force = np.asarray(solution.contact_force_time)
+    N = force.shape[0]
+    r = time_samples(R, N) if R.shape[1] else np.zeros((N, 0))
+    state = np.asarray(solution.contact_state)
+    out = []
+    for name, kind, idx in nl.groups:
+        nr = cs.normal_row[idx]
+        has = nr >= 0
+        penetration = (r[:, nr[has]] - cs.gap[idx][has]).max(initial=-np.inf) if has.any() else np.nan
+        normal = force[:, nr[has]].sum(axis=1) if has.any() else np.zeros(N)
+        normal = normal + cs.normal_load[idx].sum()
+        tr = cs.tangent_rows[idx]
+        friction = np.zeros(N)
+        if kind == "squeak":
+            t = np.where(tr >= 0, tr, 0)
+            ft = force[:, t] * (tr >= 0)
+            friction = np.sqrt((ft ** 2).sum(axis=2)).sum(axis=1)
+        st = state[:, idx]
+        amplitude_1 = np.hypot(R[1, nr[has]], R[2, nr[has]]).max(initial=0.0) if has.any() else np.nan
+        out.append({
+            "name": name, "type": kind, "pairs": int(len(idx)),
+            "max_penetration_m": float(max(penetration, 0.0)) if has.any() else float("nan"),
+            "peak_normal_force_N": float(normal.max()),
+            "peak_friction_force_N": float(friction.max()) if kind == "squeak" else float("nan"),
+            "normal_amplitude_m": float(amplitude_1),
+            "open_fraction": float(np.mean(st == 0)),
+            "closed_or_stick_fraction": float(np.mean(st == 1)),
+            "slip_fraction": float(np.mean(st == 2)),
+        })
+    return out
+
+
+def linear_baseline(case, stage, nl: NonlinearModel, omega):
+    """Linear response without contacts at ω: ERP and risk per named contact."""
+    from sarfe.risk import linear_risk_from_contacts
+
+    M, D, K = nl.model.mass, nl.model.damping, nl.model.stiffness
+    dense = (lambda A: A.toarray() if sp.issparse(A) else np.asarray(A))
+    S = dense(K) - omega ** 2 * dense(M) + 1j * omega * dense(D)
+    U1 = np.linalg.lstsq(S, nl.excitation_amplitude, rcond=None)[0]
+    H = (nl.excitation.shape[0] - 1) // 2
+    U = np.zeros((2 * H + 1, stage.dof_count))
+    U[1], U[2] = U1.real, -U1.imag
+    erp, _ = _erp(case, stage, U, omega)
+    contacts = []
+    if nl.contacts.count:
+        R = (nl.contacts.gap_map @ U.T).T
+        risks = linear_risk_from_contacts(nl.contacts, R, nl.tolerance, omega / (2 * np.pi))
+        for name, kind, idx in nl.groups:
+            sub = [risks[i] for i in idx]
+            d = np.array([x.dynamic_tolerance_m for x in sub])
+            a = np.array([x.normal_amplitude_m for x in sub])
+            s = np.array([x.tangential_peak_to_peak_m for x in sub])
+            contacts.append({
+                "name": name,
+                "normal_amplitude_m": float(np.nanmax(a)) if np.isfinite(a).any() else float("nan"),
+                "dynamic_tolerance_m": float(np.nanmin(d)) if np.isfinite(d).any() else float("nan"),
+                "rattle_risk": bool(np.any([x.rattle_risk for x in sub])),
+                "tangential_peak_to_peak_m": float(np.nanmax(s)) if np.isfinite(s).any()
+                else float("nan"),
+            })
+    return {"erp_power_W": float(erp.power_total), "erp_level_db": float(erp.level_total_db),
+            "erp_level_dba": float(erp.level_total_a_db), "contacts": contacts}
+
+
+def point_record(case, stage, nl, index, solution):
+    omega = float(solution.omega)
+    erp, W = _erp(case, stage, solution.displacement, omega)
+    contacts = contact_indicators(solution, nl) if nl.contacts.count else []
+    linear = linear_baseline(case, stage, nl, omega)
+    stable = getattr(solution, "stable", None)
+    point = {
+        "index": index, "frequency_hz": omega / (2 * np.pi), "omega_rad_s": omega,
+        "converged": bool(solution.converged), "stable": None if stable is None else bool(stable),
+        "iterations": int(getattr(solution, "iterations", 0)),
+        "residual_norm": float(getattr(solution, "residual_norm", float("nan"))),
+        "reason": str(getattr(solution, "reason", "")),
+        "erp": _erp_dict(erp), "contacts": contacts, "linear": linear,
+    }
+    row = {"case": case.name, "point": index, "frequency_hz": point["frequency_hz"],
+           "converged": point["converged"], "stable": point["stable"],
+           "iterations": point["iterations"], "erp_W": erp.power_total,
+           "erp_db": erp.level_total_db, "erp_dba": erp.level_total_a_db,
+           "linear_erp_db": linear["erp_level_db"], "linear_erp_dba": linear["erp_level_dba"]}
+    for c in contacts:
+        for key in ("max_penetration_m", "peak_normal_force_N", "peak_friction_force_N",
+                    "open_fraction", "slip_fraction"):
+            row[f"{c['name']}.{key}"] = c[key]
+    for c in linear["contacts"]:
+        row[f"{c['name']}.linear_rattle_risk"] = c["rattle_risk"]
+    return point, row, erp, W
+
+
+def worst_of(points):
+    if not points:
+        return {}
+    levels = [p["erp"]["level_dba"] for p in points]
+    finite = [i for i, x in enumerate(levels) if math.isfinite(x)]
+    j = max(finite, key=lambda i: levels[i]) if finite else 0
+    worst = {"erp_level_dba": levels[j], "erp_level_db": points[j]["erp"]["level_db"],
+             "frequency_hz": points[j]["frequency_hz"], "contacts": {}}
+    for c_index, c in enumerate(points[0]["contacts"]):
+        pen = [p["contacts"][c_index]["max_penetration_m"] for p in points]
+        force = [p["contacts"][c_index]["peak_normal_force_N"] for p in points]
+        risk = [p["linear"]["contacts"][c_index]["rattle_risk"] for p in points
+                if p["linear"]["contacts"]]
+        worst["contacts"][c["name"]] = {
+            "max_penetration_m": float(np.nanmax(pen)) if np.isfinite(pen).any() else float("nan"),
+            "peak_normal_force_N": float(np.nanmax(force)),
+            "linear_rattle_risk_any": bool(any(risk))}
+    return worst
