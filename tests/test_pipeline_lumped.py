@@ -173,3 +173,13 @@ def test_matrix_files_npz_mtx_npy(tmp_path):
     from sarfe.io.errors import CaseError
     with pytest.raises(CaseError, match=r"model.matrices.mass: cannot read matrix file"):
         build_linear_model(load_case(case, base_dir=tmp_path))
+
+
+def test_rerun_replaces_results_and_leaves_no_temporary(tmp_path):
+    target = tmp_path / "res"
+    solve_case(oscillator([20.0]), output_dir=target)
+    (target / "stale.txt").write_text("from an older run")
+    solve_case(oscillator([21.0]), output_dir=target)
+    assert not (target / "stale.txt").exists()
+    assert json.loads((target / "summary.json").read_text())["points"][0]["frequency_hz"] == 21.0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["res"]
