@@ -292,12 +292,14 @@ def _weighted_gram(b, d, weight):
 
 
 def _to_global(matrix, rotation):
-    """Tᵀ A T for T = blockdiag(R × 6); matrix (n_el, 18, 18), rotation (n_el, 3, 3)."""
+    """Tᵀ A T for T = blockdiag(R × 6); matrix (n_el, 18, 18), rotation (n_el, 3, 3).
+
+    Done block-wise (3×3 rotations on each 3-DOF block): A·T as (n_el, 108, 3) @ R, then
+    Rᵀ from the left on each of the six 3-row blocks.
+    """
     n_el = matrix.shape[0]
-    transform = np.zeros((n_el, 6, 3, 6, 3))
-    transform[:, np.arange(6), :, np.arange(6), :] = rotation
-    transform = transform.reshape(n_el, 18, 18)
-    return transform.transpose(0, 2, 1) @ matrix @ transform
+    right = (matrix.reshape(n_el, 108, 3) @ rotation).reshape(n_el, 6, 3, 18)
+    return (rotation.transpose(0, 2, 1)[:, None] @ right).reshape(n_el, 18, 18)
 
 
 def shell_matrices(points, triangles, thickness, young, poisson, density,
