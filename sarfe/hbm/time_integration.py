@@ -32,6 +32,7 @@ transient of the linear part.
 """
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -104,6 +105,7 @@ def linear_harmonic_response(model, excitation, omega, steps_per_period=None):
     H = (F.shape[0] - 1) // 2
     M, D, K = model.mass, model.damping, model.stiffness
     dense = not sp.issparse(K)
+    n_dof = K.shape[0]
     U = np.zeros(F.shape)
     for k in range(H + 1):
         w = _warped(k * omega, omega, steps_per_period)
@@ -117,7 +119,11 @@ def linear_harmonic_response(model, excitation, omega, steps_per_period=None):
         if dense:
             Uk = np.linalg.lstsq(np.asarray(S, dtype=complex), rhs, rcond=None)[0]
         else:
-            Uk = spla.spsolve(sp.csc_matrix(S, dtype=complex), rhs)
+            with warnings.catch_warnings():  # singular K (DOFs held by contacts only): zero mean
+                warnings.simplefilter("ignore", spla.MatrixRankWarning)
+                Uk = spla.spsolve(sp.csc_matrix(S, dtype=complex), rhs)
+            if not np.all(np.isfinite(Uk)):
+                Uk = np.zeros(n_dof, dtype=complex)
         if k == 0:
             U[0] = Uk.real
         else:
