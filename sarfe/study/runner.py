@@ -123,7 +123,7 @@ def solve_grid(case, stage, frequencies_hz, options=None, guesses=None):
     first-harmonic normal amplitude, the HarmonicSolution under ``_solution``) and
     {'solve_s', 'iterations'}."""
     from sarfe.hbm import SolverOptions, solve_frequency
-    from sarfe.pipeline.solve import _erp, contact_indicators, nonlinear_model
+    from sarfe.pipeline import nonlinear_model
 
     nl = nonlinear_model(case, stage)
     solver = case.data["solver"]
@@ -150,16 +150,47 @@ def solve_grid(case, stage, frequencies_hz, options=None, guesses=None):
     seconds = time.perf_counter() - clock
     points = []
     for s in solutions:
-        erp, _ = _erp(case, stage, s.displacement, s.omega)
-        indicators = contact_indicators(s, nl) if nl.contacts.count else []
-        force = max((c["peak_normal_force_N"] for c in indicators), default=0.0)
-        amplitude = max((c["normal_amplitude_m"] for c in indicators
-                         if np.isfinite(c["normal_amplitude_m"])), default=0.0)
+        level, level_a = erp_levels(case, stage, s.displacement, s.omega)
+        force, amplitude = contact_measures(s, nl)
         points.append({"frequency_hz": s.omega / (2 * np.pi), "converged": bool(s.converged),
-                       "iterations": int(s.iterations), "erp_db": float(erp.level_total_db),
-                       "erp_dba": float(erp.level_total_a_db), "peak_force_N": float(force),
-                       "amplitude_m": float(amplitude), "_solution": s})
+                       "iterations": int(s.iterations), "erp_db": level, "erp_dba": level_a,
+                       "peak_force_N": force, "amplitude_m": amplitude, "_solution": s})
     return points, {"solve_s": seconds, "iterations": iterations}
+
+
+def erp_levels(case, stage, displacement, omega):
+    """(L_W, L_WA) [dB re reference power] of displacement harmonics (2H+1, n) at ω (−inf if silent)."""
+    from sarfe.erp import equivalent_radiated_power
+
+    erp = case.data["erp"]
+    W = np.asarray(displacement) @ np.asarray(stage.erp_map).T
+    if W.shape[1] == 0:
+        return float("-inf"), float("-inf")
+    with np.errstate(divide="ignore"):
+        r = equivalent_radiated_power(W, omega, stage.erp_areas, density=erp["rho_kg_m3"],
+                                      sound_speed=erp["c_m_s"],
+                                      radiation_loss_factor=erp["radiation_loss_factor"],
+                                      reference_power=erp["reference_power_W"])
+    return float(r.level_total_db), float(r.level_total_a_db)
+
+
+def contact_measures(solution, nl):
+    """(peak normal contact force [N], largest first-harmonic normal amplitude [m]) over the named
+    contacts; the force of a named contact is the sum over its node pairs (+ constant normal loads)."""
+    c = nl.contacts
+    if not c.count:
+        return 0.0, 0.0
+    force_time = np.asarray(solution.contact_force_time)
+    R = np.asarray(solution.contact_displacement)
+    peak, amplitude = 0.0, 0.0
+    for _, _, idx in nl.groups:
+        rows = c.normal_row[idx]
+        rows = rows[rows >= 0]
+        total = force_time[:, rows].sum(axis=1) if rows.size else np.zeros(force_time.shape[0])
+        peak = max(peak, float((total + c.normal_load[idx].sum()).max()))
+        if rows.size:
+            amplitude = max(amplitude, float(np.hypot(R[1, rows], R[2, rows]).max()))
+    return peak, amplitude
 
 
 def branch_guesses(case, stage, baseline_points):
@@ -168,7 +199,7 @@ def branch_guesses(case, stage, baseline_points):
     rows, e.g. another mode count) the linear response to f̃_e − Gᵀλ̃ of the baseline contact forces;
     None where neither applies."""
     from sarfe.hbm.time_integration import linear_harmonic_response
-    from sarfe.pipeline.solve import nonlinear_model
+    from sarfe.pipeline import nonlinear_model
 
     from .accuracy import resize_harmonics
 
@@ -194,7 +225,7 @@ def branch_guesses(case, stage, baseline_points):
 
 def attach_estimates(case, stage, points):
     """estimate_errors at every converged grid point (adds estimate_amplitude_rel / _erp_db)."""
-    from sarfe.pipeline.solve import nonlinear_model
+    from sarfe.pipeline import nonlinear_model
 
     from .accuracy import estimate_errors
 
@@ -471,5 +502,5 @@ def plot_pareto(rows, path, title=""):
 
 
 __all__ = ["KNOBS", "StudyResult", "knob_levels", "variant_case", "frequency_grid", "solve_grid",
-           "attach_estimates", "run_variant", "run_study", "study_table", "write_study",
+           "attach_estimates", "erp_levels", "contact_measures", "branch_guesses", "run_variant", "run_study", "study_table", "write_study",
            "plot_pareto"]

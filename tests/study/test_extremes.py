@@ -158,6 +158,20 @@ def test_iterations_count_homotopy_work():
     assert s.iterations >= 1
 
 
+@pytest.mark.xfail(strict=False, reason="hbm: the cold start (linearized guess, then the load homotopy "
+                   "f̃_e·s, s: 0 → 1) misses a stable periodic solution that time integration finds "
+                   "and from which Newton converges in 1 iteration; fix: homotopy in the contact "
+                   "(k_n·s or gap/s) or a short time-integration first guess inside solve_frequency")
+@pytest.mark.timeout(300)
+def test_cold_start_finds_stable_solution():
+    """1 DOF rattle, k_n/k = 10, ω = 1.26 ω₀ (20 Hz): a stable T-periodic orbit exists."""
+    omega = 2 * np.pi * 20.0
+    p, s = solve(H=8, N=256, omega=omega)
+    assert_contract(s)
+    assert s.converged, s.reason
+    assert s.amplitude(0) == pytest.approx(2.764e-3, rel=1e-2)   # time integration, 512 steps
+
+
 # ------------------------------------------------------------------------------- factorial grid
 GRID = list(itertools.product(
     [1e-2, 1.0, 1e2, 1e4, 1e6, 1e8],         # penalty ratio k_n / k
