@@ -134,9 +134,10 @@ def evaluate_gate(table: pd.DataFrame, fail_above_db: float | None = None,
             lines.append(f"  {_describe(row, parameters)}: {reason}")
     total = len(levels)
     if offenders:
-        head = f"gate failed: {len(offenders)} of {total} variants"
         if fail_above_db is not None:
-            head += f" (threshold {fail_above_db:g} dB)"
+            head = f"gate failed: {len(offenders)} of {total} variants (threshold {fail_above_db:g} dB)"
+        else:
+            head = f"{len(offenders)} of {total} variants failed or did not converge"
         message = "\n".join([head + ":"] + lines)
     else:
         message = f"gate passed: {total} variants" + (f" at or below {fail_above_db:g} dB" if fail_above_db is not None else "")
