@@ -328,9 +328,10 @@ def choose_resolution(target, model, contacts, excitation, omega, *, harmonics=3
                       initial=None) -> Resolution:
     """Adaptive H, N at one ω [rad/s] until the estimates meet ``target`` (see :func:`parse_accuracy`).
 
-    Loop: solve (warm-started from the previous round); while the truncation estimate H → H' exceeds
-    half the budget, H ← H' (N kept ≥ 4H+1); else while the aliasing estimate N → 2N exceeds half the
-    budget, N ← 2N. Stops at max_harmonics / max_samples / max_rounds (met=False, reason says why)
+    Loop: solve (warm-started from the previous round, cold with the engine's homotopy if that
+    fails, and once more with 2N if it still fails); while the truncation estimate H → H' exceeds
+    half the budget, H ← H' (N doubled to keep N/H ≥ its starting ratio and N ≥ 4H+1); else while
+    the aliasing estimate N → 2N exceeds half the budget, N ← 2N. Stops at max_harmonics / max_samples / max_rounds (met=False, reason says why)
     or when a solve does not converge. excitation f̃_e (2H_e+1, n) [N] (any H_e; resized).
     """
     from sarfe.hbm.solve import solve_frequency
@@ -339,18 +340,24 @@ def choose_resolution(target, model, contacts, excitation, omega, *, harmonics=3
 
     target = parse_accuracy(target)
     H, N = int(harmonics), samples_for(int(harmonics), int(samples_per_period))
+    ratio = max(4.0, N / H)                 # keep N/H ≥ the starting ratio as H grows
     history, previous = [], initial
     solution = estimate = None
     reason = f"round cap {max_rounds} reached"
     met = False
+    retried = False
     for _ in range(max_rounds):
         clock = time.perf_counter()
         guess = None if previous is None else resize_harmonics(
             getattr(previous, "displacement", previous), H)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            solution = solve_frequency(model, contacts, resize_harmonics(excitation, H), omega, H, N,
-                                       initial=guess, options=options)
+            F = resize_harmonics(excitation, H)
+            solution = solve_frequency(model, contacts, F, omega, H, N, initial=guess,
+                                       options=options)
+            if not solution.converged and guess is not None:     # cold start (engine homotopy)
+                cold = solve_frequency(model, contacts, F, omega, H, N, options=options)
+                solution = cold if cold.converged else solution
         estimate = estimate_errors(solution, model, contacts, resize_harmonics(excitation, H),
                                    erp_map=erp_map, erp_areas=erp_areas, modal_dofs=modal_dofs,
                                    options=options)
@@ -358,6 +365,9 @@ def choose_resolution(target, model, contacts, excitation, omega, *, harmonics=3
                         "converged": bool(solution.converged), "iterations": int(solution.iterations),
                         "estimate": estimate.as_dict(), "seconds": time.perf_counter() - clock})
         if not solution.converged:
+            if not retried and 2 * N <= max_samples:           # aliasing can stall Newton: once 2N
+                retried, N = True, 2 * N
+                continue
             reason = f"not converged at H={H}, N={N}: {solution.reason}"
             break
         previous = solution
@@ -373,7 +383,7 @@ def choose_resolution(target, model, contacts, excitation, omega, *, harmonics=3
                 reason = f"harmonics cap {max_harmonics} reached"
                 break
             H = min(max_harmonics, estimate.extended_harmonics)
-            N = min(max(max_samples, 4 * H + 1), samples_for(H, N))
+            N = min(max(max_samples, 4 * H + 1), _at_least(N, max(4 * H + 1, ratio * H)))
         else:
             if 2 * N > max_samples:
                 reason = f"samples cap {max_samples} reached"
@@ -382,6 +392,12 @@ def choose_resolution(target, model, contacts, excitation, omega, *, harmonics=3
     return Resolution(solution, H if solution is None else int(solution.harmonics),
                       N if solution is None else int(solution.samples_per_period), estimate, met,
                       reason, history)
+
+
+def _at_least(N, need):
+    while N < need:
+        N *= 2
+    return int(N)
 
 
 def _finite(x):
