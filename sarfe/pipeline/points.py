@@ -90,11 +90,19 @@ def solve_point(engine, nl, omega, H, N, options, previous):
 
 
 def finish_sweep(engine, nl, solutions, start, end, H, N, options, step):
-    """Complete a continuation that stopped before ``end`` point by point (natural-parameter
-    steps of ``step``·|end − start| from the last converged point). The points it adds carry
-    ``reason`` '… (point-by-point after the continuation stopped)'."""
+    """Repair a continuation result: a point whose corrector failed is re-solved at its fixed ω
+    (starting from it); a sweep that stopped before ``end`` is completed point by point
+    (natural-parameter steps of ``step``·|end − start| from the last converged point). Such points
+    say so in their ``reason``."""
     if not solutions:
         return solutions
+    for i, solution in enumerate(solutions):  # polish corrector failures at fixed ω
+        if not solution.converged:
+            retry = solve_point(engine, nl, float(solution.omega), H, N, options, solution)
+            if retry.converged:
+                solutions[i] = dataclasses.replace(
+                    retry, reason=f"{retry.reason} (re-solved at fixed frequency after the "
+                                  f"continuation corrector stopped: {solution.reason})")
     span = abs(end - start)
     last = solutions[-1].omega
     if abs(last - end) <= 1e-3 * span:
