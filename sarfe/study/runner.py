@@ -245,8 +245,13 @@ def attach_estimates(case, stage, points):
         p["estimate_modal_rel"] = e.modal_rel
 
 
-def _errors(points, reference):
-    """Max over grid points converged in both: |ΔdB|, |ΔdB(A)|, force and amplitude errors."""
+DYNAMIC_RANGE_DB = 60.0
+
+
+def _errors(points, reference, dynamic_range_db=DYNAMIC_RANGE_DB):
+    """Max over grid points converged in both: |ΔL|, |ΔL_A| [dB] with both levels floored at the
+    reference's loudest level − ``dynamic_range_db`` (silent points, e.g. −230 dB when no impact
+    excites the radiating part, would otherwise dominate), relative force and amplitude errors."""
     pairs = [(p, r) for p, r in zip(points, reference) if p["converged"] and r["converged"]]
     nan = float("nan")
     if not pairs:
@@ -256,7 +261,12 @@ def _errors(points, reference):
     a_ref = max(r["amplitude_m"] for _, r in pairs) or 1.0
 
     def level_error(key):
-        values = [abs(p[key] - r[key]) for p, r in pairs if np.isfinite(p[key]) and np.isfinite(r[key])]
+        top = max((r[key] for _, r in pairs if np.isfinite(r[key])), default=nan)
+        if not np.isfinite(top):
+            return nan
+        floor = top - dynamic_range_db
+        values = [abs(max(p[key], floor) - max(r[key], floor)) for p, r in pairs
+                  if not (np.isnan(p[key]) or np.isnan(r[key]))]
         return max(values) if values else nan
 
     return {
