@@ -286,3 +286,16 @@ def test_fixed_dofs_components():
     with pytest.raises(ValueError):
         fixed_dofs([0], [6])
     assert list(free_dofs(8, [1, 3])) == [0, 2, 4, 5, 6, 7]
+
+
+def test_single_pass_pair_assembly_equals_separate_assembly():
+    from sarfe.fe import assemble, assemble_pair, element_dofs
+
+    points, triangles = curved_mesh()
+    k_e, m_e = shell_element_matrices(points, triangles, H, E, NU, RHO)
+    dofs = element_dofs(triangles)
+    k, m = assemble_pair(k_e, m_e, dofs, 6 * len(points))
+    assert abs(k - assemble(k_e, dofs, 6 * len(points))).max() == 0
+    assert abs(m - assemble(m_e, dofs, 6 * len(points))).max() == 0
+    k_full, m_full = shell_matrices(points, triangles, H, E, NU, RHO)
+    assert abs(k_full - k).max() <= 1e-12 * abs(k).max()
