@@ -12,10 +12,11 @@ the transformation u = T q, T = [[I, 0], [Ψ, Φ]], gives K_r = Tᵀ K T and M_r
     M_r = [[M_bb + M_bi Ψ + Ψᵀ M_ib + Ψᵀ M_ii Ψ, (M_bi + Ψᵀ M_ii) Φ], [sym, I]]
 
 K_ii is factorized once (``sarfe.reduction.linear_solvers.factorize``) and that factor serves Ψ
-(one block solve with n_b right-hand sides) and the shift-invert Lanczos iteration for Φ
-(``scipy.sparse.linalg.eigsh`` with sigma = 0 and OPinv = K_ii⁻¹). For a cutoff frequency the
-modes are found in blocks: each new block runs on the operator deflated of the modes already
-found, (I − Φ Φᵀ M_ii) K_ii⁻¹, until the highest frequency found exceeds the cutoff.
+(one block solve with n_b right-hand sides) and the shift-invert Lanczos iteration for Φ: by
+default a block Lanczos on K_ii⁻¹ M_ii whose steps are multi-RHS solves; alternatively
+``scipy.sparse.linalg.eigsh`` with sigma = 0 and OPinv = K_ii⁻¹, where for a cutoff frequency the
+modes are found in blocks, each run on the operator deflated of the modes already found,
+(I − Φ Φᵀ M_ii) K_ii⁻¹, until the highest frequency found exceeds the cutoff.
 
 Reduced coordinates q = [q_b (n_b, physical, in ``boundary_dofs`` order), q_m (n_m, modal)].
 Units: K [N/m], M [kg], frequencies [Hz].
@@ -175,7 +176,7 @@ def _fixed_interface_modes(stiffness_ii, mass_ii, operator, mode_count, cutoff_h
 
 
 def _m_orthonormal(block, mass):
-    """Q, MQ with Qᵀ M Q = I spanning ``block`` (Cholesky QR twice; rank-deficient columns dropped)."""
+    """Q, MQ with Qᵀ M Q = I spanning ``block`` (Gram-matrix eigendecomposition, twice; rank-deficient columns dropped)."""
     for _ in range(2):
         mass_block = mass @ block
         gram = block.T @ mass_block
@@ -193,7 +194,8 @@ def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, blo
     Krylov space of A = K_ii⁻¹ M_ii from a block of ``block_size`` columns: every step is ONE
     multi-RHS solve (cheaper per column than single solves). H = Qᵀ M A Q is projected exactly;
     its eigenpairs (ν, y) give ω² = 1/ν, φ = Q y, with residual ‖A φ − ν φ‖_M = ‖R y_last‖.
-    Stops when the wanted Ritz pairs have residual < tol·ν. Returns ω² (ascending), Φ (Φᵀ M Φ = I).
+    Stops when the wanted Ritz pairs have residual < tol·ν. Returns ω² (ascending), Φ (Φᵀ M Φ = I),
+    or None when the Krylov space fills the interior before that (tiny models).
     """
     n = mass_ii.shape[0]
     rng = np.random.default_rng(seed)
@@ -243,13 +245,14 @@ def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, blo
             mass_store = np.hstack([mass_store[:, :m_new], np.empty((n, capacity - m_new))])
         store[:, m_new:m_new + q.shape[1]], mass_store[:, m_new:m_new + q.shape[1]] = q, mq
         m_new += q.shape[1]
-    count = min(wanted, leading) if done else min(wanted, m_new)
-    modes = basis @ vectors[:, :count]
-    return omega2[:count], modes
+    if not done:
+        return None  # Krylov space exhausted before convergence (tiny interior): caller uses ARPACK
+    modes = basis @ vectors[:, :wanted]
+    return omega2[:wanted], modes
 
 
 def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=None, solver="auto",
-                  progress=None, free_dofs=None, total_dof_count=None, eigensolver="arpack") -> ReducedModel:
+                  progress=None, free_dofs=None, total_dof_count=None, eigensolver="block") -> ReducedModel:
     """Craig–Bampton reduction (see module docstring for the equations).
 
     stiffness, mass: (n, n) sparse K [N/m], M [kg] on the free DOFs (fixed DOFs removed, see
@@ -259,9 +262,10 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
     mode_count: number of fixed-interface modes; cutoff_hz: keep all modes up to this frequency
     [Hz] (both given: at most mode_count below the cutoff; neither: only static condensation).
     solver: backend for K_ii (see ``linear_solvers``). progress: optional callable(done, total|None)
-    called after each mode block. eigensolver: "arpack" (eigsh, single-vector shift-invert Lanczos,
-    deflated blocks for a cutoff) or "block" (block shift-invert Lanczos, multi-RHS solves; see
-    :func:`_block_lanczos_modes`). free_dofs/total_dof_count: stored for recovery on the original
+    called after each mode block. eigensolver: "block" (default: block shift-invert Lanczos with
+    16-column multi-RHS solves, :func:`_block_lanczos_modes`; 35–40 % less CPU than ARPACK on the
+    door trim, same frequencies to 1e-15; falls back to ARPACK on tiny interiors) or "arpack"
+    (``eigsh`` single-vector shift-invert Lanczos, deflated blocks for a cutoff). free_dofs/total_dof_count: stored for recovery on the original
     DOF numbering (``free_dofs_system``'s third output).
     """
     stiffness, mass = sp.csr_matrix(stiffness), sp.csr_matrix(mass)
@@ -304,12 +308,16 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
         return factor.solve(y)
 
     if (mode_count or 0) > 0 or (cutoff_hz is not None and mode_count is None):
+        if eigensolver not in ("block", "arpack"):
+            raise ValueError(f"eigensolver must be 'block' or 'arpack', got {eigensolver!r}")
+        found = None
         if eigensolver == "block":
-            omega2, phi = _block_lanczos_modes(m_ii, inverse, mode_count, cutoff_hz, progress)
-        elif eigensolver == "arpack":
-            omega2, phi = _fixed_interface_modes(k_ii, m_ii, inverse, mode_count, cutoff_hz, progress)
-        else:
-            raise ValueError(f"eigensolver must be 'arpack' or 'block', got {eigensolver!r}")
+            found = _block_lanczos_modes(m_ii, inverse, mode_count, cutoff_hz, progress)
+        if found is None:
+            found = _fixed_interface_modes(k_ii, m_ii, inverse, mode_count, cutoff_hz, progress)
+            eigensolver = "arpack"
+        omega2, phi = found
+        timings["eigensolver"] = eigensolver
     else:
         omega2, phi = np.empty(0), np.empty((len(interior), 0))
     lap("normal_modes")

@@ -102,10 +102,11 @@ def test_receptance_within_one_percent(plate, reduced, full_frequencies):
 
 
 def test_mode_count_and_cutoff_blocks(plate):
-    """By count: exactly that many modes; by cutoff: same lowest modes as the count run."""
+    """ARPACK by count: exactly that many modes; by cutoff (deflated runs): the same lowest modes."""
     b = boundary_positions(plate)
-    by_count = craig_bampton(plate.stiffness, plate.mass, b, mode_count=30)
-    by_cutoff = craig_bampton(plate.stiffness, plate.mass, b, cutoff_hz=by_count.mode_frequencies_hz[-1] * 1.0001)
+    by_count = craig_bampton(plate.stiffness, plate.mass, b, mode_count=30, eigensolver="arpack")
+    by_cutoff = craig_bampton(plate.stiffness, plate.mass, b, cutoff_hz=by_count.mode_frequencies_hz[-1] * 1.0001,
+                              eigensolver="arpack")
     assert by_count.mode_count == 30
     assert by_cutoff.mode_count == 30  # found in deflated blocks of 24
     np.testing.assert_allclose(by_cutoff.mode_frequencies_hz, by_count.mode_frequencies_hz, rtol=1e-9)
@@ -158,10 +159,23 @@ def test_local_modal_damping_matches_fe(reduced):
 def test_block_lanczos_matches_arpack(plate, kwargs):
     """Block shift-invert Lanczos finds the same fixed-interface modes as ARPACK's eigsh."""
     b = boundary_positions(plate)
-    arpack = craig_bampton(plate.stiffness, plate.mass, b, **kwargs)
+    arpack = craig_bampton(plate.stiffness, plate.mass, b, eigensolver="arpack", **kwargs)
     block = craig_bampton(plate.stiffness, plate.mass, b, eigensolver="block", **kwargs)
     assert block.mode_count == arpack.mode_count >= 10
     np.testing.assert_allclose(block.mode_frequencies_hz, arpack.mode_frequencies_hz, rtol=1e-9)
     m_ii = plate.mass[arpack.interior_dofs][:, arpack.interior_dofs]
     mac = np.abs(np.einsum("ij,ij->j", arpack.fixed_interface_modes, m_ii @ block.fixed_interface_modes))
     np.testing.assert_allclose(mac, 1.0, atol=1e-8)
+
+
+def test_tiny_interior_falls_back_to_arpack():
+    """A 28-DOF interior fills the block Krylov space before convergence: ARPACK takes over."""
+    import scipy.sparse as sp
+
+    rng = np.random.default_rng(0)
+    a = sp.random(30, 30, density=0.3, random_state=rng)
+    stiffness, mass = (a.T @ a + sp.eye(30)).tocsr(), sp.diags(1 + rng.random(30)).tocsr()
+    reduced = craig_bampton(stiffness, mass, [0, 1], mode_count=20)
+    assert reduced.timings["eigensolver"] == "arpack"
+    omega2 = sla.eigh(stiffness.toarray()[2:, 2:], mass.toarray()[2:, 2:], eigvals_only=True)[:20]
+    np.testing.assert_allclose((2 * np.pi * reduced.mode_frequencies_hz) ** 2, omega2, rtol=1e-9)
