@@ -37,6 +37,7 @@ with diagonal pivots (3.6× less fill than its COLAMD default on these matrices)
 """
 from __future__ import annotations
 
+import functools
 import weakref
 from dataclasses import dataclass, field
 from typing import Callable
@@ -94,6 +95,7 @@ class Factorization:
         return spla.LinearOperator((self.size, self.size), matvec=self.solve, matmat=self.solve, dtype=float)
 
 
+@functools.lru_cache(maxsize=None)
 def available_solvers() -> tuple[str, ...]:
     """Backends importable in this environment, in the "auto" preference order."""
     found = []
