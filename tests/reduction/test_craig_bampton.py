@@ -179,3 +179,29 @@ def test_tiny_interior_falls_back_to_arpack():
     assert reduced.timings["eigensolver"] == "arpack"
     omega2 = sla.eigh(stiffness.toarray()[2:, 2:], mass.toarray()[2:, 2:], eigvals_only=True)[:20]
     np.testing.assert_allclose((2 * np.pi * reduced.mode_frequencies_hz) ** 2, omega2, rtol=1e-9)
+
+
+def test_receptance_within_one_percent_including_peaks_up_to_quarter_cutoff(plate):
+    """Same FRF check without excluding resonance bands: 1 % holds up to f_c / 4 (measured 0.49 %).
+
+    Up to f_c / 2 the peak of the in-plane mode (carried by constraint modes only) is off by 3.4 %
+    at f_c = 2500 Hz — the reason the case layer picks a cutoff of several times the highest
+    excited harmonic.
+    """
+    cutoff = 5000.0
+    reduced = craig_bampton(plate.stiffness, plate.mass, boundary_positions(plate), cutoff_hz=cutoff,
+                            free_dofs=plate.free_dofs, total_dof_count=plate.total_dof_count)
+    alpha, beta = 22.0, 8e-6
+    damped = with_rayleigh_damping(reduced, alpha, beta)
+    b = reduced.boundary_dofs
+    n_b = len(b)
+    unit = np.zeros((reduced.full_dof_count, n_b), dtype=complex)
+    unit[b, np.arange(n_b)] = 1.0
+    errors = []
+    for f in np.geomspace(10.0, cutoff / 4, 80):
+        omega = 2 * np.pi * f
+        dynamic = plate.stiffness * (1 + 1j * omega * beta) + plate.mass * (1j * omega * alpha - omega**2)
+        h_full = spla.splu(dynamic.tocsc()).solve(unit)[b]
+        h_reduced = np.linalg.inv(damped.stiffness + 1j * omega * damped.damping - omega**2 * damped.mass)[:n_b, :n_b]
+        errors.append(np.linalg.norm(h_reduced - h_full) / np.linalg.norm(h_full))
+    assert max(errors) < 0.01
