@@ -104,11 +104,11 @@ def compare(first: pd.DataFrame, second: pd.DataFrame) -> dict:
         return {"same_rows": False}
     out = {"same_rows": True, "same_status": bool((first["status"] == second["status"]).all())}
     for column in ("erp_db", "erp_dba"):
-        if column in first:
+        if column in first and column in second:
             delta = (pd.to_numeric(first[column]) - pd.to_numeric(second[column])).abs()
             out[f"max_abs_diff_{column}"] = float(delta.max())
             out[f"rows_over_0.01dB_{column}"] = int((delta > 0.01).sum())
-    numeric = [c for c in first.columns if pd.api.types.is_float_dtype(first[c])]
+    numeric = [c for c in first.columns if pd.api.types.is_float_dtype(first[c]) and c in second]
     out["columns_not_bitwise_equal"] = [c for c in numeric if not first[c].equals(second[c])]
     return out
 

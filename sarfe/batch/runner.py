@@ -105,10 +105,12 @@ def solve_variant(variant: Variant, linear_stage, pipeline_name: str = PIPELINE,
     return record
 
 
-def failed_record(variant: Variant, message: str) -> dict:
+def failed_record(variant: Variant, message: str, transient: bool = False) -> dict:
+    """Record of a variant that produced no result. ``transient``: the cluster failed (workers
+    killed), not the variant — a re-run solves it again instead of skipping it."""
     return {"variant_id": variant.id, "variant_index": variant.index, "source": variant.source,
             "parameters": variant.parameters, "status": "failed", "error": message, "exit_code": None,
-            "summary": {}, "rows": [], "elapsed_s": 0.0}
+            "summary": {}, "rows": [], "elapsed_s": 0.0, "transient": transient}
 
 
 @dataclass
@@ -212,16 +214,18 @@ def _run_dask(client, groups, output, stats, finish, pipeline_name, write_output
 
     for future in pending:
         kind, item = task_of.pop(future.key)
+        transient = False
         try:
             value = future.result()
-        except Exception as error:  # exception raised twice, or worker lost twice (KilledWorker)
+        except Exception as error:  # exception raised twice, or workers lost (KilledWorker)
             value, message = None, _error_text(error)
+            transient = _infrastructure_error(error)
         finally:
             future.release()
         if kind == "linear":
             if value is None:
                 for variant in groups[item]:
-                    finish(failed_record(variant, f"linear model: {message}"))
+                    finish(failed_record(variant, f"linear model: {message}", transient))
                 continue
             value, seconds = value
             stats.linear_stages_built += 1
@@ -230,7 +234,15 @@ def _run_dask(client, groups, output, stats, finish, pipeline_name, write_output
                 store.save_stage(output, item, value)
             submit_group(item, value)
         else:
-            finish(value if value is not None else failed_record(item, f"worker: {message}"))
+            finish(value if value is not None else failed_record(item, f"worker: {message}", transient))
+
+
+def _infrastructure_error(error: BaseException) -> bool:
+    """Workers killed or connections lost — not the variant's fault: run it again next time."""
+    from distributed import KilledWorker
+    from distributed.comm.core import CommClosedError
+
+    return isinstance(error, (KilledWorker, CommClosedError, TimeoutError, ConnectionError))
 
 
 def _local_client(workers: int):
@@ -275,7 +287,7 @@ def run_study(study_or_cases, workers: int = 2, scheduler: str | None = None, ou
     output = pathlib.Path(output_dir) if output_dir is not None else default_output_dir(variants)
     output.mkdir(parents=True, exist_ok=True)
 
-    done = store.read_records(output, [v.id for v in variants])
+    done = store.read_records(output, [v.id for v in variants], include_transient=False)
     if retry_failed:
         done = {k: r for k, r in done.items() if r.get("status") != "failed"}
     todo = [v for v in variants if v.id not in done]

@@ -64,8 +64,9 @@ def write_record(output, record: dict) -> None:
     atomic_write(record_path(output, record["variant_id"]), to_json(record).encode())
 
 
-def read_records(output, ids=None) -> dict[str, dict]:
-    """Finished variant records in ``<output>/variants`` (optionally only ``ids``)."""
+def read_records(output, ids=None, include_transient: bool = True) -> dict[str, dict]:
+    """Variant records in ``<output>/variants`` (optionally only ``ids``); ``include_transient=False``
+    leaves out failures of the cluster (killed workers), which a re-run solves again."""
     folder = pathlib.Path(output) / "variants"
     records = {}
     if not folder.is_dir():
@@ -75,9 +76,11 @@ def read_records(output, ids=None) -> dict[str, dict]:
         if wanted is not None and path.stem not in wanted:
             continue
         try:
-            records[path.stem] = json.loads(path.read_text())
+            record = json.loads(path.read_text())
         except (OSError, ValueError):
             continue  # unreadable: treated as not finished, the variant is run again
+        if include_transient or not record.get("transient"):
+            records[path.stem] = record
     return records
 
 

@@ -187,3 +187,19 @@ def test_existing_scheduler_by_address(tmp_path, fake_log, dask_client):
     table = run_study(path, scheduler=dask_client.scheduler.address, output_dir=tmp_path / "out", pipeline=FAKE)
     assert table.attrs["summary"]["run"]["mode"] == "dask" and set(table["status"]) == {"ok"}
     assert fake_log("build") == 1 and fake_log("solve") == 3
+
+
+def test_cluster_failures_are_run_again_but_variant_failures_are_not(tmp_path, fake_log):
+    from sarfe.batch.runner import failed_record
+    from sarfe.batch.store import write_record
+    from sarfe.batch.study import collect_variants
+
+    path = study(tmp_path, "  grid: {'contacts[0].gap_m': [1.0e-4, 2.0e-4, 3.0e-4]}\n")
+    first, second, third = collect_variants(path)
+    out = tmp_path / "out"
+    write_record(out, failed_record(first, "worker: KilledWorker: …", transient=True))
+    write_record(out, failed_record(second, "RuntimeError: boom"))
+    table = run_study(path, workers=0, output_dir=out, pipeline=FAKE)
+    status = table.groupby("variant_id")["status"].first()
+    assert (status[first.id], status[second.id], status[third.id]) == ("ok", "failed", "ok")
+    assert fake_log("solve") == 2
