@@ -5,7 +5,8 @@ A study file (YAML, validated against ``STUDY_SCHEMA``; unknown keys are errors)
     name: lumped_gap_scatter               # optional, default: file stem
     base_case: ../lumped_rattle.yaml       # relative to the study file
     overrides:                             # optional, written into every variant first
-      excitation.force_N: 2.0
+      excitation.sweep: null               # (null removes a key)
+      excitation.frequency_hz: [52.0]
     variations:                            # exactly one of grid | list | monte_carlo
       monte_carlo:
         samples: 10
@@ -20,7 +21,8 @@ A study file (YAML, validated against ``STUDY_SCHEMA``; unknown keys are errors)
 file order. Distributions: ``normal {mean, std}``, ``uniform {low, high}``,
 ``lognormal {median, log_std}`` (log_std = standard deviation of ln x),
 ``truncated_normal {mean, std, low, high}`` (inverse-CDF sampling).
-Paths are those of ``sarfe.batch.paths``.
+Paths are those of ``sarfe.batch.paths``; inside ``{…}`` flow mappings quote them
+(``{'contacts[0].gap_m': 1.0e-4}``), YAML reads ``[`` there as a list.
 
 Each variant's id is ``v`` + 12 hex digits of the SHA-256 of its base case (after overrides) and its
 parameter values, so the same inputs give the same id on every run and machine.
