@@ -64,7 +64,7 @@ def pointwise_jacobian(derivative_time: np.ndarray, harmonics: int) -> np.ndarra
     """
     d = np.asarray(derivative_time, dtype=float)
     N, H = d.shape[0], int(harmonics)
-    spectrum = hm._fft.rfft(d, axis=0)
+    spectrum = hm._fft.rfft(d.reshape(N, -1), axis=0).reshape((N // 2 + 1,) + d.shape[1:])
     m = np.arange(2 * H + 1)
     mirrored = m > N // 2
     coeff = spectrum[np.where(mirrored, N - m, m)]

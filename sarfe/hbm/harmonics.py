@@ -95,7 +95,10 @@ def time_samples(U: np.ndarray, samples_per_period: int) -> np.ndarray:
     spectrum = np.zeros((N // 2 + 1,) + U.shape[1:], dtype=complex)
     spectrum[0] = N * U[0]
     spectrum[1 : H + 1] = 0.5 * N * (U[1::2] - 1j * U[2::2])
-    return _fft.irfft(spectrum, n=N, axis=0)
+    # transform along axis 0 of a 2-D view: pyFFTW's planner can return NULL for axis 0 of
+    # arrays with several trailing axes (pyFFTW issue #344); folding them is exact.
+    flat = _fft.irfft(spectrum.reshape(spectrum.shape[0], -1), n=N, axis=0)
+    return flat.reshape((N,) + U.shape[1:])
 
 
 def harmonic_coefficients(u: np.ndarray, harmonics: int) -> np.ndarray:
@@ -106,7 +109,7 @@ def harmonic_coefficients(u: np.ndarray, harmonics: int) -> np.ndarray:
     u = np.asarray(u, dtype=float)
     N = u.shape[0]
     H = int(harmonics)
-    spectrum = _fft.rfft(u, axis=0)
+    spectrum = _fft.rfft(u.reshape(N, -1), axis=0).reshape((N // 2 + 1,) + u.shape[1:])
     U = np.empty((2 * H + 1,) + u.shape[1:])
     U[0] = spectrum[0].real / N
     U[1::2] = 2.0 / N * spectrum[1 : H + 1].real

@@ -13,7 +13,7 @@ import numpy as np
 from sarfe.pipeline import adapters
 from sarfe.pipeline.nonlinear import NonlinearModel
 
-adapters.guard_fft_backend()
+# (pyFFTW axis-0 planner issue now handled in sarfe.hbm.harmonics itself)
 
 
 def solver_options(case):
