@@ -104,7 +104,7 @@ def nonlinear_points(prob, count=2):
 
 
 # ------------------------------------------------------------------------------------ part 1
-def hbm_vs_time(prob, f, ref, targets=(1e-2, 1e-3), max_steps=16384):
+def hbm_vs_time(prob, f, ref, targets=(1e-2, 1e-3), max_steps=4096):
     from sarfe.hbm import SolverOptions
     from sarfe.hbm.time_integration import integrate_time
     from sarfe.study.accuracy import choose_resolution, resize_harmonics
@@ -124,7 +124,7 @@ def hbm_vs_time(prob, f, ref, targets=(1e-2, 1e-3), max_steps=16384):
         while steps <= max_steps:
             clock = time.perf_counter()
             r = integrate_time(prob["model"], prob["contacts"], resize_harmonics(prob["excitation"], 3),
-                               omega, 40, steps_per_period=steps, max_periods=2000)
+                               omega, 40, steps_per_period=steps, max_periods=400)
             t_ti = time.perf_counter() - clock
             e_ti = amplitude_error(prob["contacts"], r.displacement_harmonics, ref.displacement)
             if r.steady and e_ti <= target:
@@ -290,7 +290,22 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer points")
     parser.add_argument("--cases", default="lumped_chain,lumped_rattle,rattle_rig,squeak_rig")
+    parser.add_argument("--no-scaling", action="store_true")
+    parser.add_argument("--no-time", action="store_true", help="skip HBM vs time integration")
+    parser.add_argument("--json-out", default=None, help="write this part's JSON only")
+    parser.add_argument("--merge", nargs="*", default=None, help="merge part JSONs → accuracy.md")
     args = parser.parse_args(argv)
+    if args.merge is not None:
+        parts = [json.loads(Path(p).read_text()) for p in args.merge]
+        data = dict(parts[0])
+        for key in ("hbm_vs_time", "estimates", "notes"):
+            data[key] = [x for part in parts for x in part.get(key, [])]
+        data["scaling"] = next(p["scaling"] for p in parts if p.get("scaling"))
+        data["load_average"] = [p["load_average"] for p in parts]
+        (RESULTS / "accuracy.json").write_text(json.dumps(data, indent=1, default=float))
+        (RESULTS / "accuracy.md").write_text(markdown(data))
+        print(f"wrote {RESULTS / 'accuracy.md'}")
+        return
     data = {"created": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
             "load_average": [round(x, 1) for x in os.getloadavg()],
             "hbm_vs_time": [], "estimates": [], "notes": []}
@@ -307,11 +322,17 @@ def main(argv=None):
                                  "active contact among " + ", ".join(f"{f:.1f}" for f in
                                                                     prob["frequencies_hz"]) + " Hz")
             continue
+        print(f"  points: {[round(f, 2) for f, _ in points]}", flush=True)
         data["estimates"] += estimate_table(prob, points)
-        if name in ("lumped_chain", "rattle_rig", "squeak_rig"):
+        print(f"  estimates: {len(data['estimates'])} rows", flush=True)
+        if name in ("lumped_chain", "rattle_rig", "squeak_rig") and not args.no_time:
             data["hbm_vs_time"] += hbm_vs_time(prob, *points[0])
-    print("scaling:", flush=True)
-    data["scaling"] = cost_scaling(args.quick)
+    if not args.no_scaling:
+        print("scaling:", flush=True)
+        data["scaling"] = cost_scaling(args.quick)
+    if args.json_out:
+        Path(args.json_out).write_text(json.dumps(data, indent=1, default=float))
+        return
     RESULTS.mkdir(parents=True, exist_ok=True)
     (RESULTS / "accuracy.json").write_text(json.dumps(data, indent=1, default=float))
     (RESULTS / "accuracy.md").write_text(markdown(data))
