@@ -250,7 +250,9 @@ def _local_client(workers: int):
 
     for name, value in _BLAS_ENV.items():  # spawned workers inherit this too
         os.environ.setdefault(name, value)
-    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+    # memory_limit=0: no per-worker share of the RAM. The default (RAM / N) let the nanny kill a
+    # worker building the door trim's linear stage (12 GB peak) on 2 workers of a 24 GB machine.
+    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, memory_limit=0,
                            dashboard_address=None, host="127.0.0.1", silence_logs=logging.ERROR,
                            scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # metrics only, loopback
                            env=dict(_BLAS_ENV))
