@@ -39,10 +39,10 @@ import numpy as np
 
 SAFETY = 2.0
 
-PRESETS = {
-    "fast": {"amplitude_rel": 5e-2, "erp_db": 0.5},
-    "balanced": {"amplitude_rel": 1e-2, "erp_db": 0.1},
-    "fine": {"amplitude_rel": 1e-3, "erp_db": 0.01},
+PRESETS = {   # ERP of impacts converges slowly in H (ERP ∝ Σ (kω)² |w_k|²): dB targets are looser
+    "fast": {"amplitude_rel": 5e-2, "erp_db": 2.0},
+    "balanced": {"amplitude_rel": 1e-2, "erp_db": 0.5},
+    "fine": {"amplitude_rel": 1e-3, "erp_db": 0.1},
 }
 
 
@@ -199,6 +199,12 @@ def _change(contacts, U, U_new, omega, erp_map, erp_areas, ref_amplitude=None):
         rel = float(np.max(np.abs(d1 - d0)) / max(d0.max(initial=0.0), 1e-300))
     p0 = _erp_proxy(U, omega, erp_map, erp_areas)
     p1 = _erp_proxy(U_new, omega, erp_map, erp_areas)
+    if erp_map is not None:
+        # a radiating surface that is silent compared with the structure (power ratio < 1e-24,
+        # amplitude < 1e-12: round-off) has no meaningful level change
+        whole = _erp_proxy(U, omega) * (np.sum(erp_areas) if erp_areas is not None else 1.0)
+        if max(p0, p1) <= 1e-24 * whole:
+            return rel, 0.0
     db = float(10 * np.log10(p1 / p0)) if p0 > 0 and p1 > 0 else (0.0 if p0 == p1 else float("inf"))
     return rel, db
 

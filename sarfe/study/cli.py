@@ -55,7 +55,7 @@ def cmd_accuracy(args) -> int:
     from .resolve import resolve_case_accuracy
 
     try:
-        report = resolve_case_accuracy(args.case, args.accuracy)
+        report = resolve_case_accuracy(args.case, args.accuracy, points=args.points)
     except ValueError as exc:
         if isinstance(exc, CaseError):
             raise

@@ -1,7 +1,7 @@
 r"""Accuracy of a whole case as an input: ``solver: {accuracy: fast | balanced | fine | {erp_db: x} |
 {amplitude_rel: x}}`` → H, N and the fixed-interface mode count.
 
-1. a stepped solve over a coarse grid (``points`` frequencies) at H = 3, N = 64 (cheap screening);
+1. a stepped solve over a coarse grid (``points`` frequencies) at the case's H, N (screening);
 2. the grid point with the largest a-posteriori estimate (nonlinearity is strongest there) is refined
    by :func:`sarfe.study.accuracy.choose_resolution` (H up until the truncation estimate, then N up
    until the aliasing estimate are each within half the budget);
@@ -20,7 +20,7 @@ import numpy as np
 
 
 def resolve_case_accuracy(case, target, points=8, start_harmonics=3, start_samples=64,
-                          max_harmonics=64, max_samples=8192) -> dict:
+                          max_harmonics=64, max_samples=8192, max_points_tuned=3) -> dict:
     """Choose H, N (and mode count) for ``target`` (see module docstring) → report dict with keys
     harmonics, samples_per_period, mode_count (None for matrices cases), estimate, met, reason,
     frequency_hz, history, seconds, text."""
@@ -28,16 +28,14 @@ def resolve_case_accuracy(case, target, points=8, start_harmonics=3, start_sampl
     from sarfe.pipeline import build_linear_model, nonlinear_model
 
     from .accuracy import choose_resolution, parse_accuracy, resize_harmonics, suggest_mode_count
+
     from .runner import attach_estimates, frequency_grid, solve_grid
 
     clock = time.perf_counter()
     target = parse_accuracy(target)
     case = load_case(case)
     stage = build_linear_model(case)
-    data = copy.deepcopy(case.data)
-    data["solver"]["harmonics"] = int(start_harmonics)
-    data["solver"]["samples_per_period"] = int(max(start_samples, 4 * start_harmonics + 1))
-    screen = load_case(data, base_dir=case.base_dir)
+    screen = case        # screening at the case's own H, N (a coarser pass can miss impacts)
     grid = frequency_grid(case, points)
     pts, _ = solve_grid(screen, stage, grid)
     attach_estimates(screen, stage, pts)
@@ -49,18 +47,43 @@ def resolve_case_accuracy(case, target, points=8, start_harmonics=3, start_sampl
                 "reason": "no grid point converged in the screening pass", "frequency_hz": None,
                 "history": [], "seconds": time.perf_counter() - clock,
                 "text": f"accuracy {target.name}: no grid point converged; case settings kept"}
-    worst = max(converged, key=lambda p: np.nan_to_num(p.get("estimate_amplitude_rel", 0.0)))
+    active = [p for p in converged if p["peak_force_N"] > 0]
+    if not active and any(not p["converged"] for p in pts):
+        note = ("no converged screening point has an active contact (the others did not converge): "
+                "tuned at a linear point, the choice may be too coarse for the impacts")
+    else:
+        note = ""
+    candidates = sorted(active or converged,
+                        key=lambda p: -np.nan_to_num(p.get("estimate_amplitude_rel", 0.0)))
     nl = nonlinear_model(case, stage)
     modal = (np.arange(int(stage.info.get("boundary_dofs", 0)), stage.dof_count)
              if stage.kind == "fe" else None)
-    omega = 2 * np.pi * worst["frequency_hz"]
-    resolution = choose_resolution(target, nl.model, nl.contacts, nl.excitation, omega,
-                                   harmonics=start_harmonics, samples_per_period=start_samples,
-                                   max_harmonics=max_harmonics, max_samples=max_samples,
-                                   erp_map=stage.erp_map, erp_areas=stage.erp_areas,
-                                   modal_dofs=modal,
-                                   initial=resize_harmonics(worst["_solution"].displacement,
-                                                            start_harmonics))
+    solver = case.data["solver"]
+
+    def adapt(point, H0, N0):
+        return choose_resolution(target, nl.model, nl.contacts, nl.excitation,
+                                 2 * np.pi * point["frequency_hz"], harmonics=H0,
+                                 samples_per_period=N0, max_harmonics=max_harmonics,
+                                 max_samples=max_samples, erp_map=stage.erp_map,
+                                 erp_areas=stage.erp_areas, modal_dofs=modal,
+                                 initial=resize_harmonics(point["_solution"].displacement, H0))
+
+    tuned = []
+    for point in candidates[:max_points_tuned]:
+        resolution = adapt(point, start_harmonics, start_samples)
+        lost = (point["peak_force_N"] > 0 and resolution.solution is not None
+                and not np.abs(resolution.solution.contact_force_time).max() > 0)
+        if lost:   # contact vanished from the coarse start: adapt from the case's H, N instead
+            resolution = adapt(point, int(solver["harmonics"]), int(solver["samples_per_period"]))
+            note = (note + "; " if note else "") + (
+                f"{point['frequency_hz']:.2f} Hz: no contact at H = {start_harmonics}, adapted "
+                f"from the case's H = {solver['harmonics']}")
+        tuned.append((point, resolution))
+    # the most demanding tuned point decides
+    worst, resolution = max(tuned, key=lambda t: (t[1].harmonics, t[1].samples_per_period))
+    H_all = max(r.harmonics for _, r in tuned)
+    N_all = max(r.samples_per_period for _, r in tuned)
+    met_all = all(r.met for _, r in tuned)
     mode = None
     if stage.kind == "fe":
         exc = case.data["excitation"]
@@ -68,25 +91,29 @@ def resolve_case_accuracy(case, target, points=8, start_harmonics=3, start_sampl
             exc["sweep"]["start_hz"], exc["sweep"]["end_hz"])
         reduced = stage.reduced
         freqs = getattr(reduced, "mode_frequencies_hz", stage.mode_frequencies_hz)
-        mode = suggest_mode_count(freqs, f_max, resolution.harmonics, target,
+        mode = suggest_mode_count(freqs, f_max, H_all, target,
                                   modal_rel=resolution.estimate.modal_rel,
                                   current=stage.info.get("modes"))
         if mode["mode_count"] >= len(freqs):
             mode["note"] = (f"all {len(freqs)} computed modes are below the cutoff: the linear stage "
                             "computes more when mode_count is set")
     e = resolution.estimate
+    tuned_text = ", ".join(f"{p['frequency_hz']:.2f}" for p, _ in tuned)
     text = (f"accuracy {target.name or 'target'} (amplitude budget {target.amplitude_budget():.2g}):"
-            f" H = {resolution.harmonics}, N = {resolution.samples_per_period}"
+            f" H = {H_all}, N = {N_all}"
             + (f", mode_count = {mode['mode_count']} ({mode['reason']})" if mode else "")
-            + f"\n  tuned at {worst['frequency_hz']:.2f} Hz (largest screening estimate); estimate: "
+            + f"\n  tuned at {tuned_text} Hz "
+            f"(active contacts, largest screening estimates); at {worst['frequency_hz']:.2f} Hz: "
             f"amplitude {e.amplitude_rel:.2e} (H→{e.extended_harmonics}: {e.harmonics_rel:.2e}, "
             f"N→2N: {e.aliasing_rel:.2e}, modes: {e.modal_rel:.2e}), ERP {e.erp_db:.3f} dB"
-            f"\n  {'met' if resolution.met else 'NOT met'}: {resolution.reason} "
-            f"({len(resolution.history)} rounds, {time.perf_counter() - clock:.1f} s)")
-    return {"harmonics": resolution.harmonics, "samples_per_period": resolution.samples_per_period,
+            f"\n  {'met' if met_all else 'NOT met'}: {resolution.reason} "
+            f"({len(resolution.history)} rounds, {time.perf_counter() - clock:.1f} s)"
+            + (f"\n  note: {note}" if note else ""))
+    return {"harmonics": H_all, "samples_per_period": N_all,
+            "tuned_hz": [p["frequency_hz"] for p, _ in tuned],
             "mode_count": None if mode is None else mode["mode_count"], "mode": mode,
-            "estimate": e.as_dict(), "met": resolution.met, "reason": resolution.reason,
-            "frequency_hz": worst["frequency_hz"], "history": resolution.history,
+            "estimate": e.as_dict(), "met": met_all, "reason": resolution.reason,
+            "frequency_hz": worst["frequency_hz"], "history": resolution.history, "note": note,
             "seconds": time.perf_counter() - clock, "text": text}
 
 
