@@ -99,6 +99,8 @@ def resolve_case_accuracy(case, target, points=8, start_harmonics=3, start_sampl
                             "computes more when mode_count is set")
     e = resolution.estimate
     tuned_text = ", ".join(f"{p['frequency_hz']:.2f}" for p, _ in tuned)
+    reason = resolution.reason if met_all else "; ".join(
+        f"{p['frequency_hz']:.2f} Hz: {r.reason}" for p, r in tuned if not r.met)
     text = (f"accuracy {target.name or 'target'} (amplitude budget {target.amplitude_budget():.2g}):"
             f" H = {H_all}, N = {N_all}"
             + (f", mode_count = {mode['mode_count']} ({mode['reason']})" if mode else "")
@@ -106,13 +108,13 @@ def resolve_case_accuracy(case, target, points=8, start_harmonics=3, start_sampl
             f"(active contacts, largest screening estimates); at {worst['frequency_hz']:.2f} Hz: "
             f"amplitude {e.amplitude_rel:.2e} (H→{e.extended_harmonics}: {e.harmonics_rel:.2e}, "
             f"N→2N: {e.aliasing_rel:.2e}, modes: {e.modal_rel:.2e}), ERP {e.erp_db:.3f} dB"
-            f"\n  {'met' if met_all else 'NOT met'}: {resolution.reason} "
+            f"\n  {'met' if met_all else 'NOT met'}: {reason} "
             f"({len(resolution.history)} rounds, {time.perf_counter() - clock:.1f} s)"
             + (f"\n  note: {note}" if note else ""))
     return {"harmonics": H_all, "samples_per_period": N_all,
             "tuned_hz": [p["frequency_hz"] for p, _ in tuned],
             "mode_count": None if mode is None else mode["mode_count"], "mode": mode,
-            "estimate": e.as_dict(), "met": met_all, "reason": resolution.reason,
+            "estimate": e.as_dict(), "met": met_all, "reason": reason,
             "frequency_hz": worst["frequency_hz"], "history": resolution.history, "note": note,
             "seconds": time.perf_counter() - clock, "text": text}
 
