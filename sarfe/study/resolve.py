@@ -20,10 +20,11 @@ import numpy as np
 
 
 def resolve_case_accuracy(case, target, points=8, start_harmonics=3, start_samples=64,
-                          max_harmonics=64, max_samples=8192, max_points_tuned=3) -> dict:
+                          max_harmonics=64, max_samples=8192, max_points_tuned=3,
+                          linear_stage=None) -> dict:
     """Choose H, N (and mode count) for ``target`` (see module docstring) → report dict with keys
     harmonics, samples_per_period, mode_count (None for matrices cases), estimate, met, reason,
-    frequency_hz, history, seconds, text."""
+    frequency_hz, tuned_hz, history, seconds, text, note. ``linear_stage``: reuse a built stage."""
     from sarfe.io.case import load_case
     from sarfe.pipeline import build_linear_model, nonlinear_model
 
@@ -34,7 +35,7 @@ def resolve_case_accuracy(case, target, points=8, start_harmonics=3, start_sampl
     clock = time.perf_counter()
     target = parse_accuracy(target)
     case = load_case(case)
-    stage = build_linear_model(case)
+    stage = linear_stage if linear_stage is not None else build_linear_model(case)
     screen = case        # screening at the case's own H, N (a coarser pass can miss impacts)
     grid = frequency_grid(case, points)
     pts, _ = solve_grid(screen, stage, grid)
