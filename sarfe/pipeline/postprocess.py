@@ -109,6 +109,26 @@ def linear_baseline(case, stage, nl: NonlinearModel, omega):
             "erp_level_dba": float(erp.level_total_a_db), "contacts": contacts}
 
 
+def _error_estimate(case, stage, nl, solution):
+    """Cheap a-posteriori error estimate of a converged point (sarfe.study.accuracy): harmonic
+    truncation (one Newton step with more harmonics), AFT aliasing (N doubled), modal truncation,
+    spectral tails. None when switched off, not converged or without contacts; a failure of the
+    estimate is reported, never raised."""
+    if not case.data["solver"].get("error_estimate", True) or not solution.converged \
+            or not nl.contacts.count:
+        return None
+    try:
+        from sarfe.study.accuracy import estimate_errors
+
+        modal = (np.arange(int(stage.info.get("boundary_dofs", 0)), stage.dof_count)
+                 if stage.kind == "fe" else None)
+        return estimate_errors(solution, nl.model, nl.contacts, nl.excitation,
+                               erp_map=stage.erp_map, erp_areas=stage.erp_areas,
+                               modal_dofs=modal).as_dict()
+    except Exception as error:  # an estimate must not break a solve
+        return {"failed": f"{type(error).__name__}: {error}"}
+
+
 def point_record(case, stage, nl, index, solution):
     omega = float(solution.omega)
     erp, W = _erp(case, stage, solution.displacement, omega)
@@ -122,6 +142,7 @@ def point_record(case, stage, nl, index, solution):
         "residual_norm": float(getattr(solution, "residual_norm", float("nan"))),
         "reason": str(getattr(solution, "reason", "")),
         "erp": _erp_dict(erp), "contacts": contacts, "linear": linear,
+        "error_estimate": _error_estimate(case, stage, nl, solution),
     }
     row = {"case": case.name, "point": index, "frequency_hz": point["frequency_hz"],
            "converged": point["converged"], "stable": point["stable"],

@@ -49,6 +49,20 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     started = time.perf_counter()
     case = load_case(case)
     timings = {}
+    accuracy = None
+    if "accuracy" in case.data["solver"]:
+        # accuracy as an input: choose H, N (and mode count) from cheap error estimates first
+        from sarfe.study.resolve import apply_resolution, resolve_case_accuracy
+
+        clock = time.perf_counter()
+        report = resolve_case_accuracy(case, case.data["solver"]["accuracy"])
+        accuracy = {k: report.get(k) for k in ("harmonics", "samples_per_period", "mode_count",
+                                               "estimate", "met", "reason", "tuned_hz")}
+        accuracy["target"] = case.data["solver"]["accuracy"]
+        case = load_case(apply_resolution(case.data, report), base_dir=case.base_dir)
+        linear_stage = None if (linear_stage is not None
+                                and linear_stage.key != linear_model_key(case)) else linear_stage
+        timings["accuracy_s"] = time.perf_counter() - clock
     if linear_stage is None:
         linear_stage = build_linear_model(case, progress=progress)
         timings.update(linear_stage.timings)
@@ -99,6 +113,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
                      for name, kind, idx in nl.groups],
         "points": points,
         "worst": worst_of(points),
+        "accuracy": accuracy,                    # None unless solver.accuracy was given
         "timings_s": timings,
         "case_data": case.data,                  # the case with every default filled in
     }
