@@ -8,6 +8,6 @@ cd "$(dirname "$0")/../.."
   echo
   cat docs/outputs.md
   for part in meshes fe reduction hbm verification study batch benchmarks dependencies; do
-    [ -f "docs/$part.md" ] && { echo; cat "docs/$part.md"; }
+    if [ -f "docs/$part.md" ]; then echo; cat "docs/$part.md"; fi
   done
 } > README.md
