@@ -202,7 +202,10 @@ def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, blo
     cutoff_omega2 = (2 * np.pi * cutoff_hz) ** 2 if cutoff_hz is not None else np.inf
     target = mode_count if mode_count is not None else n
     q, mq = _m_orthonormal(operator(mass_ii @ rng.standard_normal((n, block_size))), mass_ii)
-    capacity = min(n, max(4 * block_size, 2 * min(target, n) + 2 * block_size))
+    # initial Krylov store: from the mode count, or a modest guess for a cutoff (it grows by
+    # doubling below) — never n columns up front, which is two dense n×n arrays
+    guess = min(target, n) if mode_count is not None else 64
+    capacity = min(n, max(4 * block_size, 2 * guess + 2 * block_size))
     store, mass_store = np.empty((n, capacity)), np.empty((n, capacity))  # Q, M Q preallocated
     m_new = q.shape[1]
     store[:, :m_new], mass_store[:, :m_new] = q, mq
