@@ -62,7 +62,11 @@ def write_outputs(case, stage, nl, summary, rows, solutions, erps, normal_w, dir
         markers = outputs.contact_markers(mesh.n_nodes, [g.nodes_a for g in stage.contacts.values()])
         data = []
         for s, e, W in zip(solutions, erps, normal_w):
+            # full-field recovery only because a VTU was asked for: translations (2H+1, n, 3) [m]
+            u = recover_displacement(stage.reduced, np.asarray(s.displacement), all_dofs=True)
+            translations = u.reshape(u.shape[0], mesh.n_nodes, 6)[:, :, :3]
             data.append(outputs.erp_point_data(mesh.n_nodes, e, W, float(s.omega),
+                                               displacement=translations,
                                                radiating_nodes=stage.erp_nodes,
                                                contact_marker=markers))
         if "erp_vtu" in files:

@@ -162,7 +162,7 @@ def erp_point_data(n_points: int, erp, normal_displacement, omega: float, displa
     data["normal_velocity_amplitude_m_s"] = full
     W = np.asarray(normal_displacement, dtype=float)
     full = np.zeros(n)
-    full[nodes] = np.abs(period_samples(W, max(64, 8 * velocity.shape[0])) - W[0]).max(axis=0)
+    full[nodes] = np.abs(period_samples(W, max(64, 16 * velocity.shape[0])) - W[0]).max(axis=0)
     data["normal_displacement_amplitude_m"] = full
     if displacement is None:
         data["displacement_amplitude_m"] = np.zeros((n, 3))
