@@ -15,12 +15,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from sarfe.mesh import geometry
+
 __all__ = ["triangle_area_vectors", "nodal_areas", "nodal_normals", "normal_displacement",
            "nodal_translations"]
 
 
-def triangle_area_vectors(points, triangles) -> np.ndarray:
-    """s_t = ½ (x_b − x_a) × (x_c − x_a) [m²], shape (n_tri, 3); points (n, 3) [m], triangles (n_tri, 3)."""
+def _checked(points, triangles):
     x = np.asarray(points, dtype=float)
     tri = np.asarray(triangles, dtype=int)
     if x.ndim != 2 or x.shape[1] != 3:
@@ -29,26 +30,23 @@ def triangle_area_vectors(points, triangles) -> np.ndarray:
         raise ValueError(f"triangles must be (n_tri, 3), got {tri.shape}")
     if tri.size and (tri.min() < 0 or tri.max() >= x.shape[0]):
         raise ValueError("triangles refer to points that do not exist")
-    return 0.5 * np.cross(x[tri[:, 1]] - x[tri[:, 0]], x[tri[:, 2]] - x[tri[:, 0]])
+    return x, tri
+
+
+def triangle_area_vectors(points, triangles) -> np.ndarray:
+    """s_t = ½ (x_b − x_a) × (x_c − x_a) [m²], shape (n_tri, 3) (sarfe.mesh.geometry, with checks)."""
+    return geometry.triangle_area_vectors(*_checked(points, triangles))
 
 
 def nodal_areas(points, triangles) -> np.ndarray:
     """Lumped nodal areas A_i = Σ_{t ∋ i} |s_t| / 3 [m²], shape (n,) (0 for unused points)."""
-    tri = np.asarray(triangles, dtype=int)
-    area = np.linalg.norm(triangle_area_vectors(points, tri), axis=1)
-    return np.bincount(tri.ravel(), weights=np.repeat(area / 3.0, 3),
-                       minlength=np.asarray(points).shape[0])
+    return geometry.nodal_areas(*_checked(points, triangles))
 
 
 def nodal_normals(points, triangles) -> np.ndarray:
-    """Area-weighted unit nodal normals n_i, shape (n, 3); zero rows for points on no triangle."""
-    tri = np.asarray(triangles, dtype=int)
-    s = triangle_area_vectors(points, tri)
-    n_points = np.asarray(points).shape[0]
-    summed = np.stack([np.bincount(tri.ravel(), weights=np.repeat(s[:, j], 3), minlength=n_points)
-                       for j in range(3)], axis=1)
-    norm = np.linalg.norm(summed, axis=1, keepdims=True)
-    return np.divide(summed, norm, out=np.zeros_like(summed), where=norm > 0)
+    """Area-weighted unit nodal normals n_i following the triangle winding, shape (n, 3); zero rows
+    for points on no triangle (sarfe.mesh.geometry.node_normals without re-orientation)."""
+    return geometry.node_normals(*_checked(points, triangles), orient=False)
 
 
 def normal_displacement(displacement, normals) -> np.ndarray:
