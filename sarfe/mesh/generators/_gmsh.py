@@ -45,6 +45,17 @@ def add_group(gmsh, dim: int, tags, name: str) -> None:
     gmsh.model.addPhysicalGroup(dim, tags, name=name)
 
 
+def add_rig_clamps(gmsh, x_clamp: float, y: float, z: float, half_width: float, plate: int) -> None:
+    """Test-rig supports: ``clamp_beam`` = the strip's edge curve at x = x_clamp (height z, within
+    ±half_width of y), ``clamp_plate`` = every boundary curve of the plate surface."""
+    eps = 1e-6
+    clamp_beam = [t for _, t in gmsh.model.getEntitiesInBoundingBox(
+        x_clamp - eps, y - half_width, z - eps, x_clamp + eps, y + half_width, z + eps, 1)]
+    clamp_plate = [t for _, t in gmsh.model.getBoundary([(2, plate)], oriented=False)]
+    add_group(gmsh, 1, clamp_beam, "clamp_beam")
+    add_group(gmsh, 1, clamp_plate, "clamp_plate")
+
+
 def embed_points(gmsh, surface: int, coordinates) -> list[int]:
     """Add points (k, 3) [m] and embed them in `surface` so they become mesh nodes.
 

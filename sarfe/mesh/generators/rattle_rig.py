@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from ...mesh.gmsh_model import gmsh_session
 from ..mesh import PanelMesh
-from ._gmsh import add_group, embed_points, finish, set_mesh_size
+from ._gmsh import add_group, add_rig_clamps, embed_points, finish, set_mesh_size
 
 DEFAULTS = dict(plate_size=0.15, beam_length=0.2, beam_width=0.02, gap=0.5e-3,
                 tip_x=0.03, tip_y=0.02, striker_inset=0.005, excite_fraction=0.75)
@@ -41,12 +41,7 @@ def generate(mesh_size: float = 0.005, path=None, plate_size: float = 0.15,
         (tip_a,) = embed_points(gmsh, beam, [(*striker, gap)])
         (tip_b,) = embed_points(gmsh, plate, [(*striker, 0.0)])
         (excite,) = embed_points(gmsh, beam, [(x_clamp + excite_fraction * beam_length, tip_y, gap)])
-        eps = 1e-6
-        clamp_beam = [t for _, t in gmsh.model.getEntitiesInBoundingBox(
-            x_clamp - eps, tip_y - beam_width, gap - eps, x_clamp + eps, tip_y + beam_width, gap + eps, 1)]
-        clamp_plate = [t for _, t in gmsh.model.getBoundary([(2, plate)], oriented=False)]
-        add_group(gmsh, 1, clamp_beam, "clamp_beam")
-        add_group(gmsh, 1, clamp_plate, "clamp_plate")
+        add_rig_clamps(gmsh, x_clamp, tip_y, gap, beam_width, plate)
         add_group(gmsh, 0, tip_a, "contact_tip_a")
         add_group(gmsh, 0, tip_b, "contact_tip_b")
         add_group(gmsh, 0, excite, "excite_beam")

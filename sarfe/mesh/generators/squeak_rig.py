@@ -19,7 +19,7 @@ import math
 
 from ...mesh.gmsh_model import gmsh_session
 from ..mesh import PanelMesh
-from ._gmsh import add_group, embed_points, finish, refine_ball, set_mesh_size
+from ._gmsh import add_group, add_rig_clamps, embed_points, finish, refine_ball, set_mesh_size
 
 
 def generate(mesh_size: float = 0.005, path=None, plate_size: float = 0.1,
@@ -68,12 +68,7 @@ def generate(mesh_size: float = 0.005, path=None, plate_size: float = 0.1,
             raise RuntimeError("squeak_rig: welding the pad into the strip failed")
         (tip_b,) = embed_points(gmsh, plate, [(pad_x, pad_y, 0.0)])
         (excite,) = embed_points(gmsh, beam[0], [(x_clamp + excite_fraction * beam_length, pad_y, z_beam)])
-        eps = 1e-6
-        clamp_beam = [t for _, t in gmsh.model.getEntitiesInBoundingBox(
-            x_clamp - eps, pad_y - beam_width, z_beam - eps, x_clamp + eps, pad_y + beam_width, z_beam + eps, 1)]
-        clamp_plate = [t for _, t in gmsh.model.getBoundary([(2, plate)], oriented=False)]
-        add_group(gmsh, 1, clamp_beam, "clamp_beam")
-        add_group(gmsh, 1, clamp_plate, "clamp_plate")
+        add_rig_clamps(gmsh, x_clamp, pad_y, z_beam, beam_width, plate)
         add_group(gmsh, 0, apex_tag, "contact_rub_a")
         add_group(gmsh, 0, tip_b, "contact_rub_b")
         add_group(gmsh, 0, excite, "excite_beam")
