@@ -85,12 +85,10 @@ def cmd_verify(args) -> int:
     omega = 2 * np.pi * args.frequency_hz
     from sarfe.pipeline.points import solve_point, solver_options
 
-    engine, options, _ = solver_options(case)
-    if engine is None:
-        raise CaseError("the harmonic-balance engine (sarfe.hbm.solve_frequency) is not installed")
+    options, _ = solver_options(case)
     # HBM as in `sarfe solve` (a failed Newton is retried from a short time integration);
     # the time integration below starts independently from the linear periodic solution.
-    hbm = solve_point(engine, nl, omega, H, N, options, None)
+    hbm = solve_point(nl, omega, H, N, options, None)
     steps = max(512, 4 * N)
     tim = integrate_time(nl.model, nl.contacts, nl.excitation, omega, H, steps_per_period=steps)
     U_h, U_t = np.asarray(hbm.displacement), np.asarray(tim.displacement_harmonics)

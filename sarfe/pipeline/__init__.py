@@ -3,7 +3,7 @@
 Modules: linear (mesh → reduced model, contact geometry, load and ERP maps; the reusable linear
 stage), nonlinear (damping, ContactSet, excitation harmonics), points (HBM per frequency or
 continuation, with fallbacks), postprocess (ERP, contact indicators, linear risk baseline),
-outputs (result files, console table), solve (solve_case), adapters (calls into other parts).
+outputs (result files, console table), solve (solve_case).
 
     load_case(path_or_dict) -> Case                         schema-validated, defaults filled
     linear_model_key(case) -> str                           SHA-256 of the linear stage's inputs

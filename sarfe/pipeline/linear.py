@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import fnmatch
 import hashlib
+import importlib
 import json
 import time
 from dataclasses import dataclass, field
@@ -26,7 +27,6 @@ import scipy.sparse as sp
 
 from sarfe.io.case import Case, load_case
 from sarfe.io.errors import CaseError
-from sarfe.pipeline import adapters
 
 
 @dataclass(frozen=True)
@@ -223,24 +223,31 @@ def _build_matrices(case: Case, progress=False) -> dict:
 
 
 # ------------------------------------------------------------------------------------- FE path
+def _generate_mesh(name, mesh_size, params):
+    """sarfe.mesh.generators.<name>.generate(mesh_size=..., **params) → PanelMesh."""
+    module = importlib.import_module(f"sarfe.mesh.generators.{name}")
+    return module.generate(mesh_size=mesh_size, **params)
+
+
 def load_case_mesh(case: Case):
     """The case's PanelMesh (file or generator), in metres; errors name model.fe.mesh/generator."""
+    from sarfe.mesh import load_mesh
+
     fe = case.data["model"]["fe"]
     if "mesh" in fe:
         path = case.resolve(fe["mesh"])
         try:
-            mesh = adapters.load_mesh_file(path, fe["mesh_units"])
-        except CaseError as exc:
-            raise case.error(exc.message, ("model", "fe", "mesh")) from None
+            mesh = load_mesh(path, length_unit=fe["mesh_units"])
         except Exception as exc:
             raise case.error(f"cannot read mesh file {path}: {exc}", ("model", "fe", "mesh")) from None
         where = ("model", "fe", "mesh_units")
     else:
         gen = fe["generator"]
         try:
-            mesh = adapters.generate_mesh(gen["name"], gen["mesh_size_m"], gen["params"])
-        except CaseError as exc:
-            raise case.error(exc.message, ("model", "fe", "generator", "name")) from None
+            mesh = _generate_mesh(gen["name"], gen["mesh_size_m"], gen["params"])
+        except ImportError as exc:
+            raise case.error(f"mesh generator '{gen['name']}' is not available ({exc})",
+                             ("model", "fe", "generator", "name")) from None
         except TypeError as exc:
             raise case.error(f"generator rejected a parameter: {exc}",
                              ("model", "fe", "generator", "params")) from None

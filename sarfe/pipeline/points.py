@@ -7,28 +7,49 @@ from __future__ import annotations
 import dataclasses
 import math
 import sys
+from types import SimpleNamespace
 
 import numpy as np
 
-from sarfe.pipeline import adapters
 from sarfe.pipeline.nonlinear import NonlinearModel
-
-# (pyFFTW axis-0 planner issue now handled in sarfe.hbm.harmonics itself)
 
 
 def solver_options(case):
+    """(SolverOptions, ContinuationOptions) from the case's ``solver`` section."""
+    from sarfe.hbm import ContinuationOptions, SolverOptions
+
     solver = case.data["solver"]
-    engine = adapters.hbm_engine()
-    if engine is None:
-        return None, None, None
-    _, _, SolverOptions, ContinuationOptions = engine
-    values = {"tolerance": solver["tolerance"], "max_iterations": solver["max_iterations"],
-              "stability": solver["stability"]}
-    options = adapters.make_options(SolverOptions, values)
+    options = SolverOptions(tolerance=solver["tolerance"], max_iterations=solver["max_iterations"],
+                            stability=solver["stability"])
     cont = solver["continuation"]
-    cvalues = dict(initial_step=cont["initial_step"], min_step=cont["min_step"],
-                   max_step=cont["max_step"], max_points=cont["max_points"], solver=options)
-    return engine, options, adapters.make_options(ContinuationOptions, cvalues)
+    return options, ContinuationOptions(initial_step=cont["initial_step"], min_step=cont["min_step"],
+                                        max_step=cont["max_step"], max_points=cont["max_points"],
+                                        solver=options)
+
+
+def time_integration_point(model, contacts, excitation, omega, harmonics, samples_per_period,
+                           initial=None, max_periods=400):
+    """A HarmonicSolution look-alike from time integration: the start guess of a retry
+    (``max_periods`` small, the state need not be steady) or the stand-in for a point whose
+    engine call raised."""
+    from sarfe.hbm.harmonics import harmonic_coefficients
+    from sarfe.hbm.time_integration import integrate_time
+
+    steps = max(int(samples_per_period), 256)
+    response = integrate_time(model, contacts, excitation, omega, harmonics,
+                              steps_per_period=steps, max_periods=max_periods, initial=initial)
+    return SimpleNamespace(
+        omega=float(omega), harmonics=int(harmonics), samples_per_period=steps,
+        displacement=response.displacement_harmonics,
+        contact_displacement=harmonic_coefficients(response.contact_displacement, harmonics),
+        contact_force=response.contact_force_harmonics,
+        contact_force_time=response.contact_force,
+        contact_state=response.contact_state,
+        converged=bool(response.steady),
+        reason="time integration reached a periodic state" if response.steady
+        else "time integration did not reach a periodic state",
+        iterations=int(response.periods), residual_norm=float(response.periodicity_error),
+        friction_passes=0, stable=None, floquet_exponent=float("nan"))
 
 
 def _bar(progress, total, description):
@@ -53,29 +74,29 @@ def linear_solution(nl: NonlinearModel, omega, H, N):
         residual_norm=0.0)
 
 
-def solve_point(engine, nl, omega, H, N, options, previous):
+def solve_point(nl, omega, H, N, options, previous):
     """One HBM point; on failure retry once from a short time integration (its end state).
 
     An engine exception or a point that still fails is returned with ``converged=False`` and the
     reason (the time-integration state stands in when the engine raised), never dropped.
     """
+    from sarfe.hbm import solve_frequency
+
     contacts = nl.contacts
     if not contacts.count:
         return linear_solution(nl, omega, H, N)
-    if engine is None:
-        return adapters.time_integration_point(nl.model, contacts, nl.excitation, omega, H, N)
     error = None
     try:
-        solution = engine[0](nl.model, contacts, nl.excitation, omega, H, N, initial=previous,
+        solution = solve_frequency(nl.model, contacts, nl.excitation, omega, H, N, initial=previous,
                              options=options)
     except Exception as exc:  # an engine failure must not lose the other points
         solution, error = None, exc
     if solution is not None and (solution.converged or not contacts.count):
         return solution
-    guess = adapters.time_integration_point(nl.model, contacts, nl.excitation, omega, H, N,
+    guess = time_integration_point(nl.model, contacts, nl.excitation, omega, H, N,
                                             max_periods=40)
     try:
-        retry = engine[0](nl.model, contacts, nl.excitation, omega, H, N,
+        retry = solve_frequency(nl.model, contacts, nl.excitation, omega, H, N,
                           initial=guess.displacement, options=options)
         if retry.converged:
             return retry
@@ -89,7 +110,7 @@ def solve_point(engine, nl, omega, H, N, options, previous):
     return solution
 
 
-def finish_sweep(engine, nl, solutions, start, end, H, N, options, step):
+def finish_sweep(nl, solutions, start, end, H, N, options, step):
     """Repair a continuation result: a point whose corrector failed is re-solved at its fixed ω
     (starting from it); a sweep that stopped before ``end`` is completed point by point
     (natural-parameter steps of ``step``·|end − start| from the last converged point). Such points
@@ -98,7 +119,7 @@ def finish_sweep(engine, nl, solutions, start, end, H, N, options, step):
         return solutions
     for i, solution in enumerate(solutions):  # polish corrector failures at fixed ω
         if not solution.converged:
-            retry = solve_point(engine, nl, float(solution.omega), H, N, options, solution)
+            retry = solve_point(nl, float(solution.omega), H, N, options, solution)
             if retry.converged:
                 solutions[i] = dataclasses.replace(
                     retry, reason=f"{retry.reason} (re-solved at fixed frequency after the "
@@ -112,34 +133,36 @@ def finish_sweep(engine, nl, solutions, start, end, H, N, options, step):
     count = max(2, int(math.ceil(abs(end - last) / (step * span))) + 1)
     previous = next((s for s in reversed(solutions) if s.converged), None)
     for omega in np.linspace(last, end, count)[1:]:
-        solution = solve_point(engine, nl, float(omega), H, N, options, previous)
+        solution = solve_point(nl, float(omega), H, N, options, previous)
         try:
             solution = dataclasses.replace(
                 solution, reason=f"{solution.reason} (point-by-point after the continuation stopped)")
         except TypeError:
             solution.reason += " (point-by-point after the continuation stopped)"
         solutions.append(solution)
-        if solution.converged and not isinstance(solution, adapters.SimpleNamespace):
+        if solution.converged and not isinstance(solution, SimpleNamespace):
             previous = solution
     return solutions
 
 
 def solve_points(case, nl: NonlinearModel, progress=False):
     """HarmonicSolution per frequency point (listed frequencies in order, or a continuation)."""
+    from sarfe.hbm import continuation
+
     solver, exc = case.data["solver"], case.data["excitation"]
     H, N = solver["harmonics"], solver["samples_per_period"]
-    engine, options, cont_options = solver_options(case)
+    options, cont_options = solver_options(case)
     contacts = nl.contacts
     if "sweep" in exc:
         start, end = (2 * np.pi * exc["sweep"][k] for k in ("start_hz", "end_hz"))
-        if engine is not None and contacts.count:
+        if contacts.count:
             bar = _bar(progress, None, "sweep")
             try:
-                solutions = list(engine[1](nl.model, contacts, nl.excitation, start, end, H, N,
+                solutions = list(continuation(nl.model, contacts, nl.excitation, start, end, H, N,
                                            options=cont_options,
                                            progress=(lambda done, total: bar.update(1))
                                            if bar is not None else None))
-                return finish_sweep(engine, nl, solutions, start, end, H, N, options,
+                return finish_sweep(nl, solutions, start, end, H, N, options,
                                      solver["continuation"]["initial_step"])
             except Exception as error:  # fall back to a point-by-point sweep
                 import warnings
@@ -156,10 +179,10 @@ def solve_points(case, nl: NonlinearModel, progress=False):
     bar = _bar(progress, len(omegas), "frequencies")
     try:
         for omega in omegas:
-            solution = solve_point(engine, nl, float(omega), H, N, options, previous)
+            solution = solve_point(nl, float(omega), H, N, options, previous)
             solutions.append(solution)
             previous = solution if getattr(solution, "converged", False) and not isinstance(
-                solution, adapters.SimpleNamespace) else None
+                solution, SimpleNamespace) else None
             if bar is not None:
                 bar.update(1)
     finally:

@@ -15,7 +15,6 @@ import numpy as np
 
 from sarfe.io.case import load_case
 from sarfe.io.errors import EXIT_NOT_CONVERGED
-from sarfe.pipeline import adapters
 from sarfe.pipeline.linear import build_linear_model, linear_model_key
 from sarfe.pipeline.nonlinear import NonlinearModel, nonlinear_model
 from sarfe.pipeline.outputs import replace_directory, write_outputs, results_table
@@ -93,7 +92,6 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         span = abs(sweep["end_hz"] - sweep["start_hz"])
         sweep_complete = abs(points[-1]["frequency_hz"] - sweep["end_hz"]) <= 1e-3 * span
     exit_code = EXIT_NOT_CONVERGED if (not_converged or not points or sweep_complete is False) else 0
-    engine = "harmonic balance" if adapters.hbm_engine() else "time integration (no HBM engine)"
     summary = {
         "sarfe_version": __version__,
         "case": case.name,
@@ -104,7 +102,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         "non_converged_points": not_converged,
         "sweep_complete": sweep_complete,        # None without a sweep; False → exit code 3
         "sweep_stop_reason": (points[-1]["reason"] if sweep_complete is False else None),
-        "engine": engine,
+        "engine": "harmonic balance",
         "linear_model_key": stage.key,
         "model": dict(stage.info, kind=stage.kind, kept_dofs=int(stage.dof_count),
                       mode_frequencies_hz=np.asarray(stage.mode_frequencies_hz)[:50]),
