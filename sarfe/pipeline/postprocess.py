@@ -118,13 +118,9 @@ def _error_estimate(case, stage, nl, solution):
             or not nl.contacts.count:
         return None
     try:
-        from sarfe.study.accuracy import estimate_errors
+        from sarfe.study.accuracy import stage_error_estimate
 
-        modal = (np.arange(int(stage.info.get("boundary_dofs", 0)), stage.dof_count)
-                 if stage.kind == "fe" else None)
-        return estimate_errors(solution, nl.model, nl.contacts, nl.excitation,
-                               erp_map=stage.erp_map, erp_areas=stage.erp_areas,
-                               modal_dofs=modal).as_dict()
+        return stage_error_estimate(solution, stage, nl).as_dict()
     except Exception as error:  # an estimate must not break a solve
         return {"failed": f"{type(error).__name__}: {error}"}
 

@@ -328,6 +328,16 @@ class Resolution:
     history: list
 
 
+def stage_error_estimate(solution, stage, nl) -> ErrorEstimate:
+    """:func:`estimate_errors` of a case's point: the problem ``nl`` (sarfe.pipeline.nonlinear_model)
+    on the linear ``stage``, its ERP map and areas, and for FE stages the modal coordinates (the
+    reduced DOFs after the Craig–Bampton boundary DOFs) as the modal-truncation candidates."""
+    modal = (np.arange(int(stage.info.get("boundary_dofs", 0)), stage.dof_count)
+             if stage.kind == "fe" else None)
+    return estimate_errors(solution, nl.model, nl.contacts, nl.excitation, erp_map=stage.erp_map,
+                           erp_areas=stage.erp_areas, modal_dofs=modal)
+
+
 def choose_resolution(target, model, contacts, excitation, omega, *, harmonics=3,
                       samples_per_period=64, max_harmonics=64, max_samples=8192, max_rounds=12,
                       erp_map=None, erp_areas=None, modal_dofs=None, options=None,
@@ -435,5 +445,5 @@ def suggest_mode_count(mode_frequencies_hz, max_frequency_hz, harmonics, target=
 
 __all__ = ["SAFETY", "PRESETS", "AccuracyTarget", "parse_accuracy", "ErrorEstimate", "Resolution",
            "resize_harmonics", "spectral_tail", "harmonic_energy", "newton_correction",
-           "extended_harmonics", "samples_for", "estimate_errors", "choose_resolution",
+           "extended_harmonics", "samples_for", "estimate_errors", "stage_error_estimate", "choose_resolution",
            "suggest_mode_count"]

@@ -227,17 +227,14 @@ def attach_estimates(case, stage, points):
     """estimate_errors at every converged grid point (adds estimate_amplitude_rel / _erp_db)."""
     from sarfe.pipeline import nonlinear_model
 
-    from .accuracy import estimate_errors
+    from .accuracy import stage_error_estimate
 
     nl = nonlinear_model(case, stage)
-    modal = (np.arange(int(stage.info.get("boundary_dofs", 0)), stage.dof_count)
-             if stage.kind == "fe" else None)
     for p in points:
         s = p.get("_solution")
         if s is None or not s.converged:
             continue
-        e = estimate_errors(s, nl.model, nl.contacts, nl.excitation, erp_map=stage.erp_map,
-                            erp_areas=stage.erp_areas, modal_dofs=modal)
+        e = stage_error_estimate(s, stage, nl)
         p["estimate_amplitude_rel"] = e.amplitude_rel
         p["estimate_erp_db"] = e.erp_db
         p["estimate_harmonics_rel"] = e.harmonics_rel
