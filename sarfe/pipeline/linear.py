@@ -531,7 +531,8 @@ def _build_fe(case: Case, progress=False) -> dict:
 
 
 def _bar(progress, description, total, unit="block"):
-    """A tqdm bar on stderr, or None (no progress wanted, or stderr is not a terminal)."""
+    """A tqdm bar on stderr, or None (no progress wanted, or stderr is not a terminal); shared by
+    the linear stage and the frequency points."""
     import sys
 
     if not progress or not sys.stderr.isatty():

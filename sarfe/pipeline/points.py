@@ -6,11 +6,11 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import sys
 from types import SimpleNamespace
 
 import numpy as np
 
+from sarfe.pipeline.linear import _bar
 from sarfe.pipeline.nonlinear import NonlinearModel
 
 
@@ -50,13 +50,6 @@ def time_integration_point(model, contacts, excitation, omega, harmonics, sample
         else "time integration did not reach a periodic state",
         iterations=int(response.periods), residual_norm=float(response.periodicity_error),
         friction_passes=0, stable=None, floquet_exponent=float("nan"))
-
-
-def _bar(progress, total, description):
-    if not progress or not sys.stderr.isatty():
-        return None
-    from tqdm import tqdm
-    return tqdm(total=total, desc=description, unit="point", leave=False)
 
 
 def linear_solution(nl: NonlinearModel, omega, H, N):
@@ -156,7 +149,7 @@ def solve_points(case, nl: NonlinearModel, progress=False):
     if "sweep" in exc:
         start, end = (2 * np.pi * exc["sweep"][k] for k in ("start_hz", "end_hz"))
         if contacts.count:
-            bar = _bar(progress, None, "sweep")
+            bar = _bar(progress, "sweep", None, unit="point")
             try:
                 solutions = list(continuation(nl.model, contacts, nl.excitation, start, end, H, N,
                                            options=cont_options,
@@ -176,7 +169,7 @@ def solve_points(case, nl: NonlinearModel, progress=False):
     else:
         omegas = 2 * np.pi * np.asarray(exc["frequency_hz"], dtype=float)
     solutions, previous = [], None
-    bar = _bar(progress, len(omegas), "frequencies")
+    bar = _bar(progress, "frequencies", len(omegas), unit="point")
     try:
         for omega in omegas:
             solution = solve_point(nl, float(omega), H, N, options, previous)
