@@ -429,6 +429,7 @@ def _normalize_reduction(case, data):
     _only_one(case, red, ("reduction",), ("mode_count", "cutoff_hz"), required=False)
     red.setdefault("cutoff_margin", 1.5)
     red.setdefault("min_mode_count", 10)
+    red.setdefault("residual_vectors", True)
 
 
 def _normalize_erp(case, data):

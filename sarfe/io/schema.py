@@ -78,6 +78,7 @@ REDUCTION = _object({
     "cutoff_hz": POSITIVE,
     "cutoff_margin": {"type": "number", "minimum": 1},
     "min_mode_count": {"type": "integer", "minimum": 0},
+    "residual_vectors": {"type": "boolean"},
 })
 
 CONTACT = _object({

@@ -455,15 +455,25 @@ def _build_fe(case: Case, progress=False) -> dict:
     boundary_positions = position[(6 * boundary_nodes[:, None] + np.arange(3)).ravel()]
     boundary_positions = boundary_positions[boundary_positions >= 0]
 
+    base_load = None
+    if "base_acceleration" in exc:   # −M ι per unit base acceleration [N per m/s²] on the free DOFs
+        iota = np.zeros(6 * n_nodes)
+        for comp in range(3):
+            iota[6 * np.arange(n_nodes) + comp] = exc["base_acceleration"]["direction"][comp]
+        base_load = -(m_ff @ iota[free])
+
     clock = time.perf_counter()
     red = data["reduction"]
+    residual = red.get("residual_vectors", True)
     cutoff = red.get("cutoff_hz", None if "mode_count" in red else default_cutoff_hz(case))
     bar = _bar(progress, "Craig-Bampton mode blocks", None)
     try:
         def reduce(mode_count, cutoff_hz):
             return craig_bampton(k_ff, m_ff, boundary_positions, mode_count=mode_count,
                                  cutoff_hz=cutoff_hz, progress=(lambda done, total: bar.update(1))
-                                 if bar is not None else None, free_dofs=free, total_dof_count=6 * n_nodes)
+                                 if bar is not None else None, free_dofs=free, total_dof_count=6 * n_nodes,
+                                 residual_vectors=residual,
+                                 residual_loads=base_load if residual else None)
         reduced = reduce(red.get("mode_count"), cutoff)
         if "mode_count" not in red and reduced.mode_count < red["min_mode_count"]:
             # a cutoff below the first fixed-interface modes leaves only static condensation
@@ -502,11 +512,8 @@ def _build_fe(case: Case, progress=False) -> dict:
             ok = c[:, comp] >= 0
             np.add.at(loads[i], c[ok, comp], direction[comp] / len(nodes))
     base = None
-    if "base_acceleration" in exc:
-        iota = np.zeros(6 * n_nodes)
-        for comp in range(3):
-            iota[6 * np.arange(n_nodes) + comp] = exc["base_acceleration"]["direction"][comp]
-        f = -(m_ff @ iota[free])
+    if base_load is not None:
+        f = base_load
         base = np.zeros(n_r)
         base[:n_b] = f[reduced.boundary_dofs]
         base += reduced.interior_basis.T @ f[reduced.interior_dofs]
@@ -520,7 +527,8 @@ def _build_fe(case: Case, progress=False) -> dict:
     info = {"nodes": int(n_nodes), "triangles": int(mesh.n_triangles),
             "total_dofs": int(6 * n_nodes), "free_dofs": int(len(free)),
             "fixed_nodes": int(len(fixed_nodes)), "boundary_dofs": int(n_b),
-            "modes": int(reduced.mode_count), "reduced_dofs": int(n_r),
+            "modes": int(reduced.mode_count), "residual_vectors": int(reduced.residual_vector_count),
+            "reduced_dofs": int(n_r),
             "cutoff_hz": None if cutoff is None else float(cutoff),
             "radiating_nodes": int(len(erp_nodes)), "radiating_area_m2": float(areas.sum()),
             "linear_solver": reduced.solver}

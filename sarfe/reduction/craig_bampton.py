@@ -18,8 +18,22 @@ default a block Lanczos on K_ii⁻¹ M_ii whose steps are multi-RHS solves; alte
 modes are found in blocks, each run on the operator deflated of the modes already found,
 (I − Φ Φᵀ M_ii) K_ii⁻¹, until the highest frequency found exceeds the cutoff.
 
-Reduced coordinates q = [q_b (n_b, physical, in ``boundary_dofs`` order), q_m (n_m, modal)].
-Units: K [N/m], M [kg], frequencies [Hz].
+Residual vectors (optional, like Nastran's RESVEC): the modes above the cutoff are missing, and
+their quasi-static share of the interior response to the boundary's inertia loads is not in Ψ.
+With the interior load of unit boundary accelerations, F_i = M_ib + M_ii Ψ (plus any other interior
+load columns given, e.g. −M_ii ι_i for base excitation), the static responses
+
+    R₀ = K_ii⁻¹ F_i  (the same factor of K_ii; one block solve with n_b columns)
+
+are M_ii-orthogonalized against Φ and each other, and a Rayleigh–Ritz step in their span
+(Rᵀ K_ii R y = ω² Rᵀ M_ii R y) turns them into residual modes Φ_r that keep K_r block diagonal
+(Φ_rᵀ K_ii Φ = 0 because Φ holds exact eigenvectors) and M_r's modal block the identity; their Ritz
+frequencies lie above the cutoff. This is the first step of a block Krylov sequence
+{Ψ, K_ii⁻¹M Ψ, …}: it lowers the error of a system mode carried mostly by the constraint modes (an
+in-plane panel mode, say) from O((ω/ω_i)²) to O((ω/ω_i)⁴), ω_i the lowest omitted interior mode.
+
+Reduced coordinates q = [q_b (n_b, physical, in ``boundary_dofs`` order), q_m (n_m, modal),
+q_r (n_r, residual modes)]. Units: K [N/m], M [kg], frequencies [Hz].
 """
 from __future__ import annotations
 
@@ -43,7 +57,8 @@ class ReducedModel:
     boundary_dofs: (n_b,) positions of the boundary DOFs in the free-DOF vector (length
     ``full_dof_count``); interior_dofs: (n_i,) the others, in increasing order.
     interior_basis: (n_i, n_r) = [Ψ, Φ], the interior rows of T (u_i = interior_basis @ q).
-    mode_frequencies_hz: (n_m,) fixed-interface natural frequencies.
+    mode_frequencies_hz: (n_m,) fixed-interface natural frequencies; residual_frequencies_hz:
+    (n_rv,) Ritz frequencies of the residual modes (after the fixed-interface modes in q).
     free_dofs: (full_dof_count,) original (unconstrained) DOF number of each free DOF, or None if the
     free-DOF vector is the original one; total_dof_count: length of the original DOF vector.
     timings: wall seconds per stage (partition, factorization, constraint_modes, normal_modes,
@@ -62,6 +77,7 @@ class ReducedModel:
     total_dof_count: int | None = None
     solver: str = ""
     timings: dict = field(default_factory=dict, compare=False)
+    residual_frequencies_hz: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def boundary_count(self) -> int:
@@ -72,8 +88,12 @@ class ReducedModel:
         return len(self.mode_frequencies_hz)
 
     @property
+    def residual_vector_count(self) -> int:
+        return len(self.residual_frequencies_hz)
+
+    @property
     def reduced_dof_count(self) -> int:
-        return self.boundary_count + self.mode_count
+        return self.boundary_count + self.mode_count + self.residual_vector_count
 
     @property
     def constraint_modes(self) -> np.ndarray:
@@ -83,13 +103,19 @@ class ReducedModel:
     @property
     def fixed_interface_modes(self) -> np.ndarray:
         """Φ (n_i, n_m), mass-normalized on M_ii."""
-        return self.interior_basis[:, self.boundary_count:]
+        return self.interior_basis[:, self.boundary_count:self.boundary_count + self.mode_count]
+
+    @property
+    def residual_modes(self) -> np.ndarray:
+        """Φ_r (n_i, n_rv): residual modes (module docstring), mass-normalized, M- and K-orthogonal to Φ."""
+        return self.interior_basis[:, self.boundary_count + self.mode_count:]
 
     @property
     def size_reduction(self) -> dict:
         """Free DOFs, reduced DOFs, boundary DOFs, modes and the ratio free/reduced."""
         return {"free_dofs": self.full_dof_count, "reduced_dofs": self.reduced_dof_count,
                 "boundary_dofs": self.boundary_count, "modes": self.mode_count,
+                "residual_vectors": self.residual_vector_count,
                 "ratio": self.full_dof_count / max(self.reduced_dof_count, 1)}
 
 
@@ -254,8 +280,40 @@ def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, blo
     return omega2[:wanted], modes
 
 
+def residual_modes(stiffness_ii, mass_ii, operator, loads, modes, relative_tolerance=1e-8):
+    """Residual modes Φ_r from interior loads (module docstring): ω_r² (ascending), Φ_r.
+
+    loads: (n_i, k) interior load columns F_i; operator(F) = K_ii⁻¹ F; modes: Φ (n_i, n_m),
+    Φᵀ M_ii Φ = I. Directions whose M-norm after deflation is below relative_tolerance × their norm
+    before (already in span Φ, or dependent) are dropped.
+    """
+    n = mass_ii.shape[0]
+    if loads.shape[1] == 0:
+        return np.empty(0), np.empty((n, 0))
+    static = operator(np.asarray(loads, dtype=float))
+    norms = np.sqrt(np.einsum("ij,ij->j", static, mass_ii @ static))
+    static = static[:, norms > 0] / norms[norms > 0]  # unit M-norm before deflation
+    for _ in range(2):  # deflate Φ twice (classical Gram–Schmidt, re-orthogonalized)
+        static = static - modes @ (modes.T @ (mass_ii @ static))
+    gram = static.T @ (mass_ii @ static)
+    values, vectors = np.linalg.eigh(0.5 * (gram + gram.T))
+    keep = values > relative_tolerance ** 2   # what is left of a unit column outside span Φ
+    if not keep.any():
+        return np.empty(0), np.empty((n, 0))
+    basis = static @ (vectors[:, keep] / np.sqrt(values[keep]))
+    basis, mass_basis = _m_orthonormal(basis, mass_ii)
+    basis = basis - modes @ (modes.T @ mass_basis)  # last clean-up against Φ
+    basis, _ = _m_orthonormal(basis, mass_ii)
+    if basis.shape[1] == 0:
+        return np.empty(0), np.empty((n, 0))
+    projected = basis.T @ (stiffness_ii @ basis)
+    omega2, rotation = np.linalg.eigh(0.5 * (projected + projected.T))
+    return omega2, basis @ rotation
+
+
 def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=None, solver="auto",
-                  progress=None, free_dofs=None, total_dof_count=None, eigensolver="block") -> ReducedModel:
+                  progress=None, free_dofs=None, total_dof_count=None, eigensolver="block",
+                  residual_vectors=False, residual_loads=None) -> ReducedModel:
     """Craig–Bampton reduction (see module docstring for the equations).
 
     stiffness, mass: (n, n) sparse K [N/m], M [kg] on the free DOFs (fixed DOFs removed, see
@@ -270,6 +328,9 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
     door trim, same frequencies to 1e-15; falls back to ARPACK on tiny interiors) or "arpack"
     (``eigsh`` single-vector shift-invert Lanczos, deflated blocks for a cutoff). free_dofs/total_dof_count: stored for recovery on the original
     DOF numbering (``free_dofs_system``'s third output).
+    residual_vectors: add residual modes for the boundary inertia loads M_ib + M_ii Ψ (module
+    docstring); residual_loads: (n, k) further load columns on the free DOFs whose interior part
+    gets residual modes too (e.g. the base-excitation load −M ι); either needs one extra block solve.
     """
     stiffness, mass = sp.csr_matrix(stiffness), sp.csr_matrix(mass)
     n = stiffness.shape[0]
@@ -324,9 +385,24 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
     else:
         omega2, phi = np.empty(0), np.empty((len(interior), 0))
     lap("normal_modes")
-    timings["operator_applications"] = applications[0]
 
     m_ii_psi = m_ii @ psi
+    loads = []
+    if residual_vectors and len(boundary):
+        loads.append(m_ib + m_ii_psi)
+    if residual_loads is not None:
+        extra = np.asarray(residual_loads, dtype=float)
+        loads.append((extra[:, None] if extra.ndim == 1 else extra)[interior])
+    if loads:
+        omega2_r, phi_r = residual_modes(k_ii, m_ii, inverse, np.hstack(loads), phi)
+    else:
+        omega2_r, phi_r = np.empty(0), np.empty((len(interior), 0))
+    lap("residual_modes")
+    timings["operator_applications"] = applications[0]
+    frequencies = np.sqrt(np.maximum(omega2, 0)) / (2 * np.pi)
+    residual_frequencies = np.sqrt(np.maximum(omega2_r, 0)) / (2 * np.pi)
+    omega2 = np.concatenate([omega2, omega2_r])
+    phi = np.hstack([phi, phi_r])
     k_rbb = k_bb + k_ib.T @ psi
     m_rbb = m_bb + m_ib.T @ psi + psi.T @ m_ib + psi.T @ m_ii_psi
     m_rbm = (m_ib + m_ii_psi).T @ phi
@@ -343,6 +419,7 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
 
     return ReducedModel(
         mass=mass_r, stiffness=stiffness_r, boundary_dofs=boundary, interior_dofs=interior,
-        interior_basis=np.hstack([psi, phi]), mode_frequencies_hz=np.sqrt(np.maximum(omega2, 0)) / (2 * np.pi),
+        interior_basis=np.hstack([psi, phi]), mode_frequencies_hz=frequencies,
+        residual_frequencies_hz=residual_frequencies,
         full_dof_count=n, free_dofs=None if free_dofs is None else np.asarray(free_dofs, dtype=int),
         total_dof_count=total_dof_count, solver=factor.name, timings=timings)
