@@ -231,14 +231,17 @@ def test_residual_modes_receptance_within_one_percent_at_every_peak(plate, enric
 
 def test_residual_modes_structure(plate, enriched, full_frequencies):
     """Residual modes: one per boundary DOF, above the cutoff, M-orthonormal and K-orthogonal to Φ
-    (K_r stays block diagonal), Rayleigh–Ritz bounds kept, statics still exact."""
+    (K_r stays block diagonal up to the Lanczos residual; K_r = Tᵀ K T exactly), Rayleigh–Ritz
+    bounds kept, statics still exact."""
     n_b, n_m = enriched.boundary_count, enriched.mode_count
     assert enriched.residual_vector_count == n_b
     assert enriched.reduced_dof_count == n_b + n_m + n_b
     assert enriched.residual_frequencies_hz.min() > CUTOFF_HZ
     modal = slice(n_b, None)
     omega2 = (2 * np.pi * np.concatenate([enriched.mode_frequencies_hz, enriched.residual_frequencies_hz])) ** 2
-    np.testing.assert_allclose(enriched.stiffness[modal, modal], np.diag(omega2), atol=1e-8 * omega2.max())
+    # diag(ω²) up to the Lanczos residual (1e-8): coupling ≤ 1e-6 of √(ω_i² ω_j²)
+    scale = np.sqrt(np.outer(omega2, omega2))
+    np.testing.assert_allclose(enriched.stiffness[modal, modal] / scale, np.eye(len(omega2)), atol=1e-6)
     np.testing.assert_allclose(enriched.mass[modal, modal], np.eye(len(omega2)), atol=1e-9)
     t = np.zeros((enriched.full_dof_count, enriched.reduced_dof_count))
     t[enriched.boundary_dofs, np.arange(n_b)] = 1.0
