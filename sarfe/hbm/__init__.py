@@ -4,7 +4,8 @@
 
 Modules: harmonics (Fourier convention), contacts (ContactSet), unilateral / friction (laws),
 aft (forces + Jacobian), linear (S(ω), condensation), residual, newton, solve (one ω),
-continuation (pseudo-arclength in ω), stability (Hill), solution (options + result).
+continuation (pseudo-arclength in ω), stability (Hill), solution (options + result), harmonic_set
+(solve a subset of the orders, e.g. odd only, ``harmonic_set='odd' | 'auto'``).
 
 Example (NLvib example 03)::
 

@@ -15,6 +15,12 @@ it needed more or failed (retry), stop below ``min_step``. A corrector that land
 from z_i (branch jumping) counts as failed. The last point is solved at exactly ω_end. x is the
 condensed contact-row vector or all DOFs (see :mod:`sarfe.hbm.solve`); the linear solution with
 contacts linearized at u = 0 is the first guess.
+
+Harmonic sets (``harmonic_set`` or ``options.solver.harmonic_set``, :mod:`sarfe.hbm.harmonic_set`):
+x holds the kept coefficient rows only. With 'auto' the sweep starts on the odd set (unless the
+first point needs all orders) and switches to all orders for the rest of the sweep at the first
+point whose estimate η exceeds ``harmonic_set_tolerance``: that point is re-solved with all orders
+and the tangent is carried over (dropped components zero).
 """
 from __future__ import annotations
 
@@ -23,18 +29,20 @@ from dataclasses import replace
 import numpy as np
 import scipy.sparse as sp
 
+from .harmonic_set import expand_rows, harmonic_set_orders
 from .newton import SingularJacobian, newton, solve_linear
-from .residual import Evaluation
+from .residual import Evaluation, kept_rows
 from .solution import ContinuationOptions
 from .solve import (_check_omega, _solve, finalize, initial_slider, linearized_guess,
-                    make_evaluator, make_problem, slider_acceptor, wants_condensation)
+                    make_evaluator, make_problem, slider_acceptor, solve_auto, wants_condensation)
 
 
 def _bordered(jacobian, d_omega, x_scale, omega_scale, row, row_scale=1.0):
     """[[J x_s, ∂R/∂ω ω_s], [row · row_scale]] (dense or sparse like J)."""
     if sp.issparse(jacobian):
         return sp.bmat([[jacobian * x_scale, sp.csc_matrix(d_omega[:, None] * omega_scale)],
-                        [sp.csr_matrix(row[None] * row_scale), None]], format="csc")
+                        [sp.csr_matrix(row[None, :-1] * row_scale),
+                         sp.csr_matrix(row[None, -1:] * row_scale)]], format="csc")
     return np.block([[jacobian * x_scale, d_omega[:, None] * omega_scale],
                      [row[None] * row_scale]])
 
@@ -49,19 +57,32 @@ def tangent(evaluation, x_scale, omega_scale, previous):
     return t if t @ previous >= 0 else -t
 
 
+def _switch_set(tangent_z, rows_from, harmonics, width, x_scale_from, x_scale_to):
+    """A tangent in scaled unknowns of a harmonic set → the same direction with all rows."""
+    x = expand_rows(tangent_z[:-1] * x_scale_from, rows_from, harmonics, width).ravel()
+    t = np.append(x / x_scale_to, tangent_z[-1])
+    return t / np.linalg.norm(t)
+
+
 def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
-                 samples_per_period, options=None, progress=None):
+                 samples_per_period, options=None, progress=None, harmonic_set=None):
     """Sweep ω from ω_start to ω_end [rad/s] (either direction) → list of HarmonicSolution.
 
     progress(done, total): called after each point with done = covered fraction of the range
     (0…1) and total = 1.0. Points are in continuation order (ω is not monotonic past folds).
+    harmonic_set: None | 'all' | 'odd' | 'auto' | list of orders, replaces
+    ``options.solver.harmonic_set`` when given.
     A failed sweep returns the points found so far; the last one's ``reason`` says why it stopped.
     """
     options = options or ContinuationOptions()
     so = options.solver
+    if harmonic_set is not None:
+        so = replace(so, harmonic_set=harmonic_set)
+    auto = isinstance(so.harmonic_set, str) and so.harmonic_set == "auto"
     corrector = replace(so, max_iterations=min(so.max_iterations, options.corrector_iterations),
                         line_search_steps=min(so.line_search_steps, 3))
-    problem = make_problem(model, contacts, excitation, harmonics, samples_per_period, so)
+    full_problem = make_problem(model, contacts, excitation, harmonics, samples_per_period, so,
+                                None if auto else so.harmonic_set)
     _check_omega(omega_start, "omega_start")
     _check_omega(omega_end, "omega_end")
     if omega_start == omega_end:
@@ -69,10 +90,25 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
     direction = np.sign(omega_end - omega_start)
     span = abs(omega_end - omega_start)
     state = {"slider": None}
-    first = _solve(problem, omega_start, linearized_guess(problem, omega_start), so, homotopy=True)
+    first = (solve_auto(full_problem, omega_start, None, so) if auto else
+             _solve(full_problem, omega_start, linearized_guess(full_problem, omega_start), so,
+                    homotopy=True))
     solutions = [first]
     if not first.converged:
         return solutions
+    problem = replace(full_problem, harmonic_orders=None if first.harmonic_orders is None else
+                      np.asarray(first.harmonic_orders))
+
+    def escalate(point, guess):
+        """'auto': re-solve a point of the odd set whose η is above the tolerance with all orders."""
+        if not (auto and problem.harmonic_orders is not None and point.converged
+                and point.dropped_content > so.harmonic_set_tolerance):
+            return None
+        full = _solve(full_problem, point.omega, guess, so, state["slider"])
+        return replace(full, reason=f"{full.reason} (auto: odd set rejected, dropped content "
+                                    f"η {point.dropped_content:.3g} > "
+                                    f"{so.harmonic_set_tolerance:g}; all orders from here on)")
+
     condensed = wants_condensation(problem, so)
     evaluate, to_x, to_displacement = make_evaluator(problem, condensed)
     state["slider"] = initial_slider(problem, first.displacement)
@@ -130,12 +166,33 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
             fraction = (omega_end - z[-1] * span) / (omega_new - z[-1] * span)
             U_prev = solutions[-1].displacement
             guess = U_prev + fraction * (U_new - U_prev)
-            solutions.append(_solve(problem, omega_end, guess, so, state["slider"]))
+            last = _solve(problem, omega_end, guess, so, state["slider"])
+            solutions.append(escalate(last, last.displacement) or last)
             if progress is not None:
                 progress(1.0, 1.0)
             return solutions
-        solutions.append(finalize(problem, omega_new, U_new, True, "converged", result.iterations,
-                                  state["slider"], so))
+        point = finalize(problem, omega_new, U_new, True, "converged", result.iterations,
+                         state["slider"], so)
+        full = escalate(point, U_new)
+        if full is not None:           # continue with all orders from the re-solved point
+            if not full.converged:
+                solutions.append(full)
+                return stop("the point re-solved with all orders did not converge")
+            rows_from, old_scale, was_condensed = kept_rows(problem), x_scale, condensed
+            problem = full_problem
+            condensed = wants_condensation(problem, so)
+            evaluate, to_x, to_displacement = make_evaluator(problem, condensed)
+            x = to_x(full.displacement)
+            x_scale = max(np.linalg.norm(x), 1e-300)
+            if condensed == was_condensed:
+                width = problem.contacts.row_count if condensed else problem.model.dof_count
+                t = _switch_set(t, rows_from, problem.harmonics, width, old_scale, x_scale)
+            else:                      # other unknowns: restart the orientation along ω
+                t = np.zeros(x.size + 1)
+                t[-1] = direction
+            z_new = np.append(x / x_scale, full.omega / span)
+            point = full
+        solutions.append(point)
         if progress is not None:
             progress(float(np.clip(direction * (omega_new - omega_start) / span, 0, 1)), 1.0)
         if len(solutions) >= options.max_points:

@@ -22,6 +22,9 @@ with (2H+1) n_rows unknowns instead of (2H+1) n. The DOFs are recovered afterwar
 ũ_k = Z_k⁻¹ (f̃_k − Gᵀ λ̃_k). Z_k is factorized once per harmonic and frequency (dense LU, or
 SuperLU when the model is sparse). A singular Z_k (undamped resonance, free-floating structure at
 k = 0) makes :func:`condense` return None so that the caller falls back to the full residual.
+
+With a harmonic set (:mod:`sarfe.hbm.harmonic_set`) only the kept orders k are factorized and C,
+r̃_lin, Y_k hold only their blocks (dropped orders: zero), so the cost falls with the kept count.
 """
 from __future__ import annotations
 
@@ -114,8 +117,9 @@ class Condensation:
     """Dynamic compliance of the contact rows at one ω (see module docstring).
 
     compliance: C (P, P) real, P = (2H+1) n_rows, harmonic-major, block diagonal over harmonics
-    [m/N]; linear_response: r̃_lin (2H+1, n_rows) [m]; admittance: Y_k = Z_k⁻¹ Gᵀ (H+1, n, n_rows)
-    complex; forced: y_k = Z_k⁻¹ f_k (H+1, n) complex.
+    [m/N]; linear_response: r̃_lin (2H+1, n_rows) [m]; admittance: Y_k = Z_k⁻¹ Gᵀ (m, n, n_rows)
+    complex; forced: y_k = Z_k⁻¹ f_k (m, n) complex; orders: the m kept orders k (all 0 … H, or a
+    harmonic set: then P counts the kept rows only and r̃_lin is zero in the dropped rows).
     """
 
     omega: float
@@ -123,33 +127,36 @@ class Condensation:
     linear_response: np.ndarray
     admittance: np.ndarray
     forced: np.ndarray
+    orders: np.ndarray = None
 
 
-def condense(model, gap_map, excitation: np.ndarray, omega: float) -> Condensation | None:
-    """Solve Z_k(ω) [Gᵀ, f_k], k = 0…H, build C = G Z⁻¹ Gᵀ and r̃_lin; None if a Z_k is singular.
+def condense(model, gap_map, excitation: np.ndarray, omega: float,
+             orders=None) -> Condensation | None:
+    """Solve Z_k(ω) [Gᵀ, f_k] for the kept orders k (``orders``, default 0…H), build C = G Z⁻¹ Gᵀ
+    (kept rows only) and r̃_lin; None if a Z_k is singular.
 
-    Dense models: one batched LAPACK solve over the H+1 harmonics (singular when LAPACK says so or
-    when ‖Z_k‖ max|Z_k⁻¹ b| > 10¹³ max|b|); sparse models: one SuperLU per harmonic.
+    Dense models: one batched LAPACK solve over the kept harmonics (singular when LAPACK says so or
+    when ‖Z_k‖ max|Z_k⁻¹ b| > 10¹³ max|b|); sparse models: one SuperLU per kept harmonic.
     """
     F = np.asarray(excitation, dtype=float)
     H = (F.shape[0] - 1) // 2
     G = sp.csr_matrix(gap_map)
     n_rows, n = G.shape
-    k = np.arange(H + 1)
+    k = np.arange(H + 1) if orders is None else np.asarray(orders, dtype=int)
     Gd = G.toarray()
-    rhs = np.empty((H + 1, n, n_rows + 1), dtype=complex)
+    rhs = np.empty((k.size, n, n_rows + 1), dtype=complex)
     rhs[:, :, :n_rows] = Gd.T
-    rhs[:, :, n_rows] = to_complex(F)
+    rhs[:, :, n_rows] = to_complex(F)[k]
     if sp.issparse(model.stiffness):
         solution = np.empty_like(rhs)
         K, M, D = (sp.csc_matrix(a, dtype=complex)
                    for a in (model.stiffness, model.mass, model.damping))
-        for order in k:
+        for i, order in enumerate(k):
             Z = K - (order * omega) ** 2 * M + 1j * order * omega * D
             solve = _factorize(Z)
             if solve is None:
                 return None
-            solution[order] = solve(rhs[order])
+            solution[i] = solve(rhs[i])
     else:
         K, M, D = (np.asarray(a, dtype=float) for a in (model.stiffness, model.mass, model.damping))
         Z = K - ((k * omega) ** 2)[:, None, None] * M + 1j * (k * omega)[:, None, None] * D
@@ -164,28 +171,48 @@ def condense(model, gap_map, excitation: np.ndarray, omega: float) -> Condensati
     if not np.all(np.isfinite(solution)):
         return None
     Y, y = solution[:, :, :n_rows], solution[:, :, n_rows]
-    Ck = Gd @ Y                                            # (H+1, n_rows, n_rows)
-    C = np.zeros((2 * H + 1, n_rows, 2 * H + 1, n_rows))
-    C[0, :, 0, :] = Ck[0].real
-    c, s = 2 * k[1:] - 1, 2 * k[1:]
-    C[c, :, c, :], C[c, :, s, :] = Ck[1:].real, Ck[1:].imag
-    C[s, :, c, :], C[s, :, s, :] = -Ck[1:].imag, Ck[1:].real
-    r_lin = from_complex(y @ Gd.T)
-    P = (2 * H + 1) * n_rows
-    return Condensation(float(omega), C.reshape(P, P), r_lin, Y, y)
+    Ck = Gd @ Y                                            # (m, n_rows, n_rows)
+    # kept rows (orders sorted) in harmonic-major order: the mean if kept, then (cos, sin) per k
+    mean = k == 0
+    first = int(mean.any())
+    P_k = first + 2 * int((~mean).sum())
+    C = np.zeros((P_k, n_rows, P_k, n_rows))
+    if first:
+        C[0, :, 0, :] = Ck[mean][0].real
+    c = np.arange(first, P_k, 2)
+    s = c + 1
+    C[c, :, c, :], C[c, :, s, :] = Ck[~mean].real, Ck[~mean].imag
+    C[s, :, c, :], C[s, :, s, :] = -Ck[~mean].imag, Ck[~mean].real
+    lin = np.zeros((H + 1, n_rows), dtype=complex)
+    lin[k] = y @ Gd.T
+    r_lin = from_complex(lin)
+    return Condensation(float(omega), C.reshape(P_k * n_rows, P_k * n_rows), r_lin, Y, y, k)
+
+
+def _kept_orders(condensation, H):
+    return np.arange(H + 1) if condensation.orders is None else condensation.orders
 
 
 def recover_displacement(condensation: Condensation, contact_force: np.ndarray) -> np.ndarray:
-    """ũ (2H+1, n) from λ̃ (2H+1, n_rows): ũ_k = Z_k⁻¹ (f̃_k − Gᵀ λ̃_k) = y_k − Y_k λ̃_k."""
-    L = to_complex(np.asarray(contact_force, dtype=float))
-    return from_complex(condensation.forced - np.einsum("knm,km->kn", condensation.admittance, L))
+    """ũ (2H+1, n) from λ̃ (2H+1, n_rows): ũ_k = Z_k⁻¹ (f̃_k − Gᵀ λ̃_k) = y_k − Y_k λ̃_k (kept k;
+    dropped orders zero)."""
+    H = (np.asarray(contact_force).shape[0] - 1) // 2
+    k = _kept_orders(condensation, H)
+    L = to_complex(np.asarray(contact_force, dtype=float))[k]
+    z = np.zeros((H + 1, condensation.forced.shape[1]), dtype=complex)
+    z[k] = condensation.forced - np.einsum("knm,km->kn", condensation.admittance, L)
+    return from_complex(z)
 
 
 def condensed_omega_derivative(model, condensation: Condensation, U: np.ndarray) -> np.ndarray:
-    """∂R_c/∂ω = G Z⁻¹ (∂Z/∂ω) ũ = Yᵀ Z' ũ (Z symmetric), Z'_k = −2k²ωM + i kD; (2H+1, n_rows)."""
+    """∂R_c/∂ω = G Z⁻¹ (∂Z/∂ω) ũ = Yᵀ Z' ũ (Z symmetric), Z'_k = −2k²ωM + i kD; (2H+1, n_rows)
+    (dropped orders zero)."""
     H = (U.shape[0] - 1) // 2
-    k = np.arange(H + 1)[:, None]
-    z = to_complex(U)
+    orders = _kept_orders(condensation, H)
+    k = orders[:, None]
+    z = to_complex(U)[orders]
     dz = (-2 * k**2 * condensation.omega * np.asarray(model.mass @ z.T).T
           + 1j * k * np.asarray(model.damping @ z.T).T)
-    return from_complex(np.einsum("knm,kn->km", condensation.admittance, dz))
+    out = np.zeros((H + 1, condensation.admittance.shape[2]), dtype=complex)
+    out[orders] = np.einsum("knm,kn->km", condensation.admittance, dz)
+    return from_complex(out)

@@ -11,6 +11,10 @@ Condensed (unknowns x = r̃.ravel(), (2H+1) n_rows of them, see :mod:`sarfe.hbm.
     ∂R_c/∂ω = G Z⁻¹ Z' ũ(r̃)
 
 The contact laws are displacement-only and rate-independent, so ∂f̃_nl/∂ω = 0.
+
+With a harmonic set (``Problem.harmonic_orders``, :mod:`sarfe.hbm.harmonic_set`) x holds only the
+kept coefficient rows, and R, ∂R/∂x, ∂R/∂ω are the kept rows (and columns) of the above: the
+Galerkin projection P_𝒦 R(P_𝒦ᵀ x). The AFT runs on all 2H+1 rows, the dropped ones zero.
 """
 from __future__ import annotations
 
@@ -20,13 +24,15 @@ import numpy as np
 import scipy.sparse as sp
 
 from .aft import ContactForces, contact_forces, jacobian_matrix
+from .harmonic_set import coefficient_rows, expand_rows
 from .linear import (apply_dynamic_stiffness, apply_dynamic_stiffness_derivative,
                      condensed_omega_derivative, dynamic_stiffness_matrix, recover_displacement)
 
 
 @dataclass(frozen=True)
 class Problem:
-    """The data of one harmonic-balance problem: model (M, D, K), contacts, f̃_e (2H+1, n) [N], H, N."""
+    """The data of one harmonic-balance problem: model (M, D, K), contacts, f̃_e (2H+1, n) [N], H, N;
+    harmonic_orders: the kept orders of a harmonic set (sorted ints), None = all 0 … H."""
 
     model: object
     contacts: object
@@ -35,6 +41,17 @@ class Problem:
     samples_per_period: int
     friction_tolerance: float = 1e-12
     friction_pass_cap: int = 50
+    harmonic_orders: np.ndarray = None
+
+
+def kept_rows(problem: Problem):
+    """Coefficient rows of the kept orders (sorted), or None when all rows are kept."""
+    return None if problem.harmonic_orders is None else coefficient_rows(problem.harmonic_orders)
+
+
+def _kept_indices(rows, width):
+    """Flat indices (harmonic-major) of the kept rows of a (2H+1, width) array."""
+    return (np.asarray(rows)[:, None] * width + np.arange(width)[None, :]).ravel()
 
 
 @dataclass(frozen=True)
@@ -68,9 +85,11 @@ def nonlinear_force(contacts, U, samples_per_period, slider_start=None, jacobian
 
 
 def full_residual(problem: Problem, x, omega, slider_start=None, jacobian=True) -> Evaluation:
-    """R(ũ, ω) on all DOFs; x = ũ.ravel() (harmonic-major). Reference ‖f̃_e‖."""
+    """R(ũ, ω) on all DOFs; x = ũ.ravel() (harmonic-major; kept rows only with a harmonic set).
+    Reference ‖f̃_e‖."""
     n = problem.model.dof_count
-    U = np.asarray(x, dtype=float).reshape(-1, n)
+    rows = kept_rows(problem)
+    U = expand_rows(x, rows, problem.harmonics, n)
     G = problem.contacts.gap_map
     forces = contact_forces(problem.contacts, np.asarray(G @ U.T).T, problem.samples_per_period,
                             slider_start, jacobian, problem.friction_tolerance,
@@ -83,26 +102,40 @@ def full_residual(problem: Problem, x, omega, slider_start=None, jacobian=True) 
         J_nl = GG.T @ jacobian_matrix(forces.blocks, G.shape[0], problem.harmonics) @ GG
         J = (dynamic_stiffness_matrix(problem.model, omega, problem.harmonics) + J_nl).tocsc()
         dR = apply_dynamic_stiffness_derivative(problem.model, omega, U).ravel()
+        if rows is not None:
+            keep = _kept_indices(rows, n)
+            J, dR = J[keep][:, keep].tocsc(), dR[keep]
+    if rows is not None:
+        R = R[rows]
     return Evaluation(R.ravel(), J, dR, forces, _reference(np.linalg.norm(problem.excitation)))
 
 
 def condensed_residual(problem: Problem, condensation, x, slider_start=None,
                        jacobian=True) -> Evaluation:
-    """R_c(r̃, ω) at the ω of ``condensation``; x = r̃.ravel(). Reference ‖r̃_lin‖."""
+    """R_c(r̃, ω) at the ω of ``condensation``; x = r̃.ravel() (kept rows only with a harmonic set;
+    the condensation must then hold the same orders). Reference ‖r̃_lin‖."""
     n_rows = problem.contacts.row_count
-    Rr = np.asarray(x, dtype=float).reshape(-1, n_rows)
+    rows = kept_rows(problem)
+    Rr = expand_rows(x, rows, problem.harmonics, n_rows)
     forces = contact_forces(problem.contacts, Rr, problem.samples_per_period, slider_start,
                             jacobian, problem.friction_tolerance, problem.friction_pass_cap)
+    keep = None if rows is None else _kept_indices(rows, n_rows)
+    force = forces.force.ravel() if keep is None else forces.force.ravel()[keep]
+    r_lin = condensation.linear_response.ravel()
     C = condensation.compliance
-    R = x - condensation.linear_response.ravel() + C @ forces.force.ravel()
+    R = x - (r_lin if keep is None else r_lin[keep]) + C @ force
     J = dR = None
     if jacobian:
         dense = C.shape[0] <= 600
         J_lam = jacobian_matrix(forces.blocks, n_rows, problem.harmonics, dense=dense)
+        if keep is not None:
+            J_lam = J_lam[np.ix_(keep, keep)] if dense else J_lam[keep][:, keep]
         J = C @ J_lam if dense else np.asarray((J_lam.T @ C.T).T)
         J[np.diag_indices_from(J)] += 1.0
         U = recover_displacement(condensation, forces.force)
         dR = condensed_omega_derivative(problem.model, condensation, U).ravel()
+        if keep is not None:
+            dR = dR[keep]
     reference = _reference(np.linalg.norm(condensation.linear_response), np.linalg.norm(x))
     return Evaluation(R, J, dR, forces, reference)
 

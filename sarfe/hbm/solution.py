@@ -27,6 +27,11 @@ class SolverOptions:
     stability: compute Hill stability of the converged solution.
     friction_tolerance, friction_pass_cap: 2-D slider march, stop when the slider state repeats to
         friction_tolerance × (max |q| + max ρ), at most friction_pass_cap periods.
+    harmonic_set: None | 'all' | 'odd' | 'auto' | a list of orders: the harmonic orders solved for
+        (the others held at zero, :mod:`sarfe.hbm.harmonic_set`). 'auto' solves the odd set and
+        re-solves with all orders when the dropped-content estimate η exceeds
+        ``harmonic_set_tolerance`` (relative force in the dropped orders; default 1 %, the
+        'balanced' accuracy budget).
     """
 
     tolerance: float = 1e-9
@@ -40,6 +45,8 @@ class SolverOptions:
     stability_tolerance: float = 1e-6
     friction_tolerance: float = 1e-12
     friction_pass_cap: int = 50
+    harmonic_set: object = None
+    harmonic_set_tolerance: float = 1e-2
 
 
 @dataclass(frozen=True)
@@ -77,7 +84,12 @@ class HarmonicSolution:
     1 closed-or-stick, 2 slip); converged, reason, iterations,
     residual_norm = ‖S ũ + Gᵀλ̃ − f̃_e‖ / ‖f̃_e‖ on all DOFs; friction_passes (periods marched by
     the friction law in the last evaluation); stable (None if not computed); floquet_exponent
-    [1/s] = largest real part of the kept Floquet exponents (nan if not computed).
+    [1/s] = largest real part of the kept Floquet exponents (nan if not computed);
+    harmonic_orders: the orders solved for (tuple; None = all 0 … H), the others are zero;
+    harmonic_set: 'all' | 'odd' | 'orders' — the set used; dropped_content: the estimate η of what
+    the orders outside the set (outside the odd set, for an 'auto' solution that used all orders)
+    carry, see :func:`sarfe.hbm.harmonic_set.dropped_content` (nan if not computed).
+    Residual_norm and stability: residual of the kept rows; Hill stability of the full set.
     """
 
     omega: float
@@ -95,6 +107,9 @@ class HarmonicSolution:
     friction_passes: int = 0
     stable: object = None
     floquet_exponent: float = float("nan")
+    harmonic_orders: tuple = None
+    harmonic_set: str = "all"
+    dropped_content: float = float("nan")
 
     def amplitude(self, dof: int, harmonic: int = 1) -> float:
         """Amplitude √(u_kc² + u_ks²) of harmonic k of one DOF [m] (k = 0: the mean)."""

@@ -10,6 +10,14 @@ Steps of :func:`solve_frequency`:
    that system is smaller, else — or when some S_k(ω) is singular — on all DOFs (sparse LU);
 4. recovery of all DOFs, the residual of the full equation of motion relative to ‖f̃_e‖, Hill
    stability (:mod:`sarfe.hbm.stability`).
+
+Harmonic sets (:mod:`sarfe.hbm.harmonic_set`): with ``harmonic_set`` = 'odd' or a list of orders,
+Newton's unknowns and equations are the kept coefficient rows only (dropped rows held at zero);
+the final evaluation (4.) runs on all rows: its kept rows give ``residual_norm``, its dropped rows
+the estimate η (``dropped_content``), the Hill stability uses the full-set Jacobian. With 'auto'
+the odd set is solved first and the point is re-solved with all orders (from the odd solution)
+when η > ``harmonic_set_tolerance``; a point whose ``initial`` solution had η above the tolerance
+goes to all orders directly (a sweep keeps the set its previous point needed).
 """
 from __future__ import annotations
 
@@ -19,16 +27,22 @@ import numpy as np
 import scipy.sparse as sp
 
 from .aft import default_slider_start
+from .harmonic_set import (AUTO_CANDIDATE, coefficient_rows, dropped_content, expand_rows,
+                           harmonic_set_orders)
 from .harmonics import check_harmonics, time_samples
 from .linear import condense, dynamic_stiffness_matrix, recover_displacement
 from .newton import SingularJacobian, newton, solve_linear
-from .residual import Problem, condensed_residual, full_residual
+from .residual import Problem, condensed_residual, full_residual, kept_rows
 from .solution import HarmonicSolution, SolverOptions
 from .stability import hill_stability
 
 
-def make_problem(model, contacts, excitation, harmonics, samples_per_period, options=None):
-    """Validate and bundle the inputs (raises ValueError naming the parameter)."""
+def make_problem(model, contacts, excitation, harmonics, samples_per_period, options=None,
+                 harmonic_set=None):
+    """Validate and bundle the inputs (raises ValueError naming the parameter).
+
+    harmonic_set: None | 'all' | 'odd' | list of orders (not 'auto', which :func:`solve_frequency`
+    resolves)."""
     options = options or SolverOptions()
     check_harmonics(harmonics, samples_per_period)
     n = model.dof_count
@@ -42,7 +56,8 @@ def make_problem(model, contacts, excitation, harmonics, samples_per_period, opt
         raise ValueError(f"contacts.gap_map has {contacts.gap_map.shape[1]} columns, "
                          f"the model has {n} DOFs")
     return Problem(model, contacts, F, int(harmonics), int(samples_per_period),
-                   options.friction_tolerance, options.friction_pass_cap)
+                   options.friction_tolerance, options.friction_pass_cap,
+                   harmonic_set_orders(harmonic_set, harmonics))
 
 
 def _check_omega(omega, name="omega"):
@@ -50,8 +65,14 @@ def _check_omega(omega, name="omega"):
         raise ValueError(f"{name} must be a finite frequency > 0 [rad/s], got {omega!r}")
 
 
+def coefficient_row_count(problem):
+    """Number of kept coefficient rows (2H+1 for the full set)."""
+    rows = kept_rows(problem)
+    return 2 * problem.harmonics + 1 if rows is None else rows.size
+
+
 def condensed_size(problem):
-    return (2 * problem.harmonics + 1) * problem.contacts.row_count
+    return coefficient_row_count(problem) * problem.contacts.row_count
 
 
 def wants_condensation(problem, options) -> bool:
@@ -88,8 +109,13 @@ def linearized_guess(problem, omega) -> np.ndarray:
         np.tile(rows_k, 2 * H + 1)) @ GG
     F = problem.excitation.copy()
     F[0] -= G.T @ preload
+    rows = kept_rows(problem)
+    b = F.ravel()
+    if rows is not None:     # A is block diagonal over the harmonics: keep the kept blocks
+        keep = (rows[:, None] * n + np.arange(n)).ravel()
+        A, b = A.tocsr()[keep][:, keep], b[keep]
     try:
-        return solve_linear(A, F.ravel()).reshape(2 * H + 1, n)
+        return expand_rows(solve_linear(A, b), rows, H, n)
     except SingularJacobian:
         return np.zeros((2 * H + 1, n))
 
@@ -102,20 +128,27 @@ def make_evaluator(problem, condensed):
     """
     n = problem.model.dof_count
     G = problem.contacts.gap_map
+    rows = kept_rows(problem)
+
+    def kept(X):
+        X = np.asarray(X)
+        return (X if rows is None else X[rows]).ravel()
+
     if not condensed:
         def evaluate(x, omega, jacobian, slider):
             return full_residual(problem, x, omega, slider, jacobian)
 
         def to_displacement(x, omega, evaluation):
-            return np.asarray(x).reshape(-1, n)
+            return expand_rows(x, rows, problem.harmonics, n)
 
-        return evaluate, lambda U: np.asarray(U).ravel(), to_displacement
+        return evaluate, kept, to_displacement
     cache = {}
 
     def condensation(omega):
         if omega not in cache:
             cache.clear()
-            cache[omega] = condense(problem.model, G, problem.excitation, omega)
+            cache[omega] = condense(problem.model, G, problem.excitation, omega,
+                                    problem.harmonic_orders)
         if cache[omega] is None:
             raise SingularJacobian(f"S_k(ω) singular at ω = {omega:g}")
         return cache[omega]
@@ -126,7 +159,7 @@ def make_evaluator(problem, condensed):
     def to_displacement(x, omega, evaluation):
         return recover_displacement(condensation(omega), evaluation.forces.force)
 
-    return evaluate, lambda U: np.asarray(G @ np.asarray(U).T).T.ravel(), to_displacement
+    return evaluate, lambda U: kept(np.asarray(G @ np.asarray(U).T).T), to_displacement
 
 
 def initial_slider(problem, U):
@@ -145,11 +178,33 @@ def slider_acceptor(state):
     return accept
 
 
+def harmonic_set_label(problem) -> str:
+    """'all' | 'odd' | 'orders' for the set of ``problem``."""
+    orders = problem.harmonic_orders
+    if orders is None:
+        return "all"
+    odd = harmonic_set_orders("odd", problem.harmonics)
+    return "odd" if odd is not None and np.array_equal(orders, odd) else "orders"
+
+
 def finalize(problem, omega, U, converged, reason, iterations, slider, options) -> HarmonicSolution:
-    """Full residual on all DOFs, contact fields, Hill stability → HarmonicSolution."""
+    """Residual on all DOFs and all harmonic rows, contact fields, Hill stability → HarmonicSolution.
+
+    residual_norm: the kept rows; dropped_content: η of the dropped rows (for the full set: of the
+    rows outside the odd set, what 'auto' would drop)."""
+    full = replace(problem, harmonic_orders=None)
     with np.errstate(all="ignore"):
-        ev = full_residual(problem, U.ravel(), omega, slider, jacobian=options.stability)
-    residual = float(np.linalg.norm(ev.residual) / ev.reference)
+        ev = full_residual(full, U.ravel(), omega, slider, jacobian=options.stability)
+    n = problem.model.dof_count
+    R = ev.residual.reshape(-1, n)
+    rows = kept_rows(problem)
+    residual = float(np.linalg.norm(R if rows is None else R[rows]) / ev.reference)
+    G = problem.contacts.gap_map
+    f_nl = np.asarray(G.T @ ev.forces.force.T).T
+    candidate = rows if rows is not None else coefficient_rows(
+        harmonic_set_orders(AUTO_CANDIDATE, problem.harmonics))
+    with np.errstate(all="ignore"):
+        eta = dropped_content(f_nl, problem.excitation, candidate)
     if not np.isfinite(residual):
         converged, reason = False, "non-finite residual"
     elif converged and residual > options.full_tolerance:
@@ -159,7 +214,7 @@ def finalize(problem, omega, U, converged, reason, iterations, slider, options) 
     if converged and options.stability:
         stable, exponent = hill_stability(problem.model, omega, problem.harmonics, ev.jacobian,
                                           options.stability_tolerance)
-    G = problem.contacts.gap_map
+    orders = problem.harmonic_orders
     return HarmonicSolution(
         omega=float(omega), harmonics=problem.harmonics,
         samples_per_period=problem.samples_per_period, displacement=U,
@@ -167,25 +222,67 @@ def finalize(problem, omega, U, converged, reason, iterations, slider, options) 
         contact_force_time=ev.forces.force_time, contact_state=ev.forces.state,
         converged=bool(converged), reason=reason, iterations=int(iterations),
         residual_norm=residual, friction_passes=int(ev.forces.friction_passes),
-        stable=stable, floquet_exponent=exponent)
+        stable=stable, floquet_exponent=exponent,
+        harmonic_orders=None if orders is None else tuple(int(k) for k in orders),
+        harmonic_set=harmonic_set_label(problem), dropped_content=eta)
 
 
 def solve_frequency(model, contacts, excitation, omega, harmonics, samples_per_period,
-                    initial=None, options=None) -> HarmonicSolution:
+                    initial=None, options=None, harmonic_set=None) -> HarmonicSolution:
     """Periodic solution at one ω [rad/s] (see module docstring).
 
     excitation f̃_e (2H+1, n_dof) [N]; initial: a HarmonicSolution or ũ (2H+1, n_dof) [m].
-    The returned solution has converged=False and a ``reason`` when Newton did not converge.
+    harmonic_set: None | 'all' | 'odd' | 'auto' | list of orders; when given it replaces
+    ``options.harmonic_set``. The returned solution has converged=False and a ``reason`` when
+    Newton did not converge.
     """
     options = options or SolverOptions()
-    problem = make_problem(model, contacts, excitation, harmonics, samples_per_period, options)
+    if harmonic_set is not None:
+        options = replace(options, harmonic_set=harmonic_set)
+    auto = isinstance(options.harmonic_set, str) and options.harmonic_set == "auto"
+    problem = make_problem(model, contacts, excitation, harmonics, samples_per_period, options,
+                           None if auto else options.harmonic_set)
     _check_omega(omega)
-    if initial is None:
+    U0 = None
+    if initial is not None:
+        U0 = np.asarray(getattr(initial, "displacement", initial), dtype=float)
+        if U0.shape != problem.excitation.shape:
+            raise ValueError(f"initial displacement must have shape {problem.excitation.shape}")
+    if auto:
+        return solve_auto(problem, omega, U0, options,
+                          getattr(initial, "dropped_content", float("nan")))
+    if U0 is None:
         return _solve(problem, omega, linearized_guess(problem, omega), options, homotopy=True)
-    U0 = np.asarray(getattr(initial, "displacement", initial), dtype=float)
-    if U0.shape != problem.excitation.shape:
-        raise ValueError(f"initial displacement must have shape {problem.excitation.shape}")
     return _solve(problem, omega, U0, options)
+
+
+def auto_needs_full_set(previous_content, options) -> bool:
+    """'auto': go to all orders directly when the previous point's η exceeded the tolerance."""
+    return bool(previous_content > options.harmonic_set_tolerance)
+
+
+def solve_auto(problem, omega, U0, options, previous_content=float("nan"), slider=None):
+    """harmonic_set='auto' at one ω: the odd set, re-solved with all orders (``problem``, full set)
+    from the odd solution when its η > harmonic_set_tolerance or it did not converge. U0 None:
+    linearized guess with homotopy."""
+    tolerance = options.harmonic_set_tolerance
+    note = f"auto: previous point needed all orders (η {previous_content:.3g} > {tolerance:g})"
+    if not auto_needs_full_set(previous_content, options):
+        reduced = replace(problem, harmonic_orders=harmonic_set_orders(AUTO_CANDIDATE,
+                                                                       problem.harmonics))
+        start = linearized_guess(reduced, omega) if U0 is None else U0
+        solution = _solve(reduced, omega, start, options, slider, homotopy=U0 is None)
+        if solution.converged and solution.dropped_content <= tolerance:
+            return solution
+        if solution.converged:
+            U0 = solution.displacement
+            note = (f"auto: odd set rejected, dropped content η {solution.dropped_content:.3g} "
+                    f"> {tolerance:g}")
+        else:
+            note = f"auto: odd set did not converge ({solution.reason})"
+    start = linearized_guess(problem, omega) if U0 is None else U0
+    solution = _solve(problem, omega, start, options, slider, homotopy=U0 is None)
+    return replace(solution, reason=f"{solution.reason} ({note})")
 
 
 def _solve(problem, omega, U0, options, slider=None, homotopy=False):
