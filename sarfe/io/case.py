@@ -410,6 +410,7 @@ def _normalize_solver(case, data):
     solver.setdefault("max_iterations", 50)
     solver.setdefault("stability", True)
     solver.setdefault("error_estimate", True)
+    solver.setdefault("harmonic_set", "all")
     solver.setdefault("prune_contacts", True)
     cont = solver.setdefault("continuation", {})
     cont.setdefault("initial_step", 0.02)

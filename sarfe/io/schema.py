@@ -136,6 +136,7 @@ SOLVER = _object({
     "accuracy": {"oneOf": [{"enum": ["fast", "balanced", "fine"]},
                            _object({"erp_db": POSITIVE, "amplitude_rel": POSITIVE})]},
     "error_estimate": {"type": "boolean"},   # per-point error estimate (≈2 Newton steps a point)
+    "harmonic_set": {"enum": ["all", "odd", "auto"]},   # orders solved for (sarfe.hbm.harmonic_set)
     # contacts that never switch over the frequencies solved linearly (sarfe.pipeline.pruning)
     "prune_contacts": {"oneOf": [{"type": "boolean"}, _object({
         "margin": {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1}})]},

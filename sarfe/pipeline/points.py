@@ -15,12 +15,17 @@ from sarfe.pipeline.nonlinear import NonlinearModel
 
 
 def solver_options(case):
-    """(SolverOptions, ContinuationOptions) from the case's ``solver`` section."""
+    """(SolverOptions, ContinuationOptions) from the case's ``solver`` section. The tolerance of
+    ``harmonic_set: auto`` is the amplitude budget of ``solver.accuracy`` (default 'balanced')."""
     from sarfe.hbm import ContinuationOptions, SolverOptions
+    from sarfe.study.accuracy import parse_accuracy
 
     solver = case.data["solver"]
     options = SolverOptions(tolerance=solver["tolerance"], max_iterations=solver["max_iterations"],
-                            stability=solver["stability"])
+                            stability=solver["stability"],
+                            harmonic_set=solver.get("harmonic_set", "all"),
+                            harmonic_set_tolerance=parse_accuracy(
+                                solver.get("accuracy", "balanced")).amplitude_budget())
     cont = solver["continuation"]
     return options, ContinuationOptions(initial_step=cont["initial_step"], min_step=cont["min_step"],
                                         max_step=cont["max_step"], max_points=cont["max_points"],

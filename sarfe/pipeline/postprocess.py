@@ -125,6 +125,17 @@ def _error_estimate(case, stage, nl, solution):
         return {"failed": f"{type(error).__name__}: {error}"}
 
 
+def harmonic_set_record(case, solution):
+    """Which harmonic orders a point was solved with (solver.harmonic_set) and the estimate η of
+    what the dropped orders carry (for a full-set point: the orders outside the odd set)."""
+    H = int(solution.harmonics)
+    orders = getattr(solution, "harmonic_orders", None)
+    return {"requested": case.data["solver"].get("harmonic_set", "all"),
+            "used": getattr(solution, "harmonic_set", "all"),
+            "orders": list(range(H + 1)) if orders is None else [int(k) for k in orders],
+            "dropped_content": float(getattr(solution, "dropped_content", float("nan")))}
+
+
 def point_record(case, stage, nl, index, solution):
     omega = float(solution.omega)
     erp, W = _erp(case, stage, solution.displacement, omega)
@@ -139,6 +150,7 @@ def point_record(case, stage, nl, index, solution):
         "reason": str(getattr(solution, "reason", "")),
         "erp": _erp_dict(erp), "contacts": contacts, "linear": linear,
         "error_estimate": _error_estimate(case, stage, nl, solution),
+        "harmonic_set": harmonic_set_record(case, solution),
     }
     row = {"case": case.name, "point": index, "frequency_hz": point["frequency_hz"],
            "converged": point["converged"], "stable": point["stable"],
