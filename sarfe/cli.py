@@ -26,6 +26,7 @@ def _say(args, text):
 
 
 def cmd_solve(args) -> int:
+    from sarfe.io.outputs.summary import pruning_line
     from sarfe.pipeline import load_case, results_table, solve_case
 
     case = load_case(args.case)
@@ -39,6 +40,9 @@ def cmd_solve(args) -> int:
             print(f"model: {model['nodes']} nodes, {model['free_dofs']} free DOFs → "
                   f"{model['reduced_dofs']} reduced ({model['boundary_dofs']} boundary + "
                   f"{model['modes']} modes)")
+        pruning = pruning_line(summary.get("contact_pruning"))
+        if pruning:
+            print(pruning)
         types = {c["name"]: c["type"] for c in summary["contacts"]}
         print(results_table(result.rows, types))
         worst = summary.get("worst") or {}

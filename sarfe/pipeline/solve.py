@@ -19,6 +19,7 @@ from sarfe.pipeline.linear import build_linear_model, linear_model_key
 from sarfe.pipeline.nonlinear import NonlinearModel, nonlinear_model
 from sarfe.pipeline.outputs import replace_directory, write_outputs, results_table
 from sarfe.pipeline.points import solve_points
+from sarfe.pipeline.pruning import solve_points_pruned
 from sarfe.pipeline.postprocess import point_record, worst_of
 
 
@@ -73,7 +74,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     timings["setup_s"] = time.perf_counter() - clock
 
     clock = time.perf_counter()
-    solutions = solve_points(case, nl, progress=progress)
+    solutions, pruning = solve_points_pruned(case, nl, progress=progress)
     timings["hbm_s"] = time.perf_counter() - clock
 
     clock = time.perf_counter()
@@ -109,6 +110,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         "solver": {k: v for k, v in case.data["solver"].items()},
         "contacts": [{"name": name, "type": kind, "pairs": int(len(idx))}
                      for name, kind, idx in nl.groups],
+        "contact_pruning": pruning,              # per contact: open / closed / nonlinear
         "points": points,
         "worst": worst_of(points),
         "accuracy": accuracy,                    # None unless solver.accuracy was given

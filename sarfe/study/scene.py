@@ -53,16 +53,62 @@ class PrunedProblem:
     decisions: tuple
 
 
-def _linear_pass(model, contacts, excitation, omega):
-    from sarfe.hbm.solve import linearized_guess, make_problem
+def linearized_stiffness(model, contacts):
+    r"""(K_lin, f_pre) of the contacts linearized at u = 0, as :func:`sarfe.hbm.solve.linearized_guess`:
+    K_lin = K + Gᵀ diag(k) G with k = k_n on the normal rows of pairs with g ≤ 0 and k_t on the
+    friction tangents (stuck); f_pre = −Gᵀ p [N], p = −k_n g on those normal rows (+ N0 of squeak
+    pairs). Dense (n, n) [N/m] if the model is dense, else sparse CSC."""
+    c = contacts
+    k = np.zeros(c.row_count)
+    preload = np.zeros(c.row_count)
+    closed = (c.normal_row >= 0) & (c.gap <= 0)
+    k[c.normal_row[closed]] = c.normal_stiffness[closed]
+    preload[c.normal_row[closed]] = -c.normal_stiffness[closed] * c.gap[closed]
+    has_n = c.normal_row >= 0
+    preload[c.normal_row[has_n]] += np.where(np.asarray(c.kind)[has_n] == "squeak",
+                                             c.normal_load[has_n], 0.0)
+    for col in range(2):
+        present = c.tangent_rows[:, col] >= 0
+        k[c.tangent_rows[present, col]] = c.tangential_stiffness[present]
+    G = sp.csr_matrix(c.gap_map)
+    added = G.T @ sp.diags(k) @ G
+    K = model.stiffness
+    K = (sp.csc_matrix(K) + added).tocsc() if sp.issparse(K) else np.asarray(K) + added.toarray()
+    return K, -np.asarray(G.T @ preload).ravel()
 
-    import warnings
 
-    H = (excitation.shape[0] - 1) // 2
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        problem = make_problem(model, contacts, excitation, H, max(4 * H + 1, 16))
-        return linearized_guess(problem, omega)
+def _solve(A, b):
+    import scipy.sparse.linalg as spla
+
+    if sp.issparse(A):
+        return spla.spsolve(sp.csc_matrix(A), b)
+    try:
+        return np.linalg.solve(A, b)
+    except np.linalg.LinAlgError:          # singular (a DOF held only by contacts): least squares
+        return np.linalg.lstsq(A, b, rcond=None)[0]
+
+
+def linear_responses(model, contacts, excitation, omegas):
+    r"""ũ (2H+1, n) [m] of the linearized model at each ω of ``omegas`` [rad/s] (a generator):
+    K_lin u₀ = f̃_e,0 + f_pre and per harmonic k, (K_lin − (kω)² M + i kω D) Û_k = F_kc − i F_ks,
+    u_kc = Re Û_k, u_ks = −Im Û_k — what :func:`sarfe.hbm.solve.linearized_guess` solves as one
+    real system, here harmonic by harmonic."""
+    F = np.asarray(excitation, dtype=float)
+    K, f_pre = linearized_stiffness(model, contacts)
+    M, D = model.mass, model.damping
+    if not sp.issparse(K):
+        M, D = (A.toarray() if sp.issparse(A) else np.asarray(A) for A in (M, D))
+    static = np.real(_solve(K, F[0] + f_pre))
+    for omega in np.atleast_1d(omegas):
+        U = np.zeros(F.shape)
+        U[0] = static
+        for k in range(1, (F.shape[0] - 1) // 2 + 1):
+            rhs = F[2 * k - 1] - 1j * F[2 * k]
+            if np.any(rhs):
+                w = k * float(omega)
+                Uk = _solve(K - w * w * M + 1j * w * D, rhs)
+                U[2 * k - 1], U[2 * k] = Uk.real, -Uk.imag
+        yield U
 
 
 def screen_contacts(model, contacts, excitation, omegas, margin=0.5, samples=64) -> tuple:
@@ -74,13 +120,16 @@ def screen_contacts(model, contacts, excitation, omegas, margin=0.5, samples=64)
     from sarfe.hbm.harmonics import time_samples
 
     F = np.asarray(excitation, dtype=float)
+    # the linear response has only the harmonics of the excitation: screen with those (exact)
+    loaded = np.flatnonzero(np.any(F[1:] != 0, axis=1))
+    highest = (int(loaded[-1]) + 2) // 2 if loaded.size else 1
+    F = F[:2 * max(highest, 1) + 1]
     c = contacts
     has = c.normal_row >= 0
     w_max = np.full(c.count, -np.inf)
     w_min = np.full(c.count, np.inf)
     w_mean = np.zeros(c.count)
-    for omega in np.atleast_1d(omegas):
-        U = _linear_pass(model, c, F, float(omega))
+    for U in linear_responses(model, c, F, omegas):
         R = np.asarray(c.gap_map @ U.T).T
         r = time_samples(R, samples)
         w = r[:, np.where(has, c.normal_row, 0)]
@@ -135,8 +184,7 @@ def subset_contacts(contacts, indices):
 
     idx = np.asarray(indices, dtype=int)
     c = contacts
-    rows = np.concatenate([c.normal_row[idx], c.tangent_rows[idx].ravel()])
-    rows = np.unique(rows[rows >= 0])
+    rows = kept_rows(c, idx)
     new = {int(r): j for j, r in enumerate(rows)}
     remap = np.vectorize(lambda r: new.get(int(r), -1), otypes=[int])
     normal = remap(c.normal_row[idx]) if idx.size else np.zeros(0, int)
@@ -174,45 +222,84 @@ def prune_contacts(model, contacts, excitation, decisions) -> PrunedProblem:
 
 
 def check_pruning(contacts, decisions, displacement, samples=256) -> list:
-    """Decisions violated by a solution ũ (2H+1, n): [(name, what happened)] (empty = all hold)."""
+    """Decisions violated by a solution ũ (2H+1, n): [(name, what happened)] (empty = all hold).
+
+    w(θ) = gᵣ u(θ) of every screened contact at ``samples`` points of the period (a multiple of
+    the AFT samples N checks every sample the nonlinear solver saw, and more): ``open`` holds while
+    max w ≤ g, ``closed`` while min w ≥ g.
+    """
     from sarfe.hbm.harmonics import time_samples
 
+    screened = [d for d in decisions if d.decision != NONLINEAR]
+    if not screened:
+        return []
+    index = np.array([d.index for d in screened], dtype=int)
     U = np.asarray(displacement, dtype=float)
+    R = np.asarray(contacts.gap_map[contacts.normal_row[index]] @ U.T).T    # (2H+1, n_screened)
+    w = time_samples(R, samples)                                             # (samples, n_screened)
+    excess = w.max(axis=0) - contacts.gap[index]       # > 0: an "open" contact closes
+    deficit = w.min(axis=0) - contacts.gap[index]      # < 0: a "closed" contact opens
     violated = []
-    for d in decisions:
-        if d.decision == NONLINEAR:
-            continue
-        row = contacts.gap_map[contacts.normal_row[d.index]]
-        w = time_samples(np.asarray(row @ U.T).ravel(), samples)
-        g = contacts.gap[d.index]
-        if d.decision == OPEN and w.max() > g:
-            violated.append((d.name, f"screened open but closes (max w − g = {w.max() - g:.3g} m)"))
-        if d.decision == CLOSED and w.min() < g:
-            violated.append((d.name, f"screened closed but opens (min w − g = {w.min() - g:.3g} m)"))
+    for j, d in enumerate(screened):
+        if d.decision == OPEN and excess[j] > 0:
+            violated.append((d.name, f"screened open but closes (max w − g = {excess[j]:.3g} m)"))
+        if d.decision == CLOSED and deficit[j] < 0:
+            violated.append((d.name, f"screened closed but opens (min w − g = {deficit[j]:.3g} m)"))
     return violated
 
 
-def restore_solution(solution, model, contacts, excitation, samples_per_period=None):
-    """A HarmonicSolution of the pruned problem re-expressed with the full contact set (contact
-    displacements, forces and states of all contacts; residual on the full equations)."""
+def kept_rows(contacts, kept) -> np.ndarray:
+    """Rows of G (full set) that :func:`subset_contacts` keeps for the contacts ``kept``, in the
+    order of the subset's rows."""
+    idx = np.asarray(kept, dtype=int)
+    rows = np.concatenate([contacts.normal_row[idx], contacts.tangent_rows[idx].ravel()])
+    return np.unique(rows[rows >= 0])
+
+
+def restore_solution(solution, model, contacts, excitation, decisions):
+    r"""A HarmonicSolution of the pruned problem re-expressed with the full contact set.
+
+    Kept contacts: the solver's own forces, force samples and states (a friction contact's stuck
+    offset depends on the slider history, so it is not re-evaluated). ``closed`` contacts:
+    λ = k_n (w − g), state 1; ``open``: λ = 0, state 0. Residual ‖S ũ + Gᵀλ̃ − f̃_e‖ / ‖f̃_e‖ of the
+    full equations (on the solved harmonic rows when the solution used a harmonic subset).
+    """
     from dataclasses import replace
 
-    from sarfe.hbm.residual import full_residual
-    from sarfe.hbm.solve import make_problem
+    from sarfe.hbm.harmonics import time_samples
+    from sarfe.hbm.linear import apply_dynamic_stiffness
 
-    import warnings
-
-    H = int(solution.harmonics)
-    N = int(samples_per_period or solution.samples_per_period)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        problem = make_problem(model, contacts, np.asarray(excitation, dtype=float), H, N)
-    U = np.asarray(solution.displacement)
-    ev = full_residual(problem, U.ravel(), solution.omega, None, jacobian=False)
-    residual = float(np.linalg.norm(ev.residual) / ev.reference)
-    return replace(solution, contact_displacement=np.asarray(contacts.gap_map @ U.T).T,
-                   contact_force=ev.forces.force, contact_force_time=ev.forces.force_time,
-                   contact_state=ev.forces.state, residual_norm=residual)
+    U = np.asarray(solution.displacement, dtype=float)
+    F = np.asarray(excitation, dtype=float)
+    N = int(solution.samples_per_period)
+    R = np.asarray(contacts.gap_map @ U.T).T                     # (2H+1, n_rows)
+    kept = np.array([d.index for d in decisions if d.decision == NONLINEAR], dtype=int)
+    closed = np.array([d.index for d in decisions if d.decision == CLOSED], dtype=int)
+    rows = kept_rows(contacts, kept)
+    force = np.zeros_like(R)
+    force_time = np.zeros((N, contacts.row_count))
+    state = np.zeros((N, contacts.count), dtype=np.int8)
+    if kept.size:
+        force[:, rows] = solution.contact_force
+        force_time[:, rows] = solution.contact_force_time
+        state[:, kept] = solution.contact_state
+    if closed.size:
+        normal = contacts.normal_row[closed]
+        k_n, g = contacts.normal_stiffness[closed], contacts.gap[closed]
+        force[:, normal] = k_n * R[:, normal]
+        force[0, normal] -= k_n * g
+        force_time[:, normal] = k_n * (time_samples(R[:, normal], N) - g)
+        state[:, closed] = 1
+    residual = apply_dynamic_stiffness(model, solution.omega, U) + \
+        np.asarray(contacts.gap_map.T @ force.T).T - F
+    orders = getattr(solution, "harmonic_orders", None)
+    if orders is not None:
+        residual = residual[[r for k in sorted(orders)
+                             for r in ((0,) if k == 0 else (2 * k - 1, 2 * k))]]
+    reference = np.linalg.norm(F) or 1.0
+    return replace(solution, contact_displacement=R, contact_force=force,
+                   contact_force_time=force_time, contact_state=state,
+                   residual_norm=float(np.linalg.norm(residual) / reference))
 
 
 def solve_frequency_pruned(model, contacts, excitation, omega, harmonics, samples_per_period,
@@ -247,7 +334,7 @@ def solve_frequency_pruned(model, contacts, excitation, omega, harmonics, sample
                                     options=options)
             full = retry if retry.converged else full
         return full, report
-    return restore_solution(solution, model, contacts, excitation, samples_per_period), report
+    return restore_solution(solution, model, contacts, excitation, decisions), report
 
 
 def _linear_solution(U, omega, harmonics, samples_per_period):
@@ -315,5 +402,6 @@ def harmonic_content(solution, threshold=1e-3) -> dict:
 
 
 __all__ = ["OPEN", "CLOSED", "NONLINEAR", "ContactDecision", "PrunedProblem", "screen_contacts",
-           "subset_contacts", "prune_contacts", "check_pruning", "restore_solution",
+           "subset_contacts", "kept_rows", "prune_contacts", "check_pruning", "restore_solution",
+           "linearized_stiffness", "linear_responses",
            "solve_frequency_pruned", "harmonic_content"]

@@ -102,3 +102,36 @@ def test_harmonic_content_symmetric_response():
                              options=OPTIONS)
     r1 = harmonic_content(s1, threshold=1e-2)
     assert r1["even_share"] > 1e-4 and 1 <= r1["needed_harmonics"] <= 7
+
+
+def test_linear_responses_equal_linearized_guess():
+    """The screening pass (harmonic by harmonic, complex) solves the same system as the engine's
+    linearized start guess (one real system of all harmonics)."""
+    from sarfe.hbm.solve import linearized_guess, make_problem
+    from sarfe.study.scene import linear_responses
+
+    p = scene()
+    omegas = [60.0, 150.0, 300.0]
+    problem = make_problem(p.model, p.contacts, p.excitation, 5, 64)
+    for omega, U in zip(omegas, linear_responses(p.model, p.contacts, p.excitation, omegas)):
+        reference = linearized_guess(problem, omega)
+        np.testing.assert_allclose(U, reference, rtol=0, atol=1e-12 * np.abs(reference).max())
+
+
+def test_contact_report_groups_node_pairs():
+    """Per named contact: nonlinear if any node pair is kept, else open / closed; pair counts."""
+    from sarfe.pipeline.pruning import contact_report
+    from sarfe.study.scene import ContactDecision
+
+    d = [ContactDecision(0, "a[0]", "rattle", OPEN, 0.9, "far"),
+         ContactDecision(1, "a[1]", "rattle", NONLINEAR, 0.2, "near"),
+         ContactDecision(2, "b[0]", "rattle", OPEN, 0.8, "far"),
+         ContactDecision(3, "b[1]", "rattle", OPEN, 0.6, "less far"),
+         ContactDecision(4, "c", "rattle", CLOSED, 0.7, "preloaded")]
+    groups = [("a", "rattle", np.array([0, 1])), ("b", "rattle", np.array([2, 3])),
+              ("c", "rattle", np.array([4]))]
+    report = contact_report(d, groups)
+    assert [r["decision"] for r in report] == [NONLINEAR, OPEN, CLOSED]
+    assert report[0]["pairs"] == {OPEN: 1, CLOSED: 0, NONLINEAR: 1}
+    assert report[1]["clearance"] == 0.6 and report[1]["reason"] == "b[1]: less far"
+    assert report[2]["reason"] == "preloaded"

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["to_jsonable", "write_summary_json", "console_table", "NULL_NOTE"]
+__all__ = ["to_jsonable", "write_summary_json", "console_table", "pruning_line", "NULL_NOTE"]
 
 NULL_NOTE = ("null stands for a non-finite number (NaN, +inf or -inf), e.g. the dB level of zero "
              "power (-inf) or a quantity a contact does not have (NaN); see 'non_finite'")
@@ -131,3 +131,23 @@ def console_table(rows, columns=None, formats=None, headers=None, max_rows: int 
     if max_rows is not None and len(rows) > max_rows:
         out.append(f"... ({len(rows) - max_rows} more)")
     return "\n".join(out)
+
+
+def pruning_line(report: dict | None) -> str | None:
+    """One console line for summary.json's ``contact_pruning`` (None when there is nothing to say),
+    e.g. "contacts: 3 of 5 solved linearly (front_1, front_2 open; clip closed)"."""
+    if not report or not report.get("enabled") or not report.get("contacts"):
+        return None
+    linear = [c for c in report["contacts"] if c["decision"] != "nonlinear"]
+    if report.get("fallback"):
+        first = report["violations"][0] if report.get("violations") else {}
+        return (f"contacts: screening would solve {len(linear)} of {len(report['contacts'])} "
+                f"linearly, but {first.get('contact')} {first.get('what', 'violated its decision')} "
+                f"at {first.get('frequency_hz', float('nan')):.2f} Hz: solved with all contacts")
+    if not report.get("applied"):
+        return f"contacts: all {len(report['contacts'])} nonlinear (none screened open or closed)"
+    groups = {}
+    for c in linear:
+        groups.setdefault(c["decision"], []).append(c["name"])
+    what = "; ".join(f"{', '.join(names)} {decision}" for decision, names in groups.items())
+    return f"contacts: {len(linear)} of {len(report['contacts'])} solved linearly ({what})"
