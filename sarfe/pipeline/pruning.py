@@ -31,6 +31,7 @@ from sarfe.pipeline.nonlinear import NonlinearModel
 DEFAULT_MARGIN = 0.5
 SWEEP_GRID_POINTS = 201
 MAX_LISTED = 20          # violations listed in the report (all are counted)
+MAX_DENSE_EIGEN = 3000   # DOFs up to which the linearized natural frequencies are computed (dense)
 
 
 def pruning_options(case) -> tuple:
@@ -44,11 +45,14 @@ def pruning_options(case) -> tuple:
 def linearized_natural_frequencies(model, contacts) -> np.ndarray:
     r"""ω_n [rad/s] of K_lin φ = ω² M φ, K_lin = K + Gᵀ diag(k) G the stiffness the screening pass
     solves with (:func:`sarfe.study.scene.linearized_stiffness`: closed pairs as springs k_n,
-    friction tangents stuck, open pairs absent). Empty if M is singular (massless DOFs)."""
+    friction tangents stuck, open pairs absent). Empty if M is singular (massless DOFs) or the model
+    has more than MAX_DENSE_EIGEN DOFs (then the grid alone)."""
     import scipy.linalg
 
     from sarfe.study.scene import linearized_stiffness
 
+    if model.dof_count > MAX_DENSE_EIGEN:
+        return np.zeros(0)
     dense = (lambda A: A.toarray() if sp.issparse(A) else np.asarray(A, dtype=float))
     try:
         eigenvalues = scipy.linalg.eigh(dense(linearized_stiffness(model, contacts)[0]),
