@@ -15,7 +15,10 @@ gives the relative normal motion w(θ) of every contact. With the gap g and a ma
 
 Because the other contacts' nonlinear response can drive a screened contact, :func:`check_pruning`
 re-checks every decision on the nonlinear solution (w of the dropped contacts is still G u); a
-violated decision means: solve again with the full set (:func:`solve_frequency_pruned` does that).
+violated decision means: solve again with the full set (:func:`solve_frequency_pruned` does that
+for one ω; :mod:`sarfe.pipeline.pruning` for the points or the sweep of a case in ``sarfe solve``).
+:func:`restore_solution` re-expresses a pruned solution with all contacts, keeping the solver's own
+forces of the kept ones.
 """
 from __future__ import annotations
 
@@ -205,19 +208,15 @@ def prune_contacts(model, contacts, excitation, decisions) -> PrunedProblem:
 
     F = np.asarray(excitation, dtype=float).copy()
     K = model.stiffness
-    add = None
-    for d in decisions:
-        if d.decision != CLOSED:
-            continue
-        row = contacts.gap_map[contacts.normal_row[d.index]]
-        k_n, g = contacts.normal_stiffness[d.index], contacts.gap[d.index]
-        term = k_n * (row.T @ row)
-        add = term if add is None else add + term
-        F[0] += k_n * g * np.asarray(row.todense()).ravel()
-    if add is not None:
+    closed = np.array([d.index for d in decisions if d.decision == CLOSED], dtype=int)
+    if closed.size:
+        G = sp.csr_matrix(contacts.gap_map[contacts.normal_row[closed]])      # rows gᵣ
+        k_n, g = contacts.normal_stiffness[closed], contacts.gap[closed]
+        add = G.T @ sp.diags(k_n) @ G
+        F[0] += np.asarray(G.T @ (k_n * g)).ravel()
         K = (sp.csr_matrix(K) + add).tocsr() if sp.issparse(K) else np.asarray(K) + add.toarray()
     kept = np.array([d.index for d in decisions if d.decision == NONLINEAR], dtype=int)
-    pruned_model = make_linear_model(model.mass, model.damping, K) if add is not None else model
+    pruned_model = make_linear_model(model.mass, model.damping, K) if closed.size else model
     return PrunedProblem(pruned_model, subset_contacts(contacts, kept), F, kept, tuple(decisions))
 
 
