@@ -162,3 +162,19 @@ def test_pruning_line():
     report = solve(scene(frequencies=[40.0])).summary["contact_pruning"]
     assert pruning_line(report) == "contacts: 2 of 3 solved linearly (far_stop open; clip closed)"
     assert pruning_line({"enabled": False, "contacts": []}) is None
+
+
+def test_pruned_case_writes_all_outputs(tmp_path):
+    """The restored solutions go through every writer; summary.json reports the decisions."""
+    import json
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = solve_case(scene(frequencies=[50.0]), output_dir=tmp_path / "out")
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["contact_pruning"]["applied"]
+    assert [c["decision"] for c in summary["contact_pruning"]["contacts"]] == [
+        "nonlinear", "open", "closed"]
+    assert [c["name"] for c in summary["points"][0]["contacts"]] == ["panel_bracket", "far_stop",
+                                                                      "clip"]
+    assert result.exit_code == 0 and (tmp_path / "out" / "response.h5").exists()
