@@ -2,30 +2,61 @@ r"""Accuracy as an input: cheap a-posteriori error estimates of a harmonic-balan
 adaptive choice of H (harmonics), N (AFT samples per period) and the fixed-interface mode count.
 
 A solution ũ (2H+1, n) at ω solves R_{H,N}(ũ) = S(ω) ũ + f̃_nl^{(N)}(ũ) − f̃_e = 0. Embedded in a richer
-discretization (H', N') it leaves a residual R_{H',N'}(ũ) ≠ 0; one Newton step
+discretization (H', N') it leaves a residual R_{H',N'}(ũ) ≠ 0; Newton iterations of the richer problem
+from there, the first being
 
-    δ = −J_{H',N'}(ũ)⁻¹ R_{H',N'}(ũ)                                             (1)
+    δ = −J_{H',N'}(ũ)⁻¹ R_{H',N'}(ũ),                                           (1)
 
-estimates the change of the solution when H → H' (harmonic truncation) or N → N' = 2N (AFT aliasing).
-It costs one Jacobian factorization, i.e. one Newton iteration of the richer problem. The changes are
+give the change of the solution when H → H' (harmonic truncation) or N → N' = 2N (AFT aliasing).
+From a start this close they take one to a few iterations (condensed on the contact rows); H is
+raised to H' in steps of ×1.5 so that impacts, whose active set a large step changes, converge, and
+when a raise does not, the change up to the last converged H'' is used (noted). The changes are
 measured on the quantities users read:
 
 - ``amplitude_rel``: max over contact rows of |Δ a₁| / max a₁, a₁ = first-harmonic amplitude of r = G u;
-- ``erp_db``: 10 log₁₀(P(ũ+δ)/P(ũ)), P = Σ_k (kω)² Σ_s a_s |w_{s,k}|² (ERP ∝ normal velocity²,
+- ``erp_db``: 10 log₁₀(P(ũ')/P(ũ)), P = Σ_k (kω)² Σ_s a_s |w_{s,k}|² (ERP ∝ normal velocity²,
   w = E ũ the radiating normal displacements, a_s their areas; all DOFs with unit areas when no E).
 
 Cheaper still and model-free (no solve at all) are the spectral tails
 
     tail(X) = ‖X_{k > H − m}‖ / ‖X_{k ≥ 1}‖,  m = max(1, ⌊H/4⌋)                   (2)
 
-of the contact displacements and forces (energy in the highest kept harmonics). For the modal
-truncation of a Craig–Bampton model (coordinates [q_b, q_m], modes sorted by frequency) the
-contribution of the highest kept modes (top fifth, at least one) to the same quantities is reported
-as ``modal_rel`` / ``modal_db``: omitted modes are stiffer still, so their share is smaller.
+of the contact displacements and forces (energy in the highest kept harmonics), reported only.
 
-``amplitude_rel`` and ``erp_db`` are SAFETY = 2 × the sum of the contributions: the one-step
-estimate only sees harmonics up to H' and is first order at the contact kinks; on the shipped
-lumped case it was 0.5–1× the true error before the factor (benchmarks/results/accuracy.md).
+H' is one doubling, 2H, at least H + 4 (two more odd orders: a friction contact that does not lift
+off is nearly odd-symmetric) and, when the model's natural frequencies are known, at least the order
+past its highest mode (:func:`reach_harmonics`): an impact's harmonic k that excites a plate mode at
+k f carries most of the ERP, and only above the highest mode is the response mass-controlled and the
+decay regular. With an error that decays like e(H) ≈ C H^{−p}, the change to H' is
+d = e(H) − e(H') = (1 − (H/H')^p) e(H), so
+
+    e(H) ≈ d / (1 − (H/H')^p) ≤ max(2, 1 / (1 − H/H')) d   for p ≥ 1           (3)
+
+(Richardson; :func:`harmonics_richardson` — an extension beyond the doubling does not lower the
+factor below 2, as the decay below the highest mode is not yet the asymptotic one). p ≥ 1 holds for
+the contact laws here: the penalty (rattle) force is continuous with a kink at contact onset and the
+Jenkins (squeak) force is continuous with kinks at stick/slip, so its Fourier coefficients decay like
+k⁻² and the displacements faster. The factor RICHARDSON = 2 multiplies the N → 2N change too
+(aliasing errors of kinked forces decay like N⁻², 1/(1 − 2⁻²) < 2).
+
+Modal truncation of a Craig–Bampton model (coordinates [q_b, q_m, q_r]: boundary DOFs, fixed-interface
+modes, residual modes — the modal ones in increasing frequency): the coarser model the same reduction
+would give with the top fifth of the modes (at least one) left out — those modes and the residual
+modes replaced by the static responses of their span to the loads the residual modes stand for
+(:func:`coarser_basis`), the modal damping rebuilt on its own eigenmodes — is solved (1) from the
+solution projected on it. Its change of a₁ and of the ERP level is the error of the coarser model
+minus that of the kept one; with an error ∝ m^{−p} in the mode count m and p = 1
+(:func:`mode_richardson`)
+
+    modal_rel, modal_db = change / ((m/m') − 1) = 4 × change                       (4)
+
+It is the only part that sees the modes at the contact DOFs: those are boundary DOFs, whose
+coordinates a truncation without re-solving would not change.
+
+``amplitude_rel`` = (3)·harmonics_rel + 2·aliasing_rel + modal_rel, likewise ``erp_db`` (triangle
+inequality over the three sources; harmonics_rel, aliasing_rel are the raw changes, modal_rel already
+includes its factor). benchmarks/results/accuracy.md compares them with the true error on every
+shipped case.
 
 An ERP level error of ε_dB corresponds to a relative amplitude error 10^{ε_dB/20} − 1 (0.5 dB ≈ 5.9 %).
 """
@@ -37,7 +68,9 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-SAFETY = 2.0
+RICHARDSON = 2.0   # 1 / (1 − 2^{−p}) for an error ∝ H^{−p}, p = 1, and one doubling (3)
+REFINE_ITERATIONS = 40  # Newton iterations allowed per raise of H (1) before stopping the climb
+MAX_EXTENSION = 64      # cap of H' in :func:`reach_harmonics`
 
 PRESETS = {   # ERP of impacts converges slowly in H (ERP ∝ Σ (kω)² |w_k|²): dB targets are looser
     "fast": {"amplitude_rel": 5e-2, "erp_db": 2.0},
@@ -107,9 +140,10 @@ class ErrorEstimate:
     """Error estimates of one solution (module docstring). NaN where not computed.
 
     harmonics_rel / harmonics_db: H → ``extended_harmonics`` (1); aliasing_rel / aliasing_db:
-    N → 2N (1); modal_rel / modal_db: highest kept modes; displacement_tail / force_tail: (2).
-    amplitude_rel, erp_db: SAFETY × the sum of the computed contributions (what :func:`choose_resolution`
-    compares with the target). seconds: time spent estimating.
+    N → 2N (1); modal_rel / modal_db: top fifth of the modal coordinates removed (4);
+    displacement_tail / force_tail: (2).
+    amplitude_rel, erp_db: RICHARDSON × (harmonics + aliasing part) + modal part (3), (4) (what
+    :func:`choose_resolution` compares with the target). seconds: time spent estimating.
     """
 
     harmonics: int
@@ -211,11 +245,60 @@ def _change(contacts, U, U_new, omega, erp_map, erp_areas, ref_amplitude=None):
 
 def newton_correction(model, contacts, excitation, solution, harmonics, samples_per_period,
                       options=None):
-    """(1): one Newton step δ of the (H', N') problem from the solution embedded in it → ũ + δ.
+    """(1): the solution of the (H', N') problem from ũ embedded in it → (2H''+1, n) [m], H'' ≤ H'.
 
-    excitation f̃_e (2H_e+1, n) [N] (resized to H'). Returns (2H'+1, n) [m] or None when the
-    Jacobian is singular or the step is not finite.
+    Newton iterations of the richer problem (condensed on the contact rows, as the engine solves;
+    at most REFINE_ITERATIONS), H raised to H' in steps of ×1.5 (N ≥ 4H + 1, retried with N/H kept
+    when a step stalls), each warm-started from the last. When a
+    raise does not converge the climb stops at the last converged H'' (an impact whose active set
+    changes a lot); when none converges, the first Newton step ũ + δ at (H', N'). None when the
+    Jacobian is singular or the step is not finite. excitation f̃_e (2H_e+1, n) [N] (resized).
     """
+    from dataclasses import replace
+
+    from sarfe.hbm.solve import SolverOptions, solve_frequency
+
+    import warnings
+
+    H0, H_target = int(solution.harmonics), int(harmonics)
+    N = int(samples_per_period)
+    quick = replace(options or SolverOptions(), max_iterations=REFINE_ITERATIONS, stability=False)
+    steps = [H_target] if H_target <= H0 else []
+    H = H0
+    while H < H_target:
+        H = min(H_target, max(H + 2, int(round(1.5 * H))))
+        steps.append(H)
+    best = None
+    previous = np.asarray(solution.displacement, dtype=float)
+    for H in steps:     # N ≥ 4H + 1; a stalled raise is tried once more with N/H kept
+        first = N if H_target <= H0 else samples_for(H, N)
+        scaled = N if H_target <= H0 else _at_least(N, max(4 * H + 1, N * H / max(H0, 1)))
+        refined = None
+        for N_try in (first, scaled) if scaled != first else (first,):
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                try:
+                    refined = solve_frequency(model, contacts, resize_harmonics(excitation, H),
+                                              float(solution.omega), H, N_try,
+                                              initial=resize_harmonics(previous, H), options=quick)
+                except (ValueError, np.linalg.LinAlgError):
+                    refined = None
+            if refined is not None and refined.converged:
+                break
+        if refined is None or not refined.converged or not np.all(
+                np.isfinite(refined.displacement)):
+            break
+        best = previous = np.asarray(refined.displacement, dtype=float)
+    if best is not None:
+        return best
+    return newton_step(model, contacts, resize_harmonics(excitation, H_target),
+                       resize_harmonics(solution.displacement, H_target), float(solution.omega),
+                       H_target, N, options)
+
+
+def newton_step(model, contacts, excitation, U, omega, harmonics, samples_per_period,
+                options=None):
+    """ũ + δ, δ = −J⁻¹ R of the (H', N') problem at ũ (2H'+1, n) (1); None when singular."""
     from sarfe.hbm.newton import SingularJacobian, solve_linear
     from sarfe.hbm.residual import full_residual
     from sarfe.hbm.solve import make_problem
@@ -224,11 +307,9 @@ def newton_correction(model, contacts, excitation, solution, harmonics, samples_
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        F = resize_harmonics(excitation, harmonics)
-        problem = make_problem(model, contacts, F, harmonics, samples_per_period, options)
-        U = resize_harmonics(solution.displacement, harmonics)
+        problem = make_problem(model, contacts, excitation, harmonics, samples_per_period, options)
         with np.errstate(all="ignore"):
-            ev = full_residual(problem, U.ravel(), solution.omega, None, jacobian=True)
+            ev = full_residual(problem, U.ravel(), omega, None, jacobian=True)
         if not np.all(np.isfinite(ev.residual)):
             return None
         try:
@@ -240,8 +321,146 @@ def newton_correction(model, contacts, excitation, solution, harmonics, samples_
 
 
 def extended_harmonics(harmonics: int) -> int:
-    """H' used for the truncation estimate: H + max(2, ⌈H/2⌉)."""
-    return int(harmonics + max(2, math.ceil(harmonics / 2)))
+    """H' used for the truncation estimate: 2H (one doubling, (3)) and at least H + 4, so that the
+    next two odd orders are in (a friction contact that does not lift off is nearly odd-symmetric:
+    its even harmonics vanish, and a step to H + 1 or 2H = 2 would add none)."""
+    return int(max(2 * harmonics, harmonics + 4))
+
+
+def reach_harmonics(harmonics: int, omega: float, highest_mode_hz=None) -> int:
+    """H' for a model with natural frequencies up to ``highest_mode_hz``: :func:`extended_harmonics`
+    and at least the order ⌈f_top / f⌉ + 1 that passes the highest mode (capped at MAX_EXTENSION).
+    Harmonics below a mode can be resonant — an impact's harmonic k exciting a plate mode at k f
+    carries most of the ERP — so an estimate that stops short of them misses them; above the
+    highest mode the response is mass-controlled (G S_k⁻¹ Gᵀ ∝ (kω)⁻², w_k ≈ λ_k / (k ω)²) and the
+    decay that (3) assumes holds."""
+    H_ext = extended_harmonics(harmonics)
+    if highest_mode_hz is None or not np.isfinite(highest_mode_hz) or omega <= 0:
+        return H_ext
+    reach = int(math.ceil(2 * np.pi * float(highest_mode_hz) / float(omega))) + 1
+    return int(max(H_ext, min(MAX_EXTENSION, reach)))
+
+
+def coarser_basis(model, excitation, boundary_count, removed, residual=()):
+    """T (n, n') of the coarser Craig–Bampton model (4): the coordinates ``removed`` and
+    ``residual`` (the residual modes) are replaced by the static responses of the set S they span to
+    the loads the residual modes stand for — unit boundary accelerations (columns M_Sb) and the
+    excitation (f̃_e,S, cosine and sine rows) —
+
+        W = K_SS⁻¹ [M_Sb, f_S],  M-orthonormalized (rank-revealing),
+
+    i.e. the basis a reduction with the modes ``removed`` left out would have built (its residual
+    modes). Without residual modes the removed coordinates are just dropped. The boundary DOFs are
+    the first ``boundary_count`` coordinates."""
+    n = model.dof_count
+    removed = np.asarray(removed, dtype=int)
+    residual = np.asarray(residual, dtype=int)
+    S = np.concatenate([removed, residual])
+    keep = np.setdiff1d(np.arange(n), S)
+    blocks = [np.eye(n)[:, keep]]
+    if residual.size:
+        dense = (lambda A: A.toarray() if hasattr(A, "toarray") else np.asarray(A, dtype=float))
+        M, K = dense(model.mass), dense(model.stiffness)
+        boundary = np.arange(int(boundary_count))
+        F = np.asarray(excitation, dtype=float)
+        loads = np.column_stack([M[np.ix_(S, boundary)], F[1, S], F[2, S]])
+        W0 = np.linalg.solve(K[np.ix_(S, S)], loads)
+        gram = W0.T @ M[np.ix_(S, S)] @ W0
+        values, vectors = np.linalg.eigh(0.5 * (gram + gram.T))
+        ok = values > 1e-10 * max(values.max(initial=0.0), 1e-300)
+        W = np.zeros((n, int(ok.sum())))
+        W[S] = W0 @ vectors[:, ok] / np.sqrt(values[ok])
+        blocks.append(W)
+    return np.column_stack(blocks)
+
+
+def _rebuilt_modal_damping(model, small):
+    """``small`` with its damping rebuilt the way the case built the original's, when that is modal
+    damping: D = M Φ diag(2 ζ_j ω_j) Φᵀ M over the model's own eigenmodes, ζ_j by mode index taken
+    from the original (Φᵀ D Φ diagonal). Modal damping depends on the basis — a coarser reduction
+    puts different high system modes, with different 2 ζ ω_j, under the quasi-static response —
+    and the coarser model of (4) is meant to be the case's reduction with fewer modes."""
+    import scipy.linalg
+
+    from sarfe.hbm.model import LinearModel
+
+    dense = (lambda A: A.toarray() if hasattr(A, "toarray") else np.asarray(A, dtype=float))
+    if model.damping is None:
+        return small
+    M, K, D = dense(model.mass), dense(model.stiffness), dense(model.damping)
+    w2, phi = scipy.linalg.eigh(0.5 * (K + K.T), 0.5 * (M + M.T))
+    modal = phi.T @ D @ phi
+    off = modal - np.diag(np.diag(modal))
+    if np.abs(off).max(initial=0.0) > 1e-6 * np.abs(np.diag(modal)).max(initial=1e-300):
+        return small                                   # not modal damping: keep the projection
+    omega = np.sqrt(np.clip(w2, 1e-300, None))
+    zeta = np.diag(modal) / (2 * omega)
+    Ms, Ks = dense(small.mass), dense(small.stiffness)
+    w2s, phis = scipy.linalg.eigh(0.5 * (Ks + Ks.T), 0.5 * (Ms + Ms.T))
+    weighted = Ms @ phis
+    Ds = (weighted * (2.0 * zeta[:len(w2s)] * np.sqrt(np.clip(w2s, 0.0, None)))) @ weighted.T
+    return LinearModel(small.mass, 0.5 * (Ds + Ds.T), small.stiffness)
+
+
+def modal_truncation_change(solution, model, contacts, excitation, modal_dofs, residual_dofs=(),
+                            erp_map=None, erp_areas=None, options=None, ref_amplitude=None):
+    r"""(4): change of the solution on the coarser model T (:func:`coarser_basis`, the top fifth of
+    the modes ``modal_dofs`` — at least one — left out), re-solved (1) from the solution projected
+    on it → (relative amplitude change, |ERP level change| [dB], modes left out) or None when the
+    re-solve fails. modal_dofs: the fixed-interface modal coordinates in increasing frequency;
+    residual_dofs: the residual modes (rebuilt for the coarser model).
+    """
+    from types import SimpleNamespace
+
+    from sarfe.hbm.model import LinearModel
+
+    modal_dofs = np.asarray(modal_dofs, dtype=int)
+    removed = modal_dofs[-max(1, len(modal_dofs) // 5):]
+    T = coarser_basis(model, excitation, int(modal_dofs.min()), removed, residual_dofs)
+
+    def project(A):
+        if A is None:
+            return None
+        return T.T @ (A @ T if hasattr(A, "toarray") else np.asarray(A) @ T)
+
+    small = LinearModel(project(model.mass), project(model.damping), project(model.stiffness))
+    small = _rebuilt_modal_damping(model, small)
+    from dataclasses import replace
+
+    import scipy.sparse as sp
+
+    small_contacts = replace(contacts, gap_map=sp.csr_matrix(contacts.gap_map @ T))
+    U = np.asarray(solution.displacement, dtype=float)
+    # start: the M-orthogonal projection of ũ on span T
+    M = model.mass.toarray() if hasattr(model.mass, "toarray") else np.asarray(model.mass)
+    start = np.linalg.solve(small.mass, ((U @ M) @ T).T).T
+    U_small = newton_correction(small, small_contacts, np.asarray(excitation) @ T,
+                                SimpleNamespace(displacement=start, omega=solution.omega,
+                                                harmonics=solution.harmonics),
+                                int(solution.harmonics), int(solution.samples_per_period), options)
+    if U_small is None:
+        return None
+    rel, db = _change(contacts, U, U_small @ T.T, float(solution.omega), erp_map, erp_areas,
+                      ref_amplitude)
+    return rel, abs(db), len(removed)
+
+
+def harmonics_richardson(harmonics: int, extended: int) -> float:
+    """(3) with p = 1 for a change H → H'': 1 / (1 − H/H''), at least RICHARDSON (a doubling's) —
+    an extension past the doubling reaches resonant harmonics, below which the decay is not yet
+    the asymptotic one, so it does not lower the factor."""
+    if extended <= harmonics:
+        return RICHARDSON
+    return float(max(RICHARDSON, 1.0 / (1.0 - harmonics / extended)))
+
+
+def mode_richardson(modes, coarser_modes) -> float:
+    """1 / ((m/m')^p − 1) with p = 1: the kept model's error from the change m' → m modes (4), for
+    an error ∝ m^{−p}. With plate-like modal density (ω_j ∝ j, constant per Hz, the slowest among
+    shells) both the quasi-static share of the omitted modes without residual modes, Σ_{j>m}
+    (ω/ω_j)², and the basis dependence of modal damping (2 ζ ω/ω_h on the quasi-static response,
+    ω_h ∝ m the highest system mode) decay like m^{−1}; for m' = 4m/5 the factor is 4."""
+    return float(1.0 / (modes / max(coarser_modes, 1) - 1.0))
 
 
 def samples_for(harmonics: int, samples_per_period: int) -> int:
@@ -254,14 +473,16 @@ def samples_for(harmonics: int, samples_per_period: int) -> int:
 
 
 def estimate_errors(solution, model, contacts, excitation, *, erp_map=None, erp_areas=None,
-                    modal_dofs=None, harmonics_extension=None, aliasing=True, truncation=True,
+                    modal_dofs=None, residual_dofs=None, harmonics_extension=None, aliasing=True,
+                    truncation=True,
                     options=None) -> ErrorEstimate:
     """Error estimates of a converged :class:`HarmonicSolution` (module docstring).
 
     model, contacts, excitation f̃_e (2H+1, n) [N]: the problem the solution solves.
     erp_map (n_s, n), erp_areas (n_s,) [m²]: radiating normal displacements (default all DOFs).
     modal_dofs: indices of the fixed-interface modal coordinates, sorted by frequency (None for a
-    model without modal truncation). harmonics_extension: H' (default :func:`extended_harmonics`).
+    model without modal truncation); residual_dofs: the Craig–Bampton residual modes (4).
+    harmonics_extension: H' (default :func:`extended_harmonics`).
     """
     clock = time.perf_counter()
     H, N = int(solution.harmonics), int(solution.samples_per_period)
@@ -283,6 +504,10 @@ def estimate_errors(solution, model, contacts, excitation, *, erp_map=None, erp_
         if U_new is None:
             notes.append("truncation estimate: singular Jacobian")
         else:
+            if (U_new.shape[0] - 1) // 2 < H_ext:
+                notes.append(f"truncation estimate: H raised to {(U_new.shape[0] - 1) // 2} of "
+                             f"{H_ext} (the next raise did not converge)")
+                H_ext = (U_new.shape[0] - 1) // 2
             h_rel, h_db = _change(contacts, resize_harmonics(U, H_ext), U_new, omega, erp_map,
                                   erp_areas, a_ref)
     if aliasing:
@@ -293,23 +518,29 @@ def estimate_errors(solution, model, contacts, excitation, *, erp_map=None, erp_
             a_rel, a_db = _change(contacts, U, U_new, omega, erp_map, erp_areas, a_ref)
 
     m_rel = m_db = nan
-    if modal_dofs is not None and len(modal_dofs):
-        modal_dofs = np.asarray(modal_dofs, dtype=int)
-        top = modal_dofs[-max(1, len(modal_dofs) // 5):]
-        U_top = np.zeros_like(U)
-        U_top[:, top] = U[:, top]
-        m_rel, m_db = _change(contacts, U, U - U_top, omega, erp_map, erp_areas, a_ref)
-        m_db = abs(m_db)
-    parts_rel = [x for x in (h_rel, a_rel, m_rel) if np.isfinite(x)]
-    parts_db = [abs(x) for x in (h_db, a_db, m_db) if np.isfinite(x)]
+    if truncation and modal_dofs is not None and len(modal_dofs):
+        residual_dofs = () if residual_dofs is None else residual_dofs
+        change = modal_truncation_change(solution, model, contacts, excitation, modal_dofs,
+                                         residual_dofs, erp_map, erp_areas, options, a_ref)
+        if change is None:
+            notes.append("modal estimate: singular Jacobian")
+        else:
+            kept = len(modal_dofs)
+            factor = mode_richardson(kept, kept - change[2])
+            m_rel, m_db = factor * change[0], factor * change[1]
+    factor = harmonics_richardson(H, H_ext)
+    parts_rel = [f * x for f, x in ((factor, h_rel), (RICHARDSON, a_rel)) if np.isfinite(x)]
+    parts_db = [f * abs(x) for f, x in ((factor, h_db), (RICHARDSON, a_db)) if np.isfinite(x)]
+    parts_rel += [m_rel] if np.isfinite(m_rel) else []
+    parts_db += [m_db] if np.isfinite(m_db) else []
     if not getattr(solution, "converged", True):
         notes.append(f"solution not converged: {getattr(solution, 'reason', '')}")
     return ErrorEstimate(
         harmonics=H, samples_per_period=N, extended_harmonics=H_ext,
         harmonics_rel=h_rel, harmonics_db=h_db, aliasing_rel=a_rel, aliasing_db=a_db,
         modal_rel=m_rel, modal_db=m_db, displacement_tail=disp_tail, force_tail=force_tail,
-        amplitude_rel=SAFETY * float(sum(parts_rel)) if parts_rel else nan,
-        erp_db=SAFETY * float(sum(parts_db)) if parts_db else nan,
+        amplitude_rel=float(sum(parts_rel)) if parts_rel else nan,
+        erp_db=float(sum(parts_db)) if parts_db else nan,
         seconds=time.perf_counter() - clock, notes=tuple(notes))
 
 
@@ -330,12 +561,32 @@ class Resolution:
 
 def stage_error_estimate(solution, stage, nl) -> ErrorEstimate:
     """:func:`estimate_errors` of a case's point: the problem ``nl`` (sarfe.pipeline.nonlinear_model)
-    on the linear ``stage``, its ERP map and areas, and for FE stages the modal coordinates (the
-    reduced DOFs after the Craig–Bampton boundary DOFs) as the modal-truncation candidates."""
-    modal = (np.arange(int(stage.info.get("boundary_dofs", 0)), stage.dof_count)
-             if stage.kind == "fe" else None)
+    on the linear ``stage``, its ERP map and areas, and for FE stages the modal coordinates after
+    the Craig–Bampton boundary DOFs: the fixed-interface modes, then the residual modes (4)."""
+    modal = residual = highest = None
+    if stage.kind == "fe":
+        first = int(stage.info.get("boundary_dofs", 0))
+        modes = int(stage.info.get("modes", stage.dof_count - first))
+        modal = np.arange(first, first + modes)
+        residual = np.arange(first + modes, stage.dof_count)
+        highest = float(np.max(stage.mode_frequencies_hz, initial=0.0)) or None
+    else:   # matrices: the undamped natural frequencies of M, K
+        highest = _highest_natural_frequency_hz(nl.model)
+    H_ext = reach_harmonics(int(solution.harmonics), float(solution.omega), highest)
     return estimate_errors(solution, nl.model, nl.contacts, nl.excitation, erp_map=stage.erp_map,
-                           erp_areas=stage.erp_areas, modal_dofs=modal)
+                           erp_areas=stage.erp_areas, modal_dofs=modal, residual_dofs=residual,
+                           harmonics_extension=H_ext)
+
+
+def _highest_natural_frequency_hz(model):
+    """Highest undamped natural frequency [Hz] of a small dense model (None above 2000 DOFs)."""
+    import scipy.linalg
+
+    if model.dof_count > 2000:
+        return None
+    dense = (lambda A: A.toarray() if hasattr(A, "toarray") else np.asarray(A, dtype=float))
+    values = scipy.linalg.eigh(dense(model.stiffness), dense(model.mass), eigvals_only=True)
+    return float(np.sqrt(max(values.max(initial=0.0), 0.0)) / (2 * np.pi))
 
 
 def choose_resolution(target, model, contacts, excitation, omega, *, harmonics=3,
@@ -387,10 +638,10 @@ def choose_resolution(target, model, contacts, excitation, omega, *, harmonics=3
             reason = f"not converged at H={H}, N={N}: {solution.reason}"
             break
         previous = solution
-        h_ok = target.met_by(SAFETY * _finite(estimate.harmonics_rel),
-                             SAFETY * abs(_finite(estimate.harmonics_db)), 0.5)
-        a_ok = target.met_by(SAFETY * _finite(estimate.aliasing_rel),
-                             SAFETY * abs(_finite(estimate.aliasing_db)), 0.5)
+        h_ok = target.met_by(RICHARDSON * _finite(estimate.harmonics_rel),
+                             RICHARDSON * abs(_finite(estimate.harmonics_db)), 0.5)
+        a_ok = target.met_by(RICHARDSON * _finite(estimate.aliasing_rel),
+                             RICHARDSON * abs(_finite(estimate.aliasing_db)), 0.5)
         if h_ok and a_ok:
             met, reason = True, "target met"
             break
@@ -443,7 +694,7 @@ def suggest_mode_count(mode_frequencies_hz, max_frequency_hz, harmonics, target=
     return {"mode_count": count, "cutoff_hz": cutoff, "reason": reason}
 
 
-__all__ = ["SAFETY", "PRESETS", "AccuracyTarget", "parse_accuracy", "ErrorEstimate", "Resolution",
+__all__ = ["RICHARDSON", "PRESETS", "AccuracyTarget", "parse_accuracy", "ErrorEstimate", "Resolution",
            "resize_harmonics", "spectral_tail", "harmonic_energy", "newton_correction",
            "extended_harmonics", "samples_for", "estimate_errors", "stage_error_estimate", "choose_resolution",
            "suggest_mode_count"]
