@@ -563,12 +563,8 @@ def stage_error_estimate(solution, stage, nl) -> ErrorEstimate:
     """:func:`estimate_errors` of a case's point: the problem ``nl`` (sarfe.pipeline.nonlinear_model)
     on the linear ``stage``, its ERP map and areas, and for FE stages the modal coordinates after
     the Craig–Bampton boundary DOFs: the fixed-interface modes, then the residual modes (4)."""
-    modal = residual = highest = None
+    modal, residual = stage_modal_coordinates(stage)
     if stage.kind == "fe":
-        first = int(stage.info.get("boundary_dofs", 0))
-        modes = int(stage.info.get("modes", stage.dof_count - first))
-        modal = np.arange(first, first + modes)
-        residual = np.arange(first + modes, stage.dof_count)
         highest = float(np.max(stage.mode_frequencies_hz, initial=0.0)) or None
     else:   # matrices: the undamped natural frequencies of M, K
         highest = _highest_natural_frequency_hz(nl.model)
@@ -576,6 +572,16 @@ def stage_error_estimate(solution, stage, nl) -> ErrorEstimate:
     return estimate_errors(solution, nl.model, nl.contacts, nl.excitation, erp_map=stage.erp_map,
                            erp_areas=stage.erp_areas, modal_dofs=modal, residual_dofs=residual,
                            harmonics_extension=H_ext)
+
+
+def stage_modal_coordinates(stage):
+    """(fixed-interface modes, residual modes) of an FE stage's reduced coordinates (after the
+    Craig–Bampton boundary DOFs, each in increasing frequency); (None, None) for matrices."""
+    if stage.kind != "fe":
+        return None, None
+    first = int(stage.info.get("boundary_dofs", 0))
+    modes = int(stage.info.get("modes", stage.dof_count - first))
+    return np.arange(first, first + modes), np.arange(first + modes, stage.dof_count)
 
 
 def _highest_natural_frequency_hz(model):
@@ -591,8 +597,8 @@ def _highest_natural_frequency_hz(model):
 
 def choose_resolution(target, model, contacts, excitation, omega, *, harmonics=3,
                       samples_per_period=64, max_harmonics=64, max_samples=8192, max_rounds=12,
-                      erp_map=None, erp_areas=None, modal_dofs=None, options=None,
-                      initial=None) -> Resolution:
+                      erp_map=None, erp_areas=None, modal_dofs=None, residual_dofs=None,
+                      options=None, initial=None) -> Resolution:
     """Adaptive H, N at one ω [rad/s] until the estimates meet ``target`` (see :func:`parse_accuracy`).
 
     Loop: solve (warm-started from the previous round, cold with the engine's homotopy if that
@@ -627,6 +633,7 @@ def choose_resolution(target, model, contacts, excitation, omega, *, harmonics=3
                 solution = cold if cold.converged else solution
         estimate = estimate_errors(solution, model, contacts, resize_harmonics(excitation, H),
                                    erp_map=erp_map, erp_areas=erp_areas, modal_dofs=modal_dofs,
+                                   residual_dofs=residual_dofs,
                                    options=options)
         history.append({"harmonics": H, "samples_per_period": N,
                         "converged": bool(solution.converged), "iterations": int(solution.iterations),
@@ -696,5 +703,6 @@ def suggest_mode_count(mode_frequencies_hz, max_frequency_hz, harmonics, target=
 
 __all__ = ["RICHARDSON", "PRESETS", "AccuracyTarget", "parse_accuracy", "ErrorEstimate", "Resolution",
            "resize_harmonics", "spectral_tail", "harmonic_energy", "newton_correction",
-           "extended_harmonics", "samples_for", "estimate_errors", "stage_error_estimate", "choose_resolution",
+           "extended_harmonics", "samples_for", "estimate_errors", "stage_error_estimate",
+           "stage_modal_coordinates", "choose_resolution",
            "suggest_mode_count"]

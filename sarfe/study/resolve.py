@@ -6,7 +6,8 @@ r"""Accuracy of a whole case as an input: ``solver: {accuracy: fast | balanced |
    by :func:`sarfe.study.accuracy.choose_resolution` (H up until the truncation estimate, then N up
    until the aliasing estimate are each within half the budget);
 3. FE cases: the mode count from :func:`sarfe.study.accuracy.suggest_mode_count` (and doubled when
-   the modal estimate of the highest kept modes exceeds half the budget).
+   the modal estimate — the re-solve on the coarser Craig–Bampton model, (4) there — exceeds half
+   the budget).
 
 The chosen values, the estimate that justified them and the history are returned; the pipeline can
 apply them with :func:`apply_resolution` (see the integration notes in the report).
@@ -28,7 +29,8 @@ def resolve_case_accuracy(case, target, points=8, start_harmonics=3, start_sampl
     from sarfe.io.case import load_case
     from sarfe.pipeline import build_linear_model, nonlinear_model
 
-    from .accuracy import choose_resolution, parse_accuracy, resize_harmonics, suggest_mode_count
+    from .accuracy import (choose_resolution, parse_accuracy, resize_harmonics,
+                           stage_modal_coordinates, suggest_mode_count)
 
     from .runner import attach_estimates, frequency_grid, solve_grid
 
@@ -57,8 +59,7 @@ def resolve_case_accuracy(case, target, points=8, start_harmonics=3, start_sampl
     candidates = sorted(active or converged,
                         key=lambda p: -np.nan_to_num(p.get("estimate_amplitude_rel", 0.0)))
     nl = nonlinear_model(case, stage)
-    modal = (np.arange(int(stage.info.get("boundary_dofs", 0)), stage.dof_count)
-             if stage.kind == "fe" else None)
+    modal, residual = stage_modal_coordinates(stage)
     solver = case.data["solver"]
 
     def adapt(point, H0, N0):
@@ -67,6 +68,7 @@ def resolve_case_accuracy(case, target, points=8, start_harmonics=3, start_sampl
                                  samples_per_period=N0, max_harmonics=max_harmonics,
                                  max_samples=max_samples, erp_map=stage.erp_map,
                                  erp_areas=stage.erp_areas, modal_dofs=modal,
+                                 residual_dofs=residual,
                                  initial=resize_harmonics(point["_solution"].displacement, H0))
 
     tuned = []
