@@ -19,6 +19,10 @@ contact couples its own normal/tangent rows over all harmonics); it is assembled
   with the periodicity condition w_N = w_0 solved for ∂w_0/∂X (zero when the contact sticks).
 
 The laws are displacement-only and rate-independent: ∂f̃_nl/∂ω = 0.
+
+With ``kept_rows`` (a harmonic set, :mod:`sarfe.hbm.harmonic_set`) the forces are still computed on
+all 2H+1 rows, but the Jacobian blocks hold only the kept rows and columns (the Fourier basis Φ is
+restricted to the kept columns before the pushes through the FFT, so that work falls with the set).
 """
 from __future__ import annotations
 
@@ -54,8 +58,9 @@ def _product_tables(H: int):
     return idx1, idx2, sign1 * weight, sign2 * weight
 
 
-def pointwise_jacobian(derivative_time: np.ndarray, harmonics: int) -> np.ndarray:
-    r"""E diag(d) Φ for each column d of ``derivative_time`` (N, n) → (n, 2H+1, 2H+1).
+def pointwise_jacobian(derivative_time: np.ndarray, harmonics: int, kept_rows=None) -> np.ndarray:
+    r"""E diag(d) Φ for each column d of ``derivative_time`` (N, n) → (n, 2H+1, 2H+1), or only the
+    ``kept_rows`` rows and columns (n, P_k, P_k).
 
     With a_m = (1/N) Σ_j d_j cos mθ_j and b_m = (1/N) Σ_j d_j sin mθ_j (m = 0 … 2H, one real FFT),
     the entries follow from product-to-sum identities, e.g.
@@ -71,6 +76,9 @@ def pointwise_jacobian(derivative_time: np.ndarray, harmonics: int) -> np.ndarra
     coeff[mirrored] = coeff[mirrored].conj()
     table = np.concatenate([coeff.real, -coeff.imag], axis=0).T / N  # (n, 4H+2) = [a | b]
     idx1, idx2, s1, s2 = _product_tables(H)
+    if kept_rows is not None:
+        keep = np.ix_(kept_rows, kept_rows)
+        idx1, idx2, s1, s2 = idx1[keep], idx2[keep], s1[keep], s2[keep]
     return s1 * table[:, idx1] + s2 * table[:, idx2]
 
 
@@ -108,11 +116,13 @@ def default_slider_start(contacts, displacement_time):
 
 
 def contact_forces(contacts, contact_displacement, samples_per_period, slider_start=None,
-                   jacobian=True, friction_tolerance=1e-12, friction_pass_cap=50) -> ContactForces:
+                   jacobian=True, friction_tolerance=1e-12, friction_pass_cap=50,
+                   kept_rows=None) -> ContactForces:
     r"""λ̃(r̃) for all contacts by AFT, and ∂λ̃/∂r̃ blocks when ``jacobian``.
 
     contact_displacement r̃ (2H+1, n_rows) [m]; N = samples_per_period; slider_start (n_c, 2) [m]
     (default: q(θ_0), see :func:`default_slider_start`). Laws as in :mod:`sarfe.hbm.contacts`.
+    kept_rows: coefficient rows of a harmonic set; the blocks then hold only those (P_k of them).
     """
     R = np.asarray(contact_displacement, dtype=float)
     H, N = (R.shape[0] - 1) // 2, int(samples_per_period)
@@ -126,6 +136,7 @@ def contact_forces(contacts, contact_displacement, samples_per_period, slider_st
     slider_end = np.full((n_c, 2), np.nan)
     blocks, passes = [], 0
     kinds = np.asarray(contacts.kind)
+    rows_k = np.arange(2 * H + 1) if kept_rows is None else np.asarray(kept_rows)
 
     # --- rattle: λ_n = k_n max(0, w − g) -------------------------------------------------------
     rattle = np.flatnonzero(kinds == "rattle")
@@ -136,12 +147,12 @@ def contact_forces(contacts, contact_displacement, samples_per_period, slider_st
         np.add.at(lam, (slice(None), rows), force)
         state[:, rattle] = stiffness > 0
         if jacobian:
-            blocks.append((rows[:, None], pointwise_jacobian(stiffness, H)))
+            blocks.append((rows[:, None], pointwise_jacobian(stiffness, H, kept_rows)))
 
     # --- squeak: normal penalty + N0, Jenkins element tangentially -----------------------------
     squeak = np.flatnonzero(kinds == "squeak")
     if squeak.size:
-        P = 2 * H + 1
+        P = rows_k.size
         n_rows_c = contacts.normal_row[squeak]
         t_rows = contacts.tangent_rows[squeak]
         has_normal = n_rows_c >= 0
@@ -155,7 +166,7 @@ def contact_forces(contacts, contact_displacement, samples_per_period, slider_st
         rho = mu * force_n / k_t                            # (N, n_s) slip radius [m]
         J = np.zeros((squeak.size, 3 * P, 3 * P)) if jacobian else None
         if jacobian:
-            J[:, 0::3, 0::3] = pointwise_jacobian(stiff_n, H)
+            J[:, 0::3, 0::3] = pointwise_jacobian(stiff_n, H, kept_rows)
         one_d = t_rows[:, 1] < 0
         # 1-D contacts: clamp scan, exact steady state in one pass
         c1 = np.flatnonzero(one_d)
@@ -169,14 +180,15 @@ def contact_forces(contacts, contact_displacement, samples_per_period, slider_st
             slider_end[squeak[c1], 0] = res["slider_end"]
             passes = max(passes, res["passes"])
             if jacobian:
-                J[c1] += _jenkins_1d_jacobian(res, mu[c1] * stiff_n[:, c1], k_t[c1], H, N)
+                J[c1] += _jenkins_1d_jacobian(res, mu[c1] * stiff_n[:, c1], k_t[c1], H, N, rows_k)
         c2 = np.flatnonzero(~one_d)
         if c2.size:
             rows_t = t_rows[c2]
             q = r[:, rows_t]                                # (N, n2, 2)
             force_t, st, w_end, n_pass, J2 = _jenkins_2d(
                 q, rho[:, c2], mu[c2] * stiff_n[:, c2] / k_t[c2], k_t[c2],
-                slider_start[squeak[c2]], H, N, jacobian, friction_tolerance, friction_pass_cap)
+                slider_start[squeak[c2]], H, N, jacobian, friction_tolerance, friction_pass_cap,
+                rows_k)
             np.add.at(lam, (slice(None), rows_t[:, 0]), force_t[:, :, 0])
             np.add.at(lam, (slice(None), rows_t[:, 1]), force_t[:, :, 1])
             state[:, squeak[c2]] = st
@@ -190,16 +202,17 @@ def contact_forces(contacts, contact_displacement, samples_per_period, slider_st
     return ContactForces(hm.harmonic_coefficients(lam, H), lam, state, blocks, slider_end, passes)
 
 
-def _jenkins_1d_jacobian(res, mu_dlam, k_t, H, N):
-    """∂λ̃_(n,t)/∂(w̃, q̃) of 1-D Jenkins contacts in the local (h·3 + l) layout (l = 0 n, 1 t)."""
-    P = 2 * H + 1
+def _jenkins_1d_jacobian(res, mu_dlam, k_t, H, N, kept_rows):
+    """∂λ̃_(n,t)/∂(w̃, q̃) of 1-D Jenkins contacts in the local (h·3 + l) layout (l = 0 n, 1 t),
+    h over the kept coefficient rows."""
+    P = kept_rows.size
     n = k_t.size
-    Phi = _basis(H, N)
+    Phi = _basis(H, N)[:, kept_rows]
     j, has = last_reset_index(res["reset"])
     gathered = Phi[j]                                      # (N, n, P) rows Φ_{j(i)}
     weight = np.take_along_axis(res["sign"] * mu_dlam, j, axis=0)  # s_j μ ∂λ_n/∂w at j(i)
-    memory = np.moveaxis(hm.harmonic_coefficients(gathered, H), 0, 1)          # E P Φ (n, P, P)
-    normal = np.moveaxis(hm.harmonic_coefficients(weight[..., None] * gathered, H), 0, 1)
+    memory = np.moveaxis(hm.harmonic_coefficients(gathered, H)[kept_rows], 0, 1)  # E P Φ (n, P, P)
+    normal = np.moveaxis(hm.harmonic_coefficients(weight[..., None] * gathered, H)[kept_rows], 0, 1)
     J = np.zeros((n, 3 * P, 3 * P))
     eye = np.eye(P)
     J[:, 1::3, 1::3] = k_t[:, None, None] * (eye - np.where(has[:, None, None], memory, 0.0))
@@ -207,7 +220,7 @@ def _jenkins_1d_jacobian(res, mu_dlam, k_t, H, N):
     return J
 
 
-def _jenkins_2d(q, rho, drho_dw, k_t, start, H, N, jacobian, tolerance, pass_cap):
+def _jenkins_2d(q, rho, drho_dw, k_t, start, H, N, jacobian, tolerance, pass_cap, kept_rows):
     r"""2-D Jenkins elements marched sample by sample (vectorized over contacts).
 
     The disk projection of the slider is not composable like the 1-D clamp, so the march over
@@ -223,7 +236,7 @@ def _jenkins_2d(q, rho, drho_dw, k_t, start, H, N, jacobian, tolerance, pass_cap
     Returns (λ_t (N, n, 2), state (N, n), w_end (n, 2), passes, J (n, 3P, 3P) or None).
     """
     n = q.shape[1]
-    P = 2 * H + 1
+    P = kept_rows.size                                       # local harmonic rows (kept set)
     scale = np.abs(q).max() + rho.max() + 1e-300
     w = np.array(start, dtype=float)
     passes = 0
@@ -245,7 +258,7 @@ def _jenkins_2d(q, rho, drho_dw, k_t, start, H, N, jacobian, tolerance, pass_cap
         ok = np.abs(det) > 1e-6
         if np.any(ok):
             w[ok] = w0[ok] + np.linalg.solve(system[ok], residual[ok][..., None])[..., 0]
-    Phi = _basis(H, N)
+    Phi = _basis(H, N)[:, kept_rows]
     force = np.empty((N, n, 2))
     state = np.empty((N, n), np.int8)
     if jacobian:
@@ -277,19 +290,20 @@ def _jenkins_2d(q, rho, drho_dw, k_t, start, H, N, jacobian, tolerance, pass_cap
         system = np.eye(2) - dw_dw0[forgot]
         dw0[forgot] = np.linalg.solve(system, dw[forgot])
     dforce -= k_t[None, :, None, None] * np.einsum("jcab,cbx->jcax", history, dw0)
-    coeff = hm.harmonic_coefficients(dforce, H)             # (P, n, 2, 3P)
+    coeff = hm.harmonic_coefficients(dforce, H)[kept_rows]  # (P, n, 2, 3P)
     J = np.zeros((n, 3 * P, 3 * P))
     J[:, 1::3, :] = np.moveaxis(coeff[:, :, 0, :], 0, 1)
     J[:, 2::3, :] = np.moveaxis(coeff[:, :, 1, :], 0, 1)
     return force, state, w_start, passes, J
 
 
-def jacobian_matrix(blocks, n_rows: int, harmonics: int, dense: bool = False):
-    """Assemble ∂λ̃/∂r̃ blocks into a ((2H+1) n_rows)² matrix, harmonic-major ordering.
+def jacobian_matrix(blocks, n_rows: int, harmonics: int, dense: bool = False, kept_rows=None):
+    """Assemble ∂λ̃/∂r̃ blocks into a (P n_rows)² matrix, harmonic-major ordering; P = 2H+1, or the
+    number of ``kept_rows`` for blocks of a harmonic set.
 
     Sparse CSR by default; a dense ndarray when ``dense`` (small condensed systems).
     """
-    P = 2 * int(harmonics) + 1
+    P = 2 * int(harmonics) + 1 if kept_rows is None else len(kept_rows)
     size = P * n_rows
     I, Jc, V = [], [], []
     for rows, block in blocks:

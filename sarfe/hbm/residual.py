@@ -14,7 +14,8 @@ The contact laws are displacement-only and rate-independent, so ∂f̃_nl/∂ω 
 
 With a harmonic set (``Problem.harmonic_orders``, :mod:`sarfe.hbm.harmonic_set`) x holds only the
 kept coefficient rows, and R, ∂R/∂x, ∂R/∂ω are the kept rows (and columns) of the above: the
-Galerkin projection P_𝒦 R(P_𝒦ᵀ x). The AFT runs on all 2H+1 rows, the dropped ones zero.
+Galerkin projection P_𝒦 R(P_𝒦ᵀ x). The AFT runs on all 2H+1 rows, the dropped ones zero; its
+Jacobian blocks are built for the kept rows and columns only.
 """
 from __future__ import annotations
 
@@ -93,18 +94,21 @@ def full_residual(problem: Problem, x, omega, slider_start=None, jacobian=True) 
     G = problem.contacts.gap_map
     forces = contact_forces(problem.contacts, np.asarray(G @ U.T).T, problem.samples_per_period,
                             slider_start, jacobian, problem.friction_tolerance,
-                            problem.friction_pass_cap)
+                            problem.friction_pass_cap, rows)
     f_nl = np.asarray(G.T @ forces.force.T).T
     R = apply_dynamic_stiffness(problem.model, omega, U) + f_nl - problem.excitation
     J = dR = None
     if jacobian:
-        GG = _gap_blocks(problem.contacts, problem.harmonics)
-        J_nl = GG.T @ jacobian_matrix(forces.blocks, G.shape[0], problem.harmonics) @ GG
-        J = (dynamic_stiffness_matrix(problem.model, omega, problem.harmonics) + J_nl).tocsc()
+        P = 2 * problem.harmonics + 1 if rows is None else rows.size
+        GG = sp.kron(sp.identity(P), G, format="csr")
+        J_nl = GG.T @ jacobian_matrix(forces.blocks, G.shape[0], problem.harmonics,
+                                      kept_rows=rows) @ GG
+        S = dynamic_stiffness_matrix(problem.model, omega, problem.harmonics)
         dR = apply_dynamic_stiffness_derivative(problem.model, omega, U).ravel()
-        if rows is not None:
+        if rows is not None:     # S is block diagonal over the harmonics: keep the kept blocks
             keep = _kept_indices(rows, n)
-            J, dR = J[keep][:, keep].tocsc(), dR[keep]
+            S, dR = S[keep][:, keep], dR[keep]
+        J = (S + J_nl).tocsc()
     if rows is not None:
         R = R[rows]
     return Evaluation(R.ravel(), J, dR, forces, _reference(np.linalg.norm(problem.excitation)))
@@ -118,7 +122,7 @@ def condensed_residual(problem: Problem, condensation, x, slider_start=None,
     rows = kept_rows(problem)
     Rr = expand_rows(x, rows, problem.harmonics, n_rows)
     forces = contact_forces(problem.contacts, Rr, problem.samples_per_period, slider_start,
-                            jacobian, problem.friction_tolerance, problem.friction_pass_cap)
+                            jacobian, problem.friction_tolerance, problem.friction_pass_cap, rows)
     keep = None if rows is None else _kept_indices(rows, n_rows)
     force = forces.force.ravel() if keep is None else forces.force.ravel()[keep]
     r_lin = condensation.linear_response.ravel()
@@ -127,9 +131,8 @@ def condensed_residual(problem: Problem, condensation, x, slider_start=None,
     J = dR = None
     if jacobian:
         dense = C.shape[0] <= 600
-        J_lam = jacobian_matrix(forces.blocks, n_rows, problem.harmonics, dense=dense)
-        if keep is not None:
-            J_lam = J_lam[np.ix_(keep, keep)] if dense else J_lam[keep][:, keep]
+        J_lam = jacobian_matrix(forces.blocks, n_rows, problem.harmonics, dense=dense,
+                                kept_rows=rows)
         J = C @ J_lam if dense else np.asarray((J_lam.T @ C.T).T)
         J[np.diag_indices_from(J)] += 1.0
         U = recover_displacement(condensation, forces.force)

@@ -21,7 +21,8 @@ def two_dof(contacts_kind):
     """NLvib example 03's 2-DOF chain (M = I, K = [[1, −1], [−1, 2]], D = 0.03 K, 0.1 cos Ωt on
     DOF 2) with DOF 1 against one gap ('one-sided') or between two identical gaps ('two-sided',
     odd-symmetric force λ₁ − λ₂ = f(u) = −f(−u)), gap 0.5, k_n = 100; or a 1-D Jenkins element
-    under a constant normal load ('friction', odd-symmetric hysteresis)."""
+    under a constant normal load ('friction', odd-symmetric hysteresis), or a 2-D one in the plane
+    of both DOFs ('friction-2d')."""
     K = np.array([[1.0, -1.0], [-1.0, 2.0]])
     model = make_linear_model(np.eye(2), 0.03 * K, K)
     if contacts_kind == "two-sided":
@@ -30,6 +31,10 @@ def two_dof(contacts_kind):
     elif contacts_kind == "one-sided":
         contacts = make_contact_set(sp.csr_matrix([[1.0, 0.0]]), ["rattle"], [0], [[-1, -1]],
                                     0.5, 100.0)
+    elif contacts_kind == "friction-2d":
+        contacts = make_contact_set(sp.csr_matrix(np.eye(2)), ["squeak"], [-1], [[0, 1]],
+                                    0.0, 0.0, tangential_stiffness=5.0, friction_coefficient=0.3,
+                                    normal_load=0.2)
     else:
         contacts = make_contact_set(sp.csr_matrix([[1.0, 0.0]]), ["squeak"], [-1], [[0, -1]],
                                     0.0, 0.0, tangential_stiffness=5.0, friction_coefficient=0.3,
@@ -64,7 +69,7 @@ def test_orders_and_rows():
             harmonic_set_orders(bad, 5)
 
 
-@pytest.mark.parametrize("kind", ["two-sided", "friction"])
+@pytest.mark.parametrize("kind", ["two-sided", "friction", "friction-2d"])
 @pytest.mark.parametrize("condensation", [True, False])
 def test_symmetric_contact_odd_set_equals_full_set(kind, condensation, monkeypatch):
     """Odd-symmetric force, no mean load: the full-set solution has no even harmonics, and the odd
@@ -136,8 +141,9 @@ def finite_difference(evaluate, x, h):
     return np.array(columns).T
 
 
-@pytest.mark.parametrize("kind", ["one-sided", "friction"])
-@pytest.mark.parametrize("harmonic_set", ["odd", [0, 1, 2, 5]])
+@pytest.mark.parametrize("kind, harmonic_set", [
+    ("one-sided", "odd"), ("one-sided", [0, 1, 2, 5]), ("friction", "odd"),
+    ("friction", [0, 1, 2, 5]), ("friction-2d", [0, 1, 2, 5])])
 def test_projected_jacobian_matches_finite_differences(kind, harmonic_set):
     """∂R_𝒦/∂x and ∂R_𝒦/∂ω of the projected full and condensed residuals vs central differences,
     at the odd-set solution perturbed by a smooth random field (no sample on a kink)."""
