@@ -4,8 +4,10 @@ Steps of :func:`solve_frequency`:
 1. validate the inputs (shapes, H, N; the model and contacts were validated when built);
 2. first guess: the linear response with every contact linearized at u = 0 (closed contacts as
    springs k_n with their preload, squeak tangents stuck as springs k_t), unless ``initial`` is given;
-   if Newton fails from it, a homotopy in the excitation level (f̃_e·s, s stepped 0 → 1 with
-   adaptive steps, each solve warm-started by the previous) provides the start;
+   if Newton fails from it, homotopies provide the start, tried in turn: the excitation level
+   (f̃_e·s, s stepped 0 → 1) and then the contact stiffness (k_n·s, k_t·s, s stepped from
+   s₀ ≤ 10⁻⁴ to 1 in log s), each with adaptive steps warm-started by the previous one and capped at
+   ``max_homotopy_iterations`` Newton iterations; ``iterations`` counts all of them;
 3. Newton on the contact rows only (dynamic compliance condensation, :mod:`sarfe.hbm.linear`) when
    that system is smaller, else — or when some S_k(ω) is singular — on all DOFs (sparse LU);
 4. recovery of all DOFs, the residual of the full equation of motion relative to ‖f̃_e‖, Hill
@@ -285,26 +287,99 @@ def solve_auto(problem, omega, U0, options, previous_content=float("nan"), slide
     return replace(solution, reason=f"{solution.reason} ({note})")
 
 
+COLD_START_HOMOTOPIES = ("excitation", "contact_stiffness")
+"""Homotopies tried in turn when Newton fails from the linearized guess (see :func:`_homotopy`)."""
+
+SOFT_CONTACT_SCALE = 1e-4
+"""Largest start of the contact-stiffness homotopy: k_n, k_t × 10⁻⁴ (see :func:`soft_contact_scale`)."""
+
+
+def soft_contact_scale(problem) -> float:
+    """Start s₀ of the contact-stiffness homotopy: every scaled contact spring at most 10⁻² of the
+    structure's stiffness on its row, k·s₀ ≤ 10⁻² Σ_j G_rj² K_jj, and s₀ ≤ :data:`SOFT_CONTACT_SCALE`."""
+    c = problem.contacts
+    K = problem.model.stiffness
+    diagonal = np.abs(K.diagonal() if sp.issparse(K) else np.diag(K))
+    structure = np.asarray(c.gap_map.multiply(c.gap_map) @ diagonal).ravel()
+    spring = np.zeros(c.row_count)
+    spring[c.normal_row[c.normal_row >= 0]] = c.normal_stiffness[c.normal_row >= 0]
+    for col in range(2):
+        present = c.tangent_rows[:, col] >= 0
+        spring[c.tangent_rows[present, col]] = c.tangential_stiffness[present]
+    loaded = (spring > 0) & (structure > 0)
+    if not np.any(loaded):
+        return SOFT_CONTACT_SCALE
+    return float(min(SOFT_CONTACT_SCALE, 1e-2 * np.min(structure[loaded] / spring[loaded])))
+
+
+def scaled_contacts(problem, scale):
+    """The problem with every contact spring scaled: k_n·s, k_t·s (gaps, μ, N0 unchanged)."""
+    c = problem.contacts
+    return replace(problem, contacts=replace(c, normal_stiffness=scale * c.normal_stiffness,
+                                             tangential_stiffness=scale * c.tangential_stiffness))
+
+
+def _homotopy(problem, omega, options, kind):
+    """March a parameter s to 1, each Newton solve warm-started by the previous one.
+
+    kind 'excitation': f̃_e·s, s: 0 → 1 in adaptive steps (0.25 first, ×1.5 on success, ½ on
+    failure, give up below 10⁻³). kind 'contact_stiffness': k_n·s and k_t·s, s: s₀ → 1
+    (:func:`soft_contact_scale`) in adaptive steps of log s (×10 first; the exponent step ×1.5 on success, ½ on failure, give up
+    below 10⁻³ decades) — the soft-contact solution is close to the linear one and the path follows
+    the stable branch a stiff contact reaches by impacts, which the excitation path can miss.
+    At most ``options.max_homotopy_iterations`` Newton iterations in all.
+    Returns (ũ, slider, Newton iterations spent, reached s = 1).
+    """
+    if kind == "excitation":
+        def at(s):
+            return replace(problem, excitation=s * problem.excitation)
+        position, step, smallest, advance = 0.0, 0.25, 1e-3, lambda s, h: min(1.0, s + h)
+    else:
+        def at(s):
+            return scaled_contacts(problem, s)
+        position, step, smallest = soft_contact_scale(problem), 1.0, 1e-3
+        advance = lambda s, h: min(1.0, s * 10.0 ** h)             # noqa: E731
+    steps = replace(options, max_iterations=min(options.max_iterations, 20))
+    start = at(position)
+    current, result, current_slider = _newton(start, omega, linearized_guess(start, omega), steps)
+    spent = result.iterations
+    if not result.converged:
+        return current, current_slider, spent, False
+    while position < 1.0 and step >= smallest and spent < options.max_homotopy_iterations:
+        target = advance(position, step)
+        U_t, result_t, slider_t = _newton(at(target), omega, current, steps, current_slider)
+        spent += result_t.iterations
+        if result_t.converged:
+            position, current, current_slider = target, U_t, slider_t
+            step *= 1.5
+        else:
+            step *= 0.5
+    return current, current_slider, spent, position >= 1.0
+
+
 def _solve(problem, omega, U0, options, slider=None, homotopy=False):
-    """Newton from U0 (condensed when useful, full as fallback); with ``homotopy``, a failed
-    start is retried by stepping the excitation f̃_e·s, s: 0 → 1 (adaptive, each step warm-started)."""
+    """Newton from U0 (condensed when useful, full as fallback); with ``homotopy``, a failed start
+    is retried from the end of each of :data:`COLD_START_HOMOTOPIES` in turn until Newton converges.
+    ``iterations`` of the result counts every Newton iteration spent, homotopy steps included."""
     U, result, slider = _newton(problem, omega, U0, options, slider)
+    iterations = result.iterations
     if homotopy and not result.converged:
-        scale, step, current, current_slider = 0.0, 0.25, linearized_guess(
-            replace(problem, excitation=0 * problem.excitation), omega), None
-        steps = replace(options, max_iterations=min(options.max_iterations, 20))
-        while scale < 1.0 and step >= 1e-3:
-            target = min(1.0, scale + step)
-            trial = replace(problem, excitation=target * problem.excitation)
-            U_t, result_t, slider_t = _newton(trial, omega, current, steps, current_slider)
-            if result_t.converged:
-                scale, current, current_slider = target, U_t, slider_t
-                step *= 1.5
-            else:
-                step *= 0.5
-        if scale == 1.0:
-            U, result, slider = _newton(problem, omega, current, options, current_slider)
-    return finalize(problem, omega, U, result.converged, result.reason, result.iterations,
+        for kind in COLD_START_HOMOTOPIES:
+            start, start_slider, spent, reached = _homotopy(problem, omega, options, kind)
+            iterations += spent
+            if not reached:
+                continue
+            U_h, result_h, slider_h = _newton(problem, omega, start, options, start_slider)
+            iterations += result_h.iterations
+            if result_h.converged or not result.converged and result_h.residual_norm < \
+                    result.residual_norm:
+                U, result, slider = U_h, result_h, slider_h
+            if result.converged:
+                break
+        if not result.converged:
+            result = replace(result, reason=f"{result.reason} (cold start: linearized guess, "
+                             f"then homotopies in {' and '.join(COLD_START_HOMOTOPIES)})")
+    return finalize(problem, omega, U, result.converged, result.reason, iterations,
                     slider, options)
 
 
