@@ -352,7 +352,8 @@ def _linear_solution(U, omega, harmonics, samples_per_period):
 # ----------------------------------------------------------------------------- harmonic content
 def harmonic_content(solution, threshold=1e-3) -> dict:
     """Energy per harmonic order of the contact displacements, forces and all DOFs, and what could
-    be dropped (the engine solves full sets 0…H; this is the estimate and the report).
+    be dropped — a report on a solved point; the engine drops orders itself through
+    ``solver.harmonic_set`` (odd | auto, :mod:`sarfe.hbm.harmonic_set`).
 
     Returns {'orders', 'displacement_share', 'contact_displacement_share', 'contact_force_share',
     'even_share', 'odd_share', 'mean_share', 'needed_harmonics', 'suggestion'}; shares are fractions
