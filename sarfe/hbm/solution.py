@@ -20,8 +20,8 @@ class SolverOptions:
     step_tolerance: also converged when the scaled Newton step ‖Δ‖/max(‖x‖, x_ref) falls below it
         while the residual is ≤ √tolerance (nonsmooth laws can stall at round-off).
     max_iterations: Newton iteration cap (a point hitting it is returned with converged=False).
-    max_homotopy_iterations: cap on the Newton iterations of one cold-start homotopy (excitation
-        level, then contact stiffness) when Newton fails from the linearized guess.
+    max_homotopy_iterations: cap on the Newton iterations of one cold-start homotopy (contact
+        stiffness, then excitation level) when Newton fails from the linearized guess.
     line_search_steps: backtracking halvings of the step (α = 1, ½, …) on ‖R‖.
     condensation: 'auto' | True | False. Eliminate the linear DOFs through the dynamic compliance
         G S_k⁻¹ Gᵀ (Newton on the contact rows only). 'auto' condenses when that system is smaller

@@ -91,20 +91,29 @@ def wants_condensation(problem, options) -> bool:
     return bool(options.condensation)
 
 
+def contact_row_springs(contacts) -> np.ndarray:
+    """Spring of every row of G [N/m]: k_n on normal rows, k_t on tangent rows."""
+    c = contacts
+    springs = np.zeros(c.row_count)
+    has_n = c.normal_row >= 0
+    springs[c.normal_row[has_n]] = c.normal_stiffness[has_n]
+    for col in range(2):
+        present = c.tangent_rows[:, col] >= 0
+        springs[c.tangent_rows[present, col]] = c.tangential_stiffness[present]
+    return springs
+
+
 def linearized_guess(problem, omega) -> np.ndarray:
     """ũ of the linear system with the contacts linearized at u = 0 (see module docstring)."""
     c, H, n = problem.contacts, problem.harmonics, problem.model.dof_count
-    rows_k = np.zeros(c.row_count)
+    rows_k = contact_row_springs(c)
     preload = np.zeros(c.row_count)
-    closed = (c.normal_row >= 0) & (c.gap <= 0)
-    rows_k[c.normal_row[closed]] = c.normal_stiffness[closed]
-    preload[c.normal_row[closed]] = -c.normal_stiffness[closed] * c.gap[closed]
     has_n = c.normal_row >= 0
+    closed = has_n & (c.gap <= 0)
+    rows_k[c.normal_row[has_n & ~closed]] = 0.0            # open contacts carry no spring
+    preload[c.normal_row[closed]] = -c.normal_stiffness[closed] * c.gap[closed]
     preload[c.normal_row[has_n]] += np.where(np.asarray(c.kind)[has_n] == "squeak",
                                              c.normal_load[has_n], 0.0)
-    for col in range(2):
-        present = c.tangent_rows[:, col] >= 0
-        rows_k[c.tangent_rows[present, col]] = c.tangential_stiffness[present]
     G = c.gap_map
     GG = sp.kron(sp.identity(2 * H + 1), G, format="csr")
     A = dynamic_stiffness_matrix(problem.model, omega, H) + GG.T @ sp.diags(
@@ -304,11 +313,7 @@ def soft_contact_scale(problem) -> float:
     K = problem.model.stiffness
     diagonal = np.abs(K.diagonal() if sp.issparse(K) else np.diag(K))
     structure = np.asarray(c.gap_map.multiply(c.gap_map) @ diagonal).ravel()
-    spring = np.zeros(c.row_count)
-    spring[c.normal_row[c.normal_row >= 0]] = c.normal_stiffness[c.normal_row >= 0]
-    for col in range(2):
-        present = c.tangent_rows[:, col] >= 0
-        spring[c.tangent_rows[present, col]] = c.tangential_stiffness[present]
+    spring = contact_row_springs(c)
     loaded = (spring > 0) & (structure > 0)
     if not np.any(loaded):
         return SOFT_CONTACT_SCALE
@@ -327,8 +332,8 @@ def _homotopy(problem, omega, options, kind):
 
     kind 'excitation': f̃_e·s, s: 0 → 1 in adaptive steps (0.25 first, ×1.5 on success, ½ on
     failure, give up below 10⁻³). kind 'contact_stiffness': k_n·s and k_t·s, s: s₀ → 1
-    (:func:`soft_contact_scale`) in adaptive steps of log s (×10 first; the exponent step ×1.5 on success, ½ on failure, give up
-    below 10⁻³ decades) — the soft-contact solution is close to the linear one and the path follows
+    (:func:`soft_contact_scale`) in adaptive steps of log s (×10 first; the exponent step ×1.5 on
+    success, ½ on failure, give up below 10⁻³ decades) — the soft-contact solution is close to the linear one and the path follows
     the stable branch a stiff contact reaches by impacts, which the excitation path can miss.
     At most ``options.max_homotopy_iterations`` Newton iterations in all.
     Returns (ũ, slider, Newton iterations spent, reached s = 1).
@@ -336,12 +341,18 @@ def _homotopy(problem, omega, options, kind):
     if kind == "excitation":
         def at(s):
             return replace(problem, excitation=s * problem.excitation)
-        position, step, smallest, advance = 0.0, 0.25, 1e-3, lambda s, h: min(1.0, s + h)
+
+        def advance(s, h):
+            return min(1.0, s + h)
+        position, step = 0.0, 0.25
     else:
         def at(s):
             return scaled_contacts(problem, s)
-        position, step, smallest = soft_contact_scale(problem), 1.0, 1e-3
-        advance = lambda s, h: min(1.0, s * 10.0 ** h)             # noqa: E731
+
+        def advance(s, h):
+            return min(1.0, s * 10.0 ** h)
+        position, step = soft_contact_scale(problem), 1.0
+    smallest = 1e-3
     steps = replace(options, max_iterations=min(options.max_iterations, 20))
     start = at(position)
     current, result, current_slider = _newton(start, omega, linearized_guess(start, omega), steps)
@@ -374,8 +385,7 @@ def _solve(problem, omega, U0, options, slider=None, homotopy=False):
                 continue
             U_h, result_h, slider_h = _newton(problem, omega, start, options, start_slider)
             iterations += result_h.iterations
-            if result_h.converged or not result.converged and result_h.residual_norm < \
-                    result.residual_norm:
+            if result_h.converged or result_h.residual_norm < result.residual_norm:
                 U, result, slider = U_h, result_h, slider_h
             if result.converged:
                 break
