@@ -333,10 +333,11 @@ def _homotopy(problem, omega, options, kind):
     kind 'excitation': f̃_e·s, s: 0 → 1 in adaptive steps (0.25 first, ×1.5 on success, ½ on
     failure, give up below 10⁻³). kind 'contact_stiffness': k_n·s and k_t·s, s: s₀ → 1
     (:func:`soft_contact_scale`) in adaptive steps of log s (×10 first; the exponent step ×1.5 on
-    success, ½ on failure, give up below 10⁻³ decades) — the soft-contact solution is close to the linear one and the path follows
-    the stable branch a stiff contact reaches by impacts, which the excitation path can miss.
-    At most ``options.max_homotopy_iterations`` Newton iterations in all.
-    Returns (ũ, slider, Newton iterations spent, reached s = 1).
+    success, ½ on failure, give up below 10⁻³ decades) — the soft-contact solution is close to the
+    linear one and the path follows the stable branch a stiff contact reaches by impacts, which
+    the excitation path can miss. At most ``options.max_homotopy_iterations`` Newton iterations.
+    Returns (ũ, NewtonResult, slider) of the last converged step, the Newton iterations spent and
+    whether s reached 1 — then that step solved ``problem`` itself (at(1) is ``problem``).
     """
     if kind == "excitation":
         def at(s):
@@ -358,17 +359,17 @@ def _homotopy(problem, omega, options, kind):
     current, result, current_slider = _newton(start, omega, linearized_guess(start, omega), steps)
     spent = result.iterations
     if not result.converged:
-        return current, current_slider, spent, False
+        return current, result, current_slider, spent, False
     while position < 1.0 and step >= smallest and spent < options.max_homotopy_iterations:
         target = advance(position, step)
         U_t, result_t, slider_t = _newton(at(target), omega, current, steps, current_slider)
         spent += result_t.iterations
         if result_t.converged:
-            position, current, current_slider = target, U_t, slider_t
+            position, current, result, current_slider = target, U_t, result_t, slider_t
             step *= 1.5
         else:
             step *= 0.5
-    return current, current_slider, spent, position >= 1.0
+    return current, result, current_slider, spent, position >= 1.0
 
 
 def _solve(problem, omega, U0, options, slider=None, homotopy=False):
@@ -379,17 +380,12 @@ def _solve(problem, omega, U0, options, slider=None, homotopy=False):
     iterations = result.iterations
     if homotopy and not result.converged:
         for kind in COLD_START_HOMOTOPIES:
-            start, start_slider, spent, reached = _homotopy(problem, omega, options, kind)
+            U_h, result_h, slider_h, spent, reached = _homotopy(problem, omega, options, kind)
             iterations += spent
-            if not reached:
-                continue
-            U_h, result_h, slider_h = _newton(problem, omega, start, options, start_slider)
-            iterations += result_h.iterations
-            if result_h.converged or result_h.residual_norm < result.residual_norm:
+            if reached:                 # its last step converged on ``problem`` itself
                 U, result, slider = U_h, result_h, slider_h
-            if result.converged:
                 break
-        if not result.converged:
+        else:
             result = replace(result, reason=f"{result.reason} (cold start: linearized guess, "
                              f"then homotopies in {' and '.join(COLD_START_HOMOTOPIES)})")
     return finalize(problem, omega, U, result.converged, result.reason, iterations,
