@@ -32,7 +32,7 @@ def cmd_solve(args) -> int:
     case = load_case(args.case)
     clock = time.perf_counter()
     _say(args, f"sarfe {__version__}: solving {case.name} ({args.case})")
-    result = solve_case(case, output_dir=args.output, progress=not args.quiet)
+    result = solve_case(case, output_dir=args.output, progress=not args.quiet, force=args.force)
     summary = result.summary
     if not args.quiet:
         model = summary["model"]
@@ -124,6 +124,15 @@ def cmd_verify(args) -> int:
     return 0 if agree and hbm.converged else EXIT_NOT_CONVERGED
 
 
+def output_options(parser) -> None:
+    parser.add_argument("--output", "-o", metavar="DIR", default=None,
+                        help="result directory (default: output.directory of the case, "
+                        "results/<name>); must be absent, empty or an earlier sarfe result")
+    parser.add_argument("--force", action="store_true",
+                        help="replace an output folder that is not a sarfe result (never the "
+                        "current folder or the case file's folder)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="sarfe", description="Squeak & rattle noise of car interior panels: FE + "
@@ -139,8 +148,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("solve", help="solve a case and write results")
     common(p)
-    p.add_argument("--output", "-o", metavar="DIR", default=None,
-                   help="result directory (default: output.directory of the case, results/<name>)")
+    output_options(p)
     p.set_defaults(func=cmd_solve)
     p = sub.add_parser("verify", help="compare HBM with time integration at one frequency")
     common(p)
@@ -148,8 +156,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--tolerance", type=float, default=0.05,
                    help="relative amplitude difference accepted (default 0.05)")
     p.set_defaults(func=cmd_verify)
-    p = sub.add_parser("validate", help="check a case file (schema, mesh groups, contact pairing)")
+    p = sub.add_parser("validate", help="check a case file: everything `solve` checks before "
+                       "the heavy work (schema, numbers, mesh quality, groups, contact pairing, "
+                       "held structure, output folder)")
     common(p)
+    output_options(p)
     p.set_defaults(func=cmd_validate)
 
     for name in EXTENSION_MODULES:  # optional subcommands (study, batch)

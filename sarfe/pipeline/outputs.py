@@ -1,10 +1,8 @@
 """Result files of a case (via :mod:`sarfe.io.outputs`), the console table, and the atomic move
-of the finished result directory into place."""
+of the finished result directory into place (the rules: :mod:`sarfe.io.result_folder`)."""
 from __future__ import annotations
 
 import math
-import os
-import shutil
 from pathlib import Path
 
 import numpy as np
@@ -122,12 +120,9 @@ def results_table(rows, contact_types=None, max_contacts=6) -> str:
     return table
 
 
-def replace_directory(temporary: Path, target: Path):
-    """Move a finished temporary directory onto ``target`` (replacing an older result)."""
-    backup = None
-    if target.exists():
-        backup = target.with_name(f".{target.name}.old-{os.getpid()}")
-        os.replace(target, backup)
-    os.replace(temporary, target)
-    if backup is not None:
-        shutil.rmtree(backup, ignore_errors=True)
+def replace_directory(temporary: Path, target: Path, force: bool = False):
+    """Move a finished temporary directory onto ``target`` (replacing an older sarfe result only;
+    the previous result is restored if the move fails): :func:`sarfe.io.result_folder.replace_directory`."""
+    from sarfe.io.result_folder import replace_directory as replace
+
+    replace(temporary, target, force=force)

@@ -5,8 +5,6 @@ directory next to the target and moved into place at the end).
 from __future__ import annotations
 
 import datetime as _dt
-import shutil
-import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -17,7 +15,7 @@ from sarfe.io.case import load_case
 from sarfe.io.errors import EXIT_NOT_CONVERGED
 from sarfe.pipeline.linear import build_linear_model, linear_model_key
 from sarfe.pipeline.nonlinear import NonlinearModel, nonlinear_model
-from sarfe.pipeline.outputs import replace_directory, write_outputs, results_table
+from sarfe.pipeline.outputs import write_outputs, results_table
 from sarfe.pipeline.points import solve_points
 from sarfe.pipeline.pruning import solve_points_pruned
 from sarfe.pipeline.postprocess import point_record, worst_of
@@ -36,18 +34,32 @@ class CaseResult:
     output_dir: Path | None = None
 
 
-def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=True) -> CaseResult:
+def output_target(case, output_dir=None, force=False) -> Path:
+    """The checked result folder of a case (``output_dir`` or ``output.directory``): absent, empty
+    or a previous sarfe result (or anything but the current/case folder with ``force``), and
+    writable — else CaseError, before any work (rules: :mod:`sarfe.io.result_folder`)."""
+    from sarfe.io.result_folder import check_output_folder
+
+    target = output_dir if output_dir is not None else case.data["output"]["directory"]
+    return check_output_folder(target, force=force, protected=[case.source])
+
+
+def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=True,
+               force=False) -> CaseResult:
     """Solve a case end to end (module docstring). Returns :class:`CaseResult`.
 
     ``output_dir``: where the result files go (default ``output.directory`` of the case, relative to
-    the current directory); ``write=False`` writes nothing. Files are written into a temporary
-    directory next to the target and moved into place at the end, so a failed run leaves nothing.
+    the current directory); ``write=False`` writes nothing. The folder is checked before any work
+    (:func:`output_target`; ``force`` replaces a folder that is not a sarfe result). Files are
+    written into a temporary directory next to the target and moved into place at the end, so a
+    failed run leaves the previous result as it was.
     Raises CaseError for problems in the case; a non-converged point gives ``exit_code`` 3.
     """
     from sarfe import __version__
 
     started = time.perf_counter()
     case = load_case(case)
+    target = output_target(case, output_dir, force) if write else None
     timings = {}
     accuracy = None
     if "accuracy" in case.data["solver"]:
@@ -121,25 +133,20 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     if not write:
         summary["timings_s"]["total_s"] = time.perf_counter() - started
         return result
-    target = Path(output_dir if output_dir is not None else case.data["output"]["directory"])
-    target = target.resolve()
-    target.parent.mkdir(parents=True, exist_ok=True)
-    temporary = Path(tempfile.mkdtemp(prefix=f".{target.name}.tmp-", dir=target.parent))
-    try:
+    from sarfe.io.outputs import write_summary_json
+    from sarfe.io.result_folder import marker_info, write_result_folder
+
+    def write_files(folder):
         clock = time.perf_counter()
         summary["timings_s"]["outputs_s"] = 0.0
         summary["timings_s"]["total_s"] = time.perf_counter() - started
-        written = write_outputs(case, stage, nl, summary, rows, solutions, erps, normal_w,
-                                 temporary)
-        summary["files"] = written
+        summary["files"] = write_outputs(case, stage, nl, summary, rows, solutions, erps,
+                                         normal_w, folder)
         summary["timings_s"]["outputs_s"] = time.perf_counter() - clock
         summary["timings_s"]["total_s"] = time.perf_counter() - started
-        from sarfe.io.outputs import write_summary_json
-        write_summary_json(temporary / "summary.json", summary)
-        replace_directory(temporary, target)
-    except BaseException:
-        shutil.rmtree(temporary, ignore_errors=True)
-        raise
+        write_summary_json(folder / "summary.json", summary)
+
+    write_result_folder(target, write_files, marker_info("solve", case.name), force=force)
     result.output_dir = target
     return result
 
