@@ -108,6 +108,8 @@ class BeamElements:
     orientation   (m, 3)            global vector v in the beam's x–y plane (zeros for rods)
     area (m,) [m²]; i1, i2 (m,) [m⁴] (about the element y / z axes: bending in the
     x–y plane uses I1); i12 (m,) [m⁴]; torsion (m,) J [m⁴]
+    shear_factor_1, shear_factor_2 (m,) [-]  shear area = factor·A in planes 1, 2 (Timoshenko);
+                                     0 = rigid in shear (Euler–Bernoulli), as Nastran's blank
     young, shear_modulus (m,) [Pa]; density (m,) [kg/m³]; mass_per_length (m,) NSM [kg/m]
     """
 
@@ -121,6 +123,8 @@ class BeamElements:
     i2: np.ndarray = field(default_factory=_floats)
     i12: np.ndarray = field(default_factory=_floats)
     torsion: np.ndarray = field(default_factory=_floats)
+    shear_factor_1: np.ndarray = field(default_factory=_floats)
+    shear_factor_2: np.ndarray = field(default_factory=_floats)
     young: np.ndarray = field(default_factory=_floats)
     shear_modulus: np.ndarray = field(default_factory=_floats)
     density: np.ndarray = field(default_factory=_floats)
