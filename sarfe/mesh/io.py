@@ -53,7 +53,7 @@ def load_mesh(path, length_unit: str = "m") -> PanelMesh:
         mesh = _read_gmsh(path) if fmt == "gmsh" else _read_meshio(path, fmt)
     except MeshError:
         raise
-    except Exception as error:  # reader-specific exceptions → one line
+    except (Exception, SystemExit) as error:  # reader exceptions (meshio even exits) → one line
         message = " ".join(str(error).split()) or type(error).__name__
         raise MeshError(f"cannot read {fmt} mesh {path}: {message}") from error
     if mesh.n_triangles == 0 and mesh.tetrahedra is None:
@@ -65,13 +65,54 @@ def load_mesh(path, length_unit: str = "m") -> PanelMesh:
 def _read_gmsh(path: Path) -> PanelMesh:
     with gmsh_session() as gmsh:
         gmsh.merge(os.fspath(path))
-        return mesh_from_gmsh()
+        mesh = mesh_from_gmsh()
+    return merge_repeated_elements(mesh) if _msh_major_version(path) == 2 else mesh
+
+
+def _msh_major_version(path: Path) -> int | None:
+    """Major version of a Gmsh file from its ``$MeshFormat`` header (None if absent)."""
+    with open(path, "rb") as handle:
+        head = handle.read(256).split()
+    if len(head) >= 2 and head[0] == b"$MeshFormat":
+        try:
+            return int(float(head[1]))
+        except ValueError:
+            return None
+    return None
+
+
+def merge_repeated_elements(mesh: PanelMesh) -> PanelMesh:
+    """The mesh with each repeated element (same node list) kept once, its groups merged.
+
+    MSH 2.2 writes an element once per physical group it belongs to (the format has one
+    physical tag per element line), so gmsh reads a triangle in ``skin`` and ``part_carrier``
+    as two coincident triangles: twice the stiffness, mass and radiating area.  The copies
+    are merged here; an element group then names the one kept element.
+    """
+    triangles = mesh.triangles
+    _, first, owner = np.unique(triangles, axis=0, return_index=True, return_inverse=True)
+    owner = np.asarray(owner).reshape(-1)
+    tets = mesh.tetrahedra
+    if tets is not None:
+        _, tet_first = np.unique(tets, axis=0, return_index=True)
+        tets = tets[np.sort(tet_first)]
+    if len(first) == len(triangles) and (tets is None or len(tets) == len(mesh.tetrahedra)):
+        return mesh
+    keep = np.sort(first)                       # first copies, in file order
+    new_index = np.empty(len(first), dtype=np.int64)
+    new_index[np.argsort(first)] = np.arange(len(first))   # unique row → position in `keep`
+    element_map = new_index[owner]              # every element (copy or not) → kept element
+    groups = {name: np.unique(element_map[rows]) for name, rows in mesh.element_groups.items()}
+    return PanelMesh(mesh.points, triangles[keep], mesh.node_groups, groups, tets)
 
 
 def _read_meshio(path: Path, fmt: str) -> PanelMesh:
-    import meshio
+    import meshio.abaqus
+    import meshio.nastran
 
-    data = meshio.read(os.fspath(path), file_format=fmt)
+    # the format's own reader raises meshio.ReadError; meshio.read() would print it and exit
+    reader = meshio.abaqus.read if fmt == "abaqus" else meshio.nastran.read
+    data = reader(os.fspath(path))
     triangle_blocks, tetra_blocks = [], []
     # per meshio cell block: rows of its kept elements in the concatenated triangle list
     block_rows, offset = [], 0
