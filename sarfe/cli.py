@@ -25,14 +25,21 @@ def _say(args, text):
         print(text, flush=True)
 
 
+def _warn(line):
+    print(f"sarfe: warning: {line}", file=sys.stderr, flush=True)
+
+
 def cmd_solve(args) -> int:
     from sarfe.io.outputs.summary import pruning_line
     from sarfe.pipeline import load_case, results_table, solve_case
+    from sarfe.pipeline.checks import output_target
 
     case = load_case(args.case)
+    output_target(case, args.output, args.force)   # before any work (solve_case checks it all)
     clock = time.perf_counter()
     _say(args, f"sarfe {__version__}: solving {case.name} ({args.case})")
-    result = solve_case(case, output_dir=args.output, progress=not args.quiet, force=args.force)
+    result = solve_case(case, output_dir=args.output, progress=not args.quiet, force=args.force,
+                        warn=_warn)
     summary = result.summary
     if not args.quiet:
         model = summary["model"]
@@ -60,10 +67,15 @@ def cmd_solve(args) -> int:
 
 
 def cmd_validate(args) -> int:
-    from sarfe.pipeline import check_mesh, load_case
+    """Every check `solve` makes before the heavy work (sarfe.pipeline.checks); warnings on stderr."""
+    from sarfe.pipeline import load_case
+    from sarfe.pipeline.checks import check_case
 
     case = load_case(args.case)
-    info = check_mesh(case)
+    checked = check_case(case, output_dir=args.output, force=args.force)
+    for line in checked.warnings:
+        _warn(line)
+    info = checked.info
     text = f"{args.case}: valid"
     if info:
         pairs = ", ".join(f"{k} ({v} pairs)" for k, v in info["contact_pairs"].items())

@@ -213,6 +213,65 @@ def validate_schema(data, source=None, lines=None):
     raise CaseError(message, path, source, _line_of(lines, path))
 
 
+# ------------------------------------------------------------------------ numbers and plausibility
+def check_finite(data, source=None, lines=None, path=()):
+    """Raise CaseError at the first NaN or ±inf anywhere in the case (YAML ``.nan``, ``.inf``):
+    no key of a case takes a non-finite number, and the schema's range checks let NaN through."""
+    if isinstance(data, float) and not math.isfinite(data):
+        text = ".nan" if math.isnan(data) else ("-.inf" if data < 0 else ".inf")
+        raise CaseError(f"must be a finite number, got {text}", path, source,
+                        _line_of(lines or {}, path))
+    if isinstance(data, dict):
+        for key, value in data.items():
+            check_finite(value, source, lines, path + (key,))
+    elif isinstance(data, list):
+        for index, value in enumerate(data):
+            check_finite(value, source, lines, path + (index,))
+
+
+# Bounds outside which a value is a unit mistake rather than a material or a load; each message
+# says which unit the key is in.
+AUDIBLE_LIMIT_HZ = 20e3
+_MIN_E_PA, _MIN_RHO_KG_M3, _MAX_MESH_SIZE_M = 1e5, 1.0, 1.0
+
+
+def _check_plausible(case, data):
+    """Signs and orders of magnitude that the schema cannot judge (negative excitation amplitudes,
+    moduli in MPa/GPa, densities in t/mm³ or g/cm³, frequencies beyond hearing)."""
+    exc = data["excitation"]
+    for i, load in enumerate(exc.get("forces", [])):
+        if load["force_N"] < 0:
+            raise case.error(f"must be >= 0 (an amplitude), got {load['force_N']:g}; reverse the "
+                             "direction or set phase_deg: 180", ("excitation", "forces", i, "force_N"))
+    base = exc.get("base_acceleration")
+    if base is not None and base["amplitude_m_s2"] < 0:
+        raise case.error(f"must be >= 0 (an amplitude), got {base['amplitude_m_s2']:g}; reverse the "
+                         "direction or set phase_deg: 180",
+                         ("excitation", "base_acceleration", "amplitude_m_s2"))
+    frequencies = list(exc.get("frequency_hz", [])) + [exc["sweep"][k] for k in ("start_hz", "end_hz")
+                                                      if "sweep" in exc]
+    for key in ("frequency_hz", "sweep"):
+        if key in exc and max(frequencies) > AUDIBLE_LIMIT_HZ:
+            raise case.error(f"{max(frequencies):g} Hz is above the audible range (≤ "
+                             f"{AUDIBLE_LIMIT_HZ:g} Hz) that squeak and rattle noise is judged in; "
+                             "frequencies are in Hz", ("excitation", key))
+    fe = data["model"].get("fe")
+    if fe is None:
+        return
+    for name, material in fe.get("materials", {}).items():
+        p = ("model", "fe", "materials", name)
+        if material["E_Pa"] < _MIN_E_PA:
+            raise case.error(f"{material['E_Pa']:g} Pa is far too soft for a panel material — "
+                             "given in MPa or GPa? E_Pa is in pascals (steel 2.1e+11)", p + ("E_Pa",))
+        if material["rho_kg_m3"] < _MIN_RHO_KG_M3:
+            raise case.error(f"{material['rho_kg_m3']:g} kg/m³ is lighter than air — given in t/mm³ "
+                             "or g/cm³? rho_kg_m3 is in kg/m³ (steel 7850)", p + ("rho_kg_m3",))
+    generator = fe.get("generator")
+    if generator is not None and generator["mesh_size_m"] >= _MAX_MESH_SIZE_M:
+        raise case.error(f"{generator['mesh_size_m']:g} m elements are larger than a panel — given in "
+                         "mm? mesh_size_m is in metres", ("model", "fe", "generator", "mesh_size_m"))
+
+
 # ---------------------------------------------------------------------------------- normalizing
 def _only_one(case, section, path, keys, required=True):
     given = [k for k in keys if k in section]
@@ -472,6 +531,7 @@ def normalize(case: Case) -> Case:
     _normalize_reduction(case, data)
     _normalize_erp(case, data)
     _normalize_output(case, data)
+    _check_plausible(case, data)
     return case
 
 
@@ -489,6 +549,7 @@ def load_case(path_or_dict, base_dir=None) -> Case:
         source = str(path_or_dict)
         data, lines = read_yaml(path_or_dict)
         base = Path(base_dir) if base_dir else Path(path_or_dict).resolve().parent
+    check_finite(data, source, lines)
     validate_schema(data, source, lines)
     case = Case(name=data["name"], data=data, source=source, base_dir=base, lines=lines)
     return normalize(case)

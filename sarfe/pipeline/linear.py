@@ -224,9 +224,14 @@ def _build_matrices(case: Case, progress=False) -> dict:
 
 # ------------------------------------------------------------------------------------- FE path
 def _generate_mesh(name, mesh_size, params):
-    """sarfe.mesh.generators.<name>.generate(mesh_size=..., **params) → PanelMesh."""
-    module = importlib.import_module(f"sarfe.mesh.generators.{name}")
-    return module.generate(mesh_size=mesh_size, **params)
+    """sarfe.mesh.generators.<name>.generate(mesh_size=..., **params) → PanelMesh, through the
+    checksummed mesh cache (sarfe.mesh.cache: generated once per parameter set)."""
+    from sarfe.mesh.cache import cached_mesh
+    from sarfe.mesh.generators import GENERATORS
+
+    if name not in GENERATORS:
+        importlib.import_module(f"sarfe.mesh.generators.{name}")  # ImportError names it
+    return cached_mesh(name, mesh_size, **params)
 
 
 def load_case_mesh(case: Case):

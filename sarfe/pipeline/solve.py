@@ -13,6 +13,7 @@ import numpy as np
 
 from sarfe.io.case import load_case
 from sarfe.io.errors import EXIT_NOT_CONVERGED
+from sarfe.pipeline.checks import check_case, reduced_model_warnings
 from sarfe.pipeline.linear import build_linear_model, linear_model_key
 from sarfe.pipeline.nonlinear import NonlinearModel, nonlinear_model
 from sarfe.pipeline.outputs import write_outputs, results_table
@@ -34,23 +35,15 @@ class CaseResult:
     output_dir: Path | None = None
 
 
-def output_target(case, output_dir=None, force=False) -> Path:
-    """The checked result folder of a case (``output_dir`` or ``output.directory``): absent, empty
-    or a previous sarfe result (or anything but the current/case folder with ``force``), and
-    writable — else CaseError, before any work (rules: :mod:`sarfe.io.result_folder`)."""
-    from sarfe.io.result_folder import check_output_folder
-
-    target = output_dir if output_dir is not None else case.data["output"]["directory"]
-    return check_output_folder(target, force=force, protected=[case.source])
-
-
 def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=True,
-               force=False) -> CaseResult:
+               force=False, warn=None) -> CaseResult:
     """Solve a case end to end (module docstring). Returns :class:`CaseResult`.
 
     ``output_dir``: where the result files go (default ``output.directory`` of the case, relative to
-    the current directory); ``write=False`` writes nothing. The folder is checked before any work
-    (:func:`output_target`; ``force`` replaces a folder that is not a sarfe result). Files are
+    the current directory); ``write=False`` writes nothing. Every input check of ``sarfe validate``
+    runs first (:func:`sarfe.pipeline.checks.check_case`: mesh quality, held structure, output
+    folder; ``force`` replaces a folder that is not a sarfe result); its warnings go to
+    ``warn(line)`` as found and to summary.json ``warnings``. Files are
     written into a temporary directory next to the target and moved into place at the end, so a
     failed run leaves the previous result as it was.
     Raises CaseError for problems in the case; a non-converged point gives ``exit_code`` 3.
@@ -59,7 +52,11 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
 
     started = time.perf_counter()
     case = load_case(case)
-    target = output_target(case, output_dir, force) if write else None
+    checked = check_case(case, output_dir, force, write=write, mesh_checks=linear_stage is None)
+    target, warnings = checked.output, list(checked.warnings)
+    for line in warnings:
+        if warn is not None:
+            warn(line)
     timings = {}
     accuracy = None
     if "accuracy" in case.data["solver"]:
@@ -81,6 +78,10 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     elif linear_stage.key != linear_model_key(case):
         raise ValueError("linear_stage was built for a different linear model (key mismatch)")
     stage = linear_stage
+    for line in reduced_model_warnings(case, stage):
+        warnings.append(line)
+        if warn is not None:
+            warn(line)
     clock = time.perf_counter()
     nl = nonlinear_model(case, stage)
     timings["setup_s"] = time.perf_counter() - clock
@@ -126,6 +127,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         "points": points,
         "worst": worst_of(points),
         "accuracy": accuracy,                    # None unless solver.accuracy was given
+        "warnings": warnings,                    # inputs far outside the model's range
         "timings_s": timings,
         "case_data": case.data,                  # the case with every default filled in
     }
