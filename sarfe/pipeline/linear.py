@@ -394,7 +394,7 @@ def _build_fe(case: Case, progress=False) -> dict:
     data, fe = case.data, case.data["model"]["fe"]
     timings = {}
     clock = time.perf_counter()
-    stages = _bar(progress, "linear stage", 4, unit="step")
+    stages = _bar(progress, "linear stage: mesh", 4, unit="step")
     mesh = load_case_mesh(case)
     timings["mesh_s"] = time.perf_counter() - clock
     _step(stages, "assembly")
@@ -544,14 +544,11 @@ def _build_fe(case: Case, progress=False) -> dict:
 
 
 def _bar(progress, description, total, unit="block"):
-    """A tqdm bar on stderr, or None (no progress wanted, or stderr is not a terminal); shared by
-    the linear stage and the frequency points."""
-    import sys
+    """A tqdm bar on a terminal, one log line per stage otherwise, None without progress
+    (:func:`sarfe.pipeline.progress.bar`); shared by the linear stage and the frequency points."""
+    from sarfe.pipeline.progress import bar
 
-    if not progress or not sys.stderr.isatty():
-        return None
-    from tqdm import tqdm
-    return tqdm(total=total, desc=description, unit=unit, leave=False)
+    return bar(progress, description, total, unit)
 
 
 def _step(bar, next_description):

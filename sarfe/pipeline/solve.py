@@ -18,6 +18,7 @@ from sarfe.pipeline.linear import build_linear_model, linear_model_key
 from sarfe.pipeline.nonlinear import NonlinearModel, nonlinear_model
 from sarfe.pipeline.outputs import write_outputs, results_table
 from sarfe.pipeline.points import solve_points
+from sarfe.pipeline.progress import bar as _bar
 from sarfe.pipeline.pruning import solve_points_pruned
 from sarfe.pipeline.postprocess import point_record, worst_of
 
@@ -92,12 +93,20 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
 
     clock = time.perf_counter()
     points, rows, erps, normal_w = [], [], [], []
-    for index, solution in enumerate(solutions):
-        point, row, erp, W = point_record(case, stage, nl, index, solution)
-        points.append(point)
-        rows.append(row)
-        erps.append(erp)
-        normal_w.append(W)
+    bar = _bar(progress, "ERP and error estimates" if case.data["solver"].get("error_estimate", True)
+               else "ERP", len(solutions), unit="point")
+    try:
+        for index, solution in enumerate(solutions):
+            point, row, erp, W = point_record(case, stage, nl, index, solution)
+            points.append(point)
+            rows.append(row)
+            erps.append(erp)
+            normal_w.append(W)
+            if bar is not None:
+                bar.update(1)
+    finally:
+        if bar is not None:
+            bar.close()
     timings["postprocess_s"] = time.perf_counter() - clock
     not_converged = [p["index"] for p in points if not p["converged"]]
     sweep = case.data["excitation"].get("sweep")
@@ -148,7 +157,12 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         summary["timings_s"]["total_s"] = time.perf_counter() - started
         write_summary_json(folder / "summary.json", summary)
 
-    write_result_folder(target, write_files, marker_info("solve", case.name), force=force)
+    bar = _bar(progress, "writing results", None, unit="file")
+    try:
+        write_result_folder(target, write_files, marker_info("solve", case.name), force=force)
+    finally:
+        if bar is not None:
+            bar.close()
     result.output_dir = target
     return result
 
