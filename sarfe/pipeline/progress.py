@@ -19,7 +19,7 @@ class StageLine:
     def __init__(self, description, total=None, unit="", stream=None):
         self.stream = stream if stream is not None else sys.stderr
         self.total = total if unit in ("point", "variant") else None
-        self.unit, self.count, self.count = unit, 0
+        self.unit, self.count = unit, 0
         self.set_description(description)
 
     def set_description(self, description, refresh=True):
