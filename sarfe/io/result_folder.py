@@ -30,6 +30,7 @@ import secrets
 import shutil
 import socket
 import tempfile
+import time
 from pathlib import Path
 
 from sarfe.io.errors import CaseError
@@ -193,6 +194,27 @@ def _stale(entry: Path) -> bool:
     return not pid_alive(int(match["pid"]))
 
 
+# sarfe before the marker: ``tempfile.mkdtemp(prefix=".<name>.tmp-")`` and ``.<name>.old-<pid>``
+_LEGACY_TEMP = re.compile(r"^\.(?P<name>.+)\.(?P<kind>tmp)-[a-z0-9_]{8}$|"
+                          r"^\.(?P<name2>.+)\.(?P<kind2>old)-(?P<pid>\d+)$")
+_LEGACY_AGE_S = 86400.0
+
+
+def _legacy_stale(entry: Path, match) -> bool:
+    """A temporary folder of a sarfe version without the marker: only sarfe's result file names
+    inside, and (tmp) a day old or (old) its PID gone."""
+    try:
+        if not entry.is_dir() or entry.is_symlink():
+            return False
+        if not {p.name for p in entry.iterdir()} <= _LEGACY_RESULT_NAMES:
+            return False
+        if match["kind"] == "tmp":
+            return time.time() - entry.stat().st_mtime > _LEGACY_AGE_S
+        return not pid_alive(int(match["pid"]))
+    except OSError:
+        return False
+
+
 def clean_stale(parent, name: str | None = None) -> list:
     """Remove temporary folders of killed sarfe runs in ``parent`` (all, or those of target
     ``name``); a backup ``.old-`` whose target is missing is renamed back instead. Returns what
@@ -205,7 +227,15 @@ def clean_stale(parent, name: str | None = None) -> list:
         return done
     for entry in entries:
         match = _TEMP_NAME.match(entry.name)
-        if not match or (name is not None and match["name"] != name) or not _stale(entry):
+        if match is None:
+            legacy = _LEGACY_TEMP.match(entry.name)
+            if legacy is not None and _legacy_stale(entry, {
+                    "kind": legacy["kind"] or legacy["kind2"], "pid": legacy["pid"]}):
+                match = {"name": legacy["name"] or legacy["name2"],
+                         "kind": legacy["kind"] or legacy["kind2"]}
+            if match is None or (name is not None and match["name"] != name):
+                continue
+        elif (name is not None and match["name"] != name) or not _stale(entry):
             continue
         target = parent / match["name"]
         if match["kind"] == "old" and not target.exists():

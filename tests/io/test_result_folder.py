@@ -321,3 +321,23 @@ def test_batch_never_overwrites_the_users_summary(case, capsys):
     assert code == 0, capsys.readouterr().err
     assert json.loads((Path("out") / MARKER).read_text())["kind"] == "batch"
     assert batch_main(["--workers", "0", "--output", "out", str(case)]) == 0   # resumes there
+
+
+def test_debris_of_versions_before_the_marker(tmp_path):
+    """`.res.tmp-xxxxxxxx` (mkdtemp) a day old with only result files, and `.res.old-<dead pid>`:
+    removed; a fresh one, or one holding anything else, kept."""
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    (tmp_path / "res").mkdir()
+    old_tmp, new_tmp, foreign = (tmp_path / f".res.tmp-{s}" for s in ("ab12cd34", "ef56gh78",
+                                                                       "ij90kl12"))
+    backup = tmp_path / f".res.old-{dead.pid}"
+    for folder in (old_tmp, new_tmp, foreign, backup):
+        folder.mkdir()
+        (folder / "summary.json").write_text("{}")
+    (foreign / "thesis.tex").write_text("mine")
+    day_ago = time.time() - 2 * 86400
+    for folder in (old_tmp, foreign):
+        os.utime(folder, (day_ago, day_ago))
+    clean_stale(tmp_path, "res")
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["res", new_tmp.name, foreign.name])
