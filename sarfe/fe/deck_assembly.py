@@ -30,7 +30,7 @@ from .shell import DRILLING_PENALTY
 from .shell_section import section_shell_element_matrices
 from .solid_cells import solid_cell_matrices
 
-__all__ = ["DeckSystem", "assemble_deck", "support_dofs", "load_vector"]
+__all__ = ["DeckSystem", "assemble_deck", "support_dofs", "load_vector", "lumped_mass"]
 
 _BLOCK = 4096
 
@@ -77,8 +77,38 @@ class DeckSystem:
         return (self.transformation @ np.asarray(q)).reshape(self.n_nodes, 6)
 
 
-def _element_blocks(deck: DeckModel, drilling_penalty):
-    """Yield (K_e, M_e, dofs) blocks of every element table."""
+def lumped_mass(mass, dofs):
+    """Row-lumped element masses (n_el, k, k): per translation direction c, the HRZ diagonal
+    m_ii · (Σ_ij M_ij / Σ_i M_ii) over that direction's DOFs (total mass kept, positive for
+    quadratic cells too); the rotation–rotation block (rotary inertia) is kept, the
+    translation–rotation coupling dropped. dofs (n_el, k) give the component (dof % 6)."""
+    component = np.asarray(dofs) % 6
+    n_el, size = component.shape
+    diagonal = np.einsum("eii->ei", mass)
+    lumped = np.zeros_like(mass)
+    index = np.arange(size)
+    for c in range(3):
+        pick = (component == c).astype(float)
+        total = np.einsum("eij,ei,ej->e", mass, pick, pick)
+        diag_sum = (diagonal * pick).sum(axis=1)
+        scale = np.divide(total, diag_sum, out=np.zeros(n_el), where=diag_sum > 0)
+        lumped[:, index, index] += diagonal * pick * scale[:, None]
+    rotation = component >= 3
+    lumped += mass * (rotation[:, :, None] & rotation[:, None, :])
+    return lumped
+
+
+def _element_blocks(deck: DeckModel, drilling_penalty, mass="consistent"):
+    """Yield (K_e, M_e, dofs) blocks of every element table (CONM2 never lumped)."""
+    for k, m, dofs in _structural_blocks(deck, drilling_penalty):
+        yield k, (lumped_mass(m, dofs) if mass == "lumped" else m), dofs
+    if len(deck.point_masses.node):
+        m, dofs = point_mass_matrices(deck.point_masses)
+        yield np.zeros_like(m), m, dofs
+
+
+def _structural_blocks(deck: DeckModel, drilling_penalty):
+    """Yield (K_e, M_e, dofs) of shells, solids, beams and springs."""
     shells = deck.shells
     for start in range(0, shells.n_triangles, _BLOCK):
         rows = slice(start, start + _BLOCK)
@@ -107,9 +137,6 @@ def _element_blocks(deck: DeckModel, drilling_penalty):
     if len(deck.springs.element_ids):
         k, _, _, dofs = spring_matrices(deck.points, deck.springs)
         yield k, np.zeros_like(k), dofs
-    if len(deck.point_masses.node):
-        m, dofs = point_mass_matrices(deck.point_masses)
-        yield np.zeros_like(m), m, dofs
 
 
 def _sum_blocks(blocks, n_dof):
@@ -157,14 +184,19 @@ def _frame_transform(frames, independent):
     return rows, cols, vals
 
 
-def assemble_deck(deck: DeckModel, drilling_penalty=DRILLING_PENALTY) -> DeckSystem:
+def assemble_deck(deck: DeckModel, mass="consistent",
+                  drilling_penalty=DRILLING_PENALTY) -> DeckSystem:
     """Global K, M of a deck with RBE2/RBE3 eliminated, in CD frames, zero-stiffness DOFs held.
 
+    mass: 'consistent' (sarfe's element masses) or 'lumped' (:func:`lumped_mass`: diagonal
+    translational masses as Nastran's default without PARAM,COUPMASS, rotary inertia kept).
     See the module docstring for the steps; raises DeckError naming the element or card.
     """
+    if mass not in ("consistent", "lumped"):
+        raise ValueError(f"mass must be 'consistent' or 'lumped', got {mass!r}")
     n = deck.n_nodes
     n_dof = 6 * n
-    stiffness, mass = _sum_blocks(_element_blocks(deck, drilling_penalty), n_dof)
+    stiffness, mass = _sum_blocks(_element_blocks(deck, drilling_penalty, mass), n_dof)
     structural, viscous = _spring_damping(deck, n_dof)
     try:
         c_matrix, independent = constraint_matrix(deck.points, deck.rbe2, deck.rbe3, n)

@@ -4,12 +4,13 @@ Node order as Nastran's CTETRA / CHEXA / CPENTA (corners, then midsides in the c
 order); the element matrices of linear isotropic elasticity
     K_e = ∫ Bᵀ C B dV,  C: σ = λ tr(ε) I + 2 μ ε,   M_e[ac, bd] = δ_cd ∫ ρ N_a N_b dV,
 are formed for all cells of a block at once (arrays (cells, quadrature points, nodes, 3)).
+hex8 carries Wilson–Taylor incompatible modes (three bubbles (1 − ξ_i²) per component,
+condensed per element), as Nastran's CHEXA does not lock in bending either.
 Shape-function gradients on the reference cell are exact (complex-step differentiation of
 the polynomial shape functions); quadrature: scikit-fem's tetrahedron rules, Gauss–Legendre
-products on hexahedra and wedges (full integration: 2³ for hex8, 3³ for hex20). hex8 and
-wedge6 are the plain trilinear/linear cells and are stiff in bending (shear locking:
-FACTS.md measures +40…90 % on a one-layer plate) — model thin parts with shells or with
-quadratic cells.
+products on hexahedra and wedges (full integration: 2³ for hex8, 3³ for hex20). wedge6 is
+the plain linear cell and is stiff in bending (shear locking: FACTS.md measures +40…90 % on
+a one-layer plate) — model thin parts with shells or with quadratic cells.
 
 DOFs: the 3 translations of each node; :func:`solid_cell_matrices` returns element
 matrices and their node-major DOF lists on 6-DOF nodes (6·node + [0, 1, 2]).
@@ -105,6 +106,33 @@ def shape_functions(cell_type, points):
     return values, np.stack(grads, axis=-1)
 
 
+def _elastic_gram(grad_1, grad_2, dv, lam, mu):
+    """∫ B₁ᵀ C B₂ dV (n_el, 3k₁, 3k₂) for gradients (n_el, n_q, k, 3):
+    K[ac, bd] = Σ_q dV (λ ∂_c N_a ∂_d M_b + μ (δ_cd ∇N_a·∇M_b + ∂_d N_a ∂_c M_b))."""
+    n_el, _, k1, _ = grad_1.shape
+    k2 = grad_2.shape[2]
+    left = (grad_1.reshape(n_el, -1, 3 * k1) * dv[:, :, None]).transpose(0, 2, 1)
+    outer = (left @ grad_2.reshape(n_el, -1, 3 * k2)).reshape(n_el, k1, 3, k2, 3)
+    laplace = np.einsum("eacbc->eab", outer)
+    eye = np.eye(3)
+    gram = (lam[:, None, None, None, None] * outer
+            + mu[:, None, None, None, None]
+            * (laplace[:, :, None, :, None] * eye[None, None, :, None, :]
+               + outer.transpose(0, 1, 4, 3, 2)))
+    return gram.reshape(n_el, 3 * k1, 3 * k2)
+
+
+def _incompatible_mode_gradients(x_ref, jac, det):
+    """Gradients (n_el, n_q, 3, 3) of the Wilson bubbles (1 − ξ_i²), i = 1..3, with the
+    centroid Jacobian J₀ and Taylor's factor det J₀ / det J (passes the patch test)."""
+    ref_grad = np.zeros((x_ref.shape[1], 3, 3))  # (n_q, bubble, ξ)
+    for i in range(3):
+        ref_grad[:, i, i] = -2.0 * x_ref[i]
+    jac0 = jac.mean(axis=1)  # J at the centroid: Gauss points are symmetric, J is multilinear
+    grad = np.einsum("qai,eij->eqaj", ref_grad, np.linalg.inv(jac0))
+    return grad * (np.linalg.det(jac0)[:, None] / det)[:, :, None, None]
+
+
 def solid_cell_matrices(points, cells, cell_type, young, poisson, density):
     """Element K [N/m], M [kg] (n_el, 3k, 3k) and DOFs (n_el, 3k) on 6-DOF nodes.
 
@@ -129,17 +157,15 @@ def solid_cell_matrices(points, cells, cell_type, young, poisson, density):
     lam, mu = lame_parameters(np.asarray(young, float), np.asarray(poisson, float))
     rho = np.asarray(density, float)
 
-    flat = grad.reshape(n_el, -1, 3 * k)
-    outer = ((flat * dv[:, :, None]).transpose(0, 2, 1) @ flat).reshape(n_el, k, 3, k, 3)
-    laplace = np.einsum("eacbc->eab", outer)
+    stiffness = _elastic_gram(grad, grad, dv, lam, mu)
+    if cell_type == "hex8":  # Wilson–Taylor incompatible modes, condensed out
+        bubble = _incompatible_mode_gradients(np.asarray(x_ref, float), jac, det)
+        k_ua = _elastic_gram(grad, bubble, dv, lam, mu)
+        k_aa = _elastic_gram(bubble, bubble, dv, lam, mu)
+        stiffness = stiffness - k_ua @ np.linalg.solve(k_aa, k_ua.transpose(0, 2, 1))
     eye = np.eye(3)
-    stiffness = (lam[:, None, None, None, None] * outer
-                 + mu[:, None, None, None, None]
-                 * (laplace[:, :, None, :, None] * eye[None, None, :, None, :]
-                    + outer.transpose(0, 1, 4, 3, 2)))
     scalar_mass = np.einsum("qa,eq,qb->eab", values, dv * rho[:, None], values)
     mass = scalar_mass[:, :, None, :, None] * eye[None, None, :, None, :]
-    stiffness = stiffness.reshape(n_el, 3 * k, 3 * k)
     stiffness = 0.5 * (stiffness + stiffness.transpose(0, 2, 1))
     dofs = (6 * cells[:, :, None] + np.arange(3)).reshape(n_el, 3 * k)
     return stiffness, mass.reshape(n_el, 3 * k, 3 * k), dofs

@@ -418,11 +418,11 @@ class _Converter:
     def springs(self) -> SpringElements:
         rows = defaultdict(list)
 
-        def add(card, eid, pid, a, b, k6, frame, ge, b6):
+        def add(card, eid, pid, a, b, k6, frame, ge, b6, location=np.nan):
             for key, value in (("card", card), ("element_ids", eid), ("property_ids", pid),
                                ("node_a", a), ("node_b", b), ("stiffness", k6),
                                ("frames", frame), ("structural_damping", ge),
-                               ("viscous_damping", b6)):
+                               ("viscous_damping", b6), ("location", location)):
                 rows[key].append(value)
 
         for eid, el in sorted(self.model.elements.items()):
@@ -451,7 +451,8 @@ class _Converter:
                 ge = [float(g or 0.0) for g in (prop.GEi or [0.0])]
                 if any(g != ge[0] for g in ge):
                     self.fail("PBUSH", prop.pid, "GE per component differs: not modelled")
-                add("CBUSH", eid, prop.pid, a, b, k6, frame, ge[0], b6)
+                location = 0.5 if el.s is None else float(el.s)
+                add("CBUSH", eid, prop.pid, a, b, k6, frame, ge[0], b6, location)
             elif el.type in ("CELAS1", "CELAS2"):
                 if el.type == "CELAS1":
                     k, ge, pid = float(el.pid_ref.k), float(el.pid_ref.ge or 0.0), el.pid
