@@ -83,7 +83,6 @@ def test_deck_linear_model_equals_generator_model(door):
     assert np.all(np.abs(la - lb) < 0.1), (la, lb)
 
 
-@pytest.mark.slow
 def test_deck_rattle_erp_equals_generator_erp(door):
     directory, _, written = door
     generator, deck = cases(directory, written)

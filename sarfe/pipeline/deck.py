@@ -403,11 +403,12 @@ def free_rigid_motions(case: Case, deck, held) -> list[str]:
             rank = int(np.sum(sigma > 1e-9 * sigma.max())) if sigma.size else 0
             free = vt[rank:]
         if len(free):
-            names = [_MOTIONS[int(np.argmax(np.abs(v)))] if np.max(np.abs(v)) > 0.99
-                     else "a combined translation/rotation" for v in free]
+            share = np.einsum("ij,ij->j", free, free)   # |P e_k|² of each unit motion in the free space
+            names = [_MOTIONS[k] for k in range(6) if share[k] > 1e-3]
             grids = deck.node_ids[nodes]
             problems.append(f"a part of {len(nodes)} nodes (GRIDs {int(grids.min())}…"
-                            f"{int(grids.max())}) is free in {', '.join(names)}")
+                            f"{int(grids.max())}) is free in {len(free)} rigid-body "
+                            f"motion{'s' if len(free) > 1 else ''} ({', '.join(names)})")
     return problems
 
 
