@@ -157,3 +157,19 @@ def test_grid_id_pairs_and_missing_sets(tmp_path):
     data["model"]["fe"]["supports"] = ["initial"]
     with pytest.raises(CaseError, match=r"support set 'initial' not in the deck \(available: boundary\)"):
         check_mesh(load_case(data, base_dir=tmp_path))
+
+
+def test_outputs_carry_the_deck_ids(tmp_path):
+    import json
+
+    import pyvista as pv
+
+    data = write_case(tmp_path, plate_inp())
+    data["contacts"] = [{"name": "tip", "type": "rattle", "pairs": [[45, "ground"]],
+                         "normal_stiffness_N_m": 1e4, "gap_m": 1e-3}]
+    data["output"] = {"files": ["summary", "erp_vtu"]}
+    result = solve_case(load_case(data, base_dir=tmp_path), output_dir=tmp_path / "out")
+    summary = json.loads((result.output_dir / "summary.json").read_text())
+    assert summary["contacts"][0]["node_pairs"] == [[45, "ground"]]
+    grid = pv.read(result.output_dir / "erp.vtu")
+    assert np.array_equal(np.asarray(grid.point_data["node_id"]), np.arange(1, 46))
