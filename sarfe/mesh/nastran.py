@@ -28,6 +28,7 @@ with `sarfe.mesh.deck.to_si`.
 """
 from __future__ import annotations
 
+import io
 import os
 from collections import defaultdict
 from pathlib import Path
@@ -81,12 +82,18 @@ def _load_bdf(path: Path):
 
     with open(path, errors="replace") as handle:
         text = handle.read()
-    punch = "BEGIN BULK" not in text.upper()
+    upper = text.upper()
+    has_bulk = "BEGIN BULK" in upper
+    has_control = has_bulk and "CEND" in upper.split("BEGIN BULK")[0]
     model = BDF(debug=None)
     model.log.level = "error"
     cwd = os.getcwd()
     try:
-        model.read_bdf(os.fspath(path), xref=True, punch=punch, encoding="latin-1")
+        if has_bulk and not has_control:  # BEGIN BULK without executive/case control
+            os.chdir(path.resolve().parent)  # INCLUDEs are relative to the deck
+            model.read_bdf(io.StringIO("CEND\n" + text), xref=True, encoding="latin-1")
+        else:  # a whole job, or bulk data alone (pyNastran's punch mode)
+            model.read_bdf(os.fspath(path), xref=True, punch=not has_bulk, encoding="latin-1")
     finally:
         os.chdir(cwd)
     return model
