@@ -455,11 +455,13 @@ class _Converter:
                     frame = np.array([ex, np.cross(ez, ex), ez])
                 k6 = np.array([float(k or 0.0) for k in (list(prop.Ki) + [0] * 6)[:6]])
                 b6 = np.array([float(c or 0.0) for c in (list(prop.Bi) + [0] * 6)[:6]])
-                ge = [float(g or 0.0) for g in (prop.GEi or [0.0])]
-                if any(g != ge[0] for g in ge):
+                # GE1 alone applies to all six components; differing GEi are refused
+                given = {float(g) for g in (prop.GEi or []) if g is not None}
+                if len(given) > 1:
                     self.fail("PBUSH", prop.pid, "GE per component differs: not modelled")
+                ge = given.pop() if given else 0.0
                 location = 0.5 if el.s is None else float(el.s)
-                add("CBUSH", eid, prop.pid, a, b, k6, frame, ge[0], b6, location)
+                add("CBUSH", eid, prop.pid, a, b, k6, frame, ge, b6, location)
             elif el.type in ("CELAS1", "CELAS2"):
                 if el.type == "CELAS1":
                     k, ge, pid = float(el.pid_ref.k), float(el.pid_ref.ge or 0.0), el.pid
