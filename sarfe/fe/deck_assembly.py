@@ -141,19 +141,28 @@ def _structural_blocks(deck: DeckModel, drilling_penalty):
 
 
 def _sum_blocks(blocks, n_dof):
-    """One coo → csr pass over all element blocks; K and M as K + iM."""
-    rows, cols, vals = [], [], []
-    for k, m, dofs in blocks:
-        n_el, size = dofs.shape
-        rows.append(np.broadcast_to(dofs[:, :, None], (n_el, size, size)).ravel())
-        cols.append(np.broadcast_to(dofs[:, None, :], (n_el, size, size)).ravel())
-        vals.append((k + 1j * m).ravel())
-    if not rows:
+    """One coo → csr pass over all element blocks; K and M summed as K + iM."""
+    blocks = list(blocks)
+    if not blocks:
         zero = sp.csr_matrix((n_dof, n_dof))
         return zero, zero.copy()
-    matrix = sp.coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                           shape=(n_dof, n_dof)).tocsr()
-    return (sp.csr_matrix((matrix.data.real, matrix.indices, matrix.indptr), shape=matrix.shape),
+    index_type = np.int32 if n_dof < 2**31 - 1 else np.int64
+    total = sum(dofs.shape[0] * dofs.shape[1] ** 2 for _, _, dofs in blocks)
+    rows = np.empty(total, index_type)
+    cols = np.empty(total, index_type)
+    vals = np.empty(total, complex)
+    start = 0
+    for k, m, dofs in blocks:
+        n_el, size = dofs.shape
+        stop = start + n_el * size * size
+        rows[start:stop].reshape(n_el, size, size)[...] = dofs[:, :, None]
+        cols[start:stop].reshape(n_el, size, size)[...] = dofs[:, None, :]
+        vals[start:stop].real = k.ravel()
+        vals[start:stop].imag = m.ravel()
+        start = stop
+    matrix = sp.coo_matrix((vals, (rows, cols)), shape=(n_dof, n_dof)).tocsr()
+    del rows, cols, vals
+    return (sp.csr_matrix((matrix.data.real.copy(), matrix.indices, matrix.indptr), shape=matrix.shape),
             sp.csr_matrix((matrix.data.imag.copy(), matrix.indices.copy(), matrix.indptr.copy()),
                           shape=matrix.shape))
 
