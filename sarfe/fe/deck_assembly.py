@@ -30,7 +30,8 @@ from .shell import DRILLING_PENALTY
 from .shell_section import section_shell_element_matrices
 from .solid_cells import solid_cell_matrices
 
-__all__ = ["DeckSystem", "assemble_deck", "support_dofs", "load_vector", "lumped_mass"]
+__all__ = ["DeckSystem", "assemble_deck", "support_dofs", "load_vector", "lumped_mass",
+           "global_matrices", "mass_properties"]
 
 _BLOCK = 4096
 
@@ -140,19 +141,28 @@ def _structural_blocks(deck: DeckModel, drilling_penalty):
 
 
 def _sum_blocks(blocks, n_dof):
-    """One coo → csr pass over all element blocks; K and M as K + iM."""
-    rows, cols, vals = [], [], []
-    for k, m, dofs in blocks:
-        n_el, size = dofs.shape
-        rows.append(np.broadcast_to(dofs[:, :, None], (n_el, size, size)).ravel())
-        cols.append(np.broadcast_to(dofs[:, None, :], (n_el, size, size)).ravel())
-        vals.append((k + 1j * m).ravel())
-    if not rows:
+    """One coo → csr pass over all element blocks; K and M summed as K + iM."""
+    blocks = list(blocks)
+    if not blocks:
         zero = sp.csr_matrix((n_dof, n_dof))
         return zero, zero.copy()
-    matrix = sp.coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                           shape=(n_dof, n_dof)).tocsr()
-    return (sp.csr_matrix((matrix.data.real, matrix.indices, matrix.indptr), shape=matrix.shape),
+    index_type = np.int32 if n_dof < 2**31 - 1 else np.int64
+    total = sum(dofs.shape[0] * dofs.shape[1] ** 2 for _, _, dofs in blocks)
+    rows = np.empty(total, index_type)
+    cols = np.empty(total, index_type)
+    vals = np.empty(total, complex)
+    start = 0
+    for k, m, dofs in blocks:
+        n_el, size = dofs.shape
+        stop = start + n_el * size * size
+        rows[start:stop].reshape(n_el, size, size)[...] = dofs[:, :, None]
+        cols[start:stop].reshape(n_el, size, size)[...] = dofs[:, None, :]
+        vals[start:stop].real = k.ravel()
+        vals[start:stop].imag = m.ravel()
+        start = stop
+    matrix = sp.coo_matrix((vals, (rows, cols)), shape=(n_dof, n_dof)).tocsr()
+    del rows, cols, vals
+    return (sp.csr_matrix((matrix.data.real.copy(), matrix.indices, matrix.indptr), shape=matrix.shape),
             sp.csr_matrix((matrix.data.imag.copy(), matrix.indices.copy(), matrix.indptr.copy()),
                           shape=matrix.shape))
 
@@ -184,6 +194,14 @@ def _frame_transform(frames, independent):
     return rows, cols, vals
 
 
+def global_matrices(deck: DeckModel, mass="consistent", drilling_penalty=DRILLING_PENALTY):
+    """K, M (CSR (6n, 6n), global DOFs 6·node + c, global axes) before any constraint:
+    e.g. for mass properties, M's rigid-body quadratic forms."""
+    if mass not in ("consistent", "lumped"):
+        raise ValueError(f"mass must be 'consistent' or 'lumped', got {mass!r}")
+    return _sum_blocks(_element_blocks(deck, drilling_penalty, mass), 6 * deck.n_nodes)
+
+
 def assemble_deck(deck: DeckModel, mass="consistent",
                   drilling_penalty=DRILLING_PENALTY) -> DeckSystem:
     """Global K, M of a deck with RBE2/RBE3 eliminated, in CD frames, zero-stiffness DOFs held.
@@ -192,11 +210,9 @@ def assemble_deck(deck: DeckModel, mass="consistent",
     translational masses as Nastran's default without PARAM,COUPMASS, rotary inertia kept).
     See the module docstring for the steps; raises DeckError naming the element or card.
     """
-    if mass not in ("consistent", "lumped"):
-        raise ValueError(f"mass must be 'consistent' or 'lumped', got {mass!r}")
     n = deck.n_nodes
     n_dof = 6 * n
-    stiffness, mass = _sum_blocks(_element_blocks(deck, drilling_penalty, mass), n_dof)
+    stiffness, mass = global_matrices(deck, mass, drilling_penalty)
     structural, viscous = _spring_damping(deck, n_dof)
     try:
         c_matrix, independent = constraint_matrix(deck.points, deck.rbe2, deck.rbe3, n)
@@ -263,3 +279,25 @@ def load_vector(system: DeckSystem, deck: DeckModel, name) -> np.ndarray:
         raise DeckError(f"{deck.source}: load set {key!r} not in the deck; "
                         f"available: {', '.join(deck.loads) or 'none'}")
     return system.transformation.T @ np.asarray(deck.loads[key], float).ravel()
+
+
+def mass_properties(deck: DeckModel, mass="consistent"):
+    """Total mass [kg] and centre of gravity (3,) [m] from the assembled global M.
+
+    For a unit rigid acceleration along axis c (u = e_c at every node, r_c), the inertia
+    forces f = M r_c give the mass m = r_cᵀ M r_c and the moment about the origin
+    Σ_n (x_n × f_n,trans + f_n,rot) = m (x_cg × e_c), from which x_cg follows."""
+    _, matrix = global_matrices(deck, mass)
+    n = deck.n_nodes
+    moments, total = [], 0.0
+    for c in range(3):
+        rigid = np.zeros((n, 6))
+        rigid[:, c] = 1.0
+        force = (matrix @ rigid.ravel()).reshape(n, 6)
+        total = force[:, c].sum() if c == 0 else total
+        moments.append(np.cross(deck.points, force[:, :3]).sum(axis=0) + force[:, 3:].sum(axis=0))
+    if total == 0.0:
+        return 0.0, np.zeros(3)
+    # m (x × e_x) = m (0, z, −y); m (x × e_y) = m (−z, 0, x)
+    cg = np.array([moments[1][2], -moments[0][2], moments[0][1]]) / total
+    return float(total), cg

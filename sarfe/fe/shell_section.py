@@ -65,7 +65,11 @@ def section_shell_element_matrices(points, triangles, membrane, coupling, bendin
     b_bend = strain @ t_rot[:, None]
     k_mem = _weighted_gram(b_mem, a_bar, w_area)
     k_bend = _weighted_gram(b_bend, d_bar, w_area)
-    k_mb = np.einsum("eq,eqri,ers,eqsj->eij", w_area, b_mem, b_bar, b_bend)
+    # Σ_q w_q B_m,qᵀ B̄ B_b,q as batched matmuls (a many-operand einsum is slow)
+    n_q = b_mem.shape[1]
+    coupled = (b_bar[:, None] @ b_bend) * w_area[:, :, None, None]
+    k_mb = (b_mem.reshape(n_el, 3 * n_q, 9).transpose(0, 2, 1)
+            @ coupled.reshape(n_el, 3 * n_q, 9))
 
     # drilling penalty α (G t) A g gᵀ with G t = A66 of the section
     centroid = np.full((1, 3), 1.0 / 3.0)
