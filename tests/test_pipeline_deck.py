@@ -173,3 +173,43 @@ def test_outputs_carry_the_deck_ids(tmp_path):
     assert summary["contacts"][0]["node_pairs"] == [[45, "ground"]]
     grid = pv.read(result.output_dir / "erp.vtu")
     assert np.array_equal(np.asarray(grid.point_data["node_id"]), np.arange(1, 46))
+
+
+SHEAR_DECK = """SOL 103
+CEND
+BEGIN BULK
+GRID,1,,0.,0.,0.
+GRID,2,,100.,0.,0.
+GRID,3,,100.,100.,0.
+GRID,4,,0.,100.,0.
+GRID,5,,200.,0.,0.
+GRID,6,,200.,100.,0.
+CQUAD4,1,1,1,2,3,4
+CQUAD4,3,1,2,5,6,3
+CSHEAR,2,2,2,5,6,3
+PSHELL,1,1,2.,1
+PSHEAR,2,1,3.
+MAT1,1,2000.,,0.3,1.e-9
+SPC1,1,123456,1,4
+ENDDATA
+"""
+
+
+def test_ignored_cards_and_their_mass_are_recorded(tmp_path):
+    """A Nastran shear panel (CSHEAR, not modelled) named in ignore_cards: the run goes on
+    without it and the summary says what was left out and the mass it carried (ρ t A)."""
+    (tmp_path / "shear.bdf").write_text(SHEAR_DECK)
+    data = {"name": "shear", "model": {"fe": {"deck": "shear.bdf", "units": "mm-t-s"}},
+            "excitation": {"base_acceleration": {"direction": "z", "amplitude_m_s2": 1.0},
+                           "frequency_hz": 10.0},
+            "reduction": {"mode_count": 4}, "solver": {"harmonics": 1, "samples_per_period": 8,
+                                                        "error_estimate": False, "stability": False}}
+    with pytest.raises(CaseError, match=r"CSHEAR \(1\), PSHEAR \(1\)"):
+        check_mesh(load_case(data, base_dir=tmp_path))
+    data["model"]["fe"]["ignore_cards"] = ["CSHEAR", "PSHEAR"]
+    result = solve_case(load_case(data, base_dir=tmp_path), write=False)
+    model = result.summary["model"]
+    assert model["ignored_cards"] == {"CSHEAR": 1, "PSHEAR": 1}
+    assert model["ignored_mass_kg"]["CSHEAR"] == pytest.approx(1000 * 3e-3 * 0.01, rel=1e-12)
+    # what stays: two 100 x 100 x 2 mm quads, ρ = 1000 kg/m³
+    assert model["total_mass_kg"] == pytest.approx(1000 * 2e-3 * 2 * 0.01, rel=1e-12)

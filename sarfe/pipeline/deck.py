@@ -453,6 +453,7 @@ def prepare_deck(case: Case) -> PreparedDeck:
     notes = {"deck": str(case.resolve(case.data["model"]["fe"]["deck"])),
              "units": case.data["model"]["fe"]["units"],
              "ignored_cards": dict(deck.ignored),
+             "ignored_mass_kg": ignored_mass(case, deck.ignored),
              "coincident_nodes": [list(p) for p in quality["coincident_nodes"][:50]],
              "coincident_node_pairs": len(quality["coincident_nodes"]),
              "support_sets": [str(s) for s in case.data["model"]["fe"].get("supports", [])]
@@ -464,6 +465,34 @@ def prepare_deck(case: Case) -> PreparedDeck:
         notes["spring_damping"] = ("the springs' GE/B damping is not applied: damping comes "
                                    "from the case's damping section")
     return PreparedDeck(deck, mesh, held, element_contacts, contact_case(case, deck), notes)
+
+
+def ignored_mass(case: Case, ignored: dict) -> dict:
+    """{card: mass [kg] its elements and masses carry} of the ignored cards of a Nastran deck
+    (pyNastran's mass properties, PARAM,WTMASS included; 0 for loads and other massless cards);
+    None per card for an Abaqus file (not computed)."""
+    if not ignored:
+        return {}
+    fe = case.data["model"]["fe"]
+    path = case.resolve(fe["deck"])
+    if path.suffix.lower() == ".inp":
+        return {card: None for card in ignored}
+    from sarfe.mesh.deck import UNIT_SYSTEMS
+    from sarfe.mesh.nastran import _load_bdf
+
+    model = _load_bdf(path)
+    wtmass = model.params["WTMASS"].values[0] if "WTMASS" in model.params else 1.0
+    scale = UNIT_SYSTEMS[fe["units"]].factor(0, 1) * wtmass
+    masses = {}
+    for card in ignored:
+        key = _card_key(card)
+        cards = [el for el in list(model.elements.values()) + list(model.masses.values())
+                 if el.type == key]
+        try:   # each card's own Mass() (pyNastran: ρ, thickness/area and NSM of its property)
+            masses[card] = float(sum(el.Mass() for el in cards)) * scale
+        except Exception:   # a card pyNastran cannot weigh: say so rather than guess
+            masses[card] = None
+    return masses
 
 
 def _used_nodes(deck) -> np.ndarray:
