@@ -80,6 +80,13 @@ def cmd_validate(args) -> int:
     if info:
         pairs = ", ".join(f"{k} ({v} pairs)" for k, v in info["contact_pairs"].items())
         text += f" ({info['nodes']} nodes, {info['triangles']} triangles; contacts: {pairs or 'none'})"
+        if info.get("ignored_cards"):   # deck cards named in model.fe.ignore_cards
+            text += "\n  ignored cards: " + ", ".join(
+                f"{card} ({count})" for card, count in sorted(info["ignored_cards"].items()))
+        if info.get("coincident_node_pairs"):
+            shown = ", ".join(f"{a}={b}" for a, b in info["coincident_nodes"][:10])
+            text += (f"\n  note: {info['coincident_node_pairs']} pair(s) of coincident nodes that "
+                     f"no element joins (node ids): {shown}")
     _say(args, text)
     return 0
 

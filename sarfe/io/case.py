@@ -22,6 +22,8 @@ from sarfe.io.schema import CASE_SCHEMA
 
 _VALIDATOR = jsonschema.Draft202012Validator(CASE_SCHEMA)
 MESH_SUFFIXES = (".msh", ".bdf", ".nas", ".dat", ".inp")
+DECK_SUFFIXES = (".bdf", ".nas", ".dat", ".fem", ".inp")
+DECK_KEYS = ("units", "ignore_cards", "supports", "node_groups", "element_groups")
 MATRIX_SUFFIXES = (".npz", ".npy", ".mtx")
 DEFAULT_ZETA = 0.02
 
@@ -307,7 +309,14 @@ def _normalize_model(case, data):
     if "fe" in model:
         fe = model["fe"]
         p = ("model", "fe")
-        source = _only_one(case, fe, p, ("mesh", "generator"))
+        source = _only_one(case, fe, p, ("mesh", "generator", "deck"))
+        if source == "deck":
+            _normalize_deck(case, fe, p)
+            return
+        _not_allowed(case, fe, p, DECK_KEYS, "without model.fe.deck")
+        for key in ("materials", "thickness_m", "fixed"):
+            if key not in fe:
+                raise case.error(f"missing required key (with model.fe.{source})", p + (key,))
         fe.setdefault("mesh_units", "m")
         if source == "mesh":
             mesh = case.resolve(fe["mesh"])
@@ -336,6 +345,22 @@ def _normalize_model(case, data):
             raise case.error("give either model.matrices.damping or a damping section, not both",
                              ("damping",))
         _not_allowed(case, data, (), ("reduction",), "with model.matrices (no reduction)")
+
+
+def _normalize_deck(case, fe, p):
+    """model.fe.deck: the file exists and is a deck; units, ignore_cards, fixed defaults."""
+    deck = case.resolve(fe["deck"])
+    if deck.suffix.lower() not in DECK_SUFFIXES:
+        raise case.error(f"deck file must be one of {', '.join(DECK_SUFFIXES)}, got "
+                         f"'{deck.name}'", p + ("deck",))
+    if not deck.is_file():
+        raise case.error(f"deck file not found: {deck}", p + ("deck",))
+    _not_allowed(case, fe, p, ("mesh_units",), "with model.fe.deck (use 'units')")
+    fe.setdefault("units", "SI")
+    fe.setdefault("ignore_cards", [])
+    fe.setdefault("fixed", [])
+    fe.setdefault("node_groups", {})
+    fe.setdefault("element_groups", {})
 
 
 def _normalize_damping(case, data):
@@ -369,11 +394,16 @@ def _normalize_contacts(case, data):
         if fe:
             _not_allowed(case, contact, p, ("normal_dof", "tangential_dofs"),
                          "with model.fe (use 'between' node groups)")
-            if "between" not in contact and "pairs" not in contact:
+            deck = "deck" in data["model"]["fe"]
+            if "from_elements" in contact and not deck:
+                raise case.error("needs model.fe.deck (CBUSH/CELAS elements of a deck)",
+                                 p + ("from_elements",))
+            if "between" not in contact and "pairs" not in contact and "from_elements" not in contact:
                 raise case.error("missing required key (node groups [a, b] or [a, ground], "
-                                 "or explicit node 'pairs')", p + ("between",))
-            if "between" in contact and "pairs" in contact:
-                raise case.error("give only one of 'between' or 'pairs'", p + ("pairs",))
+                                 "or explicit node 'pairs', or deck 'from_elements')", p + ("between",))
+            _only_one(case, contact, p, ("between", "pairs", "from_elements"))
+            if "element_axis" in contact and "from_elements" not in contact:
+                raise case.error("only with from_elements", p + ("element_axis",))
             if "between" in contact and contact["between"][0] == "ground":
                 raise case.error("the first group cannot be 'ground'", p + ("between", 0))
             contact.setdefault("pairing_tolerance_m", 1e-3)
@@ -402,7 +432,8 @@ def _normalize_contacts(case, data):
         if not squeak:
             _not_allowed(case, contact, p, ("tangential_stiffness_N_m", "friction_coefficient",
                                             "tangential_dofs"), "for a rattle contact")
-        if has_normal and "normal_stiffness_N_m" not in contact:
+        from_elements = "from_elements" in contact   # stiffness defaults from the elements
+        if has_normal and "normal_stiffness_N_m" not in contact and not from_elements:
             raise case.error("missing required key", p + ("normal_stiffness_N_m",))
         if not has_normal:
             _not_allowed(case, contact, p, ("normal_stiffness_N_m", "gap_m"),
@@ -412,7 +443,7 @@ def _normalize_contacts(case, data):
                                  "without normal DOF)", p + ("preload_N",))
         if squeak:
             for key in ("tangential_stiffness_N_m", "friction_coefficient"):
-                if key not in contact:
+                if key not in contact and not (from_elements and key.startswith("tangential")):
                     raise case.error("missing required key", p + (key,))
         _only_one(case, contact, p, ("gap_m", "preload_N"), required=False)
         if has_normal and "preload_N" not in contact and not fe:
@@ -433,17 +464,24 @@ def _normalize_excitation(case, data):
     if kind == "forces":
         for i, load in enumerate(exc["forces"]):
             q = p + ("forces", i)
-            if fe:
-                _not_allowed(case, load, q, ("dof",), "with model.fe (use 'group')")
-                for key in ("group", "direction"):
+            if fe and "load_set" in load:
+                if "deck" not in data["model"]["fe"]:
+                    raise case.error("needs model.fe.deck", q + ("load_set",))
+                _not_allowed(case, load, q, ("dof", "group", "direction", "force_N"),
+                             "with load_set (the deck's forces times 'scale')")
+                load["force_N"] = float(load.setdefault("scale", 1.0))   # amplitude factor
+            elif fe:
+                _not_allowed(case, load, q, ("dof", "scale"), "with model.fe (use 'group')")
+                for key in ("group", "direction", "force_N"):
                     if key not in load:
                         raise case.error("missing required key", q + (key,))
                 load["direction"] = direction_vector(case, load["direction"], q + ("direction",))
             else:
-                _not_allowed(case, load, q, ("group", "direction"),
+                _not_allowed(case, load, q, ("group", "direction", "load_set", "scale"),
                              "with model.matrices (use 'dof')")
-                if "dof" not in load:
-                    raise case.error("missing required key", q + ("dof",))
+                for key in ("dof", "force_N"):
+                    if key not in load:
+                        raise case.error("missing required key", q + (key,))
             load.setdefault("phase_deg", 0.0)
     else:
         base = exc["base_acceleration"]

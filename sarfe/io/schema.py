@@ -41,8 +41,21 @@ MATERIAL = _object({
     "rho_kg_m3": POSITIVE,
 }, required=("E_Pa", "nu", "rho_kg_m3"))
 
+GRID_IDS = {"type": "array", "items": {"type": "integer", "minimum": 1}, "minItems": 1}
+SET_REFERENCE = {"type": ["string", "integer"], "minLength": 1, "minimum": 0}
+
 FE_MODEL = _object({
     "mesh": NAME,
+    # an engineer's own deck (Nastran .bdf/.dat/.nas/.fem, Abaqus .inp), read with its
+    # properties, supports and loads (sarfe.pipeline.deck)
+    "deck": NAME,
+    "units": {"enum": ["SI", "mm-t-s", "mm-kg-ms", "mm-kg-s", "in-lbf-s"]},
+    "ignore_cards": {"type": "array", "items": NAME, "uniqueItems": True},
+    "supports": {"type": "array", "items": SET_REFERENCE, "minItems": 1},
+    "node_groups": {"type": "object", "additionalProperties": {
+        "oneOf": [GRID_IDS, SET_REFERENCE]}},
+    "element_groups": {"type": "object", "additionalProperties": {
+        "oneOf": [GRID_IDS, SET_REFERENCE]}},
     "generator": _object({
         "name": {"enum": ["door_trim", "instrument_panel", "squeak_rig", "rattle_rig"]},
         "mesh_size_m": POSITIVE,
@@ -52,7 +65,7 @@ FE_MODEL = _object({
     "materials": {"type": "object", "minProperties": 1, "additionalProperties": MATERIAL},
     "thickness_m": {"type": "object", "minProperties": 1, "additionalProperties": POSITIVE},
     "fixed": {"type": "array", "items": NAME, "minItems": 1},
-}, required=("materials", "thickness_m", "fixed"))
+})   # materials, thickness_m and fixed are required with mesh/generator (sarfe.io.case)
 
 MATRICES_MODEL = _object({
     "mass": MATRIX,
@@ -93,6 +106,11 @@ CONTACT = _object({
                                   "pattern": "^ground$"}}},
     "normal": {"type": ["string", "array"], "pattern": "^auto$",
                "items": NUMBER, "minItems": 3, "maxItems": 3},
+    # FE decks: CBUSH/CELAS element ids turned into this contact (removed from the linear
+    # model; their stiffness along element_axis is the penalty stiffness)
+    "from_elements": {"type": "array", "items": {"type": "integer", "minimum": 1},
+                      "minItems": 1, "uniqueItems": True},
+    "element_axis": {"enum": [1, 2, 3]},
     # matrices models: DOFs
     "normal_dof": DOF_REFERENCE,
     "tangential_dofs": {"type": "array", "items": DOF_REFERENCE, "minItems": 1, "maxItems": 2},
@@ -107,11 +125,13 @@ CONTACT = _object({
 
 LOAD = _object({
     "group": NAME,
+    "load_set": SET_REFERENCE,      # FE decks: a FORCE/MOMENT/DAREA/LOAD set or *CLOAD step
+    "scale": NUMBER,                # multiplies the deck's load set (default 1)
     "dof": INDEX,
     "direction": DIRECTION,
     "force_N": NUMBER,
     "phase_deg": NUMBER,
-}, required=("force_N",))
+})   # force_N is required except with load_set (sarfe.io.case)
 
 EXCITATION = _object({
     "forces": {"type": "array", "items": LOAD, "minItems": 1},

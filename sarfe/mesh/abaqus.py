@@ -671,7 +671,8 @@ def _spring_table(rows) -> SpringElements:
         property_ids=np.zeros(len(rows), np.int64), node_a=np.array(a, dtype=np.int64),
         node_b=np.array(b, dtype=np.int64), stiffness=stiffness,
         frames=np.broadcast_to(np.eye(3), (len(rows), 3, 3)).copy(),
-        structural_damping=np.zeros(len(rows)), viscous_damping=np.zeros((len(rows), 6)))
+        structural_damping=np.zeros(len(rows)), viscous_damping=np.zeros((len(rows), 6)),
+        location=np.full(len(rows), np.nan))       # scalar springs on the node DOFs
 
 
 def _mass_table(rows) -> PointMasses:

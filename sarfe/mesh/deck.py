@@ -145,6 +145,9 @@ class SpringElements:
     frames        (k, 3, 3)         rows = spring axes 1, 2, 3 in global coordinates
     structural_damping (k,)         GE [-] (damping K·GE·i)
     viscous_damping (k, 6)          B [N·s/m ×3, N·m·s/rad ×3]
+    location      (k,)              CBUSH S: the spring acts at x_a + s (x_b − x_a), tied to
+                                    both nodes by rigid arms; NaN = scalar spring on the node
+                                    DOFs themselves (CELAS, *SPRING)
     """
 
     card: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype="<U8"))
@@ -156,6 +159,7 @@ class SpringElements:
     frames: np.ndarray = field(default_factory=lambda: _floats((0, 3, 3)))
     structural_damping: np.ndarray = field(default_factory=_floats)
     viscous_damping: np.ndarray = field(default_factory=lambda: _floats((0, 6)))
+    location: np.ndarray = field(default_factory=_floats)
 
 
 @dataclass(frozen=True)

@@ -28,6 +28,7 @@ with `sarfe.mesh.deck.to_si`.
 """
 from __future__ import annotations
 
+import io
 import os
 from collections import defaultdict
 from pathlib import Path
@@ -81,12 +82,18 @@ def _load_bdf(path: Path):
 
     with open(path, errors="replace") as handle:
         text = handle.read()
-    punch = "BEGIN BULK" not in text.upper()
+    upper = text.upper()
+    has_bulk = "BEGIN BULK" in upper
+    has_control = has_bulk and "CEND" in upper.split("BEGIN BULK")[0]
     model = BDF(debug=None)
     model.log.level = "error"
     cwd = os.getcwd()
     try:
-        model.read_bdf(os.fspath(path), xref=True, punch=punch, encoding="latin-1")
+        if has_bulk and not has_control:  # BEGIN BULK without executive/case control
+            os.chdir(path.resolve().parent)  # INCLUDEs are relative to the deck
+            model.read_bdf(io.StringIO("CEND\n" + text), xref=True, encoding="latin-1")
+        else:  # a whole job, or bulk data alone (pyNastran's punch mode)
+            model.read_bdf(os.fspath(path), xref=True, punch=not has_bulk, encoding="latin-1")
     finally:
         os.chdir(cwd)
     return model
@@ -418,11 +425,11 @@ class _Converter:
     def springs(self) -> SpringElements:
         rows = defaultdict(list)
 
-        def add(card, eid, pid, a, b, k6, frame, ge, b6):
+        def add(card, eid, pid, a, b, k6, frame, ge, b6, location=np.nan):
             for key, value in (("card", card), ("element_ids", eid), ("property_ids", pid),
                                ("node_a", a), ("node_b", b), ("stiffness", k6),
                                ("frames", frame), ("structural_damping", ge),
-                               ("viscous_damping", b6)):
+                               ("viscous_damping", b6), ("location", location)):
                 rows[key].append(value)
 
         for eid, el in sorted(self.model.elements.items()):
@@ -448,10 +455,13 @@ class _Converter:
                     frame = np.array([ex, np.cross(ez, ex), ez])
                 k6 = np.array([float(k or 0.0) for k in (list(prop.Ki) + [0] * 6)[:6]])
                 b6 = np.array([float(c or 0.0) for c in (list(prop.Bi) + [0] * 6)[:6]])
-                ge = [float(g or 0.0) for g in (prop.GEi or [0.0])]
-                if any(g != ge[0] for g in ge):
+                # GE1 alone applies to all six components; differing GEi are refused
+                given = {float(g) for g in (prop.GEi or []) if g is not None}
+                if len(given) > 1:
                     self.fail("PBUSH", prop.pid, "GE per component differs: not modelled")
-                add("CBUSH", eid, prop.pid, a, b, k6, frame, ge[0], b6)
+                ge = given.pop() if given else 0.0
+                location = 0.5 if el.s is None else float(el.s)
+                add("CBUSH", eid, prop.pid, a, b, k6, frame, ge, b6, location)
             elif el.type in ("CELAS1", "CELAS2"):
                 if el.type == "CELAS1":
                     k, ge, pid = float(el.pid_ref.k), float(el.pid_ref.ge or 0.0), el.pid

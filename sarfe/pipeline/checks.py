@@ -203,6 +203,9 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True)
     if not case.is_fe:
         _build_matrices(case)
         return CaseCheck({}, tuple(range_warnings(case)), output)
+    if "deck" in case.data["model"]["fe"]:   # a Nastran/Abaqus deck: its own checks, with ids
+        from sarfe.pipeline.deck import check_deck
+        return CaseCheck(check_deck(case), tuple(range_warnings(case)), output)
     mesh = load_case_mesh(case)
     fe = case.data["model"]["fe"]
     fixed = np.unique(np.concatenate([

@@ -2,7 +2,7 @@ r"""The linear stage of a case: model → (reduced) M, K on the kept DOFs, conta
 DOFs, unit excitation vectors and the ERP recovery map. Everything here is independent of the
 contact law parameters, damping, force amplitudes and frequencies, so a batch over those reuses it.
 
-FE path: mesh → shell K, M (per-triangle thickness/material) → remove fixed (clip/clamp) DOFs →
+FE path (a deck file: :mod:`sarfe.pipeline.deck`): mesh → shell K, M (per-triangle thickness/material) → remove fixed (clip/clamp) DOFs →
 Craig–Bampton with boundary = translations of contact and excitation nodes:
 
     u = T q,  q = [q_b, q_m],  M_r = Tᵀ M T,  K_r = Tᵀ K T,  f_r = Tᵀ f,
@@ -45,6 +45,9 @@ class ContactGeometry:
     coords_a: np.ndarray
     coords_b: np.ndarray
     distances: np.ndarray      # (n_p,) [m] n·(x_b − x_a), the geometric gap (0 for ground)
+    # (n_p,) [N/m] per-pair stiffness of deck springs turned into this contact (from_elements)
+    normal_stiffness: np.ndarray | None = None
+    tangential_stiffness: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -76,6 +79,7 @@ class LinearStage:
     mode_frequencies_hz: np.ndarray = field(default_factory=lambda: np.zeros(0))
     info: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
+    node_ids: np.ndarray | None = None     # deck GRID / node id of each mesh point (deck path)
 
     @property
     def dof_count(self) -> int:
@@ -108,7 +112,7 @@ def linear_model_key(case) -> str:
     data = case.data
     model = json.loads(json.dumps(data["model"]))
     for section in model.values():
-        for key in ("mesh", "mass", "stiffness", "damping"):
+        for key in ("mesh", "deck", "mass", "stiffness", "damping"):
             if isinstance(section.get(key), str):
                 section[key] = {"file_sha256": _file_digest(case.resolve(section[key]))}
     exc = data["excitation"]
@@ -117,9 +121,10 @@ def linear_model_key(case) -> str:
         "reduction": dict(data.get("reduction", {}), effective_cutoff_hz=default_cutoff_hz(case))
         if case.is_fe else None,
         "contacts": [{k: c.get(k) for k in ("name", "between", "pairs", "pairing_tolerance_m",
-                                            "normal", "normal_dof", "tangential_dofs")}
+                                            "normal", "normal_dof", "tangential_dofs",
+                                            "from_elements", "element_axis")}
                      for c in data["contacts"]],
-        "forces": [{k: f.get(k) for k in ("group", "dof", "direction")}
+        "forces": [{k: f.get(k) for k in ("group", "dof", "direction", "load_set")}
                    for f in exc.get("forces", [])],
         "base": {k: v for k, v in exc["base_acceleration"].items() if k in ("direction", "influence")}
         if "base_acceleration" in exc else None,
@@ -567,6 +572,9 @@ def check_mesh(case) -> dict:
     if not case.is_fe:
         _build_matrices(case)
         return {}
+    if "deck" in case.data["model"]["fe"]:
+        from sarfe.pipeline.deck import check_deck
+        return check_deck(case)
     mesh = load_case_mesh(case)
     fe = case.data["model"]["fe"]
     for i, g in enumerate(fe["fixed"]):
@@ -588,7 +596,11 @@ def build_linear_model(case, progress=False) -> LinearStage:
     """Linear stage of a case (module docstring); raises CaseError for mesh/group/file problems."""
     case = load_case(case)
     clock = time.perf_counter()
-    parts = _build_fe(case, progress) if case.is_fe else _build_matrices(case, progress)
+    if case.is_fe and "deck" in case.data["model"]["fe"]:
+        from sarfe.pipeline.deck import build_deck_stage
+        parts = build_deck_stage(case, progress)
+    else:
+        parts = _build_fe(case, progress) if case.is_fe else _build_matrices(case, progress)
     timings = dict(parts.pop("timings", {}))
     timings["linear_stage_s"] = time.perf_counter() - clock
     return LinearStage(key=linear_model_key(case), timings=timings, **parts)

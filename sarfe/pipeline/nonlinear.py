@@ -101,19 +101,28 @@ def build_contacts(case: Case, stage: LinearStage):
             tangent_rows.append((t + [-1, -1])[:2])
             share = 1.0
         stiffness = contact.get("normal_stiffness_N_m", 0.0)
+        k_pairs = np.full(pairs, stiffness * share)
+        kt_pairs = np.full(pairs, contact.get("tangential_stiffness_N_m", 0.0) * share)
+        geometry = stage.contacts.get(name) if stage.kind == "fe" else None
+        if getattr(geometry, "normal_stiffness", None) is not None:  # deck springs (from_elements)
+            if "normal_stiffness_N_m" not in contact:
+                k_pairs = np.asarray(geometry.normal_stiffness, dtype=float)
+                stiffness = float(k_pairs.sum())
+            if "tangential_stiffness_N_m" not in contact:
+                kt_pairs = np.asarray(geometry.tangential_stiffness, dtype=float)
         if not has_normal:
             g, load = np.zeros(pairs), contact["preload_N"]
         elif "gap_m" in contact:
             g, load = np.full(pairs, float(contact["gap_m"])), 0.0
         elif "preload_N" in contact:
-            g, load = np.full(pairs, -contact["preload_N"] / stiffness), 0.0
+            g, load = -contact["preload_N"] * share / k_pairs, 0.0
         else:  # FE default: the geometric gap of each node pair along its normal
             g, load = np.asarray(stage.contacts[name].distances, dtype=float), 0.0
         for p in range(pairs):
             kind.append(contact["type"])
             gap.append(g[p])
-            k_n.append(stiffness * share)
-            k_t.append(contact.get("tangential_stiffness_N_m", 0.0) * share)
+            k_n.append(k_pairs[p])
+            k_t.append(kt_pairs[p])
             mu.append(contact.get("friction_coefficient", 0.0))
             n0.append(load * share)
             tolerance.append(contact["tolerance_m"])

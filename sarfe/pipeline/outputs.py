@@ -66,7 +66,8 @@ def write_outputs(case, stage, nl, summary, rows, solutions, erps, normal_w, dir
             data.append(outputs.erp_point_data(mesh.n_nodes, e, W, float(s.omega),
                                                displacement=translations,
                                                radiating_nodes=stage.erp_nodes,
-                                               contact_marker=markers))
+                                               contact_marker=markers,
+                                               node_ids=getattr(stage, "node_ids", None)))
         if "erp_vtu" in files:
             if len(solutions) == 1:
                 outputs.write_erp_vtu(directory / "erp.vtu", mesh.points, mesh.triangles, data[0])
@@ -82,7 +83,10 @@ def write_outputs(case, stage, nl, summary, rows, solutions, erps, normal_w, dir
             U = u.reshape(u.shape[0], mesh.n_nodes, 6)[:, :, :3]
             outputs.write_deflection_animation(directory / "animation", mesh.points,
                                                mesh.triangles, U, omega=float(solutions[j].omega),
-                                               point_data={"contact_marker": markers})
+                                               point_data={"contact_marker": markers} | (
+                                                   {"node_id": stage.node_ids}
+                                                   if getattr(stage, "node_ids", None) is not None
+                                                   else {}))
             written["animation"] = "animation/deflection.pvd"
     return written
 

@@ -130,8 +130,8 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         "model": dict(stage.info, kind=stage.kind, kept_dofs=int(stage.dof_count),
                       mode_frequencies_hz=np.asarray(stage.mode_frequencies_hz)[:50]),
         "solver": {k: v for k, v in case.data["solver"].items()},
-        "contacts": [{"name": name, "type": kind, "pairs": int(len(idx))}
-                     for name, kind, idx in nl.groups],
+        "contacts": [dict({"name": name, "type": kind, "pairs": int(len(idx))},
+                          **_node_pairs(stage, name)) for name, kind, idx in nl.groups],
         "contact_pruning": pruning,              # per contact: open / closed / nonlinear
         "points": points,
         "worst": worst_of(points),
@@ -165,6 +165,19 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
             bar.close()
     result.output_dir = target
     return result
+
+
+def _node_pairs(stage, name) -> dict:
+    """{"node_pairs": [[a, b], …]} of an FE contact: the deck's GRID ids (deck models) or mesh
+    node indices; b is "ground" for a contact with ground."""
+    geometry = stage.contacts.get(name) if stage.kind == "fe" else None
+    if geometry is None:
+        return {}
+    ids = getattr(stage, "node_ids", None)
+    name_of = (lambda n: int(ids[n])) if ids is not None else int   # noqa: E731
+    return {"node_pairs": [[name_of(a), "ground" if b < 0 else name_of(b)]
+                           for a, b in zip(geometry.nodes_a, geometry.nodes_b)],
+            "node_numbering": "deck ids" if ids is not None else "mesh indices"}
 
 
 __all__ = ["CaseResult", "NonlinearModel", "nonlinear_model", "results_table", "solve_case",

@@ -51,3 +51,27 @@ def test_reader_errors_are_one_line_mesh_errors(tmp_path, name, text):
         load_mesh(path)
     message = str(info.value)
     assert "\n" not in message and str(path) in message
+
+
+NODES = "*NODE\n1, 0, 0, 0\n2, 1, 0, 0\n3, 1, 1, 0\n4, 0, 1, 0\n"
+
+
+@pytest.mark.parametrize("name, text, expected", [
+    # issue 14's silent losses through meshio, now refused with the card and its line
+    ("clip.bdf", "BEGIN BULK\nGRID,1,,0.,0.,0.\nGRID,2,,1.,0.,0.\nGRID,3,,1.,1.,0.\n"
+                 "CTRIA3,1,1,1,2,3\nCBUSH,2,5,1,3,,,,0\nCONM2,3,2,,0.5\nENDDATA\n",
+     r"it would drop CBUSH \(1, first at line 6\), CONM2 \(1, first at line 7\)"),
+    ("cyl.bdf", "BEGIN BULK\nGRID,1,7,1.,0.,0.\nENDDATA\n", r"cyl.bdf:2: GRID in coordinate system CP=7"),
+    ("quad8.bdf", "BEGIN BULK\nCQUAD8,1,1,1,2,3,4,5,6\n,7,8\n", r"CQUAD8 \(1, first at line 2\)"),
+    ("s8r.inp", NODES + "*ELEMENT, TYPE=S8R\n1, 1, 2, 3, 4, 1, 2, 3, 4\n",
+     r"\*ELEMENT, TYPE=S8R \(1, first at line 6\)"),
+    ("inst.inp", "*PART, NAME=p\n" + NODES + "*END PART\n*ASSEMBLY, NAME=a\n"
+                 "*INSTANCE, NAME=i, PART=p\n5., 0., 0.\n*END INSTANCE\n*END ASSEMBLY\n",
+     r"\*INSTANCE \(1, first at line 9\)"),
+])
+def test_mesh_path_refuses_what_it_would_drop(tmp_path, name, text, expected):
+    path = tmp_path / name
+    path.write_text(text)
+    with pytest.raises(MeshError, match=expected) as info:
+        load_mesh(path)
+    assert "model.fe.deck" in str(info.value) and "\n" not in str(info.value)

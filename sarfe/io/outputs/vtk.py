@@ -14,6 +14,8 @@ Standard ERP point arrays (:func:`erp_point_data`), n = number of mesh points:
                                            (zeros if the caller passes no nodal displacement)
     contact_marker                  (n,)   int: 0 = no contact, c+1 = node of contact c
                                            (ContactSet order; the last contact wins on shared nodes)
+    node_id                         (n,)   int: the deck's GRID / node id of each point (deck
+                                           models only)
 
 Non-radiating points get 0 in the ERP arrays.
 """
@@ -129,7 +131,7 @@ def contact_markers(n_points: int, contact_nodes) -> np.ndarray:
 
 
 def erp_point_data(n_points: int, erp, normal_displacement, omega: float, displacement=None,
-                   radiating_nodes=None, contact_marker=None) -> dict:
+                   radiating_nodes=None, contact_marker=None, node_ids=None) -> dict:
     """The standard ERP arrays (module docstring) for :func:`write_erp_vtu`.
 
     n_points : number of mesh points n.
@@ -140,6 +142,7 @@ def erp_point_data(n_points: int, erp, normal_displacement, omega: float, displa
         ``displacement_amplitude_m`` is all zeros; ``normal_displacement_amplitude_m`` is always set).
     radiating_nodes : (n_r,) point indices of the radiating nodes (default: all n points).
     contact_marker : (n,) int, e.g. from :func:`contact_markers` (default zeros).
+    node_ids : (n,) int deck ids of the points, written as ``node_id`` (default: not written).
     """
     from sarfe.erp.erp import normal_velocity_amplitudes
 
@@ -175,6 +178,8 @@ def erp_point_data(n_points: int, erp, normal_displacement, omega: float, displa
         data["displacement_amplitude_m"] = np.abs(samples).max(axis=0)
     data["contact_marker"] = (np.zeros(n, dtype=np.int32) if contact_marker is None
                               else np.asarray(contact_marker, dtype=np.int32))
+    if node_ids is not None:
+        data["node_id"] = np.asarray(node_ids, dtype=np.int64)
     return data
 
 

@@ -1,0 +1,215 @@
+"""The deck path of a case (model.fe.deck) on a small Abaqus plate: the deck's own sections,
+supports, loads and springs are used; springs named by a contact's from_elements become the
+contact; bad decks (unsupported keywords, structures not held, duplicate or zero-area elements)
+are refused at validate with one line naming what is wrong."""
+import numpy as np
+import pytest
+
+from sarfe.io.errors import CaseError
+from sarfe.pipeline import build_linear_model, check_mesh, load_case, solve_case
+
+NX, NY, LX, LY = 8, 4, 200.0, 100.0      # mm
+E_MPA, NU, RHO, T_MM = 2000.0, 0.38, 1.0e-9, 2.5
+
+
+def plate_inp(extra="", boundary="clamped, ENCASTRE\n", duplicate=False):
+    """A flat S4R plate in mm-t-s, clamped along x = 0, a grounded spring (id 900, DOF 3) at
+    the far corner, a point mass, and a *CLOAD step 'shake' at the far edge's middle."""
+    nodes, elements = [], []
+    nid = lambda i, j: 1 + i + (NX + 1) * j                       # noqa: E731
+    for j in range(NY + 1):
+        for i in range(NX + 1):
+            nodes.append(f"{nid(i, j)}, {LX * i / NX}, {LY * j / NY}, 0.")
+    for j in range(NY):
+        for i in range(NX):
+            elements.append(f"{1 + i + NX * j}, {nid(i, j)}, {nid(i + 1, j)}, "
+                            f"{nid(i + 1, j + 1)}, {nid(i, j + 1)}")
+    if duplicate:
+        elements.append(f"999, {nid(1, 0)}, {nid(2, 0)}, {nid(2, 1)}, {nid(1, 1)}")
+    corner, middle = nid(NX, NY), nid(NX, NY // 2)
+    return "\n".join([
+        "*HEADING", "sarfe test plate", "*NODE", *nodes,
+        "*ELEMENT, TYPE=S4R, ELSET=plate", *elements,
+        "*ELEMENT, TYPE=SPRING1, ELSET=clip", f"900, {corner}",
+        "*ELEMENT, TYPE=MASS, ELSET=lump", f"901, {middle}",
+        "*NSET, NSET=clamped, GENERATE", f"1, {nid(0, NY)}, {NX + 1}",
+        "*NSET, NSET=corner", f"{corner}", "*NSET, NSET=ground_side", f"{nid(0, 0)}",
+        "*MATERIAL, NAME=PP", "*ELASTIC", f"{E_MPA}, {NU}", "*DENSITY", f"{RHO}",
+        "*SHELL SECTION, ELSET=plate, MATERIAL=PP", f"{T_MM}",
+        "*SPRING, ELSET=clip", "3", "20.",                          # 20 N/mm = 2e4 N/m
+        "*MASS, ELSET=lump", "0.005",                               # 0.005 t = 5 kg
+        "*BOUNDARY", boundary.strip(), extra.strip(),
+        "*STEP, NAME=shake", "*STATIC",
+        "*CLOAD", f"{middle}, 3, 1.0", "*END STEP", ""])
+
+
+def write_case(tmp_path, inp, **fe):
+    (tmp_path / "plate.inp").write_text(inp)
+    case = {"name": "plate", "model": {"fe": {"deck": "plate.inp", "units": "mm-t-s", **fe}},
+            "excitation": {"forces": [{"load_set": "shake", "scale": 0.5}],
+                           "frequency_hz": [20.0]},
+            "damping": {"modal_zeta": 0.02}, "reduction": {"mode_count": 12},
+            "solver": {"harmonics": 1, "samples_per_period": 16, "error_estimate": False,
+                       "stability": False}}
+    return case
+
+
+def test_deck_properties_supports_loads_are_used(tmp_path):
+    case = load_case(write_case(tmp_path, plate_inp()), base_dir=tmp_path)
+    stage = build_linear_model(case)
+    area = LX * LY * 1e-6
+    # shell ρ t A + the 5 kg point mass (0.005 t)
+    assert stage.info["total_mass_kg"] == pytest.approx(RHO * 1e12 * T_MM * 1e-3 * area + 5.0,
+                                                        rel=1e-12)
+    assert stage.info["radiating_area_m2"] == pytest.approx(area, rel=1e-12)
+    # the clamped edge: 5 nodes x 6 DOFs held; the load set's DOF is a boundary coordinate
+    assert stage.info["held_dofs"] == (NY + 1) * 6
+    assert stage.load_vectors.shape == (1, stage.dof_count)
+    assert np.count_nonzero(stage.load_vectors[0][:stage.info["boundary_dofs"]]) == 1
+    assert stage.load_vectors[0].max() == pytest.approx(1.0)     # 1 N (scale applied later)
+    result = solve_case(case, linear_stage=stage, write=False)
+    assert result.summary["points"][0]["converged"]
+
+
+def test_spring_becomes_contact_with_its_stiffness(tmp_path):
+    """A preloaded rattle contact that never opens behaves as the spring it replaces: the same
+    ERP as the linear model that keeps the spring."""
+    data = write_case(tmp_path, plate_inp())
+    kept = solve_case(load_case(data, base_dir=tmp_path), write=False)
+    data["contacts"] = [{"name": "clip", "type": "rattle", "from_elements": [900],
+                         "preload_N": 50.0}]
+    case = load_case(data, base_dir=tmp_path)
+    stage = build_linear_model(case)
+    geometry = stage.contacts["clip"]
+    assert np.array_equal(geometry.nodes_b, [-1])                  # grounded spring
+    assert np.allclose(geometry.frames[0, 0], [0, 0, 1])            # its axis (DOF 3)
+    assert geometry.normal_stiffness.tolist() == [pytest.approx(2e4)]
+    as_contact = solve_case(case, linear_stage=stage, write=False)
+    point = as_contact.summary["points"][0]
+    assert point["contacts"][0]["open_fraction"] == 0.0
+    assert point["erp"]["level_db"] == pytest.approx(kept.summary["points"][0]["erp"]["level_db"],
+                                                     abs=0.01)
+    # without the spring in the linear model the plate's response differs (it is removed)
+    assert as_contact.summary["points"][0]["linear"]["erp_level_db"] != pytest.approx(
+        point["erp"]["level_db"], abs=0.05)
+
+
+def test_unsupported_keyword_is_refused_then_ignored(tmp_path):
+    inp = plate_inp().replace("*HEADING", "*SURFACE, NAME=top\nplate, SPOS\n*HEADING")
+    data = write_case(tmp_path, inp)
+    with pytest.raises(CaseError, match=r"model\.fe\.deck: .*cards sarfe does not model: "
+                                        r"\*SURFACE \(1\)"):
+        check_mesh(load_case(data, base_dir=tmp_path))
+    data["model"]["fe"]["ignore_cards"] = ["*SURFACE"]
+    info = check_mesh(load_case(data, base_dir=tmp_path))
+    assert info["ignored_cards"] == {"*SURFACE": 1}
+    data["model"]["fe"]["ignore_cards"] = ["CBAR"]
+    with pytest.raises(CaseError, match=r"ignore_cards\[0\]: 'CBAR' is not an unsupported card"):
+        check_mesh(load_case(data, base_dir=tmp_path))
+
+
+@pytest.mark.parametrize("boundary, expected", [
+    # z held at one node, the spring along x at another: 4 of 6 motions left
+    ("ground_side, 3\n", r"a part of 45 nodes \(GRIDs 1…45\) is free in 4 rigid-body motions "
+                          r"\(translation x, translation y, translation z, rotation about x, rotation about y, "
+                          r"rotation about z\)"),
+    # all six held at one node: nothing free
+    ("ground_side, ENCASTRE\n", None),
+])
+def test_structure_not_held_is_found_before_any_solve(tmp_path, boundary, expected):
+    inp = plate_inp(boundary=boundary).replace("*SPRING, ELSET=clip\n3\n", "*SPRING, ELSET=clip\n1\n")
+    case = load_case(write_case(tmp_path, inp), base_dir=tmp_path)
+    if expected is None:
+        check_mesh(case)
+        return
+    with pytest.raises(CaseError, match="model.fe.supports: the structure is not held after the "
+                                        "supports: " + expected):
+        check_mesh(case)
+
+
+def test_duplicate_and_zero_area_elements_are_named(tmp_path):
+    with pytest.raises(CaseError, match=r"1 duplicate shell element\(s\) on the same nodes: 999 \(= 2\)"):
+        check_mesh(load_case(write_case(tmp_path, plate_inp(duplicate=True)), base_dir=tmp_path))
+    inp = plate_inp().replace("*ELEMENT, TYPE=SPRING1", "*ELEMENT, TYPE=S3, ELSET=plate\n"
+                              "998, 1, 2, 3\n*ELEMENT, TYPE=SPRING1")
+    with pytest.raises(CaseError, match=r"1 zero-area shell element\(s\): 998"):
+        check_mesh(load_case(write_case(tmp_path, inp), base_dir=tmp_path))
+
+
+def test_coincident_unjoined_nodes_are_reported(tmp_path):
+    inp = plate_inp().replace("*ELEMENT, TYPE=S4R", "5001, 200., 100., 0.\n*ELEMENT, TYPE=S4R")
+    inp = inp.replace("*ELEMENT, TYPE=SPRING1", "*ELEMENT, TYPE=S3, ELSET=plate\n"
+                      "997, 5001, 44, 35\n*ELEMENT, TYPE=SPRING1")
+    info = check_mesh(load_case(write_case(tmp_path, inp), base_dir=tmp_path))
+    assert info["coincident_nodes"] == [[45, 5001]]
+
+
+def test_grid_id_pairs_and_missing_sets(tmp_path):
+    data = write_case(tmp_path, plate_inp())
+    data["contacts"] = [{"name": "tip", "type": "rattle", "pairs": [[45, "ground"]],
+                         "normal_stiffness_N_m": 1e4, "gap_m": 1e-4}]
+    info = check_mesh(load_case(data, base_dir=tmp_path))
+    assert info["contact_pairs"] == {"tip": 1}
+    data["contacts"][0]["pairs"] = [[4500, "ground"]]
+    with pytest.raises(CaseError, match=r"contacts\[0\]\.pairs\[0\]\[0\]: node id 4500 is not in the deck"):
+        check_mesh(load_case(data, base_dir=tmp_path))
+    data["contacts"] = []
+    data["model"]["fe"]["supports"] = ["initial"]
+    with pytest.raises(CaseError, match=r"support set 'initial' not in the deck \(available: boundary\)"):
+        check_mesh(load_case(data, base_dir=tmp_path))
+
+
+def test_outputs_carry_the_deck_ids(tmp_path):
+    import json
+
+    import pyvista as pv
+
+    data = write_case(tmp_path, plate_inp())
+    data["contacts"] = [{"name": "tip", "type": "rattle", "pairs": [[45, "ground"]],
+                         "normal_stiffness_N_m": 1e4, "gap_m": 1e-3}]
+    data["output"] = {"files": ["summary", "erp_vtu"]}
+    result = solve_case(load_case(data, base_dir=tmp_path), output_dir=tmp_path / "out")
+    summary = json.loads((result.output_dir / "summary.json").read_text())
+    assert summary["contacts"][0]["node_pairs"] == [[45, "ground"]]
+    grid = pv.read(result.output_dir / "erp.vtu")
+    assert np.array_equal(np.asarray(grid.point_data["node_id"]), np.arange(1, 46))
+
+
+SHEAR_DECK = """SOL 103
+CEND
+BEGIN BULK
+GRID,1,,0.,0.,0.
+GRID,2,,100.,0.,0.
+GRID,3,,100.,100.,0.
+GRID,4,,0.,100.,0.
+GRID,5,,200.,0.,0.
+GRID,6,,200.,100.,0.
+CQUAD4,1,1,1,2,3,4
+CQUAD4,3,1,2,5,6,3
+CSHEAR,2,2,2,5,6,3
+PSHELL,1,1,2.,1
+PSHEAR,2,1,3.
+MAT1,1,2000.,,0.3,1.e-9
+SPC1,1,123456,1,4
+ENDDATA
+"""
+
+
+def test_ignored_cards_and_their_mass_are_recorded(tmp_path):
+    """A Nastran shear panel (CSHEAR, not modelled) named in ignore_cards: the run goes on
+    without it and the summary says what was left out and the mass it carried (ρ t A)."""
+    (tmp_path / "shear.bdf").write_text(SHEAR_DECK)
+    data = {"name": "shear", "model": {"fe": {"deck": "shear.bdf", "units": "mm-t-s"}},
+            "excitation": {"base_acceleration": {"direction": "z", "amplitude_m_s2": 1.0},
+                           "frequency_hz": 10.0},
+            "reduction": {"mode_count": 4}, "solver": {"harmonics": 1, "samples_per_period": 8,
+                                                        "error_estimate": False, "stability": False}}
+    with pytest.raises(CaseError, match=r"CSHEAR \(1\), PSHEAR \(1\)"):
+        check_mesh(load_case(data, base_dir=tmp_path))
+    data["model"]["fe"]["ignore_cards"] = ["CSHEAR", "PSHEAR"]
+    result = solve_case(load_case(data, base_dir=tmp_path), write=False)
+    model = result.summary["model"]
+    assert model["ignored_cards"] == {"CSHEAR": 1, "PSHEAR": 1}
+    assert model["ignored_mass_kg"]["CSHEAR"] == pytest.approx(1000 * 3e-3 * 0.01, rel=1e-12)
+    # what stays: two 100 x 100 x 2 mm quads, ρ = 1000 kg/m³
+    assert model["total_mass_kg"] == pytest.approx(1000 * 2e-3 * 2 * 0.01, rel=1e-12)
