@@ -6,8 +6,8 @@ Rules (``sarfe solve --output``, ``sarfe batch --output``, the per-variant folde
   holding the marker file ``.sarfe-result`` (JSON: sarfe version, kind, case name, pid, host)
   that sarfe writes into every result. Anything else is a one-line :class:`CaseError` before any
   work, unless ``force`` is given.
-* Never the current directory, the folder of the case file, or a folder containing either (even
-  with ``force``); an existing file is never a result folder.
+* Never the current directory, the home directory, the folder of the case file, or a folder
+  containing one of them (even with ``force``); an existing file is never a result folder.
 * Writability is probed (a file is created and removed) before the solve starts; ``os.access``
   is not enough (root passes it on read-only mounts).
 * A result is written into a temporary sibling ``.<name>.tmp-<pid>-<random>`` and moved into
@@ -130,6 +130,10 @@ def check_output_folder(target, *, force: bool = False, protected=(), what: str 
     cwd = Path.cwd().resolve()
     if _contains(target, cwd):
         raise CaseError(f"the {what} would replace the current directory{'' if target == cwd else ' (it contains it)'};"
+                        " choose a new or dedicated folder, e.g. --output results/NAME", source=given)
+    home = Path.home().resolve()
+    if _contains(target, home):
+        raise CaseError(f"the {what} would replace the home directory{'' if target == home else ' (it contains it)'};"
                         " choose a new or dedicated folder, e.g. --output results/NAME", source=given)
     for path in protected:
         if path is None:

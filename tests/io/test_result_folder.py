@@ -294,6 +294,19 @@ def test_backup_of_a_run_killed_between_its_renames_is_put_back(tmp_path):
     assert (tmp_path / "res" / "a.txt").read_text() == "previous"
 
 
+def test_home_directory_is_never_the_output(tmp_path, monkeypatch):
+    home = tmp_path / "users" / "home"
+    home.mkdir(parents=True)
+    (home / "thesis.tex").write_text("years of work")
+    monkeypatch.setenv("HOME", str(home))
+    (tmp_path / "work").mkdir()
+    monkeypatch.chdir(tmp_path / "work")
+    for target in (home, tmp_path / "users"):
+        with pytest.raises(CaseError, match="home directory"):
+            check_output_folder(target, force=True)
+    assert (home / "thesis.tex").read_text() == "years of work"
+
+
 def test_check_is_silent_on_disk(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     target = check_output_folder("a/b/c")
