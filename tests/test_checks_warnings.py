@@ -68,7 +68,7 @@ def test_shipped_rig_case_has_no_warnings(far_case, capsys):
 def test_log_gets_one_line_per_stage(far_case, capsys):
     assert main(["solve", str(far_case), "--output", "res"]) == 0
     err = [line for line in capsys.readouterr().err.splitlines() if "warning" not in line]
-    assert err == ["sarfe: linear stage: mesh …", "sarfe: linear stage: assembly …",
+    assert err == ["sarfe: checking the case: mesh, groups, quality …", "sarfe: linear stage: mesh …", "sarfe: linear stage: assembly …",
                    "sarfe: linear stage: reduction …", "sarfe: Craig-Bampton mode blocks …",
                    "sarfe: linear stage: contacts, loads, ERP map …",
                    "sarfe: frequencies (1 point) …", "sarfe: ERP and error estimates (1 point) …",

@@ -19,7 +19,7 @@ class StageLine:
     def __init__(self, description, total=None, unit="", stream=None):
         self.stream = stream if stream is not None else sys.stderr
         self.total = total if unit in ("point", "variant") else None
-        self.unit, self.count = unit, 0
+        self.unit, self.n = unit, 0
         self.set_description(description)
 
     def set_description(self, description, refresh=True):
@@ -27,7 +27,7 @@ class StageLine:
         print(f"sarfe: {description}{size} …", file=self.stream, flush=True)
 
     def update(self, n=1):
-        self.count += n
+        self.n += n       # as tqdm's count
 
     def set_postfix(self, *args, **kwargs):
         pass

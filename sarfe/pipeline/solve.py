@@ -53,7 +53,13 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
 
     started = time.perf_counter()
     case = load_case(case)
-    checked = check_case(case, output_dir, force, write=write, mesh_checks=linear_stage is None)
+    bar = _bar(progress and linear_stage is None, "checking the case: mesh, groups, quality", None,
+               unit="step")
+    try:
+        checked = check_case(case, output_dir, force, write=write, mesh_checks=linear_stage is None)
+    finally:
+        if bar is not None:
+            bar.close()
     target, warnings = checked.output, list(checked.warnings)
     for line in warnings:
         if warn is not None:
