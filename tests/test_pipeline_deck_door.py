@@ -84,6 +84,7 @@ def test_deck_linear_model_equals_generator_model(door):
     assert np.all(np.abs(la - lb) < 0.1), (la, lb)
 
 
+@pytest.mark.slow   # ~15 s of HBM on top of the linear test
 def test_deck_rattle_erp_equals_generator_erp(door):
     directory, _, written = door
     generator, deck = cases(directory, written)
