@@ -213,3 +213,12 @@ def test_ignored_cards_and_their_mass_are_recorded(tmp_path):
     assert model["ignored_mass_kg"]["CSHEAR"] == pytest.approx(1000 * 3e-3 * 0.01, rel=1e-12)
     # what stays: two 100 x 100 x 2 mm quads, ρ = 1000 kg/m³
     assert model["total_mass_kg"] == pytest.approx(1000 * 2e-3 * 2 * 0.01, rel=1e-12)
+
+
+def test_deck_without_mass_is_refused_at_validate(tmp_path):
+    """Patran decks often carry MAT1 without density (shared plate.bdf, a101x.dat): no mass,
+    no dynamics — one line at validate instead of a solver failure."""
+    data = write_case(tmp_path, plate_inp().replace(f"*DENSITY\n{RHO}\n", "")
+                      .replace("*MASS, ELSET=lump\n0.005\n", "*MASS, ELSET=lump\n0.\n"))
+    with pytest.raises(CaseError, match=r"model\.fe\.deck: the deck has no mass"):
+        check_mesh(load_case(data, base_dir=tmp_path))
