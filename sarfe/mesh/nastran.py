@@ -308,8 +308,9 @@ class _Converter:
                 axis = x[1] - x[0]
                 tri_nodes.append(nodes)
                 tri_elem.append(row)
-            normal = normal / np.linalg.norm(normal)
-            axis = axis / np.linalg.norm(axis)
+            with np.errstate(invalid="ignore", divide="ignore"):  # zero area: refused at assembly
+                normal = normal / np.linalg.norm(normal)
+                axis = axis / np.linalg.norm(axis)
             theta_mcid = el.theta_mcid
             if isinstance(theta_mcid, int):  # MCID: x of that system projected on the plane
                 xm = self.coord_axes(theta_mcid, x.mean(axis=0))[0]

@@ -401,3 +401,42 @@ def test_hex20_plate_matches_the_commercial_solvers_thick_plate():
                                         deck.shells.mass_per_area[0] / 0.125))
     hz = natural_frequencies(system.stiffness, system.mass, count=10, shift_hz=100.0)[6:]
     assert np.allclose(hz, expected, rtol=5e-3), hz / expected
+
+
+@pytest.mark.parametrize("text, needle", [
+    ("GRID,1,,0.,0.,0.\nGRID,2,,1.,0.,0.\nGRID,3,,2.,0.,0.\nCTRIA3,7,1,1,2,3\n"
+     "PSHELL,1,1,0.01,1\nMAT1,1,7.e10,,0.3,2700.", "shell element 7 has zero area"),
+    ("GRID,1,,0.,0.,0.\nGRID,2,,1.,0.,0.\nCBAR,8,1,1,2,1.,0.,0.\n"
+     "PBAR,1,1,1.e-4,1.e-9,1.e-9,1.e-9\nMAT1,1,7.e10,,0.3,2700.", "CBAR 8: orientation"),
+    ("GRID,1,,0.,0.,0.\nGRID,2,,1.,0.,0.\nGRID,3,,0.,1.,0.\nGRID,4,,0.,0.,-1.\n"
+     "CTETRA,9,1,1,2,3,4\nCTETRA,10,1,1,3,2,4\nPSOLID,1,1\nMAT1,1,7.e10,,0.3,2700.", "solid element"),
+])
+def test_degenerate_elements_name_their_id(tmp_path, text, needle):
+    deck = read_nastran(_write(tmp_path, text))
+    if "CTETRA" in text:  # both orientations of one tet are fine (|det J|)
+        assert assemble_deck(deck).n_dofs > 0
+        return
+    with pytest.raises(DeckError, match=needle):
+        assemble_deck(deck)
+
+
+def test_cylindrical_cd_frame_for_supports_and_loads(tmp_path):
+    # node 2 on the y axis with CD = cylindrical system 5: its component 1 is radial = +y
+    deck = read_nastran(_write(tmp_path, """
+CORD2C,5,,0.,0.,0.,0.,0.,1.
+,1.,0.,0.
+GRID,1,,0.,0.,0.
+GRID,2,,0.,1.,0.,5
+CELAS2,1,1000.,2,1
+CELAS2,2,1000.,2,2
+CELAS2,3,1000.,2,3
+SPC1,2,1,2
+FORCE,3,2,,1.,0.,2.,0.
+"""))
+    assert np.allclose(deck.displacement_frames[1], [[0, 1, 0], [-1, 0, 0], [0, 0, 1]], atol=1e-12)
+    system = assemble_deck(deck)
+    radial = system.dof_index(1, 0)
+    assert radial in support_dofs(system, deck, 2)
+    load = load_vector(system, deck, 3)
+    assert load[radial] == pytest.approx(2.0)  # global +y force is radial at θ = 90°
+    assert load[system.dof_index(1, 1)] == pytest.approx(0.0, abs=1e-12)
