@@ -122,10 +122,13 @@ def _structural_blocks(deck: DeckModel, drilling_penalty):
                             f"({bad.size} degenerate triangle(s))")
     for start in range(0, shells.n_triangles, _BLOCK):
         rows = slice(start, start + _BLOCK)
+        offset = shells.offset[rows]
+        mass_area = shells.mass_per_area[rows]
         k, m = section_shell_element_matrices(
             deck.points, shells.triangles[rows], shells.membrane[rows], shells.coupling[rows],
-            shells.bending[rows], shells.material_axis[rows], shells.mass_per_area[rows],
-            shells.rotary_inertia_per_area[rows], drilling_penalty)
+            shells.bending[rows], shells.material_axis[rows], mass_area,
+            shells.rotary_inertia_per_area[rows] + mass_area * offset**2, drilling_penalty,
+            first_moment_per_area=mass_area * offset)
         tri = shells.triangles[rows]
         yield k, m, (6 * tri[:, :, None] + np.arange(6)).reshape(len(tri), 18)
     for kind, block in deck.solids.items():

@@ -440,3 +440,23 @@ FORCE,3,2,,1.,0.,2.,0.
     load = load_vector(system, deck, 3)
     assert load[radial] == pytest.approx(2.0)  # global +y force is radial at θ = 90°
     assert load[system.dof_index(1, 1)] == pytest.approx(0.0, abs=1e-12)
+
+
+def test_two_offset_shells_equal_one_of_double_thickness(tmp_path):
+    """ZOFFS = ±t/2 on two coincident PSHELLs of thickness t sharing the nodes: stiffness and
+    mass equal one shell of thickness 2t (parallel axes: 2 (t³/12 + t (t/2)²) = (2t)³/12)."""
+    grids = "GRID,1,,0.,0.,0.\nGRID,2,,0.3,0.05,0.\nGRID,3,,0.25,0.2,0.01\nGRID,4,,0.,0.22,0.\n"
+    material = "MAT1,1,2.e9,,0.35,1100.\n"
+    two = read_nastran(_write(tmp_path, grids + material + "PSHELL,1,1,0.002,1\n"
+                              "CQUAD4,1,1,1,2,3,4,,0.001\nCQUAD4,2,1,1,2,3,4,,-0.001"))
+    (tmp_path / "one").mkdir()
+    one = read_nastran(_write(tmp_path / "one", grids + material + "PSHELL,1,1,0.004,1\n"
+                              "CQUAD4,1,1,1,2,3,4"))
+    k2, m2 = global_matrices(two)
+    k1, m1 = global_matrices(one)
+    assert np.abs((k2 - k1).toarray()).max() < 1e-9 * np.abs(k1.toarray()).max()
+    assert np.abs((m2 - m1).toarray()).max() < 1e-12 * np.abs(m1.toarray()).max()
+    # one offset shell alone: its membrane–bending coupling is B = o A, mass first moment ρ t o
+    single = read_nastran(_write(tmp_path / "one", grids + material + "PSHELL,1,1,0.002,1\n"
+                                 "CQUAD4,1,1,1,2,3,4,,0.001"))
+    assert np.allclose(single.shells.coupling, 0.001 * single.shells.membrane)
