@@ -222,3 +222,33 @@ def test_deck_without_mass_is_refused_at_validate(tmp_path):
                       .replace("*MASS, ELSET=lump\n0.005\n", "*MASS, ELSET=lump\n0.\n"))
     with pytest.raises(CaseError, match=r"model\.fe\.deck: the deck has no mass"):
         check_mesh(load_case(data, base_dir=tmp_path))
+
+
+def test_validate_cli_lists_ignored_cards_and_errors_in_one_line(tmp_path, capsys):
+    import yaml
+
+    from sarfe import cli
+
+    inp = plate_inp().replace("*HEADING", "*SURFACE, NAME=top\nplate, SPOS\n*HEADING")
+    data = write_case(tmp_path, inp)
+    path = tmp_path / "case.yaml"
+    path.write_text(yaml.safe_dump(data))
+    assert cli.main(["validate", str(path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "*SURFACE (1)" in err and "ignore_cards" in err
+    data["model"]["fe"]["ignore_cards"] = ["*SURFACE"]
+    path.write_text(yaml.safe_dump(data))
+    assert cli.main(["validate", str(path)]) == 0
+    assert "ignored cards: *SURFACE (1)" in capsys.readouterr().out
+
+
+def test_linear_stage_key_follows_included_files(tmp_path):
+    from sarfe.pipeline import linear_model_key
+
+    (tmp_path / "nodes.inc").write_text(plate_inp().split("*ELEMENT")[0].replace("*HEADING\nsarfe test plate\n", ""))
+    body = "*ELEMENT" + plate_inp().split("*ELEMENT", 1)[1]
+    data = write_case(tmp_path, "*INCLUDE, INPUT=nodes.inc\n" + body)
+    key = linear_model_key(load_case(data, base_dir=tmp_path))
+    text = (tmp_path / "nodes.inc").read_text().replace("200.0, 100.0, 0.", "200.0, 101.0, 0.")
+    (tmp_path / "nodes.inc").write_text(text)
+    assert linear_model_key(load_case(data, base_dir=tmp_path)) != key

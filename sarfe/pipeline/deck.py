@@ -75,6 +75,26 @@ def _listing(counts: dict) -> str:
     return ", ".join(f"{card} ({count})" for card, count in sorted(counts.items()))
 
 
+def deck_files(path, seen=None) -> list:
+    """The deck file and every file it INCLUDEs (Nastran ``INCLUDE 'x'``, Abaqus
+    ``*INCLUDE, INPUT=x``), recursively, for the linear-stage key."""
+    import re
+    from pathlib import Path
+
+    path = Path(path)
+    seen = [] if seen is None else seen
+    if path in seen or not path.is_file():
+        return seen
+    seen.append(path)
+    pattern = re.compile(r"^\s*\*?\s*INCLUDE\b[^=']*(?:=\s*|\s+')([^'\s,]+)", re.IGNORECASE)
+    with open(path, errors="replace") as handle:
+        for line in handle:
+            match = pattern.match(line)
+            if match:
+                deck_files(path.parent / match.group(1).strip("'\""), seen)
+    return seen
+
+
 # ------------------------------------------------------------------------------------ groups
 def _ids_or_set(case, deck, value, path, kind):
     """Node indices (kind 'node') or element ids (kind 'element') of a group definition:

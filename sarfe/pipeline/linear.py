@@ -113,7 +113,11 @@ def linear_model_key(case) -> str:
     model = json.loads(json.dumps(data["model"]))
     for section in model.values():
         for key in ("mesh", "deck", "mass", "stiffness", "damping"):
-            if isinstance(section.get(key), str):
+            if key == "deck" and isinstance(section.get(key), str):   # with its INCLUDEs
+                from sarfe.pipeline.deck import deck_files
+                section[key] = {"file_sha256": [_file_digest(f) for f in
+                                                deck_files(case.resolve(section[key]))]}
+            elif isinstance(section.get(key), str):
                 section[key] = {"file_sha256": _file_digest(case.resolve(section[key]))}
     exc = data["excitation"]
     parts = {
