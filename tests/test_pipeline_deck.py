@@ -252,3 +252,24 @@ def test_linear_stage_key_follows_included_files(tmp_path):
     text = (tmp_path / "nodes.inc").read_text().replace("200.0, 100.0, 0.", "200.0, 101.0, 0.")
     (tmp_path / "nodes.inc").write_text(text)
     assert linear_model_key(load_case(data, base_dir=tmp_path)) != key
+
+
+def test_yaml_overrides_a_group_section(tmp_path):
+    """The deck's own sections by default; a case may override a group's thickness (material
+    kept, A ∝ t, D ∝ t³, mass ∝ t) or its material."""
+    from sarfe.pipeline.deck import apply_overrides, deck_panel_mesh, read_case_deck
+
+    data = write_case(tmp_path, plate_inp(), thickness_m={"plate": 5e-3})
+    case = load_case(data, base_dir=tmp_path)
+    deck = read_case_deck(case)
+    changed = apply_overrides(case, deck, deck_panel_mesh(case, deck))
+    assert np.allclose(changed.shells.membrane, 2 * deck.shells.membrane, rtol=1e-12)
+    assert np.allclose(changed.shells.bending, 8 * deck.shells.bending, rtol=1e-12)
+    assert np.allclose(changed.shells.mass_per_area, 2 * deck.shells.mass_per_area, rtol=1e-12)
+    data = write_case(tmp_path, plate_inp(),
+                      materials={"*": {"E_Pa": 2.2e9, "nu": 0.35, "rho_kg_m3": 1050.0}})
+    stage = build_linear_model(load_case(data, base_dir=tmp_path))
+    assert stage.info["total_mass_kg"] == pytest.approx(1050.0 * T_MM * 1e-3 * 0.02 + 5.0, rel=1e-12)
+    data = write_case(tmp_path, plate_inp(), thickness_m={"nowhere": 1e-3})
+    with pytest.raises(CaseError, match=r"model\.fe\.thickness_m\.nowhere: element group 'nowhere' not in the deck"):
+        check_mesh(load_case(data, base_dir=tmp_path))
