@@ -213,3 +213,63 @@ def test_ignored_cards_and_their_mass_are_recorded(tmp_path):
     assert model["ignored_mass_kg"]["CSHEAR"] == pytest.approx(1000 * 3e-3 * 0.01, rel=1e-12)
     # what stays: two 100 x 100 x 2 mm quads, ρ = 1000 kg/m³
     assert model["total_mass_kg"] == pytest.approx(1000 * 2e-3 * 2 * 0.01, rel=1e-12)
+
+
+def test_deck_without_mass_is_refused_at_validate(tmp_path):
+    """Patran decks often carry MAT1 without density (shared plate.bdf, a101x.dat): no mass,
+    no dynamics — one line at validate instead of a solver failure."""
+    data = write_case(tmp_path, plate_inp().replace(f"*DENSITY\n{RHO}\n", "")
+                      .replace("*MASS, ELSET=lump\n0.005\n", "*MASS, ELSET=lump\n0.\n"))
+    with pytest.raises(CaseError, match=r"model\.fe\.deck: the deck has no mass"):
+        check_mesh(load_case(data, base_dir=tmp_path))
+
+
+def test_validate_cli_lists_ignored_cards_and_errors_in_one_line(tmp_path, capsys):
+    import yaml
+
+    from sarfe import cli
+
+    inp = plate_inp().replace("*HEADING", "*SURFACE, NAME=top\nplate, SPOS\n*HEADING")
+    data = write_case(tmp_path, inp)
+    path = tmp_path / "case.yaml"
+    path.write_text(yaml.safe_dump(data))
+    assert cli.main(["validate", str(path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "*SURFACE (1)" in err and "ignore_cards" in err
+    data["model"]["fe"]["ignore_cards"] = ["*SURFACE"]
+    path.write_text(yaml.safe_dump(data))
+    assert cli.main(["validate", str(path)]) == 0
+    assert "ignored cards: *SURFACE (1)" in capsys.readouterr().out
+
+
+def test_linear_stage_key_follows_included_files(tmp_path):
+    from sarfe.pipeline import linear_model_key
+
+    (tmp_path / "nodes.inc").write_text(plate_inp().split("*ELEMENT")[0].replace("*HEADING\nsarfe test plate\n", ""))
+    body = "*ELEMENT" + plate_inp().split("*ELEMENT", 1)[1]
+    data = write_case(tmp_path, "*INCLUDE, INPUT=nodes.inc\n" + body)
+    key = linear_model_key(load_case(data, base_dir=tmp_path))
+    text = (tmp_path / "nodes.inc").read_text().replace("200.0, 100.0, 0.", "200.0, 101.0, 0.")
+    (tmp_path / "nodes.inc").write_text(text)
+    assert linear_model_key(load_case(data, base_dir=tmp_path)) != key
+
+
+def test_yaml_overrides_a_group_section(tmp_path):
+    """The deck's own sections by default; a case may override a group's thickness (material
+    kept, A ∝ t, D ∝ t³, mass ∝ t) or its material."""
+    from sarfe.pipeline.deck import apply_overrides, deck_panel_mesh, read_case_deck
+
+    data = write_case(tmp_path, plate_inp(), thickness_m={"plate": 5e-3})
+    case = load_case(data, base_dir=tmp_path)
+    deck = read_case_deck(case)
+    changed = apply_overrides(case, deck, deck_panel_mesh(case, deck))
+    assert np.allclose(changed.shells.membrane, 2 * deck.shells.membrane, rtol=1e-12)
+    assert np.allclose(changed.shells.bending, 8 * deck.shells.bending, rtol=1e-12)
+    assert np.allclose(changed.shells.mass_per_area, 2 * deck.shells.mass_per_area, rtol=1e-12)
+    data = write_case(tmp_path, plate_inp(),
+                      materials={"*": {"E_Pa": 2.2e9, "nu": 0.35, "rho_kg_m3": 1050.0}})
+    stage = build_linear_model(load_case(data, base_dir=tmp_path))
+    assert stage.info["total_mass_kg"] == pytest.approx(1050.0 * T_MM * 1e-3 * 0.02 + 5.0, rel=1e-12)
+    data = write_case(tmp_path, plate_inp(), thickness_m={"nowhere": 1e-3})
+    with pytest.raises(CaseError, match=r"model\.fe\.thickness_m\.nowhere: element group 'nowhere' not in the deck"):
+        check_mesh(load_case(data, base_dir=tmp_path))

@@ -28,7 +28,7 @@ from .constraints import constraint_matrix
 from .line_elements import beam_matrices, point_mass_matrices, spring_matrices
 from .shell import DRILLING_PENALTY
 from .shell_section import section_shell_element_matrices
-from .solid_cells import solid_cell_matrices
+from .solid_cells import DegenerateCellError, solid_cell_matrices
 
 __all__ = ["DeckSystem", "assemble_deck", "support_dofs", "load_vector", "lumped_mass",
            "global_matrices", "mass_properties"]
@@ -111,12 +111,24 @@ def _element_blocks(deck: DeckModel, drilling_penalty, mass="consistent"):
 def _structural_blocks(deck: DeckModel, drilling_penalty):
     """Yield (K_e, M_e, dofs) of shells, solids, beams and springs."""
     shells = deck.shells
+    if shells.n_triangles:
+        x = deck.points[shells.triangles]
+        twice_area = np.linalg.norm(np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]), axis=1)
+        edge = np.linalg.norm(x[:, 1] - x[:, 0], axis=1)
+        bad = np.flatnonzero(twice_area <= 1e-12 * np.maximum(edge, 1e-300) ** 2)
+        if bad.size:
+            eid = int(shells.element_ids[shells.triangle_element[bad[0]]])
+            raise DeckError(f"{deck.source}: shell element {eid} has zero area "
+                            f"({bad.size} degenerate triangle(s))")
     for start in range(0, shells.n_triangles, _BLOCK):
         rows = slice(start, start + _BLOCK)
+        offset = shells.offset[rows]
+        mass_area = shells.mass_per_area[rows]
         k, m = section_shell_element_matrices(
             deck.points, shells.triangles[rows], shells.membrane[rows], shells.coupling[rows],
-            shells.bending[rows], shells.material_axis[rows], shells.mass_per_area[rows],
-            shells.rotary_inertia_per_area[rows], drilling_penalty)
+            shells.bending[rows], shells.material_axis[rows], mass_area,
+            shells.rotary_inertia_per_area[rows] + mass_area * offset**2, drilling_penalty,
+            first_moment_per_area=mass_area * offset)
         tri = shells.triangles[rows]
         yield k, m, (6 * tri[:, :, None] + np.arange(6)).reshape(len(tri), 18)
     for kind, block in deck.solids.items():
@@ -126,9 +138,10 @@ def _structural_blocks(deck: DeckModel, drilling_penalty):
                 k, m, dofs = solid_cell_matrices(deck.points, block.connectivity[rows], kind,
                                                  block.young[rows], block.poisson[rows],
                                                  block.density[rows])
-            except ValueError as error:
-                raise DeckError(f"{deck.source}: {kind} block from element "
-                                f"{int(block.element_ids[rows][0])}: {error}") from error
+            except DegenerateCellError as error:
+                eid = int(block.element_ids[rows][error.row])
+                raise DeckError(f"{deck.source}: solid element {eid} ({kind}) has a degenerate "
+                                "or inverted mapping (check its node order)") from error
             yield k, m, dofs
     if len(deck.beams.element_ids):
         try:

@@ -46,19 +46,22 @@ def rigid_arm(r):
     return g
 
 
-def _beam_frames(points, nodes, orientation, is_rod):
+def _beam_frames(points, nodes, orientation, is_rod, card, element_ids):
     x = np.asarray(points, float)[nodes]
     axis = x[:, 1] - x[:, 0]
     length = np.linalg.norm(axis, axis=1)
     if np.any(length <= 0):
-        raise ValueError(f"line element row {int(np.flatnonzero(length <= 0)[0])} has zero length")
+        row = int(np.flatnonzero(length <= 0)[0])
+        raise ValueError(f"{card[row]} {int(element_ids[row])} has zero length")
     ex = axis / length[:, None]
     v = np.where(is_rod[:, None], _any_normal(ex), orientation)
     ey = v - np.einsum("ei,ei->e", v, ex)[:, None] * ex
     norm = np.linalg.norm(ey, axis=1)
-    if np.any(norm < 1e-9 * np.linalg.norm(v, axis=1)):
-        raise ValueError(f"line element row {int(np.flatnonzero(norm < 1e-9 * np.linalg.norm(v, axis=1))[0])}: "
-                         "orientation vector parallel to the axis")
+    parallel = norm <= 1e-9 * np.linalg.norm(v, axis=1)
+    if np.any(parallel):
+        row = int(np.flatnonzero(parallel)[0])
+        raise ValueError(f"{card[row]} {int(element_ids[row])}: orientation vector parallel to "
+                         "its axis (or zero)")
     ey /= norm[:, None]
     return np.stack([ex, ey, np.cross(ex, ey)], axis=1), length
 
@@ -101,7 +104,8 @@ def beam_matrices(points, beams):
     if np.any((beams.i12 != 0) & ~is_rod):
         row = int(np.flatnonzero((beams.i12 != 0) & ~is_rod)[0])
         raise ValueError(f"{card[row]} {int(beams.element_ids[row])}: I12 ≠ 0 is not modelled")
-    rotation, L = _beam_frames(points, beams.nodes, beams.orientation, is_rod)
+    rotation, L = _beam_frames(points, beams.nodes, beams.orientation, is_rod, card,
+                               beams.element_ids)
     e, g, a = beams.young, beams.shear_modulus, beams.area
     k = np.zeros((n, 12, 12))
     m = np.zeros((n, 12, 12))

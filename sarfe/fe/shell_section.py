@@ -13,7 +13,9 @@ in-plane shear stiffness A66 for G t. Transverse shear flexibility is not modell
 Kirchhoff element): a section's ``transverse_shear`` is not used.
 
 Mass: translations (m'' ∫ N_i N_j dA, m'' = mass per area [kg/m²]); rotary inertia
-I'' [kg] on the DKT rotation field; drilling I'' A/12 (1 + δ_ij), as in `sarfe.fe.shell`.
+I'' [kg] on the DKT rotation field; drilling I'' A/12 (1 + δ_ij), as in `sarfe.fe.shell`;
+for offset shells the first moment S'' couples in-plane translations (linear N) with the
+DKT rotations, M_uβ = S'' ∫ N_i β dA (degree-4 rule, exact).
 For an isotropic section (A = t Q, B = 0, D = t³/12 Q, m'' = ρ t, I'' = ρ t³/12) the matrices
 equal those of `sarfe.fe.shell.shell_element_matrices` to round-off.
 """
@@ -33,12 +35,15 @@ __all__ = ["section_shell_element_matrices", "section_shell_matrices"]
 
 def section_shell_element_matrices(points, triangles, membrane, coupling, bending,
                                    material_axis, mass_per_area, rotary_inertia_per_area,
-                                   drilling_penalty=DRILLING_PENALTY):
+                                   drilling_penalty=DRILLING_PENALTY, first_moment_per_area=None):
     """Element K, M (n_el, 18, 18) in the global frame, DOFs [ux, uy, uz, rx, ry, rz] per node.
 
     points (n, 3) [m]; triangles (n_el, 3); membrane A (n_el, 3, 3) [N/m], coupling B
-    (n_el, 3, 3) [N], bending D (n_el, 3, 3) [N·m] in the material axes; material_axis
-    (n_el, 3) global vector; mass_per_area (n_el,) [kg/m²]; rotary_inertia_per_area (n_el,) [kg].
+    (n_el, 3, 3) [N], bending D (n_el, 3, 3) [N·m] in the material axes, about the node plane;
+    material_axis (n_el, 3) global vector; mass_per_area m'' (n_el,) [kg/m²];
+    rotary_inertia_per_area I'' = ∫ρ z² dz about the node plane (n_el,) [kg];
+    first_moment_per_area S'' = ∫ρ z dz (n_el,) [kg/m] (offset shells; default 0): with
+    u(z) = u₀ + z β the kinetic energy is ½∫ m''|u̇₀|² + 2 S'' u̇₀·β̇ + I''|β̇|² dA.
     """
     triangles = np.asarray(triangles)
     n_el = triangles.shape[0]
@@ -105,6 +110,16 @@ def section_shell_element_matrices(points, triangles, membrane, coupling, bendin
     m_rot = _weighted_gram(beta, np.eye(2)[None], np.broadcast_to(
         weights_m * (rotary * area)[:, None], beta.shape[:2]))
     mass[:, _BENDING[:, None], _BENDING] += m_rot
+    if first_moment_per_area is not None and np.any(first_moment_per_area):
+        # S'' ∫ L_i β_c dA: in-plane translation c of corner i against the DKT rotations
+        moment = np.asarray(first_moment_per_area, float)
+        weight = weights_m[None, :] * (moment * area)[:, None]  # (n_el, n_q)
+        coupling_mass = np.einsum("eq,qi,eqcj->eicj", weight, points_m, beta)
+        for i in range(3):
+            for c in range(2):
+                row = 6 * i + c
+                mass[:, row, _BENDING] += coupling_mass[:, i, c]
+                mass[:, _BENDING, row] += coupling_mass[:, i, c]
 
     stiffness = _to_global(stiffness, rotation)
     mass = _to_global(mass, rotation)
@@ -114,20 +129,24 @@ def section_shell_element_matrices(points, triangles, membrane, coupling, bendin
 
 def section_shell_matrices(points, triangles, membrane, coupling, bending, material_axis,
                            mass_per_area, rotary_inertia_per_area,
-                           drilling_penalty=DRILLING_PENALTY):
+                           drilling_penalty=DRILLING_PENALTY, first_moment_per_area=None):
     """Global K, M CSR (6n, 6n) of section shells; arguments as in
     :func:`section_shell_element_matrices` (per-triangle arrays)."""
     points = np.asarray(points, float)
     triangles = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
     n_el = triangles.shape[0]
+    if first_moment_per_area is None:
+        first_moment_per_area = np.zeros(n_el)
     per_element = [np.asarray(v, float) for v in (membrane, coupling, bending, material_axis,
                                                   mass_per_area, rotary_inertia_per_area)]
+    moment = np.asarray(first_moment_per_area, float)
     combined = np.empty((n_el, 18, 18), dtype=complex)
     for start in range(0, n_el, BLOCK_SIZE):
         block = slice(start, start + BLOCK_SIZE)
         k_e, m_e = section_shell_element_matrices(points, triangles[block],
                                                   *[v[block] for v in per_element],
-                                                  drilling_penalty=drilling_penalty)
+                                                  drilling_penalty=drilling_penalty,
+                                                  first_moment_per_area=moment[block])
         combined[block].real = k_e
         combined[block].imag = m_e
     return assemble_pair(combined, None, element_dofs(triangles), 6 * points.shape[0])

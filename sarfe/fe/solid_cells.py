@@ -21,7 +21,15 @@ import numpy as np
 
 from .solid import lame_parameters
 
-__all__ = ["solid_cell_matrices", "shape_functions"]
+__all__ = ["solid_cell_matrices", "shape_functions", "DegenerateCellError"]
+
+
+class DegenerateCellError(ValueError):
+    """A cell's isoparametric map has a zero or sign-changing Jacobian; ``row`` is its row."""
+
+    def __init__(self, message, row):
+        super().__init__(message)
+        self.row = row
 
 _HEX_CORNERS = np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
                          [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]], float)
@@ -149,8 +157,8 @@ def solid_cell_matrices(points, cells, cell_type, young, poisson, density):
     det = np.linalg.det(jac)
     if np.any(np.abs(det) < 1e-300) or np.any(np.sign(det) != np.sign(det[:, :1])):
         bad = np.flatnonzero((np.abs(det) < 1e-300).any(1) | (np.sign(det) != np.sign(det[:, :1])).any(1))
-        raise ValueError(f"solid cell row {int(bad[0])} ({cell_type}) has a degenerate or "
-                         "inverted mapping")
+        raise DegenerateCellError(f"solid cell row {int(bad[0])} ({cell_type}) has a "
+                                  "degenerate or inverted mapping", int(bad[0]))
     # ∂N/∂ξ_i = Σ_j ∂N/∂x_j J[j, i]  →  grad_x = ref_grad · J⁻¹ (row vectors)
     grad = np.einsum("qai,eqij->eqaj", ref_grad, np.linalg.inv(jac))
     dv = np.abs(det) * weights[None, :]

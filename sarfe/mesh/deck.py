@@ -55,8 +55,10 @@ class ShellElements:
     mass_per_area       (m_t,)          ρ t + NSM [kg/m²]
     rotary_inertia_per_area (m_t,)      ∫ ρ z² dz about the mid-surface [kg]
     thickness           (m_t,)          total thickness [m] (information, drilling penalty)
-    offset              (m_t,)          mid-surface offset along the normal from the node plane
-                                        [m] (ZOFFS; already included in B and D)
+    offset              (m_t,)          mid-surface offset o along the normal from the node plane
+                                        [m] (ZOFFS, PCOMP Z0 + T/2). A, B, D are about the node
+                                        plane (B = B_mid + o A, D = D_mid + 2 o B_mid + o² A);
+                                        the assembly adds the mass's first moment m'' o
     """
 
     element_ids: np.ndarray = field(default_factory=_ints)

@@ -6,8 +6,9 @@ cross-references it; this module turns its cards into the reader-neutral `DeckMo
 * GRID in any CP system (CORD1/2 R, C, S, chained) → global coordinates; the CD system of
   each GRID → ``displacement_frames`` (cylindrical/spherical axes taken at the node);
   GRID/GRDSET PS → support set ``'permanent'``.
-* CTRIA3/CQUAD4 (THETA/MCID → material axis; a nonzero ZOFFS, PCOMP Z0 ≠ −T/2 or corner
-  thicknesses T1–T4 different from the property's are refused with a DeckError) with
+* CTRIA3/CQUAD4 (THETA/MCID → material axis; ZOFFS and PCOMP Z0 offsets honoured: the
+  section is taken about the node plane; corner thicknesses T1–T4 different from the
+  property's are refused with a DeckError) with
   PSHELL (T, MID1/MID2/MID3, 12I/T³, TS/T, NSM; MID4 refused) or PCOMP (classical lamination
   theory, `sarfe.fe.laminate`; LAM = SYM mirrored) on MAT1 / MAT2 / MAT8.
   CTRIA6/CQUAD8/CQUADR/CTRIAR are refused with a DeckError (never reduced to corners).
@@ -242,7 +243,7 @@ class _Converter:
             if rho == 0.0:
                 self.notes.append(f"PSHELL {pid}: material {prop.mid1} has no density (ρ = 0)")
             mass = rho * t + float(prop.nsm or 0.0)
-            return a, np.zeros((3, 3)), d, shear, mass, rho * t**3 / 12.0, t
+            return a, np.zeros((3, 3)), d, shear, mass, rho * t**3 / 12.0, t, 0.0
         if prop.type == "PCOMP":
             return self.laminate_section(prop)
         self.fail("shell property", pid, f"{prop.type} is not supported")
@@ -259,9 +260,7 @@ class _Converter:
         thick = np.array(thick, float)
         total = float(thick.sum())
         z0 = -total / 2.0 if prop.z0 is None else float(prop.z0)
-        if abs(z0 + total / 2.0) > 1e-9 * total:
-            self.fail("PCOMP", pid, f"Z0 = {z0:g} ≠ −T/2 (offset laminate) is not modelled")
-        top = z0 + np.cumsum(thick)
+        top = -total / 2.0 + np.cumsum(thick)  # about the laminate's mid-plane; Z0 → offset
         bottom = top - thick
         mats = [self.plane_stress(mid, "PCOMP", pid) for mid in mids]
         q = np.array([m[0] for m in mats])
@@ -272,7 +271,7 @@ class _Converter:
         rho = np.array([m[2] for m in mats])
         mass = float(rho @ thick) + float(prop.nsm or 0.0)
         rotary = float(rho @ ((top**3 - bottom**3) / 3.0))
-        return a, b, d, shear, mass, rotary, total
+        return a, b, d, shear, mass, rotary, total, z0 + total / 2.0
 
     def shells(self) -> ShellElements:
         model = self.model
@@ -280,12 +279,11 @@ class _Converter:
         if not eids:
             return ShellElements()
         sections = {}
-        tri_nodes, tri_elem, axes, pids = [], [], [], []
+        tri_nodes, tri_elem, axes, pids, zoffs = [], [], [], [], []
         for row, eid in enumerate(eids):
             el = model.elements[eid]
             nodes = [self.node(n, el.type, eid) for n in el.node_ids]
-            if el.zoffset not in (None, 0.0, "") and float(el.zoffset) != 0.0:
-                self.fail(el.type, eid, f"ZOFFS = {el.zoffset:g}: offset shells are not modelled")
+            zoffs.append(float(el.zoffset or 0.0))
             prop = el.pid_ref
             if prop.pid not in sections:
                 sections[prop.pid] = self.shell_section(prop)
@@ -308,8 +306,9 @@ class _Converter:
                 axis = x[1] - x[0]
                 tri_nodes.append(nodes)
                 tri_elem.append(row)
-            normal = normal / np.linalg.norm(normal)
-            axis = axis / np.linalg.norm(axis)
+            with np.errstate(invalid="ignore", divide="ignore"):  # zero area: refused at assembly
+                normal = normal / np.linalg.norm(normal)
+                axis = axis / np.linalg.norm(axis)
             theta_mcid = el.theta_mcid
             if isinstance(theta_mcid, int):  # MCID: x of that system projected on the plane
                 xm = self.coord_axes(theta_mcid, x.mean(axis=0))[0]
@@ -326,16 +325,21 @@ class _Converter:
         pids = np.array(pids, dtype=np.int64)
         tri_pid = pids[tri_elem]
         keys = sorted(sections)
-        table = [np.array([sections[k][i] for k in keys], float) for i in range(7)]
+        table = [np.array([sections[k][i] for k in keys], float) for i in range(8)]
         which = np.searchsorted(keys, tri_pid)
+        a, b_mid, d_mid = table[0][which], table[1][which], table[2][which]
+        # mid-surface offset from the node plane: ZOFFS + the laminate's own (PCOMP Z0 + T/2);
+        # section about the node plane: B = B_mid + o A, D = D_mid + 2 o B_mid + o² A
+        offset = (np.array(zoffs) + 0.0)[tri_elem] + table[7][which]
+        o = offset[:, None, None]
         return ShellElements(
             element_ids=np.array(eids, dtype=np.int64), property_ids=pids,
             triangles=np.array(tri_nodes, dtype=np.int64), triangle_element=tri_elem,
-            membrane=table[0][which], coupling=table[1][which], bending=table[2][which],
+            membrane=a, coupling=b_mid + o * a, bending=d_mid + 2 * o * b_mid + o**2 * a,
             transverse_shear=table[3][which], material_axis=np.array(axes)[tri_elem],
             mass_per_area=table[4][which] * self.wtmass,
             rotary_inertia_per_area=table[5][which] * self.wtmass,
-            thickness=table[6][which], offset=np.zeros(len(tri_elem)))
+            thickness=table[6][which], offset=offset)
 
     # ------------------------------------------------------------------ solids
     def solids(self) -> dict:

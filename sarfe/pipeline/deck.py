@@ -75,6 +75,26 @@ def _listing(counts: dict) -> str:
     return ", ".join(f"{card} ({count})" for card, count in sorted(counts.items()))
 
 
+def deck_files(path, seen=None) -> list:
+    """The deck file and every file it INCLUDEs (Nastran ``INCLUDE 'x'``, Abaqus
+    ``*INCLUDE, INPUT=x``), recursively, for the linear-stage key."""
+    import re
+    from pathlib import Path
+
+    path = Path(path)
+    seen = [] if seen is None else seen
+    if path in seen or not path.is_file():
+        return seen
+    seen.append(path)
+    pattern = re.compile(r"^\s*\*?\s*INCLUDE\b[^=']*(?:=\s*|\s+')([^'\s,]+)", re.IGNORECASE)
+    with open(path, errors="replace") as handle:
+        for line in handle:
+            match = pattern.match(line)
+            if match:
+                deck_files(path.parent / match.group(1).strip("'\""), seen)
+    return seen
+
+
 # ------------------------------------------------------------------------------------ groups
 def _ids_or_set(case, deck, value, path, kind):
     """Node indices (kind 'node') or element ids (kind 'element') of a group definition:
@@ -439,6 +459,9 @@ def prepare_deck(case: Case) -> PreparedDeck:
     mesh = deck_panel_mesh(case, deck)
     deck = apply_overrides(case, deck, mesh)
     deck, element_contacts = springs_to_contacts(case, deck)
+    if not _has_mass(deck):
+        raise case.error("the deck has no mass (" + ("; ".join(deck.notes) or "no density, "
+                         "no point masses") + "): give densities (or materials overrides)", DECK_KEY)
     unjoined_mass = np.setdiff1d(deck.point_masses.node, _used_nodes(deck))
     if unjoined_mass.size:
         raise case.error(f"point mass on GRID {int(deck.node_ids[unjoined_mass[0]])} which no "
@@ -493,6 +516,13 @@ def ignored_mass(case: Case, ignored: dict) -> dict:
         except Exception:   # a card pyNastran cannot weigh: say so rather than guess
             masses[card] = None
     return masses
+
+
+def _has_mass(deck) -> bool:
+    """Whether any element or point mass of the deck carries mass."""
+    return bool(np.any(deck.shells.mass_per_area > 0) or np.any(deck.point_masses.mass > 0)
+                or any(np.any(b.density > 0) for b in deck.solids.values())
+                or np.any(deck.beams.density > 0) or np.any(deck.beams.mass_per_length > 0))
 
 
 def _used_nodes(deck) -> np.ndarray:
@@ -619,6 +649,10 @@ def build_deck_stage(case: Case, progress=False) -> dict:
     clock = time.perf_counter()
     system = _assemble(case, deck)
     timings["assembly_s"] = time.perf_counter() - clock
+    mass_kg = _translational_mass(system, deck)
+    if not mass_kg > 0:
+        raise case.error("the deck has no mass (" + ("; ".join(deck.notes) or "no density, "
+                         "no point masses") + "): give densities (or materials overrides)", DECK_KEY)
     _step(stages, "reduction")
     n_kept = system.n_dofs
     fixed = system.dof_index(*np.nonzero(prepared.held))
@@ -674,7 +708,7 @@ def build_deck_stage(case: Case, progress=False) -> dict:
         if "mode_count" not in red and reduced.mode_count < red["min_mode_count"]:
             reduced = reduce(min(red["min_mode_count"], len(free) - len(boundary_positions) - 1),
                              None)
-    except (RuntimeError, ValueError, np.linalg.LinAlgError, ArithmeticError) as exc_:
+    except Exception as exc_:   # any solver's failure (PARDISO, CHOLMOD, ARPACK): one line
         raise case.error(f"the structure is not held (singular stiffness: {' '.join(str(exc_).split())[:200]}); "
                          "check the supports and for mechanisms (unconnected parts, hinges)",
                          ("model", "fe", "supports")) from None
@@ -733,7 +767,7 @@ def build_deck_stage(case: Case, progress=False) -> dict:
             "reduced_dofs": int(n_r), "cutoff_hz": None if cutoff is None else float(cutoff),
             "radiating_nodes": int(len(erp_nodes)), "radiating_area_m2": float(areas.sum()),
             "linear_solver": reduced.solver,
-            "total_mass_kg": _translational_mass(system, deck),
+            "total_mass_kg": mass_kg,
             **prepared.notes}
     return dict(kind="fe", mass=reduced.mass, stiffness=reduced.stiffness, damping=None,
                 load_vectors=loads, base_vector=base, contacts=contacts, erp_map=erp_map,

@@ -113,7 +113,11 @@ def linear_model_key(case) -> str:
     model = json.loads(json.dumps(data["model"]))
     for section in model.values():
         for key in ("mesh", "deck", "mass", "stiffness", "damping"):
-            if isinstance(section.get(key), str):
+            if key == "deck" and isinstance(section.get(key), str):   # with its INCLUDEs
+                from sarfe.pipeline.deck import deck_files
+                section[key] = {"file_sha256": [_file_digest(f) for f in
+                                                deck_files(case.resolve(section[key]))]}
+            elif isinstance(section.get(key), str):
                 section[key] = {"file_sha256": _file_digest(case.resolve(section[key]))}
     exc = data["excitation"]
     parts = {
@@ -489,7 +493,7 @@ def _build_fe(case: Case, progress=False) -> dict:
             # a cutoff below the first fixed-interface modes leaves only static condensation
             reduced = reduce(min(red["min_mode_count"], len(free) - len(boundary_positions) - 1),
                              None)
-    except (RuntimeError, ValueError, np.linalg.LinAlgError) as exc:
+    except Exception as exc:   # any solver's failure (PARDISO, CHOLMOD, ARPACK): one line
         raise case.error(f"the structure is not held (singular stiffness: {exc}); check the "
                          "fixed groups", ("model", "fe", "fixed")) from None
     finally:

@@ -316,3 +316,147 @@ def test_units_give_the_same_frequencies(tmp_path):
     system = assemble_deck(deck_mm)
     f_mm = _frequencies(system, support_dofs(system, deck_mm, 1), 4)
     assert np.allclose(f_mm, f_si, rtol=1e-6)
+
+
+def _hex20_plate(lx, ly, thickness, counts, young, poisson, density):
+    """A DeckModel of a plate of hex20 cells (counts = cells along x, y, z)."""
+    from sarfe.fe.solid_cells import _HEX_CORNERS, _HEX_EDGES
+    from sarfe.mesh.deck import DeckModel, SolidElements
+
+    nx, ny, nz = counts
+    grid = np.arange((2 * nx + 1) * (2 * ny + 1) * (2 * nz + 1)).reshape(2 * nx + 1, 2 * ny + 1, -1)
+    x, y, z = np.meshgrid(np.linspace(0, lx, 2 * nx + 1), np.linspace(0, ly, 2 * ny + 1),
+                          np.linspace(-thickness / 2, thickness / 2, 2 * nz + 1), indexing="ij")
+    points = np.column_stack([x.ravel(), y.ravel(), z.ravel()])
+    corners = (_HEX_CORNERS + 1).astype(int)
+    local = np.vstack([corners, (corners[_HEX_EDGES[:, 0]] + corners[_HEX_EDGES[:, 1]]) // 2])
+    i, j, k = (a.ravel() for a in np.meshgrid(np.arange(nx), np.arange(ny), np.arange(nz),
+                                             indexing="ij"))
+    c = np.stack([2 * i, 2 * j, 2 * k], 1)[:, None, :] + local[None]
+    cells = grid[c[..., 0], c[..., 1], c[..., 2]]
+    used = np.unique(cells)
+    remap = np.full(len(points), -1)
+    remap[used] = np.arange(len(used))
+    m = len(cells)
+    block = SolidElements("hex20", np.arange(1, m + 1), np.ones(m, int), remap[cells],
+                          np.full(m, young), np.full(m, poisson), np.full(m, density))
+    return DeckModel("hex20 plate", np.arange(1, len(used) + 1), points[used],
+                     np.tile(np.eye(3), (len(used), 1, 1)), solids={"hex20": block})
+
+
+def _shell_plate(lx, ly, thickness, counts, young, poisson, density):
+    from sarfe.fe.laminate import isotropic_plane_stress
+    from sarfe.mesh.deck import DeckModel, ShellElements
+
+    nx, ny = counts
+    x, y = np.meshgrid(np.linspace(0, lx, nx + 1), np.linspace(0, ly, ny + 1), indexing="ij")
+    points = np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)])
+    grid = np.arange(len(points)).reshape(nx + 1, ny + 1)
+    a, b, c, d = (grid[:-1, :-1].ravel(), grid[1:, :-1].ravel(), grid[1:, 1:].ravel(),
+                  grid[:-1, 1:].ravel())
+    triangles = np.vstack([np.column_stack([a, b, c]), np.column_stack([a, c, d])])
+    m = len(triangles)
+    q = isotropic_plane_stress(young, poisson)
+    shells = ShellElements(np.arange(1, m + 1), np.ones(m, int), triangles, np.arange(m),
+                           np.tile(q * thickness, (m, 1, 1)), np.zeros((m, 3, 3)),
+                           np.tile(q * thickness**3 / 12, (m, 1, 1)), np.zeros((m, 2, 2)),
+                           np.tile([1.0, 0, 0], (m, 1)), np.full(m, density * thickness),
+                           np.full(m, density * thickness**3 / 12), np.full(m, thickness),
+                           np.zeros(m))
+    return DeckModel("shell plate", np.arange(1, len(points) + 1), points,
+                     np.tile(np.eye(3), (len(points), 1, 1)), shells=shells)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("width_over_thickness, low, high", [(8, 0.005, 0.07), (100, -0.002, 0.003)])
+def test_kirchhoff_shell_vs_3d_hex20_free_plate(width_over_thickness, low, high):
+    """Transverse-shear measurement (docs/decks.md): free 2 × 1 plate (plate_py's material);
+    converged DKT (80 × 40) vs 3D quadratic solid (40 × 20 × 2 hex20), modes 7–10."""
+    from sarfe.fe.modes import natural_frequencies
+
+    e, nu, rho = 2.9e7, 0.32, 7.3315e-4
+    t = 1.0 / width_over_thickness
+    shift = 1000.0 / width_over_thickness
+    shell = assemble_deck(_shell_plate(2.0, 1.0, t, (80, 40), e, nu, rho))
+    solid = assemble_deck(_hex20_plate(2.0, 1.0, t, (40, 20, 2), e, nu, rho))
+    f_shell = natural_frequencies(shell.stiffness, shell.mass, count=10, shift_hz=shift)[6:]
+    f_solid = natural_frequencies(solid.stiffness, solid.mass, count=10, shift_hz=shift)[6:]
+    ratio = f_shell / f_solid - 1
+    assert np.all(ratio > low) and np.all(ratio < high), ratio
+
+
+@needs_decks
+def test_hex20_plate_matches_the_commercial_solvers_thick_plate():
+    """plate_py's 2 × 1 × 0.125 plate as 20 × 10 × 2 hex20 (3D elasticity, shear included)
+    reproduces the commercial solver's (Mindlin shell) free-free frequencies to 0.5 %."""
+    from sarfe.fe.modes import natural_frequencies
+
+    reference = json.loads((DECKS / "REFERENCE.json").read_text())
+    expected = np.array(reference["plate_py.dat"]["frequencies_hz"][6:10])
+    deck = read_nastran(DECKS / "plate_py.dat")
+    q = deck.shells.membrane[0] / 0.125
+    poisson = q[0, 1] / q[0, 0]
+    young = q[0, 0] * (1 - poisson**2)
+    system = assemble_deck(_hex20_plate(2.0, 1.0, 0.125, (20, 10, 2), young, poisson,
+                                        deck.shells.mass_per_area[0] / 0.125))
+    hz = natural_frequencies(system.stiffness, system.mass, count=10, shift_hz=100.0)[6:]
+    assert np.allclose(hz, expected, rtol=5e-3), hz / expected
+
+
+@pytest.mark.parametrize("text, needle", [
+    ("GRID,1,,0.,0.,0.\nGRID,2,,1.,0.,0.\nGRID,3,,2.,0.,0.\nCTRIA3,7,1,1,2,3\n"
+     "PSHELL,1,1,0.01,1\nMAT1,1,7.e10,,0.3,2700.", "shell element 7 has zero area"),
+    ("GRID,1,,0.,0.,0.\nGRID,2,,1.,0.,0.\nCBAR,8,1,1,2,1.,0.,0.\n"
+     "PBAR,1,1,1.e-4,1.e-9,1.e-9,1.e-9\nMAT1,1,7.e10,,0.3,2700.", "CBAR 8: orientation"),
+    ("GRID,1,,0.,0.,0.\nGRID,2,,1.,0.,0.\nGRID,3,,0.,1.,0.\nGRID,4,,0.,0.,-1.\n"
+     "CTETRA,9,1,1,2,3,4\nCTETRA,10,1,1,3,2,4\nPSOLID,1,1\nMAT1,1,7.e10,,0.3,2700.", "solid element"),
+])
+def test_degenerate_elements_name_their_id(tmp_path, text, needle):
+    deck = read_nastran(_write(tmp_path, text))
+    if "CTETRA" in text:  # both orientations of one tet are fine (|det J|)
+        assert assemble_deck(deck).n_dofs > 0
+        return
+    with pytest.raises(DeckError, match=needle):
+        assemble_deck(deck)
+
+
+def test_cylindrical_cd_frame_for_supports_and_loads(tmp_path):
+    # node 2 on the y axis with CD = cylindrical system 5: its component 1 is radial = +y
+    deck = read_nastran(_write(tmp_path, """
+CORD2C,5,,0.,0.,0.,0.,0.,1.
+,1.,0.,0.
+GRID,1,,0.,0.,0.
+GRID,2,,0.,1.,0.,5
+CELAS2,1,1000.,2,1
+CELAS2,2,1000.,2,2
+CELAS2,3,1000.,2,3
+SPC1,2,1,2
+FORCE,3,2,,1.,0.,2.,0.
+"""))
+    assert np.allclose(deck.displacement_frames[1], [[0, 1, 0], [-1, 0, 0], [0, 0, 1]], atol=1e-12)
+    system = assemble_deck(deck)
+    radial = system.dof_index(1, 0)
+    assert radial in support_dofs(system, deck, 2)
+    load = load_vector(system, deck, 3)
+    assert load[radial] == pytest.approx(2.0)  # global +y force is radial at θ = 90°
+    assert load[system.dof_index(1, 1)] == pytest.approx(0.0, abs=1e-12)
+
+
+def test_two_offset_shells_equal_one_of_double_thickness(tmp_path):
+    """ZOFFS = ±t/2 on two coincident PSHELLs of thickness t sharing the nodes: stiffness and
+    mass equal one shell of thickness 2t (parallel axes: 2 (t³/12 + t (t/2)²) = (2t)³/12)."""
+    grids = "GRID,1,,0.,0.,0.\nGRID,2,,0.3,0.05,0.\nGRID,3,,0.25,0.2,0.01\nGRID,4,,0.,0.22,0.\n"
+    material = "MAT1,1,2.e9,,0.35,1100.\n"
+    two = read_nastran(_write(tmp_path, grids + material + "PSHELL,1,1,0.002,1\n"
+                              "CQUAD4,1,1,1,2,3,4,,0.001\nCQUAD4,2,1,1,2,3,4,,-0.001"))
+    (tmp_path / "one").mkdir()
+    one = read_nastran(_write(tmp_path / "one", grids + material + "PSHELL,1,1,0.004,1\n"
+                              "CQUAD4,1,1,1,2,3,4"))
+    k2, m2 = global_matrices(two)
+    k1, m1 = global_matrices(one)
+    assert np.abs((k2 - k1).toarray()).max() < 1e-9 * np.abs(k1.toarray()).max()
+    assert np.abs((m2 - m1).toarray()).max() < 1e-12 * np.abs(m1.toarray()).max()
+    # one offset shell alone: its membrane–bending coupling is B = o A, mass first moment ρ t o
+    single = read_nastran(_write(tmp_path / "one", grids + material + "PSHELL,1,1,0.002,1\n"
+                                 "CQUAD4,1,1,1,2,3,4,,0.001"))
+    assert np.allclose(single.shells.coupling, 0.001 * single.shells.membrane)

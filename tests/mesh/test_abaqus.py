@@ -242,3 +242,17 @@ def test_errors_name_file_line_and_keyword(tmp_path, text, expected):
     with pytest.raises(DeckError, match=expected) as info:
         read_abaqus(_write(tmp_path, text))
     assert "\n" not in str(info.value)
+
+
+def test_abaqus_cae_export_layout():
+    """An Abaqus/CAE-style export (parts, two instances, internal generated sets, a surface,
+    a frequency step with output requests) reads; only *Surface is unsupported."""
+    from pathlib import Path
+
+    deck = read_abaqus(Path(__file__).with_name("abaqus_cae_plate.inp"))
+    assert deck.node_ids.tolist() == [1, 2, 3, 4, 5, 6, 11, 12, 13, 14, 15, 16]
+    assert np.allclose(deck.points[6:, 2], 5.0) and np.allclose(deck.points[:6, 2], 0.0)
+    assert deck.unsupported == {"*SURFACE": 1}
+    assert deck.shells.element_ids.tolist() == [1, 2, 11, 12]
+    assert deck.node_ids[deck.supports["boundary"].nodes].tolist() == [1, 4]
+    assert deck.shells.mass_per_area[0] == pytest.approx(7.8e-9 * 2.0)

@@ -102,7 +102,6 @@ MAT1,1,7.e10,,0.3,2700.
 
 
 @pytest.mark.parametrize("card, needle", [
-    ("CQUAD4,1,1,1,2,3,4,,0.002", "ZOFFS"),
     ("GRID,5,,0.5,0.,0.\nGRID,6,,1.,0.5,0.\nGRID,7,,0.5,1.,0.\nGRID,8,,0.,0.5,0.\n"
      "CQUAD8,1,1,1,2,3,4,5,6,+\n+,7,8", "CQUAD8"),
     ("CQUAD4,1,1,1,2,3,4\nCELAS2,9,1000.,1,1,2,2", "components"),
@@ -122,6 +121,17 @@ def test_theta_field_and_unsupported_cards_counted(tmp_path):
     assert deck.shells.n_triangles == 2
     assert np.allclose(deck.shells.material_axis[0], [np.cos(np.pi / 6), np.sin(np.pi / 6), 0])
     assert deck.unsupported == {"PLOAD2": 1, "TEMP": 1}
+
+
+def test_zoffs_is_honoured_as_a_section_about_the_node_plane(tmp_path):
+    from sarfe.fe.deck_assembly import mass_properties
+
+    deck = read_nastran(_write(tmp_path, _PLATE + "CQUAD4,1,1,1,2,3,4,,0.002"))
+    assert np.allclose(deck.shells.offset, 0.002)
+    assert np.allclose(deck.shells.coupling, 0.002 * deck.shells.membrane)
+    mass, cg = mass_properties(deck)
+    assert mass == pytest.approx(2700 * 0.01)
+    assert np.allclose(cg, [0.5, 0.5, 0.002])  # the mass sits on the offset mid-surface
 
 
 def test_broken_deck_is_one_line_error(tmp_path):
