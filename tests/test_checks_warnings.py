@@ -104,3 +104,29 @@ def test_terminal_gets_live_bars(far_case):
     assert os.WEXITSTATUS(status) == 0, text
     assert "linear stage: assembly:" in text and "frequencies:" in text and "%|" in text
     assert "sarfe: frequencies" not in text          # no log lines on a terminal
+
+
+@pytest.mark.parametrize("cells", [10, 20])
+def test_mesh_resolution_limit_separates_accurate_from_inaccurate_modes(cells):
+    """Simply supported square plate (closed form f_mn = (π/2)(m² + n²)/a² √(D/ρt)): every FE mode
+    below the warning's limit (6 longest edges per bending wavelength) is within 4 % of the exact
+    frequency; past the limit the error grows beyond 10 % within the first 60 modes."""
+    import numpy as np
+
+    from sarfe.fe import fixed_dofs, natural_frequencies, shell_matrices
+    from sarfe.fe.reference_meshes import boundary_nodes, rectangle_triangles
+    from sarfe.pipeline.checks import bending_resolution_hz
+
+    a, t, E, nu, rho = 0.3, 2.5e-3, 2.2e9, 0.35, 1050.0
+    wave_speed = np.sqrt(E * t ** 3 / (12 * (1 - nu ** 2)) / (rho * t))
+    m, n = np.meshgrid(np.arange(1, 30), np.arange(1, 30))
+    exact = np.sort((np.pi / 2 * (m ** 2 + n ** 2) / a ** 2 * wave_speed).ravel())[:60]
+    points, triangles = rectangle_triangles(a, a, cells, cells)
+    k, mass = shell_matrices(points, triangles, t, E, nu, rho)
+    fe = natural_frequencies(k, mass, 60, fixed_dofs(boundary_nodes(triangles), "translations"))
+    limit = np.median(bending_resolution_hz(points, triangles, t, E, nu, rho))
+    error = np.abs(fe / exact - 1)
+    below = exact <= limit
+    assert below.sum() >= 3 and not below.all()
+    assert error[below].max() < 0.04
+    assert error[~below].max() > 0.10

@@ -126,9 +126,25 @@ def check_held(case, mesh, fixed_nodes) -> None:
                          f"{members[0]}); add a fixed group on it", ("model", "fe", "fixed"))
 
 
+def bending_resolution_hz(points, triangles, thickness, young, poisson, density) -> np.ndarray:
+    """Per triangle, the frequency [Hz] whose plate bending wavelength spans
+    :data:`ELEMENTS_PER_WAVELENGTH` of its longest edge h:
+
+        k = 2π / (6 h),  f = k² √(D / (ρ t)) / 2π,  D = E t³ / (12 (1 − ν²))
+
+    points (n, 3) [m]; triangles (n_e, 3); thickness [m], young [Pa], poisson, density [kg/m³]
+    scalars or (n_e,) per triangle. Returns (n_e,)."""
+    corners = np.asarray(points, dtype=float)[np.asarray(triangles)]
+    h = np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=2).max(axis=1)
+    t = np.asarray(thickness, dtype=float)
+    bending = np.asarray(young, dtype=float) * t ** 3 / (12 * (1 - np.asarray(poisson) ** 2))
+    k = 2 * np.pi / (ELEMENTS_PER_WAVELENGTH * h)
+    return k ** 2 * np.sqrt(bending / (np.asarray(density, dtype=float) * t)) / (2 * np.pi)
+
+
 def mesh_frequency_limit_hz(case, mesh) -> float:
-    """Highest frequency [Hz] the mesh resolves: the median over triangles of the frequency whose
-    plate bending wavelength spans :data:`ELEMENTS_PER_WAVELENGTH` of the triangle's longest edge."""
+    """Highest frequency [Hz] the case's mesh resolves: the median over its triangles of
+    :func:`bending_resolution_hz` with each triangle's material and thickness."""
     from sarfe.pipeline.linear import _per_triangle
 
     fe = case.data["model"]["fe"]
@@ -137,11 +153,7 @@ def mesh_frequency_limit_hz(case, mesh) -> float:
     t = np.asarray(thickness, dtype=float)[_per_triangle(case, mesh, fe["thickness_m"],
                                                           "thickness_m")]
     E, nu, rho = (np.array([mat[k] for mat in materials])[m] for k in ("E_Pa", "nu", "rho_kg_m3"))
-    corners = mesh.points[mesh.triangles]
-    h = np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=2).max(axis=1)
-    bending = E * t ** 3 / (12 * (1 - nu ** 2))
-    k = 2 * np.pi / (ELEMENTS_PER_WAVELENGTH * h)
-    return float(np.median(k ** 2 * np.sqrt(bending / (rho * t)) / (2 * np.pi)))
+    return float(np.median(bending_resolution_hz(mesh.points, mesh.triangles, t, E, nu, rho)))
 
 
 def range_warnings(case, mesh=None) -> list:
@@ -230,4 +242,4 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True)
 
 
 __all__ = ["CaseCheck", "check_case", "output_target", "check_element_quality", "check_held", "check_thickness",
-           "mesh_frequency_limit_hz", "range_warnings", "reduced_model_warnings"]
+           "bending_resolution_hz", "mesh_frequency_limit_hz", "range_warnings", "reduced_model_warnings"]
