@@ -261,7 +261,7 @@ def new_temporary(target: Path, info: dict) -> Path:
     """An empty sibling folder of ``target`` holding only sarfe's marker (with this PID)."""
     target = Path(target)
     target.parent.mkdir(parents=True, exist_ok=True)
-    clean_stale(target.parent, target.name)
+    clean_stale(target.parent)   # every stale sarfe temporary in this folder, of any target
     temporary = _sibling(target, "tmp")
     temporary.mkdir()
     write_marker(temporary, dict(info, pid=os.getpid()))

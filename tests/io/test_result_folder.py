@@ -278,9 +278,9 @@ def test_killed_writer_debris_is_cleaned_by_the_next_run(tmp_path):
     live = tmp_path / f".res.tmp-{os.getpid()}-beef"
     live.mkdir()
     (live / MARKER).write_text(json.dumps(marker_info("solve", "x")))
-    write_result_folder(target, write_files("next"), marker_info("solve", "t"))
+    write_result_folder(tmp_path / "other", write_files("next"), marker_info("solve", "t"))
     names = sorted(p.name for p in tmp_path.iterdir())
-    assert names == sorted(["res", foreign.name, live.name])
+    assert names == sorted(["other", foreign.name, live.name])   # any target's debris
 
 
 def test_backup_of_a_run_killed_between_its_renames_is_put_back(tmp_path):
