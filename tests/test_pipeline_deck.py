@@ -273,3 +273,37 @@ def test_yaml_overrides_a_group_section(tmp_path):
     data = write_case(tmp_path, plate_inp(), thickness_m={"nowhere": 1e-3})
     with pytest.raises(CaseError, match=r"model\.fe\.thickness_m\.nowhere: element group 'nowhere' not in the deck"):
         check_mesh(load_case(data, base_dir=tmp_path))
+
+
+DAMPER_DECK = SHEAR_DECK.replace("CSHEAR,2,2,2,5,6,3\n", "CBUSH,7,9,6,,,,,0\n").replace(
+    "PSHEAR,2,1,3.\n", "PBUSH,9,K,0.,0.,5.,0.,0.,0.\n,,B,0.,0.,{b},0.,0.,0.\n")
+
+
+def test_bush_dampers_enter_the_reduced_damping(tmp_path):
+    """A grounded CBUSH with B3 = 0.04 N s/mm (40 N s/m) at GRID 6: its reduced damping on the
+    boundary DOF uz(6) is exactly 40 N s/m; the response at resonance drops when B grows."""
+    levels = []
+    for b in (0.0, 0.04):
+        (tmp_path / "damper.bdf").write_text(DAMPER_DECK.format(b=b))
+        data = {"name": "damper", "model": {"fe": {"deck": "damper.bdf", "units": "mm-t-s",
+                                                   "node_groups": {"tip": [6]}}},
+                "excitation": {"forces": [{"group": "tip", "direction": "z", "force_N": 1.0}],
+                               "frequency_hz": 10.0},
+                "damping": {"modal_zeta": 0.01}, "reduction": {"mode_count": 4},
+                "solver": {"harmonics": 1, "samples_per_period": 8, "error_estimate": False,
+                           "stability": False}}
+        case = load_case(data, base_dir=tmp_path)
+        stage = build_linear_model(case)
+        if b == 0.0:
+            assert stage.added_damping is None
+            # tune to the first system mode (boundary free) for the second run
+            from scipy.linalg import eigh
+            first = np.sqrt(eigh(stage.stiffness, stage.mass, eigvals_only=True)[0]) / (2 * np.pi)
+            data["excitation"]["frequency_hz"] = float(first)
+        else:
+            z = np.flatnonzero(stage.load_vectors[0])[0]         # the boundary DOF uz(6)
+            assert stage.added_damping[z, z] == pytest.approx(40.0, rel=1e-12)
+            assert np.count_nonzero(np.abs(stage.added_damping) > 1e-12) == 1
+        levels.append(solve_case(load_case(data, base_dir=tmp_path), write=False)
+                      .summary["points"][0]["erp"]["level_db"])
+    assert levels[1] < levels[0] - 1.0

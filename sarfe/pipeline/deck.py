@@ -483,10 +483,11 @@ def prepare_deck(case: Case) -> PreparedDeck:
              or sorted(deck.supports),
              "contact_elements": {k: v.element_ids.tolist() for k, v in element_contacts.items()},
              "deck_notes": list(deck.notes)}
-    if len(deck.springs.element_ids) and (np.any(deck.springs.structural_damping)
-                                          or np.any(deck.springs.viscous_damping)):
-        notes["spring_damping"] = ("the springs' GE/B damping is not applied: damping comes "
-                                   "from the case's damping section")
+    if len(deck.springs.element_ids) and np.any(deck.springs.structural_damping):
+        notes["spring_damping"] = ("the springs' structural damping GE is not applied (the "
+                                   "viscous B is): hysteretic damping is not a constant D")
+    elif len(deck.springs.element_ids) and np.any(deck.springs.viscous_damping):
+        notes["spring_damping"] = "the springs' viscous damping B is added to the case's damping"
     return PreparedDeck(deck, mesh, held, element_contacts, contact_case(case, deck), notes)
 
 
@@ -745,6 +746,13 @@ def build_deck_stage(case: Case, progress=False) -> dict:
             np.add.at(loads[i], c[ok, comp], load["direction"][comp] / len(nodes_i))
     base = reduced_load(base_load) if base_load is not None else None
 
+    added_damping = None
+    if system.viscous_damping.nnz:    # dampers of the deck: D_r = Bᵀ D_ff B, B = [I 0; Ψ Φ]
+        basis = np.zeros((len(free), n_r))
+        basis[reduced.boundary_dofs, np.arange(n_b)] = 1.0
+        basis[reduced.interior_dofs] = reduced.interior_basis
+        d_ff = system.viscous_damping[free][:, free]
+        added_damping = basis.T @ (d_ff @ basis)
     expanded = _expanded(reduced, system.transformation, free, boundary_global)
     contacts = {}
     for name, (a, b, frames, distance) in paired.items():
@@ -773,7 +781,7 @@ def build_deck_stage(case: Case, progress=False) -> dict:
                 load_vectors=loads, base_vector=base, contacts=contacts, erp_map=erp_map,
                 erp_areas=areas, erp_nodes=erp_nodes, mesh=mesh, reduced=expanded,
                 mode_frequencies_hz=reduced.mode_frequencies_hz, info=info, timings=timings,
-                node_ids=deck.node_ids)
+                node_ids=deck.node_ids, added_damping=added_damping)
 
 
 def _translational_mass(system, deck) -> float:

@@ -80,6 +80,7 @@ class LinearStage:
     info: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
     node_ids: np.ndarray | None = None     # deck GRID / node id of each mesh point (deck path)
+    added_damping: np.ndarray | None = None  # (n_r, n_r) [N s/m] a deck's dampers (CBUSH B), reduced
 
     @property
     def dof_count(self) -> int:
