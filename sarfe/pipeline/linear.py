@@ -586,13 +586,37 @@ def check_mesh(case) -> dict:
     _per_triangle(case, mesh, fe["thickness_m"], "thickness_m")
     from sarfe.erp import nodal_normals
     normals = nodal_normals(mesh.points, mesh.triangles)
-    pairs = {c["name"]: len(pair_contact(case, mesh, i, normals)[0])
-             for i, c in enumerate(case.data["contacts"])}
+    paired = [pair_contact(case, mesh, i, normals) for i in range(len(case.data["contacts"]))]
+    pairs = {c["name"]: len(p[0]) for c, p in zip(case.data["contacts"], paired)}
+    coincident = _mesh_quality(case, mesh, [(a, b) for a, b, _, _ in paired])
     for i, f in enumerate(case.data["excitation"].get("forces", [])):
         resolve_node_group(case, mesh, f["group"], ("excitation", "forces", i, "group"))
     if "surface" in case.data["erp"] and case.data["erp"]["surface"] not in mesh.element_groups:
         resolve_node_group(case, mesh, case.data["erp"]["surface"], ("erp", "surface"))
-    return {"nodes": mesh.n_nodes, "triangles": mesh.n_triangles, "contact_pairs": pairs}
+    return {"nodes": mesh.n_nodes, "triangles": mesh.n_triangles, "contact_pairs": pairs,
+            "coincident_node_pairs": len(coincident), "coincident_nodes": coincident[:50]}
+
+
+def _mesh_quality(case, mesh, contact_pairs):
+    """Duplicate and zero-area triangles are errors (0-based triangle indices); coincident nodes
+    that no contact pairs are returned (0-based node indices) for validate to list."""
+    from sarfe.mesh import quality
+
+    where = ("model", "fe", "mesh" if "mesh" in case.data["model"]["fe"] else "generator")
+    index = np.arange(mesh.n_triangles)
+    duplicates = quality.duplicate_elements(mesh.triangles, index)
+    if duplicates:
+        text = ", ".join(f"{b} (= {a})" for a, b in duplicates[:10])
+        raise case.error(f"{len(duplicates)} duplicate triangle(s) on the same nodes (0-based "
+                         f"indices): {text}", where)
+    degenerate = quality.degenerate_elements(mesh.points, mesh.triangles, index)
+    if degenerate:
+        raise case.error(f"{len(degenerate)} zero-area triangle(s) (0-based indices): "
+                         f"{', '.join(map(str, degenerate[:10]))}", where)
+    joined = [(int(a), int(b)) for pa, pb in contact_pairs for a, b in zip(pa, pb) if b >= 0]
+    extent = float(np.linalg.norm(np.ptp(mesh.points, axis=0)))
+    return [list(p) for p in quality.coincident_nodes(mesh.points, np.arange(mesh.n_nodes),
+                                                      1e-9 * extent, joined)]
 
 
 def build_linear_model(case, progress=False) -> LinearStage:
