@@ -2,7 +2,7 @@ r"""The linear stage of a case: model → (reduced) M, K on the kept DOFs, conta
 DOFs, unit excitation vectors and the ERP recovery map. Everything here is independent of the
 contact law parameters, damping, force amplitudes and frequencies, so a batch over those reuses it.
 
-FE path (a deck file: :mod:`sarfe.pipeline.deck`): mesh → shell K, M (per-triangle thickness/material) → remove fixed (clip/clamp) DOFs →
+FE path (a deck file: :mod:`sarfe.pipeline.deck`, :mod:`sarfe.pipeline.deck_stage`): mesh → shell K, M (per-triangle thickness/material) → remove fixed (clip/clamp) DOFs →
 Craig–Bampton with boundary = translations of contact and excitation nodes:
 
     u = T q,  q = [q_b, q_m],  M_r = Tᵀ M T,  K_r = Tᵀ K T,  f_r = Tᵀ f,
@@ -624,7 +624,7 @@ def build_linear_model(case, progress=False) -> LinearStage:
     case = load_case(case)
     clock = time.perf_counter()
     if case.is_fe and "deck" in case.data["model"]["fe"]:
-        from sarfe.pipeline.deck import build_deck_stage
+        from sarfe.pipeline.deck_stage import build_deck_stage
         parts = build_deck_stage(case, progress)
     else:
         parts = _build_fe(case, progress) if case.is_fe else _build_matrices(case, progress)
