@@ -75,7 +75,9 @@ def main(argv=None):
     results = []
     for kind in ("generator", "deck", "generator", "deck"):
         out = subprocess.run([sys.executable, __file__, "--size", str(args.size), "--one", kind,
-                              directory], capture_output=True, text=True, check=True)
+                              directory], capture_output=True, text=True)
+        if out.returncode:
+            raise SystemExit(f"{kind} run failed:\n{out.stderr[-3000:]}")
         results.append(json.loads(out.stdout.strip().splitlines()[-1]))
     best = {k: min((r for r in results if r["kind"] == k), key=lambda r: r["seconds"])
             for k in ("generator", "deck")}

@@ -195,7 +195,9 @@ def build_deck_stage(case: Case, progress=False) -> dict:
     loaded = np.unique(np.concatenate([np.flatnonzero(v) for v in set_vectors if v is not None]
                                       + [np.zeros(0, np.int64)]))
     residual_loads = []
-    if 0 < len(loaded) <= _LOADED_BOUNDARY_LIMIT:
+    basic = np.all(np.isclose(deck.displacement_frames[system.dof_nodes[loaded]], np.eye(3),
+                              atol=1e-12), axis=(1, 2))
+    if 0 < len(loaded) <= _LOADED_BOUNDARY_LIMIT and basic.all():   # boundary = global DOFs
         boundary_kept = np.union1d(boundary_kept, loaded)
     else:
         residual_loads += [v[free] for v in set_vectors if v is not None]
