@@ -279,10 +279,12 @@ class _Converter:
         if not eids:
             return ShellElements()
         sections = {}
-        tri_nodes, tri_elem, axes, pids, zoffs = [], [], [], [], []
-        for row, eid in enumerate(eids):
+        corners = np.full((len(eids), 4), -1, dtype=np.int64)  # −1: triangle
+        pids, zoffs, thetas, mcids = [], [], np.zeros(len(eids)), {}
+        for row, eid in enumerate(eids):  # card fields only; geometry is vectorized below
             el = model.elements[eid]
             nodes = [self.node(n, el.type, eid) for n in el.node_ids]
+            corners[row, :len(nodes)] = nodes
             zoffs.append(float(el.zoffset or 0.0))
             prop = el.pid_ref
             if prop.pid not in sections:
@@ -294,49 +296,51 @@ class _Converter:
                     for tc in corner_t):
                 self.fail(el.type, eid, "corner thicknesses T1–T4 different from the "
                           "property's T are not modelled")
-            x = self.points[nodes]
-            if el.type == "CQUAD4":
-                d13, d24 = x[2] - x[0], x[3] - x[1]
-                normal = np.cross(d13, d24)
-                axis = d13 / np.linalg.norm(d13) - d24 / np.linalg.norm(d24)
-                tri_nodes += [[nodes[0], nodes[1], nodes[2]], [nodes[0], nodes[2], nodes[3]]]
-                tri_elem += [row, row]
-            else:
-                normal = np.cross(x[1] - x[0], x[2] - x[0])
-                axis = x[1] - x[0]
-                tri_nodes.append(nodes)
-                tri_elem.append(row)
-            with np.errstate(invalid="ignore", divide="ignore"):  # zero area: refused at assembly
-                normal = normal / np.linalg.norm(normal)
-                axis = axis / np.linalg.norm(axis)
-            theta_mcid = el.theta_mcid
-            if isinstance(theta_mcid, int):  # MCID: x of that system projected on the plane
-                xm = self.coord_axes(theta_mcid, x.mean(axis=0))[0]
-                axis = xm - normal * (xm @ normal)
-                if np.linalg.norm(axis) < 1e-8:
-                    self.fail(el.type, eid, f"MCID {theta_mcid} axis is normal to the element")
-                axis /= np.linalg.norm(axis)
-            elif theta_mcid:
-                angle = np.radians(float(theta_mcid))
-                axis = np.cos(angle) * axis + np.sin(angle) * np.cross(normal, axis)
-            axes.append(axis)
+            if isinstance(el.theta_mcid, int):
+                mcids[row] = el.theta_mcid
+            elif el.theta_mcid:
+                thetas[row] = np.radians(float(el.theta_mcid))
             pids.append(prop.pid)
-        tri_elem = np.array(tri_elem, dtype=np.int64)
+        quad = corners[:, 3] >= 0
+        x = self.points[np.where(corners >= 0, corners, corners[:, :1])]  # (m, 4, 3)
+        # element axes: CTRIA3 x along G1→G2; CQUAD4 x bisects the diagonals' angle
+        d13, d24 = x[:, 2] - x[:, 0], x[:, 3] - x[:, 1]
+        with np.errstate(invalid="ignore", divide="ignore"):  # zero area: refused at assembly
+            normal = np.where(quad[:, None], np.cross(d13, d24),
+                              np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]))
+            normal /= np.linalg.norm(normal, axis=1)[:, None]
+            bisector = (d13 / np.linalg.norm(d13, axis=1)[:, None]
+                        - d24 / np.linalg.norm(d24, axis=1)[:, None])
+            axis = np.where(quad[:, None], bisector, x[:, 1] - x[:, 0])
+            axis /= np.linalg.norm(axis, axis=1)[:, None]
+        axis = (np.cos(thetas)[:, None] * axis
+                + np.sin(thetas)[:, None] * np.cross(normal, axis))  # THETA about the normal
+        for row, mcid in mcids.items():  # MCID: x of that system projected on the plane
+            xm = self.coord_axes(mcid, x[row].mean(axis=0))[0]
+            projected = xm - normal[row] * (xm @ normal[row])
+            if np.linalg.norm(projected) < 1e-8:
+                self.fail(model.elements[eids[row]].type, eids[row],
+                          f"MCID {mcid} axis is normal to the element")
+            axis[row] = projected / np.linalg.norm(projected)
+        rows = np.arange(len(eids))
+        tri_nodes = np.concatenate([corners[:, [0, 1, 2]], corners[quad][:, [0, 2, 3]]])
+        tri_elem = np.concatenate([rows, rows[quad]])
+        order = np.argsort(tri_elem, kind="stable")  # the two halves of a quad side by side
+        tri_nodes, tri_elem = tri_nodes[order], tri_elem[order]
         pids = np.array(pids, dtype=np.int64)
-        tri_pid = pids[tri_elem]
         keys = sorted(sections)
         table = [np.array([sections[k][i] for k in keys], float) for i in range(8)]
-        which = np.searchsorted(keys, tri_pid)
+        which = np.searchsorted(keys, pids[tri_elem])
         a, b_mid, d_mid = table[0][which], table[1][which], table[2][which]
         # mid-surface offset from the node plane: ZOFFS + the laminate's own (PCOMP Z0 + T/2);
         # section about the node plane: B = B_mid + o A, D = D_mid + 2 o B_mid + o² A
-        offset = (np.array(zoffs) + 0.0)[tri_elem] + table[7][which]
+        offset = np.array(zoffs)[tri_elem] + table[7][which]
         o = offset[:, None, None]
         return ShellElements(
             element_ids=np.array(eids, dtype=np.int64), property_ids=pids,
-            triangles=np.array(tri_nodes, dtype=np.int64), triangle_element=tri_elem,
+            triangles=tri_nodes, triangle_element=tri_elem,
             membrane=a, coupling=b_mid + o * a, bending=d_mid + 2 * o * b_mid + o**2 * a,
-            transverse_shear=table[3][which], material_axis=np.array(axes)[tri_elem],
+            transverse_shear=table[3][which], material_axis=axis[tri_elem],
             mass_per_area=table[4][which] * self.wtmass,
             rotary_inertia_per_area=table[5][which] * self.wtmass,
             thickness=table[6][which], offset=offset)
