@@ -71,10 +71,12 @@ def section_shell_element_matrices(points, triangles, membrane, coupling, bendin
     k_mem = _weighted_gram(b_mem, a_bar, w_area)
     k_bend = _weighted_gram(b_bend, d_bar, w_area)
     # Σ_q w_q B_m,qᵀ B̄ B_b,q as batched matmuls (a many-operand einsum is slow)
-    n_q = b_mem.shape[1]
-    coupled = (b_bar[:, None] @ b_bend) * w_area[:, :, None, None]
-    k_mb = (b_mem.reshape(n_el, 3 * n_q, 9).transpose(0, 2, 1)
-            @ coupled.reshape(n_el, 3 * n_q, 9))
+    k_mb = None
+    if np.any(b_bar):
+        n_q = b_mem.shape[1]
+        coupled = (b_bar[:, None] @ b_bend) * w_area[:, :, None, None]
+        k_mb = (b_mem.reshape(n_el, 3 * n_q, 9).transpose(0, 2, 1)
+                @ coupled.reshape(n_el, 3 * n_q, 9))
 
     # drilling penalty α (G t) A g gᵀ with G t = A66 of the section
     centroid = np.full((1, 3), 1.0 / 3.0)
@@ -89,8 +91,9 @@ def section_shell_element_matrices(points, triangles, membrane, coupling, bendin
     stiffness = np.zeros((n_el, 18, 18))
     stiffness[:, _MEMBRANE[:, None], _MEMBRANE] = k_mem
     stiffness[:, _BENDING[:, None], _BENDING] = k_bend
-    stiffness[:, _MEMBRANE[:, None], _BENDING] = k_mb
-    stiffness[:, _BENDING[:, None], _MEMBRANE] = k_mb.transpose(0, 2, 1)
+    if k_mb is not None:
+        stiffness[:, _MEMBRANE[:, None], _BENDING] = k_mb
+        stiffness[:, _BENDING[:, None], _MEMBRANE] = k_mb.transpose(0, 2, 1)
 
     m_area = np.asarray(mass_per_area, float)
     rotary = np.asarray(rotary_inertia_per_area, float)

@@ -160,6 +160,7 @@ class _Converter:
     def __init__(self, model, path: Path):
         self.model, self.path = model, path
         self.notes: list[str] = []
+        self.apply_grdset()
         nids = np.array(sorted(model.nodes), dtype=np.int64)
         self.node_ids = nids
         self.index = {int(n): i for i, n in enumerate(nids)}
@@ -174,6 +175,27 @@ class _Converter:
         if "WTMASS" in model.params:
             self.wtmass = float(model.params["WTMASS"].values[0])
             self.notes.append(f"PARAM,WTMASS,{self.wtmass:g} applied to every mass")
+
+    def apply_grdset(self):
+        """GRDSET CP/CD/PS defaults for GRIDs that leave those fields blank.
+
+        pyNastran 1.4 reads GRDSET but does not apply its CP or PS; a blank and an explicit 0
+        CP/CD read alike, so GRDSET's nonzero CP/CD go to every GRID whose CP/CD is 0 (noted)."""
+        grdset = getattr(self.model, "grdset", None)
+        if grdset is None:
+            return
+        cp, cd, ps = int(grdset.cp or 0), int(grdset.cd or 0), grdset.ps or ""
+        for node in self.model.nodes.values():
+            if cp and not node.cp:
+                node.cp = cp
+                node.cp_ref = self.model.Coord(cp)
+            if cd and not node.cd:
+                node.cd = cd
+                node.cd_ref = self.model.Coord(cd)
+            if ps and not node.ps:
+                node.ps = str(ps)
+        if cp or cd:
+            self.notes.append(f"GRDSET CP {cp} / CD {cd} applied to every GRID with CP/CD 0 or blank")
 
     # ------------------------------------------------------------------ helpers
     def fail(self, card, ident, why):

@@ -174,3 +174,24 @@ PCOMP,1,,,,,,,SYM
 def test_reference_frequencies_file_is_there():
     reference = json.loads((DECKS / "REFERENCE.json").read_text())
     assert len(reference["mode_solid_shell_bar.bdf"]["frequencies_hz"]) == 3
+
+
+def test_blank_grid_fields_and_grdset_defaults(tmp_path):
+    # blank coordinates are 0.0; GRDSET supplies CP/CD/PS for GRIDs that leave them blank
+    # (pyNastran 1.4 reads GRDSET but does not apply its CP/PS: sarfe does)
+    deck = read_nastran(_write(tmp_path, """
+CORD2R,3,,0.,0.,1.,0.,0.,2.
+,1.,0.,1.
+GRDSET,,3,,,,,6
+GRID,1
+GRID,2,,1.
+GRID,3,,1.,1.
+GRID,4,,0.,1.
+CTRIA3,1,1,1,2,3
+CTRIA3,2,1,1,3,4
+PSHELL,1,1,0.01,1
+MAT1,1,7.e10,,0.3,2700.
+"""))
+    assert np.allclose(deck.points, [[0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]])
+    assert deck.supports["permanent"].components[:, 5].all()
+    assert any("GRDSET" in note for note in deck.notes)  # blank and explicit 0 read alike
