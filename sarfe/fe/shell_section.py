@@ -2,7 +2,7 @@
 
 Same kinematics as `sarfe.fe.shell` (Allman membrane + drilling penalty, DKT bending, 6
 DOF per node, element frame e1 along edge 1→2, e3 = normal); the section stiffness is given
-per element instead of (t, E, ν), so laminates (PCOMP via `sarfe.fe.laminate`), orthotropic
+per element instead of (t, E, ν), so laminates (PCOMP via `sarfe.mesh.laminate`), orthotropic
 and anisotropic sections fit:
     K = ∫ [B_m; B_b]ᵀ [[A, B], [B, D]] [B_m; B_b] dA
 with B_m the Allman membrane strain operator (ε⁰) and B_b the DKT curvature operator (κ);
@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 from .assembly import assemble_pair, element_dofs
-from .laminate import rotate_plane_stress
+from sarfe.mesh.laminate import rotate_plane_stress
 from .shell import (_BENDING, _DEGREE4_RULE, _MEMBRANE, _MIDSIDE_RULE, BLOCK_SIZE,
                     DRILLING_PENALTY, _allman_field, _dkt_rotation_field, _edge_geometry,
                     _p2_gradients, _p2_values, _strain_operator, _to_global, _weighted_gram,

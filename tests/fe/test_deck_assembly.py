@@ -225,7 +225,7 @@ def test_plate_py_free_free_thin_shell_on_a_thick_plate():
 
 
 def test_isotropic_section_shell_equals_the_shell_element():
-    from sarfe.fe.laminate import isotropic_plane_stress
+    from sarfe.mesh.laminate import isotropic_plane_stress
     from sarfe.fe.shell import shell_element_matrices
     from sarfe.fe.shell_section import section_shell_element_matrices
 
@@ -345,7 +345,7 @@ def _hex20_plate(lx, ly, thickness, counts, young, poisson, density):
 
 
 def _shell_plate(lx, ly, thickness, counts, young, poisson, density):
-    from sarfe.fe.laminate import isotropic_plane_stress
+    from sarfe.mesh.laminate import isotropic_plane_stress
     from sarfe.mesh.deck import DeckModel, ShellElements
 
     nx, ny = counts
