@@ -11,7 +11,8 @@ cross-references it; this module turns its cards into the reader-neutral `DeckMo
   property's are refused with a DeckError) with
   PSHELL (T, MID1/MID2/MID3, 12I/T³, TS/T, NSM; MID4 refused) or PCOMP (classical lamination
   theory, `sarfe.mesh.laminate`; LAM = SYM mirrored) on MAT1 / MAT2 / MAT8.
-  CTRIA6/CQUAD8/CQUADR/CTRIAR are refused with a DeckError (never reduced to corners).
+  CTRIA6/CQUAD8 become 4/6 facet triangles through their midside nodes; CQUADR/CTRIAR
+  are refused with a DeckError.
 * CTETRA (4/10), CHEXA (8/20), CPENTA (6) with PSOLID on MAT1.
 * CBAR/PBAR, CBEAM/PBEAM (end stations equal to 0.1 %: their mean; a tapered beam is
   refused), CROD/PROD, CONROD;
@@ -47,7 +48,7 @@ __all__ = ["read_nastran", "nastran_deck", "CONTROL_CARDS", "MODELLED_CARDS"]
 #: cards sarfe turns into the model
 MODELLED_CARDS = frozenset({
     "GRID", "GRDSET", "CORD1R", "CORD1C", "CORD1S", "CORD2R", "CORD2C", "CORD2S",
-    "CTRIA3", "CQUAD4", "PSHELL", "PCOMP", "MAT1", "MAT2", "MAT8",
+    "CTRIA3", "CQUAD4", "CTRIA6", "CQUAD8", "PSHELL", "PCOMP", "MAT1", "MAT2", "MAT8",
     "CTETRA", "CHEXA", "CPENTA", "PSOLID",
     "CBAR", "PBAR", "CBEAM", "PBEAM", "CROD", "PROD", "CONROD",
     "CBUSH", "PBUSH", "CELAS1", "CELAS2", "PELAS", "CONM2", "RBE2", "RBE3",
@@ -59,8 +60,6 @@ CONTROL_CARDS = frozenset({"ENDDATA", "PARAM", "EIGRL", "EIGR", "MAT4", "MAT5", 
                            "INCLUDE", "ECHOON", "ECHOOFF"})
 #: element cards whose loss would silently change the model: refused with an error
 REFUSED_CARDS = {
-    "CTRIA6": "6-node triangles (midside nodes) are not modelled by the facet shell",
-    "CQUAD8": "8-node quadrilaterals (midside nodes) are not modelled by the facet shell",
     "CQUADR": "CQUADR is not modelled", "CTRIAR": "CTRIAR is not modelled",
 }
 _SOLID_KIND = {("CTETRA", 4): "tet4", ("CTETRA", 10): "tet10", ("CHEXA", 8): "hex8",

@@ -7,8 +7,10 @@ PSHELL: A = T·Q(MID1), D = 12I/T³ · T³/12 · Q(MID2), transverse shear TS/T 
 mass T ρ(MID1) + NSM, rotary inertia ρ T³/12. PCOMP: classical lamination theory
 (`sarfe.mesh.laminate`) about the laminate's mid-plane, LAM = SYM mirrored. Offsets
 (ZOFFS, PCOMP Z0 + T/2) move the section to the node plane: B = B_mid + o A,
-D = D_mid + 2 o B_mid + o² A. Element axes: CTRIA3 x along G1→G2, CQUAD4 x bisecting the
-diagonals; THETA rotates it about the normal, MCID projects that system's x on the plane.
+D = D_mid + 2 o B_mid + o² A. Element axes: CTRIA3/6 x along G1→G2, CQUAD4/8 x bisecting
+the diagonals; THETA rotates it about the normal, MCID projects that system's x on the plane.
+Facets: CQUAD4 → 2 triangles; CTRIA6 → 4 and CQUAD8 → 6 flat triangles through the midside
+nodes (the facet shell has no quadratic element: the midside nodes stay in the model).
 """
 from __future__ import annotations
 
@@ -100,18 +102,34 @@ def laminate_section(reader, prop):
     rotary = float(rho @ ((top**3 - bottom**3) / 3.0))
     return a, b, d, shear, mass, rotary, total, z0 + total / 2.0
 
+#: facet triangles of each shell card, as local node positions (corners, then midsides):
+#: CTRIA6 and CQUAD8 are divided through their midside nodes (4 and 6 flat triangles)
+SUBDIVISION = {
+    "CTRIA3": [[0, 1, 2]],
+    "CQUAD4": [[0, 1, 2], [0, 2, 3]],
+    "CTRIA6": [[0, 3, 5], [3, 1, 4], [5, 4, 2], [3, 4, 5]],
+    "CQUAD8": [[0, 4, 7], [4, 1, 5], [5, 2, 6], [6, 3, 7], [4, 5, 6], [4, 6, 7]],
+}
+_CORNERS = {"CTRIA3": 3, "CQUAD4": 4, "CTRIA6": 3, "CQUAD8": 4}
+
+
 def shells(reader) -> ShellElements:
     model = reader.model
-    eids = [e for e, el in sorted(model.elements.items()) if el.type in ("CTRIA3", "CQUAD4")]
+    eids = [e for e, el in sorted(model.elements.items()) if el.type in SUBDIVISION]
     if not eids:
         return ShellElements()
     sections = {}
-    corners = np.full((len(eids), 4), -1, dtype=np.int64)  # −1: triangle
+    nodes_all = np.full((len(eids), 8), -1, dtype=np.int64)
+    kinds = []
     pids, zoffs, thetas, mcids = [], [], np.zeros(len(eids)), {}
     for row, eid in enumerate(eids):  # card fields only; geometry is vectorized below
         el = model.elements[eid]
+        if any(n in (None, 0) for n in el.node_ids):
+            reader.fail(el.type, eid, "midside nodes partly given: not modelled")
         nodes = [reader.node(n, el.type, eid) for n in el.node_ids]
-        corners[row, :len(nodes)] = nodes
+        nodes_all[row, :len(nodes)] = nodes
+        kinds.append(el.type)
+        nodes = nodes[:_CORNERS[el.type]]
         zoffs.append(float(el.zoffset or 0.0))
         prop = el.pid_ref
         if prop.pid not in sections:
@@ -128,9 +146,12 @@ def shells(reader) -> ShellElements:
         elif el.theta_mcid:
             thetas[row] = np.radians(float(el.theta_mcid))
         pids.append(prop.pid)
-    quad = corners[:, 3] >= 0
-    x = reader.points[np.where(corners >= 0, corners, corners[:, :1])]  # (m, 4, 3)
-    # element axes: CTRIA3 x along G1→G2; CQUAD4 x bisects the diagonals' angle
+    kinds = np.array(kinds)
+    quad = np.isin(kinds, ["CQUAD4", "CQUAD8"])
+    corners = np.where(quad[:, None], nodes_all[:, :4], np.column_stack([nodes_all[:, :3],
+                                                                          nodes_all[:, :1]]))
+    x = reader.points[corners]  # (m, 4, 3)
+    # element axes: triangles x along G1→G2; quadrilaterals x bisects the diagonals' angle
     d13, d24 = x[:, 2] - x[:, 0], x[:, 3] - x[:, 1]
     with np.errstate(invalid="ignore", divide="ignore"):  # zero area: refused at assembly
         normal = np.where(quad[:, None], np.cross(d13, d24),
@@ -150,9 +171,14 @@ def shells(reader) -> ShellElements:
                       f"MCID {mcid} axis is normal to the element")
         axis[row] = projected / np.linalg.norm(projected)
     rows = np.arange(len(eids))
-    tri_nodes = np.concatenate([corners[:, [0, 1, 2]], corners[quad][:, [0, 2, 3]]])
-    tri_elem = np.concatenate([rows, rows[quad]])
-    order = np.argsort(tri_elem, kind="stable")  # the two halves of a quad side by side
+    tri_nodes, tri_elem = [], []
+    for kind, pattern in SUBDIVISION.items():
+        pick = kinds == kind
+        for local in pattern:
+            tri_nodes.append(nodes_all[pick][:, local])
+            tri_elem.append(rows[pick])
+    tri_nodes, tri_elem = np.concatenate(tri_nodes), np.concatenate(tri_elem)
+    order = np.argsort(tri_elem, kind="stable")  # an element's triangles side by side
     tri_nodes, tri_elem = tri_nodes[order], tri_elem[order]
     pids = np.array(pids, dtype=np.int64)
     keys = sorted(sections)

@@ -518,7 +518,6 @@ PCOMP,1
     assert np.abs((k_a - k_b).toarray()).max() < 1e-9 * np.abs(k_a.toarray()).max()
 
 
-@needs_decks
 @pytest.mark.filterwarnings("ignore:CONM2.*inertia method:UserWarning")  # pyNastran's own inertia
 def test_point_masses_and_offsets_equal_pynastran_mass_properties(tmp_path):
     from pyNastran.bdf.mesh_utils.mass_properties import mass_properties as pyn_mass

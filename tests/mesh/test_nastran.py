@@ -96,14 +96,13 @@ GRID,1,,0.,0.,0.
 GRID,2,,1.,0.,0.
 GRID,3,,1.,1.,0.
 GRID,4,,0.,1.,0.
-PSHELL,1,1,0.01
+PSHELL,1,1,0.01,1
 MAT1,1,7.e10,,0.3,2700.
 """
 
 
 @pytest.mark.parametrize("card, needle", [
-    ("GRID,5,,0.5,0.,0.\nGRID,6,,1.,0.5,0.\nGRID,7,,0.5,1.,0.\nGRID,8,,0.,0.5,0.\n"
-     "CQUAD8,1,1,1,2,3,4,5,6,+\n+,7,8", "CQUAD8"),
+    ("CQUADR,1,1,1,2,3,4", "CQUADR"),
     ("CQUAD4,1,1,1,2,3,4\nCELAS2,9,1000.,1,1,2,2", "components"),
     ("CQUAD4,1,1,1,2,3,4\nCBUSH,9,7,1,,,,,\nPBUSH,7,K,1.,1.,1.,1.,1.,1.", "CID"),
 ])
@@ -113,6 +112,34 @@ def test_lossy_features_are_refused_with_one_line(tmp_path, card, needle):
         read_nastran(path)
     message = str(info.value)
     assert needle in message and str(path) in message and "\n" not in message
+
+
+@pytest.mark.filterwarnings("ignore::UserWarning")
+def test_quadratic_shells_become_facets_through_their_midside_nodes(tmp_path):
+    from pyNastran.bdf.mesh_utils.mass_properties import mass_properties as pyn_mass
+
+    from sarfe.fe.deck_assembly import assemble_deck, mass_properties
+
+    path = _write(tmp_path, _PLATE + """
+GRID,5,,0.5,0.,0.
+GRID,6,,1.,0.5,0.
+GRID,7,,0.5,1.,0.
+GRID,8,,0.,0.5,0.
+GRID,9,,2.,0.,0.
+GRID,10,,1.5,0.,0.
+GRID,11,,1.5,0.5,0.
+CQUAD8,1,1,1,2,3,4,5,6,+
++,7,8
+CTRIA6,2,1,2,9,3,10,11,6
+""")
+    deck = read_nastran(path)
+    assert deck.shells.n_triangles == 6 + 4
+    assert set(np.unique(deck.shells.triangles)) == set(range(11))  # midside nodes kept
+    mass, cg = mass_properties(deck)
+    ref_mass, ref_cg, _ = pyn_mass(_pynastran_model(path))
+    assert mass == pytest.approx(float(ref_mass), rel=1e-9)
+    assert np.allclose(cg, ref_cg, atol=1e-9)
+    assert len(assemble_deck(deck).auto_held_nodes) == 0
 
 
 def test_theta_field_and_unsupported_cards_counted(tmp_path):
