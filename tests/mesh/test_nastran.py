@@ -68,6 +68,15 @@ def test_include_followed_and_every_card_accounted_for():
     assert sorted(deck.beams.card) == ["CBAR", "CBEAM", "CROD", "CROD"]
     assert len(deck.shells.element_ids) == 12 and deck.shells.n_triangles == 16
     assert deck.unsupported == {}
+    # SPCADD 2 = SPC1 set 123456: GRIDs 22–25 clamped, 5–13 rotations held
+    support = deck.supports["2"]
+    held = dict(zip(deck.node_ids[support.nodes].tolist(), support.components.tolist()))
+    assert all(held[n] == [True] * 6 for n in (22, 23, 24, 25))
+    assert all(held[n] == [False] * 3 + [True] * 3 for n in range(5, 14))
+    # LOAD 123458 = 1.0 · 1.0 · FORCE 10000 (10 000 along z on GRID 13)
+    load = deck.loads["123458"]
+    assert load[deck.node_index([13])[0], 2] == pytest.approx(10000.0)
+    assert np.count_nonzero(load) == 1
     plate = read_nastran(DECKS / "plate.bdf")
     assert plate.unsupported == {"PLOAD4": 2}  # pressure loads are not modelled: listed
     assert any("no density" in note for note in plate.notes)
@@ -201,6 +210,22 @@ PCOMP,1,,,,,,,SYM
 def test_reference_frequencies_file_is_there():
     reference = json.loads((DECKS / "REFERENCE.json").read_text())
     assert len(reference["mode_solid_shell_bar.bdf"]["frequencies_hz"]) == 3
+
+
+def test_darea_in_cd_frame_and_load_combination(tmp_path):
+    deck = read_nastran(_write(tmp_path, """
+CORD2R,2,,0.,0.,0.,0.,0.,1.
+,0.,1.,0.
+GRID,1,,0.,0.,0.,2
+DAREA,5,1,1,3.
+MOMENT,6,1,,2.,0.,0.,1.
+FORCE,8,1,2,4.,1.,0.,0.
+LOAD,7,2.,1.,8,0.5,6
+"""))
+    # CD (and FORCE CID) 2 has its x along global y: component 1 acts along +y
+    assert np.allclose(deck.loads["5"][0], [0, 3, 0, 0, 0, 0])
+    assert np.allclose(deck.loads["8"][0], [0, 4, 0, 0, 0, 0])
+    assert np.allclose(deck.loads["7"][0], 2.0 * np.array([0, 4, 0, 0, 0, 1.0]))
 
 
 def test_blank_grid_fields_and_grdset_defaults(tmp_path):
