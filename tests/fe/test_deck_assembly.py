@@ -535,3 +535,19 @@ CONM2,905,7,-1,0.04,0.5,0.5,0.5
     ref_mass, ref_cg, _ = pyn_mass(_load_bdf(path))
     assert mass == pytest.approx(float(ref_mass), rel=1e-9)
     assert np.allclose(cg, ref_cg, atol=1e-9)
+
+
+def test_chained_rigid_elements_resolve_and_circular_ones_are_refused(tmp_path):
+    from sarfe.fe.constraints import constraint_matrix
+
+    base = "GRID,1,,0.,0.,0.\nGRID,2,,1.,0.,0.\nGRID,3,,1.,2.,0.\n"
+    deck = read_nastran(_write(tmp_path, base + "RBE2,10,1,123456,2\nRBE2,11,2,123456,3\n"))
+    c_matrix, independent = constraint_matrix(deck.points, deck.rbe2, deck.rbe3, 3)
+    assert independent.tolist() == list(range(6))  # node 1 carries everything
+    rotation = np.array([0.0, 0.0, 0.01])
+    u = (c_matrix @ np.r_[np.zeros(3), rotation]).reshape(3, 6)
+    assert np.allclose(u[2, :3], np.cross(rotation, deck.points[2]))
+    (tmp_path / "loop").mkdir()
+    loop = read_nastran(_write(tmp_path / "loop", base + "RBE2,10,1,123456,2\nRBE2,11,2,123456,1\n"))
+    with pytest.raises(DeckError, match="rigid"):
+        assemble_deck(loop)
