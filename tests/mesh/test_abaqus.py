@@ -237,6 +237,8 @@ def test_unsupported_keywords_and_types_are_counted_not_dropped(tmp_path):
      "*SHELL SECTION, ELSET=s, MATERIAL=m\n1.\n", r"node 99 is not defined"),
     ("*NODE\n1, 5, 5, 5\n", r"bad.inp:6: \*NODE: node 1 defined twice"),
     ("*INCLUDE, INPUT=nowhere.inc\n", r"bad.inp:5: \*INCLUDE file not found"),
+    (SECTION + "*BOUNDARY, OP=NEW\n1, 1, 3\n", r"bad.inp:12: \*BOUNDARY: OP=NEW"),
+    ("*MATERIAL, NAME=m\n*DENSITY\n1., 20.\n2., 80.\n", r"bad.inp:6: \*DENSITY: a temperature table"),
 ])
 def test_errors_name_file_line_and_keyword(tmp_path, text, expected):
     with pytest.raises(DeckError, match=expected) as info:
