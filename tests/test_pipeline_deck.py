@@ -273,3 +273,71 @@ def test_yaml_overrides_a_group_section(tmp_path):
     data = write_case(tmp_path, plate_inp(), thickness_m={"nowhere": 1e-3})
     with pytest.raises(CaseError, match=r"model\.fe\.thickness_m\.nowhere: element group 'nowhere' not in the deck"):
         check_mesh(load_case(data, base_dir=tmp_path))
+
+
+DAMPER_DECK = SHEAR_DECK.replace("CSHEAR,2,2,2,5,6,3\n", "CBUSH,7,9,6,,,,,0\n").replace(
+    "PSHEAR,2,1,3.\n", "PBUSH,9,K,0.,0.,5.,0.,0.,0.\n,,B,0.,0.,{b},0.,0.,0.\n")
+
+
+def test_bush_dampers_enter_the_reduced_damping(tmp_path):
+    """A grounded CBUSH with B3 = 0.04 N s/mm (40 N s/m) at GRID 6: its reduced damping on the
+    boundary DOF uz(6) is exactly 40 N s/m; the response at resonance drops when B grows."""
+    levels = []
+    for b in (0.0, 0.04):
+        (tmp_path / "damper.bdf").write_text(DAMPER_DECK.format(b=b))
+        data = {"name": "damper", "model": {"fe": {"deck": "damper.bdf", "units": "mm-t-s",
+                                                   "node_groups": {"tip": [6]}}},
+                "excitation": {"forces": [{"group": "tip", "direction": "z", "force_N": 1.0}],
+                               "frequency_hz": 10.0},
+                "damping": {"modal_zeta": 0.01}, "reduction": {"mode_count": 4},
+                "solver": {"harmonics": 1, "samples_per_period": 8, "error_estimate": False,
+                           "stability": False}}
+        case = load_case(data, base_dir=tmp_path)
+        stage = build_linear_model(case)
+        if b == 0.0:
+            assert stage.added_damping is None
+            # tune to the first system mode (boundary free) for the second run
+            from scipy.linalg import eigh
+            first = np.sqrt(eigh(stage.stiffness, stage.mass, eigvals_only=True)[0]) / (2 * np.pi)
+            data["excitation"]["frequency_hz"] = float(first)
+        else:
+            z = np.flatnonzero(stage.load_vectors[0])[0]         # the boundary DOF uz(6)
+            assert stage.added_damping[z, z] == pytest.approx(40.0, rel=1e-12)
+            assert np.count_nonzero(np.abs(stage.added_damping) > 1e-12) == 1
+        levels.append(solve_case(load_case(data, base_dir=tmp_path), write=False)
+                      .summary["points"][0]["erp"]["level_db"])
+    assert levels[1] < levels[0] - 1.0
+
+
+BUSH_DECK = SHEAR_DECK.replace("CSHEAR,2,2,2,5,6,3\n", "GRID,7,,200.,100.,0.\nCBUSH,7,9,6,7,,,,0\n").replace(
+    "PSHEAR,2,1,3.\n", "PBUSH,9,K,{k}\n").replace("SPC1,1,123456,1,4\n", "SPC1,1,123456,1,4,7\n")
+
+
+@pytest.mark.parametrize("k, axis, expected", [
+    ("1.,2.,5.,0.,0.,0.", None, ([0, 0, 1], 5e3, 1.5e3)),      # largest stiffness: axis 3
+    ("5.,5.,1.,0.,0.,0.", 1, ([1, 0, 0], 5e3, 3e3)),            # a tie needs element_axis
+    ("5.,5.,1.,0.,0.,0.", None, "equally stiff along two axes; give element_axis"),
+])
+def test_cbush_squeak_contact_takes_axis_and_stiffness_from_the_element(tmp_path, k, axis, expected):
+    from sarfe.pipeline.deck import read_case_deck, springs_to_contacts
+
+    (tmp_path / "bush.bdf").write_text(BUSH_DECK.format(k=k))
+    contact = {"name": "clip", "type": "squeak", "from_elements": [7], "friction_coefficient": 0.3,
+               "preload_N": 1.0}
+    if axis:
+        contact["element_axis"] = axis
+    data = {"name": "bush", "model": {"fe": {"deck": "bush.bdf", "units": "mm-t-s"}},
+            "contacts": [contact], "excitation": {"base_acceleration": {"direction": "z",
+                                                                        "amplitude_m_s2": 1.0},
+                                                  "frequency_hz": 10.0}}
+    case = load_case(data, base_dir=tmp_path)
+    if isinstance(expected, str):
+        with pytest.raises(CaseError, match=r"contacts\[0\]\.from_elements: element 7 is " + expected):
+            springs_to_contacts(case, read_case_deck(case))
+        return
+    deck, contacts = springs_to_contacts(case, read_case_deck(case))
+    assert len(deck.springs.element_ids) == 0                    # left the linear model
+    normal, k_n, k_t = expected
+    assert np.allclose(contacts["clip"].frames[0, 0], normal)
+    assert contacts["clip"].normal_stiffness.tolist() == [pytest.approx(k_n)]
+    assert contacts["clip"].tangential_stiffness.tolist() == [pytest.approx(k_t)]

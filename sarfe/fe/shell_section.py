@@ -2,7 +2,7 @@
 
 Same kinematics as `sarfe.fe.shell` (Allman membrane + drilling penalty, DKT bending, 6
 DOF per node, element frame e1 along edge 1→2, e3 = normal); the section stiffness is given
-per element instead of (t, E, ν), so laminates (PCOMP via `sarfe.fe.laminate`), orthotropic
+per element instead of (t, E, ν), so laminates (PCOMP via `sarfe.mesh.laminate`), orthotropic
 and anisotropic sections fit:
     K = ∫ [B_m; B_b]ᵀ [[A, B], [B, D]] [B_m; B_b] dA
 with B_m the Allman membrane strain operator (ε⁰) and B_b the DKT curvature operator (κ);
@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 from .assembly import assemble_pair, element_dofs
-from .laminate import rotate_plane_stress
+from sarfe.mesh.laminate import rotate_plane_stress
 from .shell import (_BENDING, _DEGREE4_RULE, _MEMBRANE, _MIDSIDE_RULE, BLOCK_SIZE,
                     DRILLING_PENALTY, _allman_field, _dkt_rotation_field, _edge_geometry,
                     _p2_gradients, _p2_values, _strain_operator, _to_global, _weighted_gram,
@@ -71,10 +71,12 @@ def section_shell_element_matrices(points, triangles, membrane, coupling, bendin
     k_mem = _weighted_gram(b_mem, a_bar, w_area)
     k_bend = _weighted_gram(b_bend, d_bar, w_area)
     # Σ_q w_q B_m,qᵀ B̄ B_b,q as batched matmuls (a many-operand einsum is slow)
-    n_q = b_mem.shape[1]
-    coupled = (b_bar[:, None] @ b_bend) * w_area[:, :, None, None]
-    k_mb = (b_mem.reshape(n_el, 3 * n_q, 9).transpose(0, 2, 1)
-            @ coupled.reshape(n_el, 3 * n_q, 9))
+    k_mb = None
+    if np.any(b_bar):
+        n_q = b_mem.shape[1]
+        coupled = (b_bar[:, None] @ b_bend) * w_area[:, :, None, None]
+        k_mb = (b_mem.reshape(n_el, 3 * n_q, 9).transpose(0, 2, 1)
+                @ coupled.reshape(n_el, 3 * n_q, 9))
 
     # drilling penalty α (G t) A g gᵀ with G t = A66 of the section
     centroid = np.full((1, 3), 1.0 / 3.0)
@@ -89,8 +91,9 @@ def section_shell_element_matrices(points, triangles, membrane, coupling, bendin
     stiffness = np.zeros((n_el, 18, 18))
     stiffness[:, _MEMBRANE[:, None], _MEMBRANE] = k_mem
     stiffness[:, _BENDING[:, None], _BENDING] = k_bend
-    stiffness[:, _MEMBRANE[:, None], _BENDING] = k_mb
-    stiffness[:, _BENDING[:, None], _MEMBRANE] = k_mb.transpose(0, 2, 1)
+    if k_mb is not None:
+        stiffness[:, _MEMBRANE[:, None], _BENDING] = k_mb
+        stiffness[:, _BENDING[:, None], _MEMBRANE] = k_mb.transpose(0, 2, 1)
 
     m_area = np.asarray(mass_per_area, float)
     rotary = np.asarray(rotary_inertia_per_area, float)

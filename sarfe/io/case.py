@@ -358,7 +358,6 @@ def _normalize_deck(case, fe, p):
     _not_allowed(case, fe, p, ("mesh_units",), "with model.fe.deck (use 'units')")
     fe.setdefault("units", "SI")
     fe.setdefault("ignore_cards", [])
-    fe.setdefault("fixed", [])
     fe.setdefault("node_groups", {})
     fe.setdefault("element_groups", {})
 

@@ -18,7 +18,8 @@ keyword                      read as
 ``*SPRING``                  stiffness of SPRING1/SPRING2 elements (same DOF at both ends)
 ``*MASS``                    point mass of MASS elements
 ``*BOUNDARY``                zero displacements (DOF ranges, ENCASTRE, PINNED, X/Y/ZSYMM,
-                             X/Y/ZASYMM) → support set ``boundary``
+                             X/Y/ZASYMM) → support set ``boundary`` (model level and steps
+                             together; OP=NEW refused)
 ``*CLOAD``                   nodal forces/moments → load set ``cload`` (or the step's name)
 ``*PART`` … ``*ASSEMBLY``    parts placed by ``*INSTANCE`` (translation line, then rotation
                              line a, b, angle°: x' = a + R_ab(θ)(x + t − a))
@@ -355,6 +356,9 @@ class _Reader:
     def k_density(self, block):
         if self.material is None:
             raise DeckError(f"{block.where()}: *DENSITY outside a *MATERIAL")
+        if len(block.data) != 1:
+            raise DeckError(f"{block.where()}: a temperature table of densities is not supported "
+                            "(one density line)")
         fields, _, line = block.data[0]
         self.material["rho"] = _number(_trimmed(fields)[0], block, line, "density")
 
@@ -422,6 +426,9 @@ class _Reader:
             if option not in ("OP",):
                 raise DeckError(f"{block.where()}: option {option} is not supported "
                                 "(zero displacements only)")
+        if str(block.options.get("OP", "MOD")).upper() != "MOD":
+            raise DeckError(f"{block.where()}: OP={block.options['OP']} (removing earlier "
+                            "supports) is not supported: all *BOUNDARY lines form one support set")
         for fields, _, line in block.data:
             fields = _trimmed(fields)
             if len(fields) >= 2 and fields[1].upper() in _BOUNDARY_TYPES:

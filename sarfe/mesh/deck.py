@@ -40,7 +40,8 @@ def _floats(shape=0):
 
 @dataclass(frozen=True)
 class ShellElements:
-    """Shell elements (CTRIA3/CQUAD4, S3/S4): quads split in two triangles.
+    """Shell elements (CTRIA3/CQUAD4/CTRIA6/CQUAD8, S3/S4/…) as flat facet triangles: quads
+    split in two, 6/8-node elements into 4/6 triangles through their midside nodes.
 
     element_ids         (m,) int        deck element ids
     property_ids        (m,) int        PSHELL/PCOMP id (Abaqus: section number)

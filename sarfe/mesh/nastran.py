@@ -10,10 +10,12 @@ cross-references it; this module turns its cards into the reader-neutral `DeckMo
   section is taken about the node plane; corner thicknesses T1–T4 different from the
   property's are refused with a DeckError) with
   PSHELL (T, MID1/MID2/MID3, 12I/T³, TS/T, NSM; MID4 refused) or PCOMP (classical lamination
-  theory, `sarfe.fe.laminate`; LAM = SYM mirrored) on MAT1 / MAT2 / MAT8.
-  CTRIA6/CQUAD8/CQUADR/CTRIAR are refused with a DeckError (never reduced to corners).
+  theory, `sarfe.mesh.laminate`; LAM = SYM mirrored) on MAT1 / MAT2 / MAT8.
+  CTRIA6/CQUAD8 become 4/6 facet triangles through their midside nodes; CQUADR/CTRIAR
+  are refused with a DeckError.
 * CTETRA (4/10), CHEXA (8/20), CPENTA (6) with PSOLID on MAT1.
-* CBAR/PBAR, CBEAM/PBEAM (first station; a tapered beam is refused), CROD/PROD, CONROD;
+* CBAR/PBAR, CBEAM/PBEAM (end stations equal to 0.1 %: their mean; a tapered beam is
+  refused), CROD/PROD, CONROD;
   end offsets (WA/WB) and pin flags refused.
 * CBUSH/PBUSH (K, B, GE), CELAS1/PELAS, CELAS2; CONM2 (offset, inertia, CID);
   RBE2; RBE3 (UM set refused).
@@ -37,15 +39,16 @@ from pathlib import Path
 import numpy as np
 
 from .deck import (BeamElements, DeckError, DeckModel, InterpolationElements, PointMasses,
-                   RigidElements, ShellElements, SolidElements, SpringElements, SupportSet,
-                   to_si)
+                   RigidElements, SolidElements, SpringElements, to_si)
+from .nastran_sections import isotropic, shells
+from .nastran_sets import component_mask, loads, sets, supports
 
 __all__ = ["read_nastran", "nastran_deck", "CONTROL_CARDS", "MODELLED_CARDS"]
 
 #: cards sarfe turns into the model
 MODELLED_CARDS = frozenset({
     "GRID", "GRDSET", "CORD1R", "CORD1C", "CORD1S", "CORD2R", "CORD2C", "CORD2S",
-    "CTRIA3", "CQUAD4", "PSHELL", "PCOMP", "MAT1", "MAT2", "MAT8",
+    "CTRIA3", "CQUAD4", "CTRIA6", "CQUAD8", "PSHELL", "PCOMP", "MAT1", "MAT2", "MAT8",
     "CTETRA", "CHEXA", "CPENTA", "PSOLID",
     "CBAR", "PBAR", "CBEAM", "PBEAM", "CROD", "PROD", "CONROD",
     "CBUSH", "PBUSH", "CELAS1", "CELAS2", "PELAS", "CONM2", "RBE2", "RBE3",
@@ -57,8 +60,6 @@ CONTROL_CARDS = frozenset({"ENDDATA", "PARAM", "EIGRL", "EIGR", "MAT4", "MAT5", 
                            "INCLUDE", "ECHOON", "ECHOOFF"})
 #: element cards whose loss would silently change the model: refused with an error
 REFUSED_CARDS = {
-    "CTRIA6": "6-node triangles (midside nodes) are not modelled by the facet shell",
-    "CQUAD8": "8-node quadrilaterals (midside nodes) are not modelled by the facet shell",
     "CQUADR": "CQUADR is not modelled", "CTRIAR": "CTRIAR is not modelled",
 }
 _SOLID_KIND = {("CTETRA", 4): "tet4", ("CTETRA", 10): "tet10", ("CHEXA", 8): "hex8",
@@ -145,21 +146,13 @@ def axes_at(coord, points) -> np.ndarray:
     return rows @ beta
 
 
-def _mask(components) -> np.ndarray:
-    """Nastran component string/int ('123456', 0 = scalar) → (6,) bool."""
-    mask = np.zeros(6, dtype=bool)
-    for char in str(components if components is not None else "").strip():
-        if char in "123456":
-            mask[int(char) - 1] = True
-    return mask
-
-
 class _Converter:
     """One pass over the cross-referenced pyNastran model (a reading step, not a hot path)."""
 
     def __init__(self, model, path: Path):
         self.model, self.path = model, path
         self.notes: list[str] = []
+        self.apply_grdset()
         nids = np.array(sorted(model.nodes), dtype=np.int64)
         self.node_ids = nids
         self.index = {int(n): i for i, n in enumerate(nids)}
@@ -175,6 +168,27 @@ class _Converter:
             self.wtmass = float(model.params["WTMASS"].values[0])
             self.notes.append(f"PARAM,WTMASS,{self.wtmass:g} applied to every mass")
 
+    def apply_grdset(self):
+        """GRDSET CP/CD/PS defaults for GRIDs that leave those fields blank.
+
+        pyNastran 1.4 reads GRDSET but does not apply its CP or PS; a blank and an explicit 0
+        CP/CD read alike, so GRDSET's nonzero CP/CD go to every GRID whose CP/CD is 0 (noted)."""
+        grdset = getattr(self.model, "grdset", None)
+        if grdset is None:
+            return
+        cp, cd, ps = int(grdset.cp or 0), int(grdset.cd or 0), grdset.ps or ""
+        for node in self.model.nodes.values():
+            if cp and not node.cp:
+                node.cp = cp
+                node.cp_ref = self.model.Coord(cp)
+            if cd and not node.cd:
+                node.cd = cd
+                node.cd_ref = self.model.Coord(cd)
+            if ps and not node.ps:
+                node.ps = str(ps)
+        if cp or cd:
+            self.notes.append(f"GRDSET CP {cp} / CD {cd} applied to every GRID with CP/CD 0 or blank")
+
     # ------------------------------------------------------------------ helpers
     def fail(self, card, ident, why):
         raise DeckError(f"{self.path}: {card} {ident}: {why}")
@@ -187,159 +201,6 @@ class _Converter:
 
     def coord_axes(self, cid, point):
         return axes_at(self.model.coords[int(cid)], point)[0]
-
-    # ------------------------------------------------------------------ materials
-    def plane_stress(self, mid, card, eid):
-        """(Q (3,3) [Pa], transverse shear G (2,2) [Pa], density) of a MAT1/MAT2/MAT8."""
-        from sarfe.fe.laminate import isotropic_plane_stress, orthotropic_plane_stress
-
-        mat = self.model.materials.get(int(mid))
-        if mat is None:
-            self.fail(card, eid, f"material {mid} is missing or not structural")
-        rho = float(mat.rho or 0.0)
-        if mat.type == "MAT1":
-            q = isotropic_plane_stress(mat.e, mat.nu, mat.g)
-            return q, float(mat.g) * np.eye(2), rho
-        if mat.type == "MAT8":
-            q = orthotropic_plane_stress(mat.e11, mat.e22, mat.nu12, mat.g12)
-            g1z = mat.g1z if mat.g1z else mat.g12
-            g2z = mat.g2z if mat.g2z else mat.g12
-            return q, np.diag([float(g1z), float(g2z)]), rho
-        if mat.type == "MAT2":
-            q = np.array([[mat.G11, mat.G12, mat.G13], [mat.G12, mat.G22, mat.G23],
-                          [mat.G13, mat.G23, mat.G33]], float)
-            return q, np.zeros((2, 2)), rho
-        self.fail(card, eid, f"material {mat.type} {mid} is not supported for this property")
-
-    def isotropic(self, mid, card, eid):
-        mat = self.model.materials.get(int(mid))
-        if mat is None or mat.type != "MAT1":
-            self.fail(card, eid, f"material {mid} must be a MAT1")
-        return float(mat.e), float(mat.nu), float(mat.g), float(mat.rho or 0.0)
-
-    # ------------------------------------------------------------------ shell sections
-    def shell_section(self, prop):
-        """Per property: A, B, D, Gt (2,2), mass/area, rotary inertia/area, thickness."""
-        pid = prop.pid
-        if prop.type == "PSHELL":
-            t = float(prop.t or 0.0)
-            if not prop.mid1 or t <= 0.0:
-                self.fail("PSHELL", pid, "needs MID1 and a thickness T > 0 (membrane-less "
-                          "shells are not modelled)")
-            if prop.mid4:
-                self.fail("PSHELL", pid, "MID4 (membrane-bending coupling) is not modelled")
-            q1, _, rho = self.plane_stress(prop.mid1, "PSHELL", pid)
-            a = q1 * t
-            d = np.zeros((3, 3))
-            if prop.mid2 and prop.mid2 > 0:
-                q2, _, _ = self.plane_stress(prop.mid2, "PSHELL", pid)
-                d = q2 * float(prop.twelveIt3) * t**3 / 12.0
-            elif prop.mid2 not in (None, 0):
-                self.fail("PSHELL", pid, f"MID2 = {prop.mid2} (plane strain) is not modelled")
-            shear = np.zeros((2, 2))
-            if prop.mid3:
-                _, g3, _ = self.plane_stress(prop.mid3, "PSHELL", pid)
-                shear = g3 * float(prop.tst) * t
-            if rho == 0.0:
-                self.notes.append(f"PSHELL {pid}: material {prop.mid1} has no density (ρ = 0)")
-            mass = rho * t + float(prop.nsm or 0.0)
-            return a, np.zeros((3, 3)), d, shear, mass, rho * t**3 / 12.0, t, 0.0
-        if prop.type == "PCOMP":
-            return self.laminate_section(prop)
-        self.fail("shell property", pid, f"{prop.type} is not supported")
-
-    def laminate_section(self, prop):
-        from sarfe.fe.laminate import laminate_stiffness, rotate_transverse_shear
-
-        pid = prop.pid
-        mids, thick, angles = list(prop.mids), list(prop.thicknesses), list(prop.thetas)
-        if str(prop.lam).upper() == "SYM":
-            mids, thick, angles = mids + mids[::-1], thick + thick[::-1], angles + angles[::-1]
-        elif prop.lam not in (None, "", "BLANK"):
-            self.fail("PCOMP", pid, f"LAM = {prop.lam} is not modelled")
-        thick = np.array(thick, float)
-        total = float(thick.sum())
-        z0 = -total / 2.0 if prop.z0 is None else float(prop.z0)
-        top = -total / 2.0 + np.cumsum(thick)  # about the laminate's mid-plane; Z0 → offset
-        bottom = top - thick
-        mats = [self.plane_stress(mid, "PCOMP", pid) for mid in mids]
-        q = np.array([m[0] for m in mats])
-        angle = np.radians(np.array(angles, float))
-        a, b, d = laminate_stiffness(q, angle, bottom, top)
-        g = rotate_transverse_shear(np.array([m[1] for m in mats]), angle)
-        shear = np.einsum("k,kij->ij", thick, g)
-        rho = np.array([m[2] for m in mats])
-        mass = float(rho @ thick) + float(prop.nsm or 0.0)
-        rotary = float(rho @ ((top**3 - bottom**3) / 3.0))
-        return a, b, d, shear, mass, rotary, total, z0 + total / 2.0
-
-    def shells(self) -> ShellElements:
-        model = self.model
-        eids = [e for e, el in sorted(model.elements.items()) if el.type in ("CTRIA3", "CQUAD4")]
-        if not eids:
-            return ShellElements()
-        sections = {}
-        tri_nodes, tri_elem, axes, pids, zoffs = [], [], [], [], []
-        for row, eid in enumerate(eids):
-            el = model.elements[eid]
-            nodes = [self.node(n, el.type, eid) for n in el.node_ids]
-            zoffs.append(float(el.zoffset or 0.0))
-            prop = el.pid_ref
-            if prop.pid not in sections:
-                sections[prop.pid] = self.shell_section(prop)
-            t_prop = sections[prop.pid][6]
-            corner_t = [getattr(el, f"T{i}", None) for i in range(1, len(nodes) + 1)]
-            if getattr(el, "tflag", 0) or any(
-                    tc not in (None, -1.0) and abs(float(tc) - t_prop) > 1e-9 * t_prop
-                    for tc in corner_t):
-                self.fail(el.type, eid, "corner thicknesses T1–T4 different from the "
-                          "property's T are not modelled")
-            x = self.points[nodes]
-            if el.type == "CQUAD4":
-                d13, d24 = x[2] - x[0], x[3] - x[1]
-                normal = np.cross(d13, d24)
-                axis = d13 / np.linalg.norm(d13) - d24 / np.linalg.norm(d24)
-                tri_nodes += [[nodes[0], nodes[1], nodes[2]], [nodes[0], nodes[2], nodes[3]]]
-                tri_elem += [row, row]
-            else:
-                normal = np.cross(x[1] - x[0], x[2] - x[0])
-                axis = x[1] - x[0]
-                tri_nodes.append(nodes)
-                tri_elem.append(row)
-            with np.errstate(invalid="ignore", divide="ignore"):  # zero area: refused at assembly
-                normal = normal / np.linalg.norm(normal)
-                axis = axis / np.linalg.norm(axis)
-            theta_mcid = el.theta_mcid
-            if isinstance(theta_mcid, int):  # MCID: x of that system projected on the plane
-                xm = self.coord_axes(theta_mcid, x.mean(axis=0))[0]
-                axis = xm - normal * (xm @ normal)
-                if np.linalg.norm(axis) < 1e-8:
-                    self.fail(el.type, eid, f"MCID {theta_mcid} axis is normal to the element")
-                axis /= np.linalg.norm(axis)
-            elif theta_mcid:
-                angle = np.radians(float(theta_mcid))
-                axis = np.cos(angle) * axis + np.sin(angle) * np.cross(normal, axis)
-            axes.append(axis)
-            pids.append(prop.pid)
-        tri_elem = np.array(tri_elem, dtype=np.int64)
-        pids = np.array(pids, dtype=np.int64)
-        tri_pid = pids[tri_elem]
-        keys = sorted(sections)
-        table = [np.array([sections[k][i] for k in keys], float) for i in range(8)]
-        which = np.searchsorted(keys, tri_pid)
-        a, b_mid, d_mid = table[0][which], table[1][which], table[2][which]
-        # mid-surface offset from the node plane: ZOFFS + the laminate's own (PCOMP Z0 + T/2);
-        # section about the node plane: B = B_mid + o A, D = D_mid + 2 o B_mid + o² A
-        offset = (np.array(zoffs) + 0.0)[tri_elem] + table[7][which]
-        o = offset[:, None, None]
-        return ShellElements(
-            element_ids=np.array(eids, dtype=np.int64), property_ids=pids,
-            triangles=np.array(tri_nodes, dtype=np.int64), triangle_element=tri_elem,
-            membrane=a, coupling=b_mid + o * a, bending=d_mid + 2 * o * b_mid + o**2 * a,
-            transverse_shear=table[3][which], material_axis=np.array(axes)[tri_elem],
-            mass_per_area=table[4][which] * self.wtmass,
-            rotary_inertia_per_area=table[5][which] * self.wtmass,
-            thickness=table[6][which], offset=offset)
 
     # ------------------------------------------------------------------ solids
     def solids(self) -> dict:
@@ -356,7 +217,7 @@ class _Converter:
             prop = el.pid_ref
             if prop.type != "PSOLID":
                 self.fail(el.type, eid, f"property {prop.type} {prop.pid} is not supported")
-            e, nu, _, rho = self.isotropic(prop.mid, "PSOLID", prop.pid)
+            e, nu, _, rho = isotropic(self, prop.mid, "PSOLID", prop.pid)
             block = blocks[kind]
             block["element_ids"].append(eid)
             block["property_ids"].append(prop.pid)
@@ -409,7 +270,7 @@ class _Converter:
                 area, j, nsm = prop.A, prop.j, prop.nsm
                 i1 = i2 = i12 = k1 = k2 = 0.0
                 mid, v = prop.mid, np.zeros(3)
-            e, _, g, rho = self.isotropic(mid, el.type, eid)
+            e, _, g, rho = isotropic(self, mid, el.type, eid)
             for key, value in (("card", el.type), ("element_ids", eid),
                                ("property_ids", getattr(prop, "pid", 0)), ("nodes", [a, b]),
                                ("orientation", v), ("area", area), ("i1", i1), ("i2", i2),
@@ -534,7 +395,7 @@ class _Converter:
             if el.type == "RBE2":
                 gn = self.node(el.gn, "RBE2", eid)
                 dep = [self.node(n, "RBE2", eid) for n in el.Gmi_node_ids]
-                mask = _mask(el.cm)
+                mask = component_mask(el.cm)
                 self.frame_free_mask(mask, dep + [gn], "RBE2", eid)
                 rbe2["element_ids"].append(eid)
                 rbe2["independent"].append(gn)
@@ -545,7 +406,7 @@ class _Converter:
                 if el.Gmi:
                     self.fail("RBE3", eid, "UM (user-chosen dependent DOFs) is not modelled")
                 ref = self.node(el.ref_grid_id, "RBE3", eid)
-                refc = _mask(el.refc)
+                refc = component_mask(el.refc)
                 self.frame_free_mask(refc, [ref], "RBE3", eid)
                 row = len(rbe3["element_ids"])
                 rbe3["element_ids"].append(eid)
@@ -553,7 +414,7 @@ class _Converter:
                 rbe3["reference_components"].append(refc)
                 for weight, comp, group in zip(el.weights, el.comps, el.Gijs_node_ids):
                     nodes = [self.node(n, "RBE3", eid) for n in group]
-                    mask = _mask(comp)
+                    mask = component_mask(comp)
                     self.frame_free_mask(mask, nodes, "RBE3", eid)
                     rbe3["independent"] += nodes
                     rbe3["independent_element"] += [row] * len(nodes)
@@ -567,97 +428,6 @@ class _Converter:
             for k, v in rbe3.items()}) if rbe3 else InterpolationElements()
         return two, three
 
-    # ------------------------------------------------------------------ supports, loads, sets
-    def supports(self) -> dict:
-        model = self.model
-        sets = defaultdict(list)
-        for sid, cards in model.spcs.items():
-            for card in cards:
-                if card.type == "SPC1":
-                    mask = _mask(card.components)
-                    for n in card.node_ids:
-                        sets[sid].append((self.node(n, "SPC1", sid), mask))
-                elif card.type == "SPC":
-                    for n, comp, value in zip(card.node_ids, card.components, card.enforced):
-                        if value not in (None, 0.0):
-                            self.notes.append(f"SPC {sid} node {n}: enforced value {value:g} "
-                                              "read as a held DOF (value not applied)")
-                        sets[sid].append((self.node(n, "SPC", sid), _mask(comp)))
-                else:
-                    self.fail(card.type, sid, "is not supported")
-
-        def expand(sid, seen=()):
-            if sid in seen:
-                self.fail("SPCADD", sid, "refers to itself")
-            out = list(sets.get(sid, []))
-            for card in model.spcadds.get(sid, []):
-                for child in card.sets:
-                    if child not in sets and child not in model.spcadds:
-                        self.fail("SPCADD", sid, f"set {child} does not exist")
-                    out += expand(child, seen + (sid,))
-            return out
-
-        result = {}
-        for sid in sorted(set(sets) | set(model.spcadds)):
-            result[str(sid)] = _support(expand(sid))
-        permanent = [(i, _mask(model.nodes[int(n)].ps)) for i, n in enumerate(self.node_ids)
-                     if model.nodes[int(n)].ps]
-        if permanent:
-            result["permanent"] = _support(permanent)
-        return result
-
-    def loads(self) -> dict:
-        model = self.model
-        n = len(self.node_ids)
-        base = {}
-        for sid, cards in model.loads.items():
-            vector = np.zeros((n, 6))
-            for card in cards:
-                if card.type in ("FORCE", "MOMENT"):
-                    i = self.node(card.node, card.type, sid)
-                    local = float(card.mag) * np.asarray(card.xyz, float)
-                    axes = self.coord_axes(card.cid, self.points[i]) if card.cid else np.eye(3)
-                    part = slice(0, 3) if card.type == "FORCE" else slice(3, 6)
-                    vector[i, part] += axes.T @ local
-                # other load cards (PLOAD4, GRAV, ...) are listed in ``unsupported``
-            base[sid] = vector
-        for sid, cards in model.dareas.items():
-            vector = base.setdefault(sid, np.zeros((n, 6)))
-            for card in cards if isinstance(cards, list) else [cards]:
-                for node, comp, scale in zip(card.node_ids, card.components, card.scales):
-                    i = self.node(node, "DAREA", sid)
-                    local = np.zeros(6)
-                    local[_mask(comp)] = float(scale)
-                    vector[i, :3] += self.frames[i].T @ local[:3]
-                    vector[i, 3:] += self.frames[i].T @ local[3:]
-        result = {str(sid): v for sid, v in base.items()}
-        for sid, cards in model.load_combinations.items():
-            total = np.zeros((n, 6))
-            for card in cards:
-                for scale, lid in zip(card.scale_factors, card.load_ids):
-                    if lid not in base:
-                        self.fail("LOAD", sid, f"load set {lid} does not exist")
-                    total += float(card.scale) * float(scale) * base[lid]
-            result[str(sid)] = total
-        return result
-
-    def sets(self):
-        node_sets, element_sets = {}, {}
-        for sid, card in self.model.sets.items():
-            ids = [int(i) for i in card.ids]
-            if all(i in self.index for i in ids):
-                node_sets[f"set_{sid}"] = np.array([self.index[i] for i in ids], np.int64)
-            if all(i in self.model.elements for i in ids):
-                element_sets[f"set_{sid}"] = np.array(ids, np.int64)
-        by_pid = defaultdict(list)
-        for eid, el in self.model.elements.items():
-            pid = getattr(el, "pid", None)
-            if isinstance(pid, int):
-                by_pid[pid].append(eid)
-        for pid, eids in sorted(by_pid.items()):
-            element_sets[f"pid_{pid}"] = np.array(sorted(eids), np.int64)
-        return node_sets, element_sets
-
     def census(self) -> dict:
         counts = dict(self.model.card_count)
         for card, why in REFUSED_CARDS.items():
@@ -666,20 +436,17 @@ class _Converter:
                 self.fail(card, element, why)
         unsupported = {card: int(count) for card, count in sorted(counts.items())
                        if card not in MODELLED_CARDS and card not in CONTROL_CARDS}
-        mass_cards = {el.type for el in self.model.masses.values()} - {"CONM2"}
-        for card in mass_cards:
-            unsupported.setdefault(card, 0)
         return unsupported
 
     def deck(self) -> DeckModel:
         unsupported = self.census()
         rbe2, rbe3 = self.rigid()
-        node_sets, element_sets = self.sets()
+        node_sets, element_sets = sets(self)
         return DeckModel(
             source=os.fspath(self.path), node_ids=self.node_ids, points=self.points,
-            displacement_frames=self.frames, shells=self.shells(), solids=self.solids(),
+            displacement_frames=self.frames, shells=shells(self), solids=self.solids(),
             beams=self.beams(), springs=self.springs(), point_masses=self.point_masses(),
-            rbe2=rbe2, rbe3=rbe3, supports=self.supports(), loads=self.loads(),
+            rbe2=rbe2, rbe3=rbe3, supports=supports(self), loads=loads(self),
             node_sets=node_sets, element_sets=element_sets, unsupported=unsupported,
             ignored={}, notes=tuple(self.notes))
 
@@ -688,12 +455,3 @@ def _shear_factor(value) -> float:
     """Nastran K1/K2 → shear area factor; blank or ≥ 1e8 (pyNastran's blank) = rigid in shear (0)."""
     value = float(value or 0.0)
     return 0.0 if value >= 1e8 else value
-
-
-def _support(entries) -> SupportSet:
-    """Merge (node, mask) pairs into one `SupportSet` (union of components per node)."""
-    merged = {}
-    for node, mask in entries:
-        merged[node] = merged.get(node, np.zeros(6, bool)) | mask
-    nodes = np.array(sorted(merged), dtype=np.int64)
-    return SupportSet(nodes, np.array([merged[n] for n in nodes], dtype=bool).reshape(-1, 6))

@@ -2,7 +2,7 @@ r"""The linear stage of a case: model → (reduced) M, K on the kept DOFs, conta
 DOFs, unit excitation vectors and the ERP recovery map. Everything here is independent of the
 contact law parameters, damping, force amplitudes and frequencies, so a batch over those reuses it.
 
-FE path (a deck file: :mod:`sarfe.pipeline.deck`): mesh → shell K, M (per-triangle thickness/material) → remove fixed (clip/clamp) DOFs →
+FE path (a deck file: :mod:`sarfe.pipeline.deck`, :mod:`sarfe.pipeline.deck_stage`): mesh → shell K, M (per-triangle thickness/material) → remove fixed (clip/clamp) DOFs →
 Craig–Bampton with boundary = translations of contact and excitation nodes:
 
     u = T q,  q = [q_b, q_m],  M_r = Tᵀ M T,  K_r = Tᵀ K T,  f_r = Tᵀ f,
@@ -80,6 +80,7 @@ class LinearStage:
     info: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
     node_ids: np.ndarray | None = None     # deck GRID / node id of each mesh point (deck path)
+    added_damping: np.ndarray | None = None  # (n_r, n_r) [N s/m] a deck's dampers (CBUSH B), reduced
 
     @property
     def dof_count(self) -> int:
@@ -587,13 +588,37 @@ def check_mesh(case) -> dict:
     _per_triangle(case, mesh, fe["thickness_m"], "thickness_m")
     from sarfe.erp import nodal_normals
     normals = nodal_normals(mesh.points, mesh.triangles)
-    pairs = {c["name"]: len(pair_contact(case, mesh, i, normals)[0])
-             for i, c in enumerate(case.data["contacts"])}
+    paired = [pair_contact(case, mesh, i, normals) for i in range(len(case.data["contacts"]))]
+    pairs = {c["name"]: len(p[0]) for c, p in zip(case.data["contacts"], paired)}
+    coincident = _mesh_quality(case, mesh, [(a, b) for a, b, _, _ in paired])
     for i, f in enumerate(case.data["excitation"].get("forces", [])):
         resolve_node_group(case, mesh, f["group"], ("excitation", "forces", i, "group"))
     if "surface" in case.data["erp"] and case.data["erp"]["surface"] not in mesh.element_groups:
         resolve_node_group(case, mesh, case.data["erp"]["surface"], ("erp", "surface"))
-    return {"nodes": mesh.n_nodes, "triangles": mesh.n_triangles, "contact_pairs": pairs}
+    return {"nodes": mesh.n_nodes, "triangles": mesh.n_triangles, "contact_pairs": pairs,
+            "coincident_node_pairs": len(coincident), "coincident_nodes": coincident[:50]}
+
+
+def _mesh_quality(case, mesh, contact_pairs):
+    """Duplicate and zero-area triangles are errors (0-based triangle indices); coincident nodes
+    that no contact pairs are returned (0-based node indices) for validate to list."""
+    from sarfe.mesh import quality
+
+    where = ("model", "fe", "mesh" if "mesh" in case.data["model"]["fe"] else "generator")
+    index = np.arange(mesh.n_triangles)
+    duplicates = quality.duplicate_elements(mesh.triangles, index)
+    if duplicates:
+        text = ", ".join(f"{b} (= {a})" for a, b in duplicates[:10])
+        raise case.error(f"{len(duplicates)} duplicate triangle(s) on the same nodes (0-based "
+                         f"indices): {text}", where)
+    degenerate = quality.degenerate_elements(mesh.points, mesh.triangles, index)
+    if degenerate:
+        raise case.error(f"{len(degenerate)} zero-area triangle(s) (0-based indices): "
+                         f"{', '.join(map(str, degenerate[:10]))}", where)
+    joined = [(int(a), int(b)) for pa, pb in contact_pairs for a, b in zip(pa, pb) if b >= 0]
+    extent = float(np.linalg.norm(np.ptp(mesh.points, axis=0)))
+    return [list(p) for p in quality.coincident_nodes(mesh.points, np.arange(mesh.n_nodes),
+                                                      1e-9 * extent, joined)]
 
 
 def build_linear_model(case, progress=False) -> LinearStage:
@@ -601,7 +626,7 @@ def build_linear_model(case, progress=False) -> LinearStage:
     case = load_case(case)
     clock = time.perf_counter()
     if case.is_fe and "deck" in case.data["model"]["fe"]:
-        from sarfe.pipeline.deck import build_deck_stage
+        from sarfe.pipeline.deck_stage import build_deck_stage
         parts = build_deck_stage(case, progress)
     else:
         parts = _build_fe(case, progress) if case.is_fe else _build_matrices(case, progress)

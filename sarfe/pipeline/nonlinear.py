@@ -31,7 +31,14 @@ class NonlinearModel:
 
 
 def damping_matrix(case: Case, stage: LinearStage):
-    """D on the kept DOFs: the matrices' own D, modal ζ (reduced eigenmodes) or α M + β K."""
+    """D on the kept DOFs: the matrices' own D, modal ζ (reduced eigenmodes) or α M + β K,
+    plus a deck's discrete dampers (CBUSH B, reduced: ``stage.info['spring_damping']``)."""
+    added = getattr(stage, "added_damping", None)
+    matrix = _case_damping(case, stage)
+    return matrix if added is None else matrix + added
+
+
+def _case_damping(case: Case, stage: LinearStage):
     damping = case.data["damping"]
     M, K = stage.mass, stage.stiffness
     if stage.damping is not None:

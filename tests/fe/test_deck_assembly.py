@@ -225,7 +225,7 @@ def test_plate_py_free_free_thin_shell_on_a_thick_plate():
 
 
 def test_isotropic_section_shell_equals_the_shell_element():
-    from sarfe.fe.laminate import isotropic_plane_stress
+    from sarfe.mesh.laminate import isotropic_plane_stress
     from sarfe.fe.shell import shell_element_matrices
     from sarfe.fe.shell_section import section_shell_element_matrices
 
@@ -345,7 +345,7 @@ def _hex20_plate(lx, ly, thickness, counts, young, poisson, density):
 
 
 def _shell_plate(lx, ly, thickness, counts, young, poisson, density):
-    from sarfe.fe.laminate import isotropic_plane_stress
+    from sarfe.mesh.laminate import isotropic_plane_stress
     from sarfe.mesh.deck import DeckModel, ShellElements
 
     nx, ny = counts
@@ -460,3 +460,94 @@ def test_two_offset_shells_equal_one_of_double_thickness(tmp_path):
     single = read_nastran(_write(tmp_path / "one", grids + material + "PSHELL,1,1,0.002,1\n"
                                  "CQUAD4,1,1,1,2,3,4,,0.001"))
     assert np.allclose(single.shells.coupling, 0.001 * single.shells.membrane)
+
+
+def test_rbe3_reference_follows_the_weighted_mean_motion(tmp_path):
+    """Four independent nodes at the corners of a square around the reference (translations,
+    weights 1, 1, 3, 3): reference translation = Σ w u / Σ w for a uniform-plus-antisymmetric
+    field, reference rotation = the least-squares rotation of a pure rigid rotation."""
+    deck = read_nastran(_write(tmp_path, """
+GRID,1,,-1.,-1.,0.
+GRID,2,,1.,-1.,0.
+GRID,3,,1.,1.,0.
+GRID,4,,-1.,1.,0.
+GRID,5,,0.,0.,0.
+RBE3,7,,5,123456,1.,123,1,2
+,3.,123,3,4
+"""))
+    system = assemble_deck(deck, mass="consistent")
+    # (no elements: every DOF is held for lack of stiffness, so probe C directly)
+    from sarfe.fe.constraints import constraint_matrix
+
+    c_matrix, independent = constraint_matrix(deck.points, deck.rbe2, deck.rbe3, deck.n_nodes)
+    assert len(system.dof_nodes) == 0
+    u_ind = np.zeros((5, 6))
+    u_ind[:4, 2] = [1.0, 2.0, 3.0, 4.0]  # uz of the corners
+    full = c_matrix @ u_ind.ravel()[independent]
+    weights = np.array([1.0, 1.0, 3.0, 3.0])
+    # weighted least squares of uz = w_r + θx y − θy x over the corners
+    x, y = deck.points[:4, 0], deck.points[:4, 1]
+    design = np.column_stack([np.ones(4), y, -x])
+    fit = np.linalg.solve(design.T @ (weights[:, None] * design), design.T @ (weights * u_ind[:4, 2]))
+    assert np.allclose(full.reshape(5, 6)[4, [2, 3, 4]], fit)
+    rigid = np.zeros((5, 6))
+    rotation = np.array([0.01, -0.02, 0.03])
+    rigid[:4, :3] = np.cross(rotation, deck.points[:4])
+    full = (c_matrix @ rigid.ravel()[independent]).reshape(5, 6)
+    assert np.allclose(full[4, 3:], rotation) and np.allclose(full[4, :3], 0, atol=1e-15)
+
+
+def test_material_axis_rotation_equals_swapped_orthotropic_material(tmp_path):
+    """MAT8 (E1, E2) with THETA = 90° gives the same K as MAT8 (E2, E1) with THETA = 0."""
+    def deck(folder, theta, e1, e2, nu12):
+        (tmp_path / folder).mkdir()
+        return read_nastran(_write(tmp_path / folder, f"""
+GRID,1,,0.,0.,0.
+GRID,2,,0.4,0.,0.
+GRID,3,,0.4,0.3,0.
+GRID,4,,0.,0.3,0.
+CQUAD4,1,1,1,2,3,4,{theta}
+MAT8,1,{e1},{e2},{nu12},4.e9,,,1500.
+PCOMP,1
+,1,0.002,0.
+"""))
+    a = deck("a", "90.", "1.2e11", "9.e9", "0.3")
+    b = deck("b", "0.", "9.e9", "1.2e11", f"{0.3 * 9e9 / 1.2e11:.12f}")
+    k_a, _ = global_matrices(a)
+    k_b, _ = global_matrices(b)
+    assert np.abs((k_a - k_b).toarray()).max() < 1e-9 * np.abs(k_a.toarray()).max()
+
+
+@pytest.mark.filterwarnings("ignore:CONM2.*inertia method:UserWarning")  # pyNastran's own inertia
+def test_point_masses_and_offsets_equal_pynastran_mass_properties(tmp_path):
+    from pyNastran.bdf.mesh_utils.mass_properties import mass_properties as pyn_mass
+
+    from sarfe.fe.deck_assembly import mass_properties
+    from sarfe.mesh.nastran import _load_bdf
+
+    path = _write(tmp_path, _free_plate_with_rigid_elements() + """
+CORD2R,4,,0.1,0.,0.,0.1,0.,1.
+,1.,1.,0.
+CONM2,904,3,4,0.03,0.01,0.02,0.03
+CONM2,905,7,-1,0.04,0.5,0.5,0.5
+""")
+    mass, cg = mass_properties(read_nastran(path))
+    ref_mass, ref_cg, _ = pyn_mass(_load_bdf(path))
+    assert mass == pytest.approx(float(ref_mass), rel=1e-9)
+    assert np.allclose(cg, ref_cg, atol=1e-9)
+
+
+def test_chained_rigid_elements_resolve_and_circular_ones_are_refused(tmp_path):
+    from sarfe.fe.constraints import constraint_matrix
+
+    base = "GRID,1,,0.,0.,0.\nGRID,2,,1.,0.,0.\nGRID,3,,1.,2.,0.\n"
+    deck = read_nastran(_write(tmp_path, base + "RBE2,10,1,123456,2\nRBE2,11,2,123456,3\n"))
+    c_matrix, independent = constraint_matrix(deck.points, deck.rbe2, deck.rbe3, 3)
+    assert independent.tolist() == list(range(6))  # node 1 carries everything
+    rotation = np.array([0.0, 0.0, 0.01])
+    u = (c_matrix @ np.r_[np.zeros(3), rotation]).reshape(3, 6)
+    assert np.allclose(u[2, :3], np.cross(rotation, deck.points[2]))
+    (tmp_path / "loop").mkdir()
+    loop = read_nastran(_write(tmp_path / "loop", base + "RBE2,10,1,123456,2\nRBE2,11,2,123456,1\n"))
+    with pytest.raises(DeckError, match="rigid"):
+        assemble_deck(loop)

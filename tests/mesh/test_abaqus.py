@@ -237,6 +237,8 @@ def test_unsupported_keywords_and_types_are_counted_not_dropped(tmp_path):
      "*SHELL SECTION, ELSET=s, MATERIAL=m\n1.\n", r"node 99 is not defined"),
     ("*NODE\n1, 5, 5, 5\n", r"bad.inp:6: \*NODE: node 1 defined twice"),
     ("*INCLUDE, INPUT=nowhere.inc\n", r"bad.inp:5: \*INCLUDE file not found"),
+    (SECTION + "*BOUNDARY, OP=NEW\n1, 1, 3\n", r"bad.inp:12: \*BOUNDARY: OP=NEW"),
+    ("*MATERIAL, NAME=m\n*DENSITY\n1., 20.\n2., 80.\n", r"bad.inp:6: \*DENSITY: a temperature table"),
 ])
 def test_errors_name_file_line_and_keyword(tmp_path, text, expected):
     with pytest.raises(DeckError, match=expected) as info:
@@ -256,3 +258,37 @@ def test_abaqus_cae_export_layout():
     assert deck.shells.element_ids.tolist() == [1, 2, 11, 12]
     assert deck.node_ids[deck.supports["boundary"].nodes].tolist() == [1, 4]
     assert deck.shells.mass_per_area[0] == pytest.approx(7.8e-9 * 2.0)
+
+
+def test_s8r_strip_first_bending_mode_is_the_beam_s(tmp_path):
+    """A cantilever strip of ten S8R elements (split into six triangles each on all eight
+    nodes): first bending frequency vs Euler–Bernoulli 1.8751²/(2π) √(EI/(ρA L⁴)), ν = 0."""
+    import scipy.sparse.linalg as sla
+
+    from sarfe.fe.deck_assembly import assemble_deck
+
+    length, width, t, nx = 100.0, 10.0, 1.0, 10
+    nid = lambda i, j: 1 + i + (2 * nx + 1) * j                          # noqa: E731
+    lines = ["*NODE"]
+    for j, y in enumerate((0.0, width / 2, width)):
+        for i, x in enumerate(np.linspace(0, length, 2 * nx + 1)):
+            if not (j == 1 and i % 2):
+                lines.append(f"{nid(i, j)}, {x}, {y}, 0.")
+    lines.append("*ELEMENT, TYPE=S8R, ELSET=s")
+    for e in range(nx):
+        i = 2 * e
+        lines.append(f"{e + 1}, {nid(i, 0)}, {nid(i + 2, 0)}, {nid(i + 2, 2)}, {nid(i, 2)}, "
+                     f"{nid(i + 1, 0)}, {nid(i + 2, 1)}, {nid(i + 1, 2)}, {nid(i, 1)}")
+    lines += ["*NSET, NSET=clamp", f"{nid(0, 0)}, {nid(0, 1)}, {nid(0, 2)}", "*MATERIAL, NAME=m",
+              "*ELASTIC", f"{E}, 0.0", "*DENSITY", f"{RHO}", "*SHELL SECTION, ELSET=s, MATERIAL=m",
+              f"{t}", "*BOUNDARY", "clamp, ENCASTRE"]
+    (tmp_path / "strip.inp").write_text("\n".join(lines) + "\n")
+    deck = to_si(read_abaqus(tmp_path / "strip.inp"), "mm-t-s")
+    system = assemble_deck(deck)
+    support = deck.supports["boundary"]
+    held = system.dof_index(np.repeat(support.nodes, 6), np.tile(np.arange(6), len(support.nodes)))
+    free = np.setdiff1d(np.arange(system.n_dofs), held)
+    omega2 = sla.eigsh(system.stiffness[free][:, free], 1, system.mass[free][:, free], sigma=0)[0]
+    inertia, area = width * t**3 / 12 * 1e-12, width * t * 1e-6
+    beam = 1.875104**2 / (2 * np.pi) * np.sqrt(E * 1e6 * inertia / (RHO * 1e12 * area * 0.1**4))
+    assert np.sqrt(omega2[0]) / (2 * np.pi) == pytest.approx(beam, rel=2e-3)

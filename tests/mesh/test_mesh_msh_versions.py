@@ -75,3 +75,17 @@ def test_mesh_path_refuses_what_it_would_drop(tmp_path, name, text, expected):
     with pytest.raises(MeshError, match=expected) as info:
         load_mesh(path)
     assert "model.fe.deck" in str(info.value) and "\n" not in str(info.value)
+
+
+def test_quality_checks_name_ids():
+    from sarfe.mesh import quality
+
+    points = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [2, 0, 0], [1, 1, 0]], float)
+    shells = np.array([[0, 1, 2, -1], [0, 1, 2, 3], [2, 1, 0, -1], [0, 1, 4, -1], [1, 2, 5, -1]])
+    ids = np.array([10, 11, 12, 13, 14])
+    assert quality.duplicate_elements(shells, ids) == [(10, 12)]       # reversed copy
+    assert quality.degenerate_elements(points, shells, ids) == [13, 14]  # collinear, repeated point
+    assert np.allclose(quality.shell_areas(points, shells[:2]), [0.5, 1.0])
+    node_ids = np.arange(1, 7)
+    assert quality.coincident_nodes(points, node_ids, 1e-9) == [(3, 6)]
+    assert quality.coincident_nodes(points, node_ids, 1e-9, joined=[(2, 5)]) == []

@@ -68,6 +68,15 @@ def test_include_followed_and_every_card_accounted_for():
     assert sorted(deck.beams.card) == ["CBAR", "CBEAM", "CROD", "CROD"]
     assert len(deck.shells.element_ids) == 12 and deck.shells.n_triangles == 16
     assert deck.unsupported == {}
+    # SPCADD 2 = SPC1 set 123456: GRIDs 22–25 clamped, 5–13 rotations held
+    support = deck.supports["2"]
+    held = dict(zip(deck.node_ids[support.nodes].tolist(), support.components.tolist()))
+    assert all(held[n] == [True] * 6 for n in (22, 23, 24, 25))
+    assert all(held[n] == [False] * 3 + [True] * 3 for n in range(5, 14))
+    # LOAD 123458 = 1.0 · 1.0 · FORCE 10000 (10 000 along z on GRID 13)
+    load = deck.loads["123458"]
+    assert load[deck.node_index([13])[0], 2] == pytest.approx(10000.0)
+    assert np.count_nonzero(load) == 1
     plate = read_nastran(DECKS / "plate.bdf")
     assert plate.unsupported == {"PLOAD4": 2}  # pressure loads are not modelled: listed
     assert any("no density" in note for note in plate.notes)
@@ -96,14 +105,13 @@ GRID,1,,0.,0.,0.
 GRID,2,,1.,0.,0.
 GRID,3,,1.,1.,0.
 GRID,4,,0.,1.,0.
-PSHELL,1,1,0.01
+PSHELL,1,1,0.01,1
 MAT1,1,7.e10,,0.3,2700.
 """
 
 
 @pytest.mark.parametrize("card, needle", [
-    ("GRID,5,,0.5,0.,0.\nGRID,6,,1.,0.5,0.\nGRID,7,,0.5,1.,0.\nGRID,8,,0.,0.5,0.\n"
-     "CQUAD8,1,1,1,2,3,4,5,6,+\n+,7,8", "CQUAD8"),
+    ("CQUADR,1,1,1,2,3,4", "CQUADR"),
     ("CQUAD4,1,1,1,2,3,4\nCELAS2,9,1000.,1,1,2,2", "components"),
     ("CQUAD4,1,1,1,2,3,4\nCBUSH,9,7,1,,,,,\nPBUSH,7,K,1.,1.,1.,1.,1.,1.", "CID"),
 ])
@@ -113,6 +121,34 @@ def test_lossy_features_are_refused_with_one_line(tmp_path, card, needle):
         read_nastran(path)
     message = str(info.value)
     assert needle in message and str(path) in message and "\n" not in message
+
+
+@pytest.mark.filterwarnings("ignore::UserWarning")
+def test_quadratic_shells_become_facets_through_their_midside_nodes(tmp_path):
+    from pyNastran.bdf.mesh_utils.mass_properties import mass_properties as pyn_mass
+
+    from sarfe.fe.deck_assembly import assemble_deck, mass_properties
+
+    path = _write(tmp_path, _PLATE + """
+GRID,5,,0.5,0.,0.
+GRID,6,,1.,0.5,0.
+GRID,7,,0.5,1.,0.
+GRID,8,,0.,0.5,0.
+GRID,9,,2.,0.,0.
+GRID,10,,1.5,0.,0.
+GRID,11,,1.5,0.5,0.
+CQUAD8,1,1,1,2,3,4,5,6,+
++,7,8
+CTRIA6,2,1,2,9,3,10,11,6
+""")
+    deck = read_nastran(path)
+    assert deck.shells.n_triangles == 6 + 4
+    assert set(np.unique(deck.shells.triangles)) == set(range(11))  # midside nodes kept
+    mass, cg = mass_properties(deck)
+    ref_mass, ref_cg, _ = pyn_mass(_pynastran_model(path))
+    assert mass == pytest.approx(float(ref_mass), rel=1e-9)
+    assert np.allclose(cg, ref_cg, atol=1e-9)
+    assert len(assemble_deck(deck).auto_held_nodes) == 0
 
 
 def test_theta_field_and_unsupported_cards_counted(tmp_path):
@@ -174,3 +210,40 @@ PCOMP,1,,,,,,,SYM
 def test_reference_frequencies_file_is_there():
     reference = json.loads((DECKS / "REFERENCE.json").read_text())
     assert len(reference["mode_solid_shell_bar.bdf"]["frequencies_hz"]) == 3
+
+
+def test_darea_in_cd_frame_and_load_combination(tmp_path):
+    deck = read_nastran(_write(tmp_path, """
+CORD2R,2,,0.,0.,0.,0.,0.,1.
+,0.,1.,0.
+GRID,1,,0.,0.,0.,2
+DAREA,5,1,1,3.
+MOMENT,6,1,,2.,0.,0.,1.
+FORCE,8,1,2,4.,1.,0.,0.
+LOAD,7,2.,1.,8,0.5,6
+"""))
+    # CD (and FORCE CID) 2 has its x along global y: component 1 acts along +y
+    assert np.allclose(deck.loads["5"][0], [0, 3, 0, 0, 0, 0])
+    assert np.allclose(deck.loads["8"][0], [0, 4, 0, 0, 0, 0])
+    assert np.allclose(deck.loads["7"][0], 2.0 * np.array([0, 4, 0, 0, 0, 1.0]))
+
+
+def test_blank_grid_fields_and_grdset_defaults(tmp_path):
+    # blank coordinates are 0.0; GRDSET supplies CP/CD/PS for GRIDs that leave them blank
+    # (pyNastran 1.4 reads GRDSET but does not apply its CP/PS: sarfe does)
+    deck = read_nastran(_write(tmp_path, """
+CORD2R,3,,0.,0.,1.,0.,0.,2.
+,1.,0.,1.
+GRDSET,,3,,,,,6
+GRID,1
+GRID,2,,1.
+GRID,3,,1.,1.
+GRID,4,,0.,1.
+CTRIA3,1,1,1,2,3
+CTRIA3,2,1,1,3,4
+PSHELL,1,1,0.01,1
+MAT1,1,7.e10,,0.3,2700.
+"""))
+    assert np.allclose(deck.points, [[0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]])
+    assert deck.supports["permanent"].components[:, 5].all()
+    assert any("GRDSET" in note for note in deck.notes)  # blank and explicit 0 read alike

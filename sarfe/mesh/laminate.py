@@ -8,6 +8,9 @@ Voigt order [xx, yy, xy] with engineering shear γ_xy. Section resultants per un
 with z measured from the reference (node) plane [m], Q̄_k the ply's plane-stress matrix
 [Pa] rotated by its angle θ_k (counter-clockwise from the section's axis 1 to the ply's
 fibre axis). Transverse shear G t per ply: Σ_k R̄_k (z_k − z_{k−1}) (no shear factor).
+
+Section properties of the deck (`DeckModel.shells`) are computed here by the readers; the
+section shell element (`sarfe.fe.shell_section`) rotates them into its frame.
 """
 from __future__ import annotations
 
