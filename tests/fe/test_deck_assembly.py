@@ -551,3 +551,34 @@ def test_chained_rigid_elements_resolve_and_circular_ones_are_refused(tmp_path):
     loop = read_nastran(_write(tmp_path / "loop", base + "RBE2,10,1,123456,2\nRBE2,11,2,123456,1\n"))
     with pytest.raises(DeckError, match="rigid"):
         assemble_deck(loop)
+
+
+def test_chexa20_cantilever_read_from_a_deck(tmp_path):
+    """CHEXA (20 nodes, Nastran's midside order) written from a structured grid and read
+    back: the tip deflection of a 10 × 1 × 1 cantilever equals Euler–Bernoulli + shear."""
+    model = _hex20_plate(10.0, 1.0, 1.0, (10, 1, 1), 1e3, 0.0, 1.0)
+    block = model.solids["hex20"]
+    lines = [f"GRID,{i + 1},,{x:.6f},{y:.6f},{z:.6f}" for i, (x, y, z) in enumerate(model.points)]
+    for eid, cell in zip(block.element_ids, block.connectivity + 1):
+        fields = [str(n) for n in cell]
+        lines.append(f"CHEXA,{eid},1," + ",".join(fields[:6]))
+        lines.append("," + ",".join(fields[6:14]))
+        lines.append("," + ",".join(fields[14:]))
+    root = np.flatnonzero(np.isclose(model.points[:, 0], 0.0)) + 1
+    tip = np.flatnonzero(np.isclose(model.points[:, 0], 10.0)) + 1
+    lines += ["PSOLID,1,1", "MAT1,1,1000.,,0.,1."]
+    lines += [f"SPC1,1,123,{n}" for n in root]
+    deck = read_nastran(_write(tmp_path, "\n".join(lines)))
+    assert len(deck.solids["hex20"].element_ids) == 10
+    system = assemble_deck(deck)
+    fixed = support_dofs(system, deck, 1)
+    free = np.setdiff1d(np.arange(system.n_dofs), fixed)
+    force = np.zeros((deck.n_nodes, 6))
+    force[deck.node_index(tip), 2] = -1.0 / len(tip)
+    q = np.zeros(system.n_dofs)
+    q[free] = np.linalg.solve(system.stiffness[free][:, free].toarray(),
+                              (system.transformation.T @ force.ravel())[free])
+    w = system.displacement(q)[deck.node_index(tip), 2].mean()
+    bending = 10.0**3 / (3 * 1e3 / 12)
+    shear = 10.0 / (5 / 6 * 500.0)
+    assert -w == pytest.approx(bending + shear, rel=0.01)
