@@ -73,15 +73,33 @@ def branch_ids(x) -> np.ndarray:
     return np.concatenate((turns[:1], turns))
 
 
-def _plot_branches(ax, x, y, category, color, label_prefix="", labelled=None, width=1.5):
-    """y(x) in sweep order, one line per branch (:func:`branch_ids`) and per run of equal
-    stability inside it (each run joined to the next point so the curve is unbroken); points with
-    NaN y break the line."""
+def jump_starts(y, factor: float = 5.0, minimum_db: float = 6.0) -> np.ndarray:
+    """(n,) bool: True where a point jumps from the previous one by more than
+    max(``minimum_db``, ``factor`` × the median step) — a point-by-point sweep landing on another
+    branch, not a continuous curve, so no line is drawn across it."""
+    y = np.asarray(y, dtype=float)
+    step = np.abs(np.diff(y))
+    out = np.zeros(y.size, dtype=bool)
+    finite = step[np.isfinite(step)]
+    if finite.size:
+        limit = max(minimum_db, factor * float(np.median(finite)))
+        out[1:] = np.isfinite(step) & (step > limit)
+    return out
+
+
+def _plot_branches(ax, x, y, category, color, label_prefix="", labelled=None, width=1.5,
+                   jumps=None):
+    """y(x) in sweep order, one line per branch (:func:`branch_ids`; a new line also at each
+    ``jumps`` point) and per run of equal stability inside it (each run joined to the next point
+    so the curve is unbroken); points with NaN y break the line."""
     labelled = set() if labelled is None else labelled
     branch = branch_ids(x)
+    if jumps is not None:
+        branch = branch + np.cumsum(np.asarray(jumps, dtype=int)) * (branch.max(initial=0) + 1)
+    starts = np.zeros(branch.size, dtype=bool) if jumps is None else np.asarray(jumps, bool)
     for b0, b1 in _runs(branch):
-        # the fold point belongs to both branches
-        lo = b0 - 1 if b0 > 0 else b0
+        # the fold point belongs to both branches (not a jump: nothing joins across it)
+        lo = b0 - 1 if b0 > 0 and not starts[b0] else b0
         for r0, r1 in _runs(category[lo:b1]):
             r0, r1 = r0 + lo, r1 + lo
             end = min(r1 + 1, b1)
@@ -105,7 +123,9 @@ def plot_erp_sweep(path, frequencies_hz, level_db, stable=None, level_a_db=None,
     converged : optional (n_f,) bool — points that did not converge are drawn as red circles and
     not joined; target_dba : optional target level [dB(A)] (red dashed line); loudest_index :
     optional point marked with a star (the run's loudest point).
-    Each branch between folds is its own line, unstable parts dashed. The y axis shows at most
+    Each branch between folds is its own line, unstable parts dashed; a jump between two
+    consecutive points (:func:`jump_starts`, e.g. a point-by-point sweep falling onto another
+    branch) is left open rather than drawn as a vertical line. The y axis shows at most
     ``dynamic_range_db`` below the highest level: lower levels (e.g. a motionless surface at
     −190 dB) leave a gap and a grey ▼ on the axis instead of a line to the floor.
     Returns the PNG path.
@@ -124,6 +144,11 @@ def plot_erp_sweep(path, frequencies_hz, level_db, stable=None, level_a_db=None,
         finite = np.append(finite, float(target_dba))
     top = float(finite.max()) if finite.size else 0.0
     floor = top - dynamic_range_db
+    primary = np.where(good, series["db"], np.nan)
+    jumps = jump_starts(primary[good]) if good.any() else np.zeros(0, bool)
+    jumps_all = np.zeros(n, dtype=bool)
+    jumps_all[np.flatnonzero(good)] = jumps
+    jumps = jumps_all
     fig = _figure(7.0, 4.2)
     ax = fig.add_subplot()
     labelled = set()
@@ -131,7 +156,7 @@ def plot_erp_sweep(path, frequencies_hz, level_db, stable=None, level_a_db=None,
         if key not in series:
             continue
         y = np.where(good & np.isfinite(series[key]) & (series[key] >= floor), series[key], np.nan)
-        _plot_branches(ax, x, y, category, color, prefix, labelled=set())
+        _plot_branches(ax, x, y, category, color, prefix, labelled=set(), jumps=jumps)
         low = good & ~(np.isfinite(series[key]) & (series[key] >= floor))
         if low.any():
             ax.plot(x[low], np.full(low.sum(), floor), linestyle="none", marker="v", color="0.5",
@@ -259,17 +284,14 @@ def plot_friction(path, friction_time, state, names=None, omega=None, title=None
         top.plot(x, np.concatenate([F[:, i], F[:1, i]]), label=str(names[i]))
     top.set_ylabel("friction force [N]")
     top.grid(True, alpha=0.3)
-    if n <= 12:
-        top.legend(fontsize="x-small")
+    handles = top.get_lines()[:12] + [Patch(color=c, label=t) for c, t in zip(
+        _STATE_COLORS, ("state: open", "stick", "slip"))]
+    top.legend(handles=handles, fontsize="x-small", ncol=2)
     bottom.pcolormesh(x, np.arange(n + 1), S.T.astype(float), cmap=ListedColormap(_STATE_COLORS),
                       vmin=-0.5, vmax=2.5, shading="flat")
     bottom.set_yticks(np.arange(n) + 0.5)
     bottom.set_yticklabels([str(v) for v in names], fontsize="x-small")
     bottom.set_xlabel("time [ms]" if omega else "phase θ/2π [-]")
-    bottom.legend(handles=[Patch(color=c, label=t) for c, t in zip(_STATE_COLORS,
-                                                                   ("open", "stick", "slip"))],
-                  fontsize="x-small", ncol=3, loc="upper center", bbox_to_anchor=(0.5, -0.45),
-                  frameon=False)
     if title:
         top.set_title(title)
     return _save(fig, path)
