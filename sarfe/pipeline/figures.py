@@ -89,31 +89,32 @@ def surface_maps(case, mesh, point_data, translations, point, directory: Path) -
     """Report renders at the loudest point: the ERP map [dB re 1 pW/m²], the deflection at the
     phase of largest displacement (exaggerated warp, colour |u| [mm]) and, when contacts move,
     their relative displacement [mm]. Returns {key: PNG path, 'renderer': text}."""
-    from sarfe.io.outputs.render import render_surface
+    from sarfe.io.outputs.render import render_surfaces
     from sarfe.io.outputs.vtk import period_samples
 
     directory = Path(directory)
     at = f"{point['frequency_hz']:.1f} Hz"
     level = point_data["erp_level_db_m2"]
-    maps = {}
-    maps["erp_map"], renderer = render_surface(
-        directory / "erp_map.png", mesh.points, mesh.triangles, level,
-        "ERP density [dB re 1 pW/m2]", title=f"{case.name}: ERP at {at}",
-        clim=[float(level.min()), float(level.max())])
+    jobs = [dict(path=directory / "erp_map.png", points=mesh.points, triangles=mesh.triangles,
+                 values=level, label="ERP density [dB re 1 pW/m2]",
+                 title=f"{case.name}: ERP at {at}", clim=[float(level.min()), float(level.max())])]
     frames = period_samples(translations, 24)                              # (24, n, 3)
     frame = frames[int(np.argmax(np.linalg.norm(frames, axis=2).max(axis=1)))]
     magnitude = np.linalg.norm(frame, axis=1)
     extent = float(np.ptp(mesh.points, axis=0).max())
     scale = 0.05 * extent / magnitude.max() if magnitude.max() > 0 else 0.0
-    maps["deflection"], _ = render_surface(
-        directory / "deflection.png", mesh.points, mesh.triangles, 1e3 * magnitude,
-        "|u| [mm]", title=f"deflection at {at} (×{scale:.3g})", warp=scale * frame,
-        cmap="viridis", use_pyvista=renderer == "pyvista")
+    jobs.append(dict(path=directory / "deflection.png", points=mesh.points,
+                     triangles=mesh.triangles, values=1e3 * magnitude, label="|u| [mm]",
+                     title=f"deflection at {at} (x{scale:.3g})", warp=scale * frame,
+                     cmap="viridis"))
     motion = point_data.get("contact_relative_displacement_m")
     if motion is not None and np.any(motion > 0):
-        maps["contact_map"], _ = render_surface(
-            directory / "contact_map.png", mesh.points, mesh.triangles, 1e3 * motion,
-            "contact relative displacement [mm]", title=f"contact motion at {at}",
-            cmap="plasma", use_pyvista=renderer == "pyvista")
-    maps["renderer"] = renderer
+        jobs.append(dict(path=directory / "contact_map.png", points=mesh.points,
+                         triangles=mesh.triangles, values=1e3 * motion,
+                         label="relative motion [mm]",
+                         title=f"contact motion at {at}", cmap="plasma", spots=True))
+    rendered = render_surfaces(jobs)
+    maps = {key: path for key, (path, _) in zip(("erp_map", "deflection", "contact_map"),
+                                                rendered)}
+    maps["renderer"] = rendered[0][1]
     return maps
