@@ -65,8 +65,8 @@ def test_report_is_self_contained_with_every_section(report):
                              "contacts", "maps", "points"]
     for table in ("ranking-table", "band-table", "points-table"):
         assert table in page.tables
-    # a listed-frequency run has no sweep line, but every plot at the loudest point is there
-    for image in ("img-contributions", "img-third-octave", "img-erp-spectrum",
+    # five listed frequencies: the level-vs-frequency plot and every plot at the loudest point
+    for image in ("img-erp-sweep", "img-contributions", "img-third-octave", "img-erp-spectrum",
                   "img-contact-forces", "img-friction"):
         src = page.images[image]
         assert src.startswith("data:image/png;base64,")
