@@ -103,6 +103,8 @@ def _plot_branches(ax, x, y, category, color, label_prefix="", labelled=None, wi
         for r0, r1 in _runs(category[lo:b1]):
             r0, r1 = r0 + lo, r1 + lo
             end = min(r1 + 1, b1)
+            if not np.isfinite(y[r0:end]).any():
+                continue
             style = dict(_STYLE[int(category[r0])])
             label = style.pop("label")
             if category[r0] not in labelled:
@@ -149,7 +151,7 @@ def plot_erp_sweep(path, frequencies_hz, level_db, stable=None, level_a_db=None,
     jumps_all = np.zeros(n, dtype=bool)
     jumps_all[np.flatnonzero(good)] = jumps
     jumps = jumps_all
-    fig = _figure(7.0, 4.2)
+    fig = _figure(9.0, 4.2)
     ax = fig.add_subplot()
     labelled = set()
     for key, color, prefix in (("db", "C0", "ERP [dB], "), ("dba", "C1", "ERP [dB(A)], ")):
@@ -158,14 +160,16 @@ def plot_erp_sweep(path, frequencies_hz, level_db, stable=None, level_a_db=None,
         y = np.where(good & np.isfinite(series[key]) & (series[key] >= floor), series[key], np.nan)
         _plot_branches(ax, x, y, category, color, prefix, labelled=set(), jumps=jumps)
         low = good & ~(np.isfinite(series[key]) & (series[key] >= floor))
-        if low.any():
-            ax.plot(x[low], np.full(low.sum(), floor), linestyle="none", marker="v", color="0.5",
-                    markersize=4, label=None if "low" in labelled else "below the plotted range")
+        if low.any() and "low" not in labelled:  # a rug on the lower edge, whatever the limits
+            ax.plot(x[low], np.full(low.sum(), 0.015), linestyle="none", marker="v", color="0.5",
+                    markersize=3, alpha=0.7, transform=ax.get_xaxis_transform(), clip_on=False,
+                    label=f"below the plotted range ({int(low.sum())} points; silent)")
             labelled.add("low")
     if linear is not None:
         y = np.where(np.isfinite(linear) & (linear >= floor), linear, np.nan)
         order = np.argsort(x, kind="stable")
-        ax.plot(x[order], y[order], color="0.5", linewidth=0.8, label="linear baseline [dB]")
+        if np.isfinite(y).any():
+            ax.plot(x[order], y[order], color="0.5", linewidth=0.8, label="linear baseline [dB]")
     if not good.all():
         y = series.get("dba", series["db"])
         y = np.where(np.isfinite(y) & (y >= floor), y, floor)
@@ -181,13 +185,13 @@ def plot_erp_sweep(path, frequencies_hz, level_db, stable=None, level_a_db=None,
             ax.plot([x[j]], [y], marker="*", markersize=11, color="k", linestyle="none",
                     label=f"loudest point {x[j]:.4g} Hz")
     if finite.size:
-        low = max(float(finite.min()), floor)
+        low = float(finite[finite >= floor].min())
         margin = 0.05 * max(top - low, 1.0)
         ax.set_ylim(low - margin, top + margin)
     ax.set_xlabel("excitation frequency [Hz]")
     ax.set_ylabel("ERP level [dB re 1 pW]" + (" / [dB(A)]" if level_a_db is not None else ""))
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize="x-small", loc="best", framealpha=0.8)
+    ax.legend(fontsize="x-small", loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     if title:
         ax.set_title(title)
     return _save(fig, path)
