@@ -21,7 +21,9 @@ Shares over the period's harmonics, unweighted and A-weighted (α_k = 10^(A(f_k)
     share_s   = Σ_k Q_s,k / Σ_k P_k,          share_A,s = Σ_k α_k Q_s,k / Σ_k α_k P_k,
 
 so Σ_s share_s = Σ_s share_A,s = 1 exactly. The ranking orders the sources by share_A (the total is
-judged in dB(A)); a motionless surface (P = 0) has no shares (NaN).
+judged in dB(A)). A motionless surface (total below ``MOTIONLESS_LEVEL_DB`` = −100 dB re 1 pW,
+round-off radiates about −180 dB) has no sound to split: its shares and its superposition error
+are NaN.
 """
 from __future__ import annotations
 
@@ -32,7 +34,10 @@ import numpy as np
 from sarfe.erp.erp import AIR_DENSITY, REFERENCE_POWER, SOUND_SPEED, power_level_db
 from sarfe.erp.weighting import a_weighting_db
 
-__all__ = ["ErpContributions", "erp_contributions", "ranking_lines", "normal_velocity"]
+__all__ = ["ErpContributions", "erp_contributions", "ranking_lines", "normal_velocity",
+           "MOTIONLESS_LEVEL_DB"]
+
+MOTIONLESS_LEVEL_DB = -100.0  # [dB re P_ref] below this total the surface counts as motionless
 
 
 def normal_velocity(normal_displacement, omega: float) -> np.ndarray:
@@ -109,6 +114,9 @@ def erp_contributions(names, source_velocity, nodal_areas, omega: float, total_v
     with np.errstate(invalid="ignore", divide="ignore"):
         share = coherent.sum(axis=1) / P.sum()
         share_a = (coherent @ alpha) / (P @ alpha)
+    if not P.sum() >= reference_power * 10.0 ** (MOTIONLESS_LEVEL_DB / 10.0):
+        share, share_a = np.full(len(names), np.nan), np.full(len(names), np.nan)
+        error = float("nan")
     return ErpContributions(
         names=tuple(str(n) for n in names), frequencies_hz=f, partial_power_W=partial,
         coherent_power_W=coherent, total_power_W=P, partial_total_W=partial.sum(axis=1),
