@@ -5,7 +5,6 @@ import json
 import re
 
 import numpy as np
-import pytest
 
 import sarfe.pipeline.solve as solve_module
 from sarfe.io import outputs
