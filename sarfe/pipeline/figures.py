@@ -85,10 +85,12 @@ def point_figures(case, stage, nl, summary, solutions, erps, directory: Path, lo
     return images
 
 
-def surface_maps(case, mesh, point_data, translations, point, directory: Path) -> dict:
+def surface_maps(case, mesh, point_data, translations, point, directory: Path,
+                 contact_nodes=None) -> dict:
     """Report renders at the loudest point: the ERP map [dB re 1 pW/m²], the deflection at the
     phase of largest displacement (exaggerated warp, colour |u| [mm]) and, when contacts move,
-    their relative displacement [mm]. Returns {key: PNG path, 'renderer': text}."""
+    their relative displacement [mm], named at ``contact_nodes`` {name: mesh node}. Returns
+    {key: PNG path, 'renderer': text}."""
     from sarfe.io.outputs.render import render_surfaces
     from sarfe.io.outputs.vtk import period_samples
 
@@ -112,7 +114,9 @@ def surface_maps(case, mesh, point_data, translations, point, directory: Path) -
         jobs.append(dict(path=directory / "contact_map.png", points=mesh.points,
                          triangles=mesh.triangles, values=1e3 * motion,
                          label="relative motion [mm]",
-                         title=f"contact motion at {at}", cmap="plasma", spots=True))
+                         title=f"contact motion at {at}", cmap="plasma", spots=True,
+                         labels=[(mesh.points[node], name)
+                                 for name, node in (contact_nodes or {}).items()]))
     rendered = render_surfaces(jobs)
     maps = {key: path for key, (path, _) in zip(("erp_map", "deflection", "contact_map"),
                                                 rendered)}

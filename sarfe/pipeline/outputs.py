@@ -93,7 +93,10 @@ def write_outputs(case, stage, nl, summary, rows, solutions, erps, normal_w, dir
             from sarfe.pipeline.figures import surface_maps
 
             maps = surface_maps(case, mesh, point_data(loudest), nodal_translations(loudest),
-                                summary["points"][loudest], directory / ".report-figures")
+                                summary["points"][loudest], directory / ".report-figures",
+                                contact_nodes={name: int(g.nodes_a[0])
+                                               for name, g in stage.contacts.items()
+                                               if len(g.nodes_a)})
     if "report" in files:
         notes = {"renderer": maps.pop("renderer", None)}
         outputs.write_report_html(directory / "report.html", summary, {**images, **maps}, notes)

@@ -222,10 +222,14 @@ def worst_of(points):
     else:
         p = points[j]
         contributions = p.get("contributions") or {}
+        excitation = next((s for s in contributions.get("sources", [])
+                           if s["name"] == "excitation"), None)
         worst = {"index": p["index"], "erp_level_dba": p["erp"]["level_dba"],
                  "erp_level_db": p["erp"]["level_db"], "frequency_hz": p["frequency_hz"],
-                 "ranking": contributions.get("ranking", []), "bands": p.get("bands"),
-                 "contacts": {}}
+                 "ranking": contributions.get("ranking", []),
+                 "excitation": None if excitation is None else {
+                     "level_dba": excitation["level_dba"], "share_a": excitation["share_a"]},
+                 "bands": p.get("bands"), "contacts": {}}
     for c_index, c in enumerate(points[0]["contacts"]):
         pen = [p["contacts"][c_index]["max_penetration_m"] for p in points]
         force = [p["contacts"][c_index]["peak_normal_force_N"] for p in points]

@@ -24,13 +24,14 @@ TIMEOUT_S = 120
 
 
 def render_surface(path, points, triangles, values, label, title=None, warp=None, clim=None,
-                   cmap="inferno", use_pyvista: bool = True, spots: bool = False):
+                   cmap="inferno", use_pyvista: bool = True, spots: bool = False, labels=None):
     """Render ``values`` on the surface (module docstring); returns (PNG path, 'pyvista' |
     'matplotlib (pyvista failed: …)' | 'matplotlib'). ``spots``: show the surface grey and the
     nodes with a nonzero value as coloured spheres (fields that live on a few nodes, e.g. contacts).
+    ``labels``: [(xyz (3,) [m], text)] written next to those points (pyvista only).
     """
     job = dict(path=path, points=points, triangles=triangles, values=values, label=label,
-               title=title, warp=warp, clim=clim, cmap=cmap, spots=spots)
+               title=title, warp=warp, clim=clim, cmap=cmap, spots=spots, labels=labels)
     return render_surfaces([job], use_pyvista=use_pyvista)[0]
 
 
@@ -54,7 +55,10 @@ def render_surfaces(jobs, use_pyvista: bool = True) -> list:
                      clim=np.asarray(clim if clim is not None else [np.nan, np.nan], float),
                      label=str(job["label"]), title=str(job.get("title") or ""),
                      cmap=str(job.get("cmap", "inferno")), spots=bool(job.get("spots", False)),
-                     png=str(job["path"]))
+                     png=str(job["path"]),
+                     label_points=np.asarray([p for p, _ in job.get("labels") or []],
+                                             dtype=float).reshape(-1, 3),
+                     label_texts=np.asarray([t for _, t in job.get("labels") or []], dtype=str))
             data.append(name)
         env = dict(os.environ, PYVISTA_OFF_SCREEN="true")
         try:
@@ -117,6 +121,10 @@ def _render(data_path):
         plotter.add_mesh(pv.PolyData(points, np.hstack([np.full((triangles.shape[0], 1), 3),
                                                         triangles]).ravel()),
                          style="wireframe", color="gray", opacity=0.15)
+    if d["label_points"].shape[0]:  # names next to points (e.g. each contact)
+        plotter.add_point_labels(d["label_points"], [str(t) for t in d["label_texts"]],
+                                 font_size=14, point_size=1, shape_opacity=0.5,
+                                 always_visible=True)
     title = str(d["title"])
     if title:
         plotter.add_text(title, font_size=12, color="black")

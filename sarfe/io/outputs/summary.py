@@ -186,4 +186,10 @@ def loudest_lines(worst: dict | None, count: int = 5) -> list[str]:
              f"({level_text(worst.get('erp_level_db'), unit='dB re 1 pW')}) at "
              f"{worst['frequency_hz']:.2f} Hz"]
     lines += [f"  {line}" for line in (worst.get("ranking") or [])[:count]]
+    excitation = worst.get("excitation")
+    if excitation and worst.get("ranking"):
+        share = excitation.get("share_a")
+        share = "-" if share is None or not math.isfinite(share) else f"{100 * share:.0f} %"
+        lines.append(f"  (the excitation through the structure without contact forces: "
+                     f"{level_text(excitation.get('level_dba'), unit='dB(A)')}, {share})")
     return lines
