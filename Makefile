@@ -11,7 +11,8 @@ export OMP_NUM_THREADS ?= 1
 export MKL_NUM_THREADS ?= 1
 export MPLBACKEND := Agg
 # gmsh's wheel links FLTK/OpenGL even headless; these are the Debian libraries it needs.
-APT_PACKAGES := libglu1-mesa libgl1 libxcursor1 libxft2 libxinerama1 libgomp1
+# chromium: the report test renders report.html in a real headless browser (skipped without it).
+APT_PACKAGES := libglu1-mesa libgl1 libxcursor1 libxft2 libxinerama1 libgomp1 chromium
 # Exact versions every dependency was tested with (pip constraints file, sarfe itself excluded).
 LOCK   := constraints.txt
 

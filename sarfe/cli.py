@@ -52,10 +52,10 @@ def cmd_solve(args) -> int:
             print(pruning)
         types = {c["name"]: c["type"] for c in summary["contacts"]}
         print(results_table(result.rows, types))
-        worst = summary.get("worst") or {}
-        if worst:
-            print(f"loudest point: {worst['erp_level_dba']:.1f} dB(A) "
-                  f"({worst['erp_level_db']:.1f} dB re 1 pW) at {worst['frequency_hz']:.2f} Hz")
+        from sarfe.io.outputs.summary import loudest_lines
+
+        for line in loudest_lines(summary.get("worst")):
+            print(line)
         print(f"results: {result.output_dir}  ({time.perf_counter() - clock:.1f} s)")
     if summary["non_converged_points"]:
         print(f"sarfe: {len(summary['non_converged_points'])} point(s) did not converge: "

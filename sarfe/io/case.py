@@ -551,7 +551,8 @@ def _normalize_erp(case, data):
 def _normalize_output(case, data):
     out = data.setdefault("output", {})
     out.setdefault("directory", str(Path("results") / data["name"]))
-    default = ["summary", "response", "plots", "table"] + (["erp_vtu", "animation"] if case.is_fe else [])
+    default = ["summary", "response", "plots", "table", "report"] + (
+        ["erp_vtu", "animation"] if case.is_fe else [])
     out.setdefault("files", default)
     if "summary" not in out["files"]:
         out["files"] = ["summary"] + list(out["files"])

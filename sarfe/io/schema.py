@@ -178,9 +178,10 @@ ERP = _object({
     "reference_power_W": POSITIVE,
 })
 
-OUTPUT_FILES = ["summary", "response", "erp_vtu", "animation", "plots", "table"]
+OUTPUT_FILES = ["summary", "response", "erp_vtu", "animation", "plots", "table", "report"]
 OUTPUT = _object({
     "directory": NAME,
+    "target_dba": NUMBER,   # optional target level [dB(A)]: a line in the plots and the report
     "files": {"type": "array", "items": {"enum": OUTPUT_FILES}, "uniqueItems": True},
 })
 

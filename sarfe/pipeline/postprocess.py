@@ -1,8 +1,13 @@
-r"""Per-point results: ERP of the HBM solution, contact indicators, linear risk baseline.
+r"""Per-point results: ERP of the HBM solution, contact indicators, linear risk baseline,
+third-octave bands, the contribution of each contact, and the loudest point of a run.
 
 ERP: w_s = N ũ (radiating-node normal displacement harmonics) → :func:`sarfe.erp.
 equivalent_radiated_power`. Linear baseline: (K − ω² M + iω D) Û = F̂ without contacts →
-:func:`sarfe.risk.linear_risk_from_contacts` and its ERP.
+:func:`sarfe.risk.linear_risk_from_contacts` and its ERP. Bands: :func:`sarfe.erp.bands.
+third_octave_levels` of the harmonic powers (the linear baseline radiates at ω only).
+Contributions: :mod:`sarfe.pipeline.contributions`; per-period contact dynamics:
+:mod:`sarfe.pipeline.contact_dynamics`. The loudest point (:func:`loudest_point`) is the converged,
+not unstable point of highest A-weighted ERP; every artefact "at the loudest point" uses it.
 """
 from __future__ import annotations
 
@@ -136,10 +141,33 @@ def harmonic_set_record(case, solution):
             "dropped_content": float(getattr(solution, "dropped_content", float("nan")))}
 
 
+def band_record(erp, linear, omega) -> dict:
+    """Third-octave bands of the point's ERP harmonics and of the linear baseline (at ω only)."""
+    from sarfe.erp.bands import third_octave_levels
+
+    f = omega / (2 * np.pi)
+    linear_power = linear.get("erp_power_W", float("nan"))
+    linear_power = linear_power if math.isfinite(linear_power) else 0.0
+    return {"nonlinear": third_octave_levels(erp.frequencies_hz, erp.power).as_dict(),
+            "linear": third_octave_levels([f], [linear_power]).as_dict()}
+
+
 def point_record(case, stage, nl, index, solution):
+    from sarfe.pipeline.contact_dynamics import contact_dynamics
+    from sarfe.pipeline.contributions import contributions_record
+
     omega = float(solution.omega)
     erp, W = _erp(case, stage, solution.displacement, omega)
     contacts = contact_indicators(solution, nl) if nl.contacts.count else []
+    for record, dynamics in zip(contacts, contact_dynamics(solution, nl)):
+        record.update({k: v for k, v in dynamics.items() if k != "name"})
+    contributions = contributions_record(case, stage, nl, solution)
+    if contributions.get("available"):
+        shares = {c["name"]: c for c in contributions["sources"]}
+        for record in contacts:
+            source = shares.get(record["name"], {})
+            record.update({"erp_level_dba": source.get("level_dba", float("nan")),
+                           "erp_share_a": source.get("share_a", float("nan"))})
     linear = linear_baseline(case, stage, nl, omega)
     stable = getattr(solution, "stable", None)
     point = {
@@ -151,6 +179,8 @@ def point_record(case, stage, nl, index, solution):
         "erp": _erp_dict(erp), "contacts": contacts, "linear": linear,
         "error_estimate": _error_estimate(case, stage, nl, solution),
         "harmonic_set": harmonic_set_record(case, solution),
+        "bands": band_record(erp, linear, omega),
+        "contributions": contributions,
     }
     row = {"case": case.name, "point": index, "frequency_hz": point["frequency_hz"],
            "converged": point["converged"], "stable": point["stable"],
@@ -159,21 +189,47 @@ def point_record(case, stage, nl, index, solution):
            "linear_erp_db": linear["erp_level_db"], "linear_erp_dba": linear["erp_level_dba"]}
     for c in contacts:
         for key in ("max_penetration_m", "peak_normal_force_N", "peak_friction_force_N",
-                    "open_fraction", "slip_fraction"):
-            row[f"{c['name']}.{key}"] = c[key]
+                    "open_fraction", "slip_fraction", "impacts_per_period", "erp_share_a"):
+            if key in c:
+                row[f"{c['name']}.{key}"] = c[key]
     for c in linear["contacts"]:
         row[f"{c['name']}.linear_rattle_risk"] = c["rattle_risk"]
     return point, row, erp, W
 
 
+def loudest_point(points) -> int | None:
+    """Index (into ``points``) of the loudest point: the highest finite A-weighted ERP among the
+    converged points that are not unstable (``stable`` true or not assessed); None if there is none.
+    """
+    candidates = [i for i, p in enumerate(points)
+                  if p["converged"] and p.get("stable") is not False
+                  and math.isfinite(p["erp"]["level_dba"])]
+    if not candidates:
+        return None
+    return max(candidates, key=lambda i: points[i]["erp"]["level_dba"])
+
+
 def worst_of(points):
+    """summary.json ``worst``: the loudest point (:func:`loudest_point`: its ``index``, frequency,
+    levels, contact ranking and bands) and per contact the sweep maxima over all points."""
     if not points:
         return {}
-    levels = [p["erp"]["level_dba"] for p in points]
-    finite = [i for i, x in enumerate(levels) if math.isfinite(x)]
-    j = max(finite, key=lambda i: levels[i]) if finite else 0
-    worst = {"erp_level_dba": levels[j], "erp_level_db": points[j]["erp"]["level_db"],
-             "frequency_hz": points[j]["frequency_hz"], "contacts": {}}
+    j = loudest_point(points)
+    if j is None:
+        worst = {"index": None, "erp_level_dba": float("nan"), "erp_level_db": float("nan"),
+                 "frequency_hz": float("nan"),
+                 "note": "no converged, not unstable point with a finite level", "contacts": {}}
+    else:
+        p = points[j]
+        contributions = p.get("contributions") or {}
+        excitation = next((s for s in contributions.get("sources", [])
+                           if s["name"] == "excitation"), None)
+        worst = {"index": p["index"], "erp_level_dba": p["erp"]["level_dba"],
+                 "erp_level_db": p["erp"]["level_db"], "frequency_hz": p["frequency_hz"],
+                 "ranking": contributions.get("ranking", []),
+                 "excitation": None if excitation is None else {
+                     "level_dba": excitation["level_dba"], "share_a": excitation["share_a"]},
+                 "bands": p.get("bands"), "contacts": {}}
     for c_index, c in enumerate(points[0]["contacts"]):
         pen = [p["contacts"][c_index]["max_penetration_m"] for p in points]
         force = [p["contacts"][c_index]["peak_normal_force_N"] for p in points]
