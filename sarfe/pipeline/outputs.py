@@ -3,6 +3,7 @@ of the finished result directory into place (the rules: :mod:`sarfe.io.result_fo
 from __future__ import annotations
 
 import math
+import shutil
 from pathlib import Path
 
 import numpy as np
