@@ -145,12 +145,19 @@ def _check_law(contact_law, mine, normal_row, tangent_rows, table):
     if contact_law.tangent_dofs == "required" and np.any(mine & (tangent_rows[:, 0] < 0)):
         raise ValueError(f"a {name} contact needs at least one tangent row")
     for p in contact_law.parameters:
-        if p.minimum is None:
-            continue
         applies = mine & has_normal if p.normal_part else mine
+        if p.tangent_part:
+            applies = applies & (tangent_rows[:, 0] >= 0)
         values = table[p.name][applies]
-        bad = values <= p.minimum if p.exclusive else values < p.minimum
-        if np.any(bad):
-            relation = ">" if p.exclusive else ">="
-            raise ValueError(f"{p.name} of a {name} contact must be {relation} {p.minimum:g}, "
-                             f"got {values[bad].min():g}")
+        if p.minimum is not None:
+            bad = values <= p.minimum if p.exclusive else values < p.minimum
+            if np.any(bad):
+                relation = ">" if p.exclusive else ">="
+                raise ValueError(f"{p.name} of a {name} contact must be {relation} "
+                                 f"{p.minimum:g}, got {values[bad].min():g}")
+        if p.maximum is not None and np.any(values > p.maximum):
+            raise ValueError(f"{p.name} of a {name} contact must be <= {p.maximum:g}, "
+                             f"got {values.max():g}")
+    if contact_law.check is not None and np.any(mine):
+        index = np.flatnonzero(mine)
+        contact_law.check({k: v[index] for k, v in table.items()})

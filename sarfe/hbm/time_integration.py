@@ -45,7 +45,8 @@ import scipy.sparse.linalg as spla
 from . import laws
 from .harmonics import harmonic_coefficients, time_samples
 
-__all__ = ["TimeResponse", "integrate_time", "linear_harmonic_response", "period_work"]
+__all__ = ["TimeResponse", "integrate_time", "integrate_transient", "linear_harmonic_response",
+           "period_work"]
 
 DENSE_LIMIT = 3000  # models up to this many DOFs use a dense propagator (reduced models)
 
@@ -540,6 +541,30 @@ def integrate_time(model, contacts, excitation, omega, harmonics, steps_per_peri
         contact_work=run["contact_work"],
         max_contact_iterations=int(run["iterations"]),
     )
+
+
+def integrate_transient(model, contacts, displacement, velocity, duration, steps):
+    """Free response (no excitation) from a given state over ``duration`` [s] in ``steps`` Newmark
+    steps, with the same contact handling as :func:`integrate_time` (e.g. a single impact).
+
+    displacement, velocity: u(0) [m], u̇(0) [m/s] (n_dof,). Returns a dict: time (steps,) [s]
+    t_j = j·duration/steps, displacement, velocity (steps, n_dof), contact_displacement,
+    contact_force (steps, n_rows), and the state at t = duration: final_displacement,
+    final_velocity (n_dof,).
+    """
+    n = model.dof_count
+    N = int(steps)
+    omega = 2.0 * np.pi / float(duration)
+    law = _ContactLaws(contacts) if contacts is not None and contacts.count else None
+    u0 = np.asarray(displacement, dtype=float).reshape(n)
+    v0 = np.asarray(velocity, dtype=float).reshape(n)
+    slider = _slider_from_initial(law, contacts.gap_map @ u0, None) if law is not None \
+        else np.zeros((0, 2))
+    run = _run(model, contacts, np.zeros((N, n)), omega, N, u0, v0, slider, 1, 0.0, False, None, 0)
+    u_end, v_end, _ = run["final"]
+    return {"time": np.arange(N) * (float(duration) / N), "displacement": run["u"],
+            "velocity": run["v"], "contact_displacement": run["r"], "contact_force": run["lam"],
+            "final_displacement": u_end, "final_velocity": v_end}
 
 
 def period_work(displacement_harmonics, excitation, damping, contact_displacement_harmonics,

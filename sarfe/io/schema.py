@@ -83,10 +83,12 @@ REDUCTION = _object({
 
 def _law_key_schema(parameter):
     """JSON schema of one scalar law parameter from its declaration (bounds, number)."""
-    if parameter.minimum is None:
-        return dict(NUMBER)
-    bound = "exclusiveMinimum" if parameter.exclusive else "minimum"
-    return {"type": "number", bound: parameter.minimum}
+    schema = dict(NUMBER)
+    if parameter.minimum is not None:
+        schema["exclusiveMinimum" if parameter.exclusive else "minimum"] = parameter.minimum
+    if parameter.maximum is not None:
+        schema["maximum"] = parameter.maximum
+    return schema
 
 
 def contact_schema():

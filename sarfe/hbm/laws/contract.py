@@ -40,7 +40,8 @@ class Parameter:
     ``default`` (None: no default); ``required`` in a case file; ``split``: a named contact's value
     is shared equally over its node pairs (stiffnesses, forces); ``scaled``: multiplied by s in the
     cold start's contact-stiffness homotopy; ``normal_part``: only with a normal DOF (required
-    then, not allowed without); ``key`` None: not a case key (set by the pipeline); ``from_model``:
+    then, not allowed without); ``tangent_part``: only checked where the contact has tangent rows
+    (a law whose tangent element is optional); ``key`` None: not a case key (set by the pipeline); ``from_model``:
     when left out, the pipeline computes it from the model (the effective mass of the contact's
     normal row, 1/m_eff = g M⁻¹ gᵀ)."""
 
@@ -50,11 +51,13 @@ class Parameter:
     description: str
     minimum: float | None = None
     exclusive: bool = False
+    maximum: float | None = None
     default: float | None = None
     required: bool = False
     split: bool = False
     scaled: bool = False
     normal_part: bool = False
+    tangent_part: bool = False
     from_model: bool = False
 
 
@@ -97,7 +100,8 @@ class ContactLaw:
     ``states``: labels of the state codes 0, 1, 2; ``table_column``: contact indicator shown in the
     console table; ``case_keys``: further case-file keys {key: JSON schema} that are not scalar
     parameters, turned into parameters by ``prepare(contact, resolve) -> {name: array}`` (resolve:
-    a path relative to the case file; raises :class:`LawInputError` naming the key)."""
+    a path relative to the case file; raises :class:`LawInputError` naming the key);
+    ``check(p)``: further consistency of the parameters of a ContactSet (raises ValueError)."""
 
     name: str
     summary: str
@@ -115,6 +119,7 @@ class ContactLaw:
     table_column: str = "max_penetration_m"
     case_keys: dict = field(default_factory=dict)
     prepare: Callable = None
+    check: Callable = None
 
     def case_parameters(self):
         """The parameters read from a case file (those with a key), the tangent element's included."""
