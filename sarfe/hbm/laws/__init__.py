@@ -6,9 +6,10 @@ else tests a law's name.
 """
 from __future__ import annotations
 
+from importlib import import_module
+
 import numpy as np
 
-from . import rattle, squeak
 from .contract import ContactLaw, LawInputError, Linearization, NormalForce, Parameter
 
 LAWS = {}
@@ -24,8 +25,12 @@ def register(contact_law: ContactLaw) -> ContactLaw:
     return contact_law
 
 
-register(rattle.LAW)
-register(squeak.LAW)
+REGISTERED = (          # one line per law: its module in sarfe/hbm/laws, which defines LAW
+    "rattle",
+    "squeak",
+)
+for _module in REGISTERED:
+    register(import_module(f".{_module}", __name__).LAW)
 
 
 def law(name) -> ContactLaw:
