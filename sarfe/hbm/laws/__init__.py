@@ -28,6 +28,7 @@ def register(contact_law: ContactLaw) -> ContactLaw:
 REGISTERED = (          # one line per law: its module in sarfe/hbm/laws, which defines LAW
     "rattle",
     "squeak",
+    "damped_impact",
 )
 for _module in REGISTERED:
     register(import_module(f".{_module}", __name__).LAW)
