@@ -175,26 +175,37 @@ def contact_forces(contacts, contact_displacement, samples_per_period, slider_st
                 nabla = hm.derivative_matrix(H)[np.ix_(rows_k, rows_k)]
                 normal_jacobian = normal_jacobian + omega * viscous @ nabla
                 damping_blocks.append((np.where(has_normal, normal_rows, -1)[:, None], viscous))
-        if law.tangent is None:
+        # a tangent element acts on the contacts with tangent rows (optional for some laws)
+        with_tangent = contacts.tangent_rows[idx, 0] >= 0 if law.tangent is not None \
+            else np.zeros(idx.size, bool)
+        if not np.all(with_tangent):
             if jacobian:
-                blocks.append((np.where(has_normal, normal_rows, -1)[:, None], normal_jacobian))
-            continue
-        t_rows = contacts.tangent_rows[idx]
+                alone = ~with_tangent
+                blocks.append((np.where(has_normal, normal_rows, -1)[alone, None],
+                               normal_jacobian[alone] if np.any(with_tangent)
+                               else normal_jacobian))
+            if not np.any(with_tangent):
+                continue
+        sel = np.flatnonzero(with_tangent) if not np.all(with_tangent) else slice(None)
+        t_idx = idx[sel]
+        t_rows = contacts.tangent_rows[t_idx]
         present = t_rows >= 0
-        q = np.where(present[None], r[:, np.maximum(t_rows, 0)], 0.0)       # (N, n_g, 2)
+        q = np.where(present[None], r[:, np.maximum(t_rows, 0)], 0.0)       # (N, n_t, 2)
+        p_t = p if isinstance(sel, slice) else {k: v[sel] for k, v in p.items()}
         force_t, st, w_end, n_pass, J_t = law.tangent.periodic_forces(
-            p, q, ~present[:, 1], out.force, stiffness, slider_start[idx], H, N, jacobian,
-            friction_tolerance, friction_pass_cap, rows_k)
+            p_t, q, ~present[:, 1], out.force[:, sel], stiffness[:, sel], slider_start[t_idx], H,
+            N, jacobian, friction_tolerance, friction_pass_cap, rows_k)
         for col in range(2):
             on = present[:, col]
             if np.any(on):
                 np.add.at(lam, (slice(None), t_rows[on, col]), force_t[:, on, col])
-        state[:, idx] = st
-        slider_end[idx] = w_end
+        state[:, t_idx] = st
+        slider_end[t_idx] = w_end
         passes = max(passes, n_pass)
         if jacobian:
-            J_t[:, 0::3, 0::3] = normal_jacobian
-            blocks.append((np.column_stack([np.where(has_normal, normal_rows, -1), t_rows]), J_t))
+            J_t[:, 0::3, 0::3] = normal_jacobian[sel]
+            normal_t = np.where(has_normal, normal_rows, -1)[sel]
+            blocks.append((np.column_stack([normal_t, t_rows]), J_t))
     return ContactForces(hm.harmonic_coefficients(lam, H), lam, state, blocks, slider_end, passes,
                          omega_derivative, damping_blocks)
 

@@ -171,19 +171,23 @@ class _ContactLaws:
             g = dict(law=law, idx=idx, p=p, gap=contacts.gap[idx], has_normal=nr >= 0,
                      normal_safe=np.maximum(nr, 0))
             g["normal_rows"] = nr[g["has_normal"]]
-            if law.tangent is not None:
-                t_rows = contacts.tangent_rows[idx]
+            sel = np.flatnonzero(contacts.tangent_rows[idx, 0] >= 0) if law.tangent is not None \
+                else np.zeros(0, int)
+            g["tangent"] = sel.size > 0        # the element acts on the contacts with tangent rows
+            if g["tangent"]:
+                t_rows = contacts.tangent_rows[idx[sel]]
                 mask = t_rows >= 0
-                g.update(t_mask=mask, t_safe=np.where(mask, t_rows, 0), t_used=t_rows[mask],
-                         sliders=slice(first, first + idx.size))
-                first += idx.size
+                g.update(t_sel=sel, p_t={k: v[sel] for k, v in p.items()}, t_mask=mask,
+                         t_safe=np.where(mask, t_rows, 0), t_used=t_rows[mask],
+                         sliders=slice(first, first + sel.size))
+                first += sel.size
                 pair = mask[:, :, None] & mask[:, None, :]
                 g.update(pair=pair,
                          pair_rows=np.broadcast_to(g["t_safe"][:, :, None], pair.shape)[pair],
                          pair_cols=np.broadcast_to(g["t_safe"][:, None, :], pair.shape)[pair])
-                coupled = mask & g["has_normal"][:, None]
+                coupled = mask & g["has_normal"][sel][:, None]
                 g.update(coupled=coupled, coupled_rows=g["t_safe"][coupled],
-                         coupled_cols=np.broadcast_to(g["normal_safe"][:, None],
+                         coupled_cols=np.broadcast_to(g["normal_safe"][sel][:, None],
                                                       coupled.shape)[coupled])
             self.groups.append(g)
         self.slider_count = first
@@ -192,8 +196,8 @@ class _ContactLaws:
         """Round-off floor of the contact Newton [m]: 1e-15 × the largest gap or slip length."""
         lengths = [np.abs(gap).max(initial=0.0)]
         for g in self.groups:
-            if g["law"].tangent is not None:
-                lengths.append(g["law"].tangent.slip_length(g["p"]).max(initial=0.0))
+            if g["tangent"]:
+                lengths.append(g["law"].tangent.slip_length(g["p_t"]).max(initial=0.0))
         return 1e-15 * max(max(lengths), 1e-9)
 
     def forces(self, r, rdot, slider_previous):
@@ -212,12 +216,12 @@ class _ContactLaws:
             state[g["idx"]] = out.closed
             keep = {"stiffness": np.where(has, out.stiffness, 0.0),
                     "damping": None if out.damping is None else np.where(has, out.damping, 0.0)}
-            if g["law"].tangent is not None:
+            if g["tangent"]:
                 q = r[g["t_safe"]] * g["t_mask"]
                 force_t, new, fstate, d_tq, d_tn = g["law"].tangent.step(
-                    g["p"], q, out.force, slider_previous[g["sliders"]])
+                    g["p_t"], q, out.force[g["t_sel"]], slider_previous[g["sliders"]])
                 lam[g["t_used"]] = force_t[g["t_mask"]]
-                state[g["idx"]] = fstate
+                state[g["idx"][g["t_sel"]]] = fstate
                 slider[g["sliders"]] = new
                 keep.update(d_tq=d_tq, d_tn=d_tn)
             self._last.append(keep)
@@ -233,10 +237,10 @@ class _ContactLaws:
             if keep["damping"] is not None:
                 stiffness = stiffness + rate_factor * keep["damping"]
             jac[g["normal_rows"], g["normal_rows"]] = stiffness[has]
-            if g["law"].tangent is not None:
+            if g["tangent"]:
                 jac[g["pair_rows"], g["pair_cols"]] += keep["d_tq"][g["pair"]]
                 if g["coupled_rows"].size:   # slip limit follows the normal force
-                    d_tn = keep["d_tn"] * stiffness[:, None]
+                    d_tn = keep["d_tn"] * stiffness[g["t_sel"], None]
                     jac[g["coupled_rows"], g["coupled_cols"]] += d_tn[g["coupled"]]
         return jac
 
@@ -245,12 +249,12 @@ def _slider_from_initial(law, r0, initial_force):
     """Slider positions w = q − λ_t/k_t from a given contact force (or w = q: unloaded spring)."""
     slider = np.zeros((law.slider_count, 2))
     for g in law.groups:
-        if g["law"].tangent is None:
+        if not g["tangent"]:
             continue
         q = np.where(g["t_mask"], r0[g["t_safe"]], 0.0)
         force = None if initial_force is None else np.where(g["t_mask"],
                                                             initial_force[g["t_safe"]], 0.0)
-        slider[g["sliders"]] = g["law"].tangent.initial_slider(g["p"], q, force)
+        slider[g["sliders"]] = g["law"].tangent.initial_slider(g["p_t"], q, force)
     return slider
 
 
