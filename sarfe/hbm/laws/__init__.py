@@ -29,6 +29,7 @@ REGISTERED = (          # one line per law: its module in sarfe/hbm/laws, which 
     "rattle",
     "squeak",
     "damped_impact",
+    "tabulated",
 )
 for _module in REGISTERED:
     register(import_module(f".{_module}", __name__).LAW)
