@@ -83,27 +83,6 @@ def linearization(contacts):
     return Linearization(spring, dashpot, preload, closed), tangent
 
 
-def normal_forces(contacts, index, w, wdot=None):
-    """λ_n, ∂λ_n/∂w, ∂λ_n/∂ẇ (None if all rate independent), closed over (samples, len(index)) of
-    the contacts ``index`` at normal displacements w (and velocities ẇ) [m, m/s]."""
-    index = np.asarray(index, dtype=int)
-    w = np.asarray(w, dtype=float)
-    force, stiffness = np.zeros(w.shape), np.zeros(w.shape)
-    damping, closed = None, np.zeros(w.shape, bool)
-    kinds = np.asarray(contacts.kind)[index]
-    for name in dict.fromkeys(kinds):
-        contact_law = law(name)
-        sel = np.flatnonzero(kinds == name)
-        p = contacts.law_parameters(contact_law, index[sel])
-        v = None if wdot is None else np.asarray(wdot)[..., sel]
-        out = contact_law.normal(p, contacts.gap[index[sel]], w[..., sel], v)
-        force[..., sel], stiffness[..., sel], closed[..., sel] = out.force, out.stiffness, out.closed
-        if out.damping is not None:
-            damping = np.zeros(w.shape) if damping is None else damping
-            damping[..., sel] = out.damping
-    return NormalForce(force, stiffness, damping, closed)
-
-
 def velocity_dependent(contacts) -> bool:
     return any(law(k).velocity_dependent for k in dict.fromkeys(np.asarray(contacts.kind)))
 
@@ -138,6 +117,6 @@ def uses_tangent(contact_law, given_keys) -> bool:
     return any(p.key in given_keys for p in contact_law.tangent.PARAMETERS)
 
 
-__all__ = ["ContactLaw", "LawInputError", "Parameter", "NormalForce", "Linearization", "LAWS", "register", "law",
-           "names", "all_parameters", "groups", "linearization", "normal_forces",
+__all__ = ["ContactLaw", "LawInputError", "Parameter", "NormalForce", "Linearization", "LAWS",
+           "REGISTERED", "register", "law", "names", "all_parameters", "groups", "linearization",
            "velocity_dependent", "pruning_rules", "table_column", "uses_tangent"]

@@ -129,8 +129,3 @@ class ContactLaw:
     def keys(self):
         """Every case-file key of the law (parameters and ``case_keys``)."""
         return {p.key for p in self.case_parameters()} | set(self.case_keys)
-
-
-def zero_preload(p, n):
-    """The constant normal load N0 (n,) [N] of the contacts (0 when the law has none)."""
-    return np.asarray(p.get("normal_load", np.zeros(n)), dtype=float)
