@@ -381,15 +381,21 @@ def _normalize_damping(case, data):
 
 
 def _normalize_contacts(case, data):
+    """Contact keys checked against the contact's law (:mod:`sarfe.hbm.laws`): its parameters (with
+    their defaults), normal / tangential DOFs it needs, keys of other laws not allowed."""
+    from sarfe.hbm import laws
+
     contacts = data.setdefault("contacts", [])
     fe = case.is_fe
     names = set()
+    every_key = set().union(*(law.keys() for law in laws.LAWS.values()))
     for i, contact in enumerate(contacts):
         p = ("contacts", i)
         if contact["name"] in names:
             raise case.error(f"duplicate contact name '{contact['name']}'", p + ("name",))
         names.add(contact["name"])
-        squeak = contact["type"] == "squeak"
+        law = laws.law(contact["type"])
+        kind = law.name
         if fe:
             _not_allowed(case, contact, p, ("normal_dof", "tangential_dofs"),
                          "with model.fe (use 'between' node groups)")
@@ -412,11 +418,11 @@ def _normalize_contacts(case, data):
             _not_allowed(case, contact, p, ("between", "pairs", "normal", "pairing_tolerance_m"),
                          "with model.matrices (use 'normal_dof' / 'tangential_dofs')")
             has_normal = "normal_dof" in contact
-            if not squeak and not has_normal:
-                raise case.error("missing required key (a rattle contact needs a normal DOF)",
+            if law.normal_dof == "required" and not has_normal:
+                raise case.error(f"missing required key (a {kind} contact needs a normal DOF)",
                                  p + ("normal_dof",))
-            if squeak and "tangential_dofs" not in contact:
-                raise case.error("missing required key (a squeak contact needs a tangential DOF)",
+            if law.tangent_dofs == "required" and "tangential_dofs" not in contact:
+                raise case.error(f"missing required key (a {kind} contact needs a tangential DOF)",
                                  p + ("tangential_dofs",))
             for key in ("normal_dof",):
                 if isinstance(contact.get(key), int):
@@ -428,22 +434,41 @@ def _normalize_contacts(case, data):
                     "tangential_dofs", []):
                 ref.setdefault("relative_to", "ground")
                 ref.setdefault("sign", 1)
-        if not squeak:
-            _not_allowed(case, contact, p, ("tangential_stiffness_N_m", "friction_coefficient",
-                                            "tangential_dofs"), "for a rattle contact")
-        from_elements = "from_elements" in contact   # stiffness defaults from the elements
-        if has_normal and "normal_stiffness_N_m" not in contact and not from_elements:
-            raise case.error("missing required key", p + ("normal_stiffness_N_m",))
-        if not has_normal:
-            _not_allowed(case, contact, p, ("normal_stiffness_N_m", "gap_m"),
+        others = sorted(every_key - law.keys(), key=lambda k: list(contact).index(k)
+                        if k in contact else 0)
+        if law.tangent_dofs == "forbidden":
+            others.append("tangential_dofs")
+        _not_allowed(case, contact, p, others, f"for a {kind} contact")
+        normal_keys = [q.key for q in law.case_parameters() if q.normal_part]
+        tangent_keys = [q.key for q in law.tangent.PARAMETERS] if law.tangent is not None else []
+        # FE decks: a contact made of CBUSH/CELAS elements takes its springs from them
+        from_elements = {"normal_stiffness", "tangential_stiffness"} if "from_elements" in contact \
+            else set()
+        if has_normal:
+            for q in law.case_parameters():
+                key = q.key
+                if q.normal_part and q.required and key not in contact \
+                        and q.name not in from_elements:
+                    raise case.error("missing required key", p + (key,))
+        else:
+            _not_allowed(case, contact, p, tuple(normal_keys) + ("gap_m",),
                          "without a normal DOF (the normal load is the constant preload_N)")
             if "preload_N" not in contact:
                 raise case.error("missing required key (normal load of a friction contact "
                                  "without normal DOF)", p + ("preload_N",))
-        if squeak:
-            for key in ("tangential_stiffness_N_m", "friction_coefficient"):
-                if key not in contact and not (from_elements and key.startswith("tangential")):
-                    raise case.error("missing required key", p + (key,))
+        tangent = laws.uses_tangent(law, contact) if fe else "tangential_dofs" in contact
+        for q in law.case_parameters():
+            if q.normal_part or not q.required:
+                continue
+            if q.key in tangent_keys and not tangent or q.name in from_elements:
+                continue
+            if q.key not in contact:
+                raise case.error("missing required key", p + (q.key,))
+        if law.prepare is not None:
+            try:
+                law.prepare(contact, case.resolve)
+            except laws.LawInputError as error:
+                raise case.error(str(error), p + (error.key,)) from None
         _only_one(case, contact, p, ("gap_m", "preload_N"), required=False)
         if has_normal and "preload_N" not in contact and not fe:
             contact.setdefault("gap_m", 0.0)  # FE: default = geometric gap of each node pair

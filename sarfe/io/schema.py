@@ -94,34 +94,57 @@ REDUCTION = _object({
     "residual_vectors": {"type": "boolean"},
 })
 
-CONTACT = _object({
-    "name": {"type": "string", "pattern": "^[A-Za-z0-9_.-]+$"},
-    "type": {"enum": ["rattle", "squeak"]},
-    # FE models: node groups
-    "between": {"type": "array", "items": NAME, "minItems": 2, "maxItems": 2},
-    "pairing_tolerance_m": NON_NEGATIVE,
-    "pairs": {"type": "array", "minItems": 1,
-              "items": {"type": "array", "minItems": 2, "maxItems": 2,
-                        "items": {"type": ["integer", "string"], "minimum": 0,
-                                  "pattern": "^ground$"}}},
-    "normal": {"type": ["string", "array"], "pattern": "^auto$",
-               "items": NUMBER, "minItems": 3, "maxItems": 3},
-    # FE decks: CBUSH/CELAS element ids turned into this contact (removed from the linear
-    # model; their stiffness along element_axis is the penalty stiffness)
-    "from_elements": {"type": "array", "items": {"type": "integer", "minimum": 1},
-                      "minItems": 1, "uniqueItems": True},
-    "element_axis": {"enum": [1, 2, 3]},
-    # matrices models: DOFs
-    "normal_dof": DOF_REFERENCE,
-    "tangential_dofs": {"type": "array", "items": DOF_REFERENCE, "minItems": 1, "maxItems": 2},
-    # law
-    "gap_m": NUMBER,
-    "preload_N": NON_NEGATIVE,
-    "normal_stiffness_N_m": POSITIVE,
-    "tangential_stiffness_N_m": POSITIVE,
-    "friction_coefficient": NON_NEGATIVE,
-    "tolerance_m": NON_NEGATIVE,
-}, required=("name", "type"))
+def _law_key_schema(parameter):
+    """JSON schema of one scalar law parameter from its declaration (bounds, number)."""
+    schema = dict(NUMBER)
+    if parameter.minimum is not None:
+        schema["exclusiveMinimum" if parameter.exclusive else "minimum"] = parameter.minimum
+    if parameter.maximum is not None:
+        schema["maximum"] = parameter.maximum
+    return schema
+
+
+def contact_schema():
+    """The contact object: geometry keys, then every registered law's keys from its declaration
+    (:mod:`sarfe.hbm.laws`; which keys a type allows is checked in :mod:`sarfe.io.case`)."""
+    from sarfe.hbm import laws
+
+    law_keys = {}
+    for law in laws.LAWS.values():
+        for parameter in law.case_parameters():
+            law_keys.setdefault(parameter.key, _law_key_schema(parameter))
+        for key, schema in law.case_keys.items():
+            law_keys.setdefault(key, schema)
+    return _object({
+        "name": {"type": "string", "pattern": "^[A-Za-z0-9_.-]+$"},
+        "type": {"enum": list(laws.names())},
+        # FE models: node groups
+        "between": {"type": "array", "items": NAME, "minItems": 2, "maxItems": 2},
+        "pairing_tolerance_m": NON_NEGATIVE,
+        "pairs": {"type": "array", "minItems": 1,
+                  "items": {"type": "array", "minItems": 2, "maxItems": 2,
+                            "items": {"type": ["integer", "string"], "minimum": 0,
+                                      "pattern": "^ground$"}}},
+        "normal": {"type": ["string", "array"], "pattern": "^auto$",
+                   "items": NUMBER, "minItems": 3, "maxItems": 3},
+        # FE decks: CBUSH/CELAS element ids turned into this contact (removed from the linear
+        # model; their stiffness along element_axis is the penalty stiffness)
+        "from_elements": {"type": "array", "items": {"type": "integer", "minimum": 1},
+                          "minItems": 1, "uniqueItems": True},
+        "element_axis": {"enum": [1, 2, 3]},
+        # matrices models: DOFs
+        "normal_dof": DOF_REFERENCE,
+        "tangential_dofs": {"type": "array", "items": DOF_REFERENCE, "minItems": 1, "maxItems": 2},
+        # every law: the initial gap or a static preload, the rattle tolerance
+        "gap_m": NUMBER,
+        "preload_N": NON_NEGATIVE,
+        "tolerance_m": NON_NEGATIVE,
+        # the laws' own keys
+        **law_keys,
+    }, required=("name", "type"))
+
+
+CONTACT = contact_schema()
 
 LOAD = _object({
     "group": NAME,

@@ -9,16 +9,16 @@ import numpy as np
 
 
 def _squeak_series(nl, solution):
-    """(friction |λ_t| (N, n_sq) [N], state (N, n_sq) int, names) of the squeak contacts: the
+    """(friction |λ_t| (N, n_sq) [N], state (N, n_sq) int, names) of the contacts with a friction (tangent) element: the
     pair forces summed per named contact, the state 'slip' if any pair slips, else 'stick' if any
     sticks, else 'open'."""
     cs = nl.contacts
     force = np.asarray(solution.contact_force_time, dtype=float)
     state = np.asarray(solution.contact_state)
     friction, states, names = [], [], []
-    for name, kind, idx in nl.groups:
+    for name, _, idx in nl.groups:
         tr = np.asarray(cs.tangent_rows)[idx]
-        if kind != "squeak" or not (tr >= 0).any():
+        if not (tr >= 0).any():        # no friction (tangent) element
             continue
         lam = force[:, np.where(tr >= 0, tr, 0)] * (tr >= 0)                  # (N, p, 2)
         friction.append(np.sqrt((lam.sum(axis=1) ** 2).sum(axis=1)))

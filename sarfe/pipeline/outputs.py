@@ -110,8 +110,9 @@ def write_outputs(case, stage, nl, summary, rows, solutions, erps, normal_w, dir
 
 def results_table(rows, contact_types=None, max_contacts=6) -> str:
     """Console table of the frequency points: convergence, ERP and, per contact (at most
-    ``max_contacts``), the max penetration of a rattle contact or the slip fraction of a squeak
-    contact. ``contact_types``: {name: 'rattle' | 'squeak'} (default: all rattle)."""
+    ``max_contacts``), the indicator its law declares (max penetration, or the slip fraction of a
+    friction law). ``contact_types``: {name: law name} (default: max penetration)."""
+    from sarfe.hbm.laws import table_column
     from sarfe.io.outputs import console_table
 
     columns = ["frequency_hz", "converged", "stable", "iterations", "erp_db", "erp_dba",
@@ -122,7 +123,8 @@ def results_table(rows, contact_types=None, max_contacts=6) -> str:
     names = [k[: -len(".max_penetration_m")] for k in (rows[0] if rows else {})
              if k.endswith(".max_penetration_m")]
     for name in names[:max_contacts]:
-        if (contact_types or {}).get(name) == "squeak":
+        law = (contact_types or {}).get(name)
+        if law is not None and table_column(law) == "slip_fraction":
             key, header, fmt = f"{name}.slip_fraction", f"{name} slip", ".2f"
         else:
             key, header, fmt = f"{name}.max_penetration_m", f"{name} pen [mm]", ".3f"

@@ -62,7 +62,8 @@ def contact_indicators(solution, nl: NonlinearModel) -> list[dict]:
         normal = normal + cs.normal_load[idx].sum()
         tr = cs.tangent_rows[idx]
         friction = np.zeros(N)
-        if kind == "squeak":
+        has_tangent = bool(np.any(tr >= 0))        # a law with a tangent (friction) element
+        if has_tangent:
             t = np.where(tr >= 0, tr, 0)
             ft = force[:, t] * (tr >= 0)
             friction = np.sqrt((ft ** 2).sum(axis=2)).sum(axis=1)
@@ -72,7 +73,7 @@ def contact_indicators(solution, nl: NonlinearModel) -> list[dict]:
             "name": name, "type": kind, "pairs": int(len(idx)),
             "max_penetration_m": float(max(penetration, 0.0)) if has.any() else float("nan"),
             "peak_normal_force_N": float(normal.max()),
-            "peak_friction_force_N": float(friction.max()) if kind == "squeak" else float("nan"),
+            "peak_friction_force_N": float(friction.max()) if has_tangent else float("nan"),
             "normal_amplitude_m": float(amplitude_1),
             "open_fraction": float(np.mean(st == 0)),
             "closed_or_stick_fraction": float(np.mean(st == 1)),
