@@ -131,13 +131,14 @@ def build_contacts(case: Case, stage: LinearStage):
             except ValueError as error:
                 raise case.error(str(error), ("contacts", case.data["contacts"].index(contact),
                                               "type")) from None
+        per_pair = {}                   # deck springs (from_elements): one value per node pair
         geometry = stage.contacts.get(name) if stage.kind == "fe" else None
-        if getattr(geometry, "normal_stiffness", None) is not None:  # deck springs (from_elements)
+        if getattr(geometry, "normal_stiffness", None) is not None:
             if "normal_stiffness_N_m" not in contact:
-                values["normal_stiffness"] = np.asarray(geometry.normal_stiffness, dtype=float)
+                per_pair["normal_stiffness"] = np.asarray(geometry.normal_stiffness, dtype=float)
             if "tangential_stiffness_N_m" not in contact and "tangential_stiffness" in values:
-                values["tangential_stiffness"] = np.asarray(geometry.tangential_stiffness,
-                                                            dtype=float)
+                per_pair["tangential_stiffness"] = np.asarray(geometry.tangential_stiffness,
+                                                              dtype=float)
         if not has_normal:
             g = np.zeros(pairs)
             values["normal_load"] = contact["preload_N"] * share
@@ -151,7 +152,7 @@ def build_contacts(case: Case, stage: LinearStage):
             table.setdefault(key, [np.nan] * start)
         for key in table:
             value = values.get(key, np.nan)
-            table[key] += list(np.broadcast_to(value, (pairs,)))
+            table[key] += list(per_pair[key]) if key in per_pair else [value] * pairs
         kind += [contact["type"]] * pairs
         gap += list(g)
         tolerance += [contact["tolerance_m"]] * pairs
