@@ -225,7 +225,7 @@ def condense(model, gap_map, excitation: np.ndarray, omega: float,
     3000, K positive definite and D diagonal in the undamped modes — or ``modal`` = a ModalBasis of
     this model): C_k = G K⁻¹ Gᵀ + (GV) diag(q_k) (GV)ᵀ, y_k = K⁻¹ f_k + V (q_k ⊙ Vᵀ f_k), no
     factorization per point (the eigen-solve and the Cholesky factor of K are computed once per
-    model and cached). Otherwise (``modal`` = False / None, or the basis does not apply):
+    model, at its second condensation, and cached: the first one is factorized). Otherwise (``modal`` = False / None, or the basis does not apply):
     dense models, one batched LAPACK solve of Z_k [Gᵀ, f_k] over the kept harmonics (singular when
     LAPACK says so or when ‖Z_k‖ max|Z_k⁻¹ b| > 10¹³ max|b|); sparse models, one SuperLU per kept
     harmonic.

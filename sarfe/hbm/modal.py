@@ -17,7 +17,8 @@ dynamic remainder (the mode-acceleration form):
 in which a stiff mode's term is O((kω)² μ_j) → 0, so its inaccurate eigenvector does not matter.
 Then G Z_k⁻¹ Gᵀ = G K⁻¹ Gᵀ + (GV) diag(q_k) (GV)ᵀ costs O(n_rows² n_modes) per harmonic and
 frequency and Z_k⁻¹ f = K⁻¹ f + V (q_k ⊙ Vᵀ f) O(n n_modes), with no factorization per point: the
-O(n³) eigen-solve and the Cholesky factor are paid once per model (:func:`cached_modal_basis`). V
+O(n³) eigen-solve and the Cholesky factor are paid once per model, at its second condensation
+(:func:`cached_modal_basis`). V
 is the complete basis of the (reduced) model, not a truncation: nothing is approximated except the
 damping check below. Models with a singular K (rigid-body modes; Z_0 is singular anyway) keep the
 factorization path.
@@ -117,19 +118,28 @@ def modal_basis(model, max_dofs=MODAL_MAX_DOFS, tolerance=MODAL_DAMPING_TOLERANC
 
 
 _CACHE: dict = {}
+_SEEN_ONCE = object()
 
 
 def cached_modal_basis(model):
-    """:func:`modal_basis` of ``model``, computed once per model object (cache keyed on id(model),
-    the entry dropped when the model is garbage-collected; the model must not be mutated —
-    LinearModel is frozen). None (also cached) when the modal path does not apply."""
+    """:func:`modal_basis` of ``model`` from its second call on, cached per model object.
+
+    The first call for a model returns None (the caller factorizes): a model condensed at a single
+    frequency — a fixed-frequency Newton caches its condensation, the error estimate's coarser
+    model is solved at one ω — never pays the eigen-solve; from the second call (a sweep, a
+    continuation, several frequencies) the basis is computed once and reused. The cache is keyed
+    on id(model) and the entry dropped when the model is garbage-collected; the model must not be
+    mutated (LinearModel is frozen). None is also cached when the modal path does not apply.
+    """
     key = id(model)
-    if key in _CACHE:
-        return _CACHE[key]
-    basis = modal_basis(model)
-    try:
-        weakref.finalize(model, _CACHE.pop, key, None)
-    except TypeError:            # not weak-referenceable: do not cache (ids could be reused)
-        return basis
-    _CACHE[key] = basis
-    return basis
+    entry = _CACHE.get(key)
+    if entry is None and key not in _CACHE:
+        try:
+            weakref.finalize(model, _CACHE.pop, key, None)
+        except TypeError:        # not weak-referenceable: no cache (ids could be reused)
+            return modal_basis(model)
+        _CACHE[key] = _SEEN_ONCE
+        return None
+    if entry is _SEEN_ONCE:
+        entry = _CACHE[key] = modal_basis(model)
+    return entry
