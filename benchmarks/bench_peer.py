@@ -91,17 +91,19 @@ def sarfe_curve(output):
     return omega, np.hypot(u[:, 1], u[:, 2]), stable
 
 
-def curve_difference(omega_a, amp_a, omega_b, amp_b):
-    """Largest |a − b| / max(b) over the Ω where both curves are single valued (monotone Ω runs
-    of each, interpolated on b's points)."""
+def curve_difference(omega_sarfe, amp_sarfe, omega_peer, amp_peer):
+    """Largest |a_sarfe − a_peer| / max a_peer at sarfe's points, the peer's (denser) curve
+    interpolated linearly; None when either curve folds (Ω not monotone)."""
     def monotone(omega):
         step = np.sign(np.diff(omega))
         return np.all(step == step[0]) if step.size else True
-    if not (monotone(omega_a) and monotone(omega_b)):
+    if not (monotone(omega_sarfe) and monotone(omega_peer)):
         return None
-    oa, aa = (omega_a, amp_a) if omega_a[0] < omega_a[-1] else (omega_a[::-1], amp_a[::-1])
-    inside = (omega_b >= oa[0]) & (omega_b <= oa[-1])
-    return float(np.abs(np.interp(omega_b[inside], oa, aa) - amp_b[inside]).max() / amp_b.max())
+    order = np.argsort(omega_peer)
+    op, ap = omega_peer[order], amp_peer[order]
+    inside = (omega_sarfe >= op[0]) & (omega_sarfe <= op[-1])
+    return float(np.abs(np.interp(omega_sarfe[inside], op, ap) - amp_sarfe[inside]).max()
+                 / amp_peer.max())
 
 
 def run_problem(problem, python, repeats, directory):
@@ -167,8 +169,8 @@ def write(results):
                      f"({s['peak_omega']:.5f}) | {diff} |")
     lines += ["", "Peak = largest first-harmonic amplitude among the computed points (a coarse "
               "sweep samples the peak below its true value). Curve difference = max |a_sarfe − "
-              "a_peer| / max a_peer on the peer's points, sarfe interpolated (single-valued curves "
-              "only)."]
+              "a_peer| / max a_peer at sarfe's points, the peer's denser curve interpolated "
+              "(single-valued curves only)."]
     (HERE / "results" / "peer.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
 

@@ -32,6 +32,7 @@ r̃_lin, Y_k hold only their blocks (dropped orders: zero), so the cost falls wi
 """
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -74,13 +75,43 @@ def apply_dynamic_stiffness_derivative(model, omega: float, U: np.ndarray) -> np
 def dynamic_stiffness_matrix(model, omega: float, harmonics: int) -> sp.csr_matrix:
     """Sparse block-diagonal S(ω) of size (2H+1)n, harmonic-major (for the uncondensed Newton).
 
-    S = I⊗K − ω² diag(k²)⊗M + ω ∇⊗D  (∇ = :func:`derivative_matrix`, sparse Kronecker products).
+    S = I⊗K − ω² diag(k²)⊗M + ω ∇⊗D  (∇ = :func:`derivative_matrix`). The three Kronecker
+    products are built once per (model, H) on one sparsity pattern (:func:`_dynamic_stiffness_parts`),
+    so each call only forms the values a₀ + ω b₁ + ω² b₂.
     """
+    pattern, a0, b1, b2 = _dynamic_stiffness_parts(model, int(harmonics))
+    return sp.csr_matrix((a0 + omega * b1 + omega**2 * b2, pattern.indices.copy(),
+                          pattern.indptr.copy()), shape=pattern.shape)
+
+
+_STIFFNESS_PARTS: dict = {}
+
+
+def _dynamic_stiffness_parts(model, harmonics):
+    """(pattern, a₀, b₁, b₂): the union sparsity pattern of I⊗K, ∇⊗D, diag(k²)⊗M and the values of
+    I⊗K, ∇⊗D and −diag(k²)⊗M on it; cached per model object (id, dropped when it is collected)."""
+    per_model = _STIFFNESS_PARTS.get(id(model))
+    if per_model is not None and harmonics in per_model:
+        return per_model[harmonics]
     K, M, D = (sp.csr_matrix(a) for a in (model.stiffness, model.mass, model.damping))
     P = 2 * harmonics + 1
     orders = np.concatenate(([0], np.repeat(np.arange(1, harmonics + 1), 2)))
-    return (sp.kron(sp.identity(P), K) - omega**2 * sp.kron(sp.diags(orders**2.0), M)
-            + omega * sp.kron(sp.csr_matrix(derivative_matrix(harmonics)), D)).tocsr()
+    terms = (sp.kron(sp.identity(P), K, format="csr"),
+             sp.kron(sp.csr_matrix(derivative_matrix(harmonics)), D, format="csr"),
+             -sp.kron(sp.diags(orders**2.0), M, format="csr"))
+    pattern = sum(abs(t) for t in terms).tocsr()
+    pattern.sort_indices()
+    rows = np.repeat(np.arange(pattern.shape[0]), np.diff(pattern.indptr))
+    values = [np.asarray(t[rows, pattern.indices]).ravel() for t in terms]
+    parts = (pattern, *values)
+    if per_model is None:
+        try:
+            weakref.finalize(model, _STIFFNESS_PARTS.pop, id(model), None)
+        except TypeError:                  # not weak-referenceable: do not cache
+            return parts
+        per_model = _STIFFNESS_PARTS[id(model)] = {}
+    per_model[harmonics] = parts
+    return parts
 
 
 def hill_matrices(model, omega: float, harmonics: int):

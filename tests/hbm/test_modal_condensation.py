@@ -121,6 +121,19 @@ def test_single_dof_closed_form():
                                rtol=1e-12)
 
 
+def test_dynamic_stiffness_matrix_reuses_its_pattern():
+    """S(ω) from the cached Kronecker parts acts like the harmonic-by-harmonic product S(ω) ũ
+    (cos rows K u_c − k²ω² M u_c + kω D u_s, sin rows … − kω D u_c) at several ω."""
+    from sarfe.hbm.linear import apply_dynamic_stiffness, dynamic_stiffness_matrix
+
+    for model in (chain(damping="dashpot"), chain(damping="rayleigh")):
+        U = np.random.default_rng(2).normal(size=(2 * H + 1, model.dof_count))
+        for omega in (3.0, 17.3, 40.0):
+            S = dynamic_stiffness_matrix(model, omega, H)
+            np.testing.assert_allclose(S @ U.ravel(), apply_dynamic_stiffness(model, omega, U).ravel(),
+                                       rtol=1e-13, atol=1e-12 * np.abs(S).max())
+
+
 def test_non_proportional_damping_falls_back():
     model = chain(damping="dashpot")
     assert modal_basis(model) is None
