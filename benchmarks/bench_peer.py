@@ -108,11 +108,11 @@ def curve_difference(omega_sarfe, amp_sarfe, omega_peer, amp_peer):
 
 def run_problem(problem, python, repeats, directory):
     cases = {v: sarfe_case(problem, v, directory) for v in ("defaults", "bare")}
-    timed(peer_command(python, problem))                   # warm-up: numba compiles its cache
+    timed(peer_command(python, problem), cwd=directory)    # warm-up: numba compiles its cache
     times = {"peer": [], "defaults": [], "bare": []}
     peer_out = None
     for _ in range(repeats):                               # A B A B ...
-        wall, cpu, out = timed(peer_command(python, problem))
+        wall, cpu, out = timed(peer_command(python, problem), cwd=directory)   # its logs there
         times["peer"].append((wall, cpu))
         peer_out = json.loads(out.strip().splitlines()[-1])
         for variant, case in cases.items():
