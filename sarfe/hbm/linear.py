@@ -19,13 +19,13 @@ contact rows, C_k = G Z_k⁻¹ Gᵀ (n_rows × n_rows), so that r̃ = G ũ satis
     R_c(r̃) = r̃ − r̃_lin + C λ̃(r̃) = 0,    r̃_lin = G S⁻¹ f̃_e,
 
 with (2H+1) n_rows unknowns instead of (2H+1) n. The DOFs are recovered afterwards from
-ũ_k = Z_k⁻¹ (f̃_k − Gᵀ λ̃_k). Z_k⁻¹ comes from the undamped modes of the model when its damping is
-diagonal in them (modal ζ, Rayleigh, none; n ≤ 3000): Z_k⁻¹ = K⁻¹ + V diag(q_k) Vᵀ with the modes V
-and the Cholesky factor of K computed once per model (:mod:`sarfe.hbm.modal`), so a point costs no
-factorization; otherwise Z_k is factorized
-once per harmonic and frequency (dense LU, or SuperLU when the model is sparse). A singular Z_k
-(undamped resonance, free-floating structure at k = 0) makes :func:`condense` return None so that
-the caller falls back to the full residual.
+ũ_k = Z_k⁻¹ (f̃_k − Gᵀ λ̃_k). For a dense (reduced) model with n ≤ 3000 whose damping is
+diagonal in its undamped modes (modal ζ, Rayleigh, none), Z_k⁻¹ = K⁻¹ + V diag(q_k) Vᵀ with the
+modes V and the Cholesky factor of K computed once per model (:mod:`sarfe.hbm.modal`), so a sweep
+point costs no factorization; otherwise Z_k is factorized once per harmonic and frequency (dense
+LU, or SuperLU when the model is sparse). A singular Z_k (undamped resonance, free-floating
+structure at k = 0) makes :func:`condense` return None so that the caller falls back to the full
+residual.
 
 With a harmonic set (:mod:`sarfe.hbm.harmonic_set`) only the kept orders k are factorized and C,
 r̃_lin, Y_k hold only their blocks (dropped orders: zero), so the cost falls with the kept count.
@@ -252,9 +252,9 @@ def condense(model, gap_map, excitation: np.ndarray, omega: float,
     """C = G Z_k⁻¹ Gᵀ (kept rows only), r̃_lin and y_k = Z_k⁻¹ f_k for the kept orders k (``orders``,
     default 0…H); None if a Z_k is singular.
 
-    Modal path (``modal`` = 'auto' and :func:`sarfe.hbm.modal.cached_modal_basis` applies — n ≤
-    3000, K positive definite and D diagonal in the undamped modes — or ``modal`` = a ModalBasis of
-    this model): C_k = G K⁻¹ Gᵀ + (GV) diag(q_k) (GV)ᵀ, y_k = K⁻¹ f_k + V (q_k ⊙ Vᵀ f_k), no
+    Modal path (``modal`` = 'auto' and :func:`sarfe.hbm.modal.cached_modal_basis` applies — a
+    dense model (e.g. Craig–Bampton), n ≤ 3000, K positive definite and D diagonal in the undamped
+    modes — or ``modal`` = a ModalBasis of this model): C_k = G K⁻¹ Gᵀ + (GV) diag(q_k) (GV)ᵀ, y_k = K⁻¹ f_k + V (q_k ⊙ Vᵀ f_k), no
     factorization per point (the eigen-solve and the Cholesky factor of K are computed once per
     model, at its second condensation, and cached: the first one is factorized). Otherwise (``modal`` = False / None, or the basis does not apply):
     dense models, one batched LAPACK solve of Z_k [Gᵀ, f_k] over the kept harmonics (singular when

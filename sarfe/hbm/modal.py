@@ -122,7 +122,10 @@ _SEEN_ONCE = object()
 
 
 def cached_modal_basis(model):
-    """:func:`modal_basis` of ``model`` from its second call on, cached per model object.
+    """:func:`modal_basis` of a dense ``model`` from its second call on, cached per model object.
+
+    Sparse models (unreduced FE, lumped chains) get None: their per-harmonic sparse LU costs less
+    than the O(n²) dense modal products.
 
     The first call for a model returns None (the caller factorizes): a model condensed at a single
     frequency — a fixed-frequency Newton caches its condensation, the error estimate's coarser
@@ -131,6 +134,8 @@ def cached_modal_basis(model):
     on id(model) and the entry dropped when the model is garbage-collected; the model must not be
     mutated (LinearModel is frozen). None is also cached when the modal path does not apply.
     """
+    if sp.issparse(model.stiffness):
+        return None              # SuperLU of a sparse Z_k is cheaper than the O(n²) modal products
     key = id(model)
     entry = _CACHE.get(key)
     if entry is None and key not in _CACHE:

@@ -93,6 +93,8 @@ def test_lumped_modal_path_equals_factorization(damping):
     sparse = make_linear_model(*(sp.csr_matrix(a) for a in (model.mass, model.damping,
                                                             model.stiffness)))
     compare_paths(sparse, G, omega)
+    for _ in range(2):      # 'auto' keeps the sparse LU for sparse models
+        assert condense(sparse, G, excitation(6), omega).modal is None
 
 
 @pytest.mark.parametrize("damping", ["modal", "rayleigh", "none"])
