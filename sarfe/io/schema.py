@@ -132,7 +132,7 @@ SOLVER = _object({
     "tolerance": {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1},
     "max_iterations": {"type": "integer", "minimum": 1},
     "stability": {"type": "boolean"},
-    # accuracy as an input (sarfe.study.resolve): a preset or a target; H, N, modes are chosen
+    # accuracy as an input (sarfe.accuracy.resolve): a preset or a target; H, N, modes are chosen
     "accuracy": {"oneOf": [{"enum": ["fast", "balanced", "fine"]},
                            _object({"erp_db": POSITIVE, "amplitude_rel": POSITIVE})]},
     "error_estimate": {"type": "boolean"},   # per-point error estimate (≈2 Newton steps a point)

@@ -18,7 +18,7 @@ def solver_options(case):
     """(SolverOptions, ContinuationOptions) from the case's ``solver`` section. The tolerance of
     ``harmonic_set: auto`` is the amplitude budget of ``solver.accuracy`` (default 'balanced')."""
     from sarfe.hbm import ContinuationOptions, SolverOptions
-    from sarfe.study.accuracy import parse_accuracy
+    from sarfe.accuracy.estimates import parse_accuracy
 
     solver = case.data["solver"]
     options = SolverOptions(tolerance=solver["tolerance"], max_iterations=solver["max_iterations"],

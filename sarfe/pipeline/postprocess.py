@@ -110,7 +110,7 @@ def linear_baseline(case, stage, nl: NonlinearModel, omega):
 
 
 def _error_estimate(case, stage, nl, solution):
-    """Cheap a-posteriori error estimate of a converged point (sarfe.study.accuracy): harmonic
+    """Cheap a-posteriori error estimate of a converged point (sarfe.accuracy): harmonic
     truncation (one Newton step with more harmonics), AFT aliasing (N doubled), modal truncation,
     spectral tails. None when switched off, not converged or without contacts; a failure of the
     estimate is reported, never raised."""
@@ -118,7 +118,7 @@ def _error_estimate(case, stage, nl, solution):
             or not nl.contacts.count:
         return None
     try:
-        from sarfe.study.accuracy import stage_error_estimate
+        from sarfe.pipeline.accuracy import stage_error_estimate
 
         return stage_error_estimate(solution, stage, nl).as_dict()
     except Exception as error:  # an estimate must not break a solve

@@ -52,7 +52,8 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     accuracy = None
     if "accuracy" in case.data["solver"]:
         # accuracy as an input: choose H, N (and mode count) from cheap error estimates first
-        from sarfe.study.resolve import apply_resolution, resolve_case_accuracy
+        from sarfe.accuracy.resolve import apply_resolution
+        from sarfe.pipeline.accuracy import resolve_case_accuracy
 
         clock = time.perf_counter()
         report = resolve_case_accuracy(case, case.data["solver"]["accuracy"])
