@@ -273,14 +273,16 @@ def _normalize_model(case, data):
                                      f"got '{path.name}'", p + (key,))
                 if not path.is_file():
                     raise case.error(f"matrix file not found: {path}", p + (key,))
-        if "damping" in mat and "damping" in data:
+        # an empty damping section is what normalizing a case with its own damping matrix leaves
+        # (so a normalized case, e.g. after solver.accuracy chose H, loads again)
+        if "damping" in mat and data.get("damping"):
             raise case.error("give either model.matrices.damping or a damping section, not both",
                              ("damping",))
         _not_allowed(case, data, (), ("reduction",), "with model.matrices (no reduction)")
 
 
 def _normalize_damping(case, data):
-    if "damping" not in data:
+    if not data.get("damping"):       # absent, or {} left by normalizing a matrices damping
         if "matrices" in data["model"] and "damping" in data["model"]["matrices"]:
             data["damping"] = {}
             return
