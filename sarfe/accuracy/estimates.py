@@ -71,6 +71,9 @@ import numpy as np
 RICHARDSON = 2.0   # 1 / (1 − 2^{−p}) for an error ∝ H^{−p}, p = 1, and one doubling (3)
 REFINE_ITERATIONS = 40  # Newton iterations allowed per raise of H (1) before stopping the climb
 MAX_EXTENSION = 64      # cap of H' in :func:`reach_harmonics`
+ESTIMATE_ITERATIONS = 8      # Newton iterations of one estimate solve (1) (usually 1–4)
+ESTIMATE_TOLERANCE = 1e-7    # its relative residual: the changes sought are ≥ 1e-4 of a₁
+STALLED_RESIDUAL = 1e-5      # a solve stalled below this residual (at a kink) is still used
 
 PRESETS = {   # ERP of impacts converges slowly in H (ERP ∝ Σ (kω)² |w_k|²): dB targets are looser
     "fast": {"amplitude_rel": 5e-2, "erp_db": 2.0},
@@ -245,24 +248,15 @@ def _change(contacts, U, U_new, omega, erp_map, erp_areas, ref_amplitude=None):
 
 def newton_correction(model, contacts, excitation, solution, harmonics, samples_per_period,
                       options=None):
-    """(1): the solution of the (H', N') problem from ũ embedded in it → (2H''+1, n) [m], H'' ≤ H'.
-
-    Newton iterations of the richer problem (condensed on the contact rows, as the engine solves;
-    at most REFINE_ITERATIONS), H raised to H' in steps of ×1.5 (N ≥ 4H + 1, retried with N/H kept
-    when a step stalls), each warm-started from the last. When a
-    raise does not converge the climb stops at the last converged H'' (an impact whose active set
-    changes a lot); when none converges, the first Newton step ũ + δ at (H', N'). None when the
-    Jacobian is singular or the step is not finite. excitation f̃_e (2H_e+1, n) [N] (resized).
-    """
-    from dataclasses import replace
-
-    from sarfe.hbm.solve import SolverOptions, solve_frequency
-
-    import warnings
-
+    """(1) climbing: the solution of the (H', N') problem from ũ embedded in it, H raised to H' in
+    steps of ×1.5 (N ≥ 4H + 1, retried with N/H kept when a step stalls), each a
+    :func:`newton_step` warm-started from the last → (2H''+1, n) [m], H'' ≤ H'. The fallback when
+    one solve at H' does not converge (an impact whose active set a large raise changes a lot);
+    the climb stops at the last converged H''. None when no raise converges. excitation f̃_e
+    (2H_e+1, n) [N] (resized)."""
     H0, H_target = int(solution.harmonics), int(harmonics)
     N = int(samples_per_period)
-    quick = replace(options or SolverOptions(), max_iterations=REFINE_ITERATIONS, stability=False)
+    omega = float(solution.omega)
     steps = [H_target] if H_target <= H0 else []
     H = H0
     while H < H_target:
@@ -275,48 +269,51 @@ def newton_correction(model, contacts, excitation, solution, harmonics, samples_
         scaled = N if H_target <= H0 else _at_least(N, max(4 * H + 1, N * H / max(H0, 1)))
         refined = None
         for N_try in (first, scaled) if scaled != first else (first,):
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                try:
-                    refined = solve_frequency(model, contacts, resize_harmonics(excitation, H),
-                                              float(solution.omega), H, N_try,
-                                              initial=resize_harmonics(previous, H), options=quick)
-                except (ValueError, np.linalg.LinAlgError):
-                    refined = None
-            if refined is not None and refined.converged:
+            refined = newton_step(model, contacts, resize_harmonics(excitation, H),
+                                  resize_harmonics(previous, H), omega, H, N_try, options)
+            if refined is not None:
                 break
-        if refined is None or not refined.converged or not np.all(
-                np.isfinite(refined.displacement)):
+        if refined is None:
             break
-        best = previous = np.asarray(refined.displacement, dtype=float)
-    if best is not None:
-        return best
-    return newton_step(model, contacts, resize_harmonics(excitation, H_target),
-                       resize_harmonics(solution.displacement, H_target), float(solution.omega),
-                       H_target, N, options)
+        best = previous = refined
+    return best
 
 
 def newton_step(model, contacts, excitation, U, omega, harmonics, samples_per_period,
-                options=None):
-    """ũ + δ, δ = −J⁻¹ R of the (H', N') problem at ũ (2H'+1, n) (1); None when singular."""
-    from sarfe.hbm.newton import SingularJacobian, solve_linear
-    from sarfe.hbm.residual import full_residual
-    from sarfe.hbm.solve import make_problem
+                options=None, steps=None):
+    """The (H', N') problem solved from ũ (2H'+1, n) [m] by Newton (1), condensed on the contact
+    rows as the engine solves it (x = G ũ; one condensation S_k(ω)⁻¹ Gᵀ at ω for every iteration;
+    ũ recovered from the contact forces at the end) → ũ' (2H'+1, n), or None when the Jacobian is
+    singular, Newton stalls above STALLED_RESIDUAL or ũ' is not finite. ``steps``: at most that
+    many iterations (default ESTIMATE_ITERATIONS, relative residual ESTIMATE_TOLERANCE, at most 3
+    line-search halvings); from a start this close they are usually 1–4."""
+    from dataclasses import replace
+
+    from sarfe.hbm.newton import SingularJacobian, newton
+    from sarfe.hbm.solve import (SolverOptions, initial_slider, make_evaluator, make_problem,
+                                 slider_acceptor)
 
     import warnings
 
-    with warnings.catch_warnings():
+    U = np.asarray(U, dtype=float)
+    base = options or SolverOptions()
+    options = replace(base, stability=False, max_iterations=int(steps or ESTIMATE_ITERATIONS),
+                      tolerance=max(base.tolerance, ESTIMATE_TOLERANCE),
+                      line_search_steps=min(base.line_search_steps, 3))
+    with warnings.catch_warnings(), np.errstate(all="ignore"):
         warnings.simplefilter("ignore")
         problem = make_problem(model, contacts, excitation, harmonics, samples_per_period, options)
-        with np.errstate(all="ignore"):
-            ev = full_residual(problem, U.ravel(), omega, None, jacobian=True)
-        if not np.all(np.isfinite(ev.residual)):
-            return None
         try:
-            step = solve_linear(ev.jacobian, -ev.residual)
+            evaluate, to_x, to_displacement = make_evaluator(problem, contacts.row_count > 0)
+            state = {"slider": initial_slider(problem, U)}
+            result = newton(lambda x, jacobian: evaluate(x, omega, jacobian, state["slider"]),
+                            to_x(U), options, accept=slider_acceptor(state))
+            if not (result.converged or result.residual_norm <= STALLED_RESIDUAL):
+                return None     # (stalled at a kink of the sampled forces close by: kept)
+            U_new = np.asarray(to_displacement(result.x, omega, result.evaluation))
         except SingularJacobian:
             return None
-    U_new = U + step.reshape(U.shape)
+    U_new = U_new.reshape(U.shape)
     return U_new if np.all(np.isfinite(U_new)) else None
 
 
@@ -402,19 +399,24 @@ def _rebuilt_modal_damping(model, small):
     return LinearModel(small.mass, 0.5 * (Ds + Ds.T), small.stiffness)
 
 
-def modal_truncation_change(solution, model, contacts, excitation, modal_dofs, residual_dofs=(),
-                            erp_map=None, erp_areas=None, options=None, ref_amplitude=None):
-    r"""(4): change of the solution on the coarser model T (:func:`coarser_basis`, the top fifth of
-    the modes ``modal_dofs`` — at least one — left out), re-solved (1) from the solution projected
-    on it → (relative amplitude change, |ERP level change| [dB], modes left out) or None when the
-    re-solve fails. modal_dofs: the fixed-interface modal coordinates in increasing frequency;
-    residual_dofs: the residual modes (rebuilt for the coarser model).
-    """
-    from types import SimpleNamespace
+_COARSER = {}     # coarser model per (model, contacts, excitation, modes): built once per run
+
+
+def coarser_model(model, contacts, excitation, modal_dofs, residual_dofs=()):
+    """(T, coarser LinearModel, its ContactSet, modes left out) of (4), cached: the coarser model
+    does not depend on the point, only its start does."""
+    from dataclasses import replace
+
+    import scipy.sparse as sp
 
     from sarfe.hbm.model import LinearModel
 
     modal_dofs = np.asarray(modal_dofs, dtype=int)
+    residual_dofs = np.asarray(residual_dofs, dtype=int)
+    key = (id(model), id(contacts), id(excitation), modal_dofs.tobytes(), residual_dofs.tobytes())
+    hit = _COARSER.get(key)
+    if hit is not None and hit[0] is model and hit[1] is contacts and hit[2] is excitation:
+        return hit[3]
     removed = modal_dofs[-max(1, len(modal_dofs) // 5):]
     T = coarser_basis(model, excitation, int(modal_dofs.min()), removed, residual_dofs)
 
@@ -425,24 +427,44 @@ def modal_truncation_change(solution, model, contacts, excitation, modal_dofs, r
 
     small = LinearModel(project(model.mass), project(model.damping), project(model.stiffness))
     small = _rebuilt_modal_damping(model, small)
-    from dataclasses import replace
-
-    import scipy.sparse as sp
-
     small_contacts = replace(contacts, gap_map=sp.csr_matrix(contacts.gap_map @ T))
+    value = (T, small, small_contacts, len(removed))
+    if len(_COARSER) >= 4:
+        _COARSER.clear()
+    _COARSER[key] = (model, contacts, excitation, value)
+    return value
+
+
+def modal_truncation_change(solution, model, contacts, excitation, modal_dofs, residual_dofs=(),
+                            erp_map=None, erp_areas=None, options=None, ref_amplitude=None,
+                            steps=None):
+    r"""(4): change of the solution on the coarser model T (:func:`coarser_basis`, the top fifth of
+    the modes ``modal_dofs`` — at least one — left out), re-solved (1) from the solution projected
+    on it → (relative amplitude change, |ERP level change| [dB], modes left out) or None when the
+    re-solve fails. modal_dofs: the fixed-interface modal coordinates in increasing frequency;
+    residual_dofs: the residual modes (rebuilt for the coarser model).
+    """
+    from types import SimpleNamespace
+
+    T, small, small_contacts, removed = coarser_model(model, contacts, excitation, modal_dofs,
+                                                      residual_dofs)
     U = np.asarray(solution.displacement, dtype=float)
     # start: the M-orthogonal projection of ũ on span T
     M = model.mass.toarray() if hasattr(model.mass, "toarray") else np.asarray(model.mass)
     start = np.linalg.solve(small.mass, ((U @ M) @ T).T).T
-    U_small = newton_correction(small, small_contacts, np.asarray(excitation) @ T,
-                                SimpleNamespace(displacement=start, omega=solution.omega,
-                                                harmonics=solution.harmonics),
-                                int(solution.harmonics), int(solution.samples_per_period), options)
+    H, N = int(solution.harmonics), int(solution.samples_per_period)
+    F_small = resize_harmonics(np.asarray(excitation) @ T, H)
+    U_small = newton_step(small, small_contacts, F_small, start, float(solution.omega), H, N,
+                          options, steps)
+    if U_small is None:
+        U_small = newton_correction(small, small_contacts, F_small,
+                                    SimpleNamespace(displacement=start, omega=solution.omega,
+                                                    harmonics=H), H, N, options)
     if U_small is None:
         return None
     rel, db = _change(contacts, U, U_small @ T.T, float(solution.omega), erp_map, erp_areas,
                       ref_amplitude)
-    return rel, abs(db), len(removed)
+    return rel, abs(db), removed
 
 
 def harmonics_richardson(harmonics: int, extended: int) -> float:
@@ -474,8 +496,7 @@ def samples_for(harmonics: int, samples_per_period: int) -> int:
 
 def estimate_errors(solution, model, contacts, excitation, *, erp_map=None, erp_areas=None,
                     modal_dofs=None, residual_dofs=None, harmonics_extension=None, aliasing=True,
-                    truncation=True,
-                    options=None) -> ErrorEstimate:
+                    truncation=True, options=None, steps=None) -> ErrorEstimate:
     """Error estimates of a converged :class:`HarmonicSolution` (module docstring).
 
     model, contacts, excitation f̃_e (2H+1, n) [N]: the problem the solution solves.
@@ -499,8 +520,14 @@ def estimate_errors(solution, model, contacts, excitation, *, erp_map=None, erp_
     h_rel = h_db = a_rel = a_db = nan
     H_ext = int(harmonics_extension or extended_harmonics(H))
     if truncation:
-        U_new = newton_correction(model, contacts, excitation, solution, H_ext,
-                                  samples_for(H_ext, N), options)
+        U_new = newton_step(model, contacts, resize_harmonics(excitation, H_ext),
+                            resize_harmonics(U, H_ext), omega, H_ext, samples_for(H_ext, N),
+                            options, steps)
+        if U_new is None:   # a large raise changed the active set too much: climb ×1.5 a step
+            U_new = newton_correction(model, contacts, excitation, solution, H_ext,
+                                      samples_for(H_ext, N), options)
+            notes.append("truncation estimate: H raised in steps (one Newton solve at H' did "
+                         "not converge)")
         if U_new is None:
             notes.append("truncation estimate: singular Jacobian")
         else:
@@ -511,7 +538,10 @@ def estimate_errors(solution, model, contacts, excitation, *, erp_map=None, erp_
             h_rel, h_db = _change(contacts, resize_harmonics(U, H_ext), U_new, omega, erp_map,
                                   erp_areas, a_ref)
     if aliasing:
-        U_new = newton_correction(model, contacts, excitation, solution, H, 2 * N, options)
+        U_new = newton_step(model, contacts, resize_harmonics(excitation, H), U, omega, H, 2 * N,
+                            options, steps)
+        if U_new is None:
+            U_new = newton_correction(model, contacts, excitation, solution, H, 2 * N, options)
         if U_new is None:
             notes.append("aliasing estimate: singular Jacobian")
         else:
@@ -521,7 +551,7 @@ def estimate_errors(solution, model, contacts, excitation, *, erp_map=None, erp_
     if truncation and modal_dofs is not None and len(modal_dofs):
         residual_dofs = () if residual_dofs is None else residual_dofs
         change = modal_truncation_change(solution, model, contacts, excitation, modal_dofs,
-                                         residual_dofs, erp_map, erp_areas, options, a_ref)
+                                         residual_dofs, erp_map, erp_areas, options, a_ref, steps)
         if change is None:
             notes.append("modal estimate: singular Jacobian")
         else:

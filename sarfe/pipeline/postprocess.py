@@ -109,11 +109,15 @@ def linear_baseline(case, stage, nl: NonlinearModel, omega):
             "erp_level_dba": float(erp.level_total_a_db), "contacts": contacts}
 
 
+ESTIMATE_STRIDE = 8     # a sweep's estimate is computed at every 8th converged point (+ ends, peak)
+
+
 def _error_estimate(case, stage, nl, solution):
-    """Cheap a-posteriori error estimate of a converged point (sarfe.accuracy): harmonic
-    truncation (one Newton step with more harmonics), AFT aliasing (N doubled), modal truncation,
-    spectral tails. None when switched off, not converged or without contacts; a failure of the
-    estimate is reported, never raised."""
+    """A-posteriori error estimate of a converged point (:mod:`sarfe.accuracy.estimates`): harmonic
+    truncation (H → H' and N → N' solved by condensed Newton from the point, usually 1–4
+    iterations), AFT aliasing (N → 2N, likewise), modal truncation (the same on the cached coarser
+    Craig–Bampton model), spectral tails. None when switched off, not converged or without
+    contacts; a failure of the estimate is reported, never raised."""
     if not case.data["solver"].get("error_estimate", True) or not solution.converged \
             or not nl.contacts.count:
         return None
@@ -123,6 +127,48 @@ def _error_estimate(case, stage, nl, solution):
         return stage_error_estimate(solution, stage, nl).as_dict()
     except Exception as error:  # an estimate must not break a solve
         return {"failed": f"{type(error).__name__}: {error}"}
+
+
+def error_estimates(case, stage, nl, solutions, stride=ESTIMATE_STRIDE) -> list:
+    """Per point: the error estimate dict, or None (see :func:`_error_estimate`).
+
+    A sweep's points are estimated on a subset and the others take the larger estimate of their
+    two estimated neighbours in continuation order (``interpolated: true``, ``from_points``): every
+    ``stride``-th converged point, the first and last, and the point with the largest first-harmonic
+    contact amplitude (the resonance, where the error peaks). The error of a harmonic-balance
+    solution varies smoothly along a branch between those points, so the subset costs 1/stride of
+    the per-point estimates; benchmarks/results/accuracy.md measures cost and bracketing."""
+    n = len(solutions)
+    if not case.data["solver"].get("error_estimate", True) or not nl.contacts.count:
+        return [None] * n
+    eligible = [i for i, s in enumerate(solutions) if s.converged]
+    if "sweep" not in case.data["excitation"] or len(eligible) <= 2 * stride:
+        return [_error_estimate(case, stage, nl, s) for s in solutions]
+    G = nl.contacts.gap_map
+
+    def amplitude(i):
+        U = np.asarray(solutions[i].displacement)
+        return float(np.max(np.hypot(G @ U[1], G @ U[2]), initial=0.0))
+
+    chosen = set(eligible[::stride]) | {eligible[0], eligible[-1], max(eligible, key=amplitude)}
+    computed = {i: _error_estimate(case, stage, nl, solutions[i]) for i in sorted(chosen)}
+    usable = [i for i in sorted(computed) if computed[i] is not None and "failed" not in computed[i]]
+    out = []
+    for i, s in enumerate(solutions):
+        if i in computed or not s.converged or not usable:
+            out.append(computed.get(i) if s.converged else None)
+            continue
+        below = [j for j in usable if j < i]
+        above = [j for j in usable if j > i]
+        near = ([below[-1]] if below else []) + ([above[0]] if above else [])
+        merged = {"interpolated": True, "from_points": near, "notes": []}
+        for key, value in computed[near[0]].items():
+            if isinstance(value, (int, float)) and not isinstance(value, bool):
+                values = [computed[j][key] for j in near if np.isfinite(computed[j][key])]
+                merged[key] = max(values) if values else float("nan")
+        merged["seconds"] = 0.0
+        out.append(merged)
+    return out
 
 
 def harmonic_set_record(case, solution):
@@ -136,7 +182,10 @@ def harmonic_set_record(case, solution):
             "dropped_content": float(getattr(solution, "dropped_content", float("nan")))}
 
 
-def point_record(case, stage, nl, index, solution):
+def point_record(case, stage, nl, index, solution, error_estimate=False):
+    """(point dict of summary.json, flat table row, ErpResult, radiating displacements W).
+    ``error_estimate``: the point's estimate when computed beforehand (:func:`error_estimates`),
+    False to compute it here."""
     omega = float(solution.omega)
     erp, W = _erp(case, stage, solution.displacement, omega)
     contacts = contact_indicators(solution, nl) if nl.contacts.count else []
@@ -149,7 +198,8 @@ def point_record(case, stage, nl, index, solution):
         "residual_norm": float(getattr(solution, "residual_norm", float("nan"))),
         "reason": str(getattr(solution, "reason", "")),
         "erp": _erp_dict(erp), "contacts": contacts, "linear": linear,
-        "error_estimate": _error_estimate(case, stage, nl, solution),
+        "error_estimate": (_error_estimate(case, stage, nl, solution) if error_estimate is False
+                           else error_estimate),
         "harmonic_set": harmonic_set_record(case, solution),
     }
     row = {"case": case.name, "point": index, "frequency_hz": point["frequency_hz"],

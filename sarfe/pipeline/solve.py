@@ -20,7 +20,7 @@ from sarfe.pipeline.nonlinear import NonlinearModel, nonlinear_model
 from sarfe.pipeline.outputs import replace_directory, write_outputs, results_table
 from sarfe.pipeline.points import solve_points, sweep_status
 from sarfe.pipeline.pruning import solve_points_pruned
-from sarfe.pipeline.postprocess import point_record, worst_of
+from sarfe.pipeline.postprocess import error_estimates, point_record, worst_of
 
 
 @dataclass
@@ -81,8 +81,10 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
 
     clock = time.perf_counter()
     points, rows, erps, normal_w = [], [], [], []
+    estimates = error_estimates(case, stage, nl, solutions)
+    timings["error_estimate_s"] = time.perf_counter() - clock
     for index, solution in enumerate(solutions):
-        point, row, erp, W = point_record(case, stage, nl, index, solution)
+        point, row, erp, W = point_record(case, stage, nl, index, solution, estimates[index])
         points.append(point)
         rows.append(row)
         erps.append(erp)
