@@ -53,6 +53,8 @@ def cmd_solve(args) -> int:
     if summary["non_converged_points"]:
         print(f"sarfe: {len(summary['non_converged_points'])} point(s) did not converge: "
               f"{summary['non_converged_points']} (see summary.json)", file=sys.stderr)
+    if (summary.get("accuracy_check") or {}).get("warning"):
+        print(f"sarfe: {summary['accuracy_check']['warning']}", file=sys.stderr)
     if summary.get("sweep_complete") is False:
         print(f"sarfe: {summary['sweep_stop_reason']}", file=sys.stderr)
     return result.exit_code

@@ -78,3 +78,33 @@ def test_study_runs_on_a_matrices_model_with_its_own_damping(tmp_path):
     result = run_study(data, knobs=["harmonics"], points=2, output_dir=tmp_path / "study",
                        estimate=False)
     assert result.rows
+
+
+@pytest.mark.timeout(300)
+def test_error_bound_is_shown_and_warned_about():
+    """lumped_rattle at 48 and 55 Hz (it rattles) at H = 3: each point's ERP error estimate is in
+    summary.json and in the table's ±dB column, it brackets the true ERP level error against
+    H = 40, N = 4096, and the run warns in one line that the 'balanced' budget is exceeded,
+    naming solver.harmonics. At H = 15 the budget is met and there is no warning."""
+    from sarfe.pipeline import results_table
+
+    data = load_case(CASE).data
+    data["excitation"].pop("sweep")
+    data["excitation"]["frequency_hz"] = [48.0, 55.0]
+    data["solver"].update(harmonics=3, samples_per_period=64, stability=False)
+    coarse = solve_case(copy.deepcopy(data), write=False)
+    data["solver"].update(harmonics=40, samples_per_period=4096, error_estimate=False)
+    reference = solve_case(copy.deepcopy(data), write=False)
+    for point, ref in zip(coarse.summary["points"], reference.summary["points"]):
+        true_db = abs(point["erp"]["level_db"] - ref["erp"]["level_db"])
+        assert true_db > 0.05                                   # a real error to bound
+        assert true_db <= abs(point["error_estimate"]["erp_db"]) <= 5 * true_db
+    table = results_table(coarse.rows)
+    assert "±dB" in table.splitlines()[0]
+    check = coarse.summary["accuracy_check"]
+    assert check["met"] is False and "raise solver.harmonics" in check["warning"]
+    assert len(check["warning"].splitlines()) == 1
+    data["solver"].update(harmonics=15, samples_per_period=512, error_estimate=True)
+    fine = solve_case(copy.deepcopy(data), write=False)
+    assert fine.summary["accuracy_check"]["met"] is True
+    assert fine.summary["accuracy_check"]["warning"] is None

@@ -79,5 +79,62 @@ def resolve_case_accuracy(case, target, points=8, start_harmonics=3, start_sampl
                             current_modes=stage.info.get("modes"))
 
 
-__all__ = ["stage_modal_coordinates", "accuracy_problem", "stage_error_estimate", "sweep_grid_hz",
+RELEVANT_DB = 30.0     # points quieter than the loudest by more than this do not count (dB(A))
+
+KNOBS = {"harmonics": "solver.harmonics", "aliasing": "solver.samples_per_period",
+         "modal": "reduction.cutoff_hz (or mode_count)"}
+
+
+def accuracy_check(case, points) -> dict | None:
+    """The run's error estimates against its accuracy budget (``solver.accuracy``, default
+    'balanced': 1 % first-harmonic amplitude, 0.5 dB ERP) → {'met', 'target', 'point',
+    'frequency_hz', 'amplitude_rel', 'erp_db', 'knob', 'warning'} or None without estimates.
+
+    Counted: converged points with an estimate whose ERP is within RELEVANT_DB of the loudest
+    (a 5 dB error 60 dB below the headline changes nothing a user reads). The knob to raise is the
+    one whose part (Richardson factors included) is largest at the worst point: harmonics →
+    solver.harmonics, aliasing → solver.samples_per_period, modal → the reduction cutoff."""
+    from sarfe.accuracy.estimates import RICHARDSON, harmonics_richardson, parse_accuracy
+
+    target = parse_accuracy(case.data["solver"].get("accuracy", "balanced"))
+    rated = [p for p in points if p["converged"] and p.get("error_estimate")
+             and "failed" not in p["error_estimate"]]
+    if not rated:
+        return None
+    loudest = max((p["erp"]["level_dba"] for p in rated if np.isfinite(p["erp"]["level_dba"])),
+                  default=float("nan"))
+    if np.isfinite(loudest):
+        rated = [p for p in rated if not p["erp"]["level_dba"] < loudest - RELEVANT_DB] or rated
+    budget = target.amplitude_budget()
+
+    def badness(p):
+        e = p["error_estimate"]
+        ratios = [np.nan_to_num(e["amplitude_rel"]) / budget]
+        if target.erp_db is not None:
+            ratios.append(np.nan_to_num(abs(e["erp_db"])) / target.erp_db)
+        return max(ratios)
+
+    worst = max(rated, key=badness)
+    e = worst["error_estimate"]
+    met = badness(worst) <= 1.0
+    factor = harmonics_richardson(int(e["harmonics"]), int(e["extended_harmonics"]))
+    parts = {"harmonics": factor * np.nan_to_num(e["harmonics_rel"]),
+             "aliasing": RICHARDSON * np.nan_to_num(e["aliasing_rel"]),
+             "modal": np.nan_to_num(e["modal_rel"])}
+    parts_db = {"harmonics": factor * abs(np.nan_to_num(e["harmonics_db"])),
+                "aliasing": RICHARDSON * abs(np.nan_to_num(e["aliasing_db"])),
+                "modal": abs(np.nan_to_num(e["modal_db"]))}
+    share = {k: max(parts[k] / budget, parts_db[k] / (target.erp_db or 1e300)) for k in parts}
+    knob = max(share, key=share.get)
+    warning = None
+    if not met:
+        warning = (f"accuracy: the error estimate exceeds the '{target.name}' budget at "
+                   f"{worst['frequency_hz']:.2f} Hz (amplitude ±{100 * e['amplitude_rel']:.2g} %, "
+                   f"ERP ±{abs(e['erp_db']):.2g} dB); mostly from {knob}: raise {KNOBS[knob]}")
+    return {"met": bool(met), "target": target.name, "point": worst["index"],
+            "frequency_hz": worst["frequency_hz"], "amplitude_rel": float(e["amplitude_rel"]),
+            "erp_db": float(e["erp_db"]), "knob": KNOBS[knob], "warning": warning}
+
+
+__all__ = ["accuracy_check", "stage_modal_coordinates", "accuracy_problem", "stage_error_estimate", "sweep_grid_hz",
            "resolve_case_accuracy"]

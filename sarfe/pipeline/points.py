@@ -195,6 +195,29 @@ def finish_sweep(nl, solutions, start, end, H, N, options, step):
     return solutions
 
 
+def common_samples(nl, solutions):
+    """Solutions with one N: a continuation raises N at corners of its branch (sarfe.hbm.
+    continuation), but the result files hold one time grid (applied after the error estimates,
+    which use the N each point was solved with). Points solved with fewer samples get
+    their contact time histories (force, state) re-sampled by the AFT at the largest N used
+    (harmonics unchanged; the ``reason`` says so)."""
+    from sarfe.hbm.residual import nonlinear_force
+
+    largest = max((int(s.samples_per_period) for s in solutions), default=0)
+    out = []
+    for s in solutions:
+        N = int(s.samples_per_period)
+        if N == largest or isinstance(s, SimpleNamespace) or not nl.contacts.count:
+            out.append(s)
+            continue
+        _, _, forces = nonlinear_force(nl.contacts, s.displacement, largest, jacobian=False)
+        out.append(dataclasses.replace(
+            s, samples_per_period=largest, contact_force_time=forces.force_time,
+            contact_state=forces.state,
+            reason=f"{s.reason} (solved with N = {N}; time histories at N = {largest})"))
+    return out
+
+
 def solve_points(case, nl: NonlinearModel, progress=False):
     """HarmonicSolution per frequency point (listed frequencies in order, or a continuation)."""
     from sarfe.hbm import continuation

@@ -206,7 +206,9 @@ def point_record(case, stage, nl, index, solution, error_estimate=False):
            "converged": point["converged"], "stable": point["stable"],
            "iterations": point["iterations"], "erp_W": erp.power_total,
            "erp_db": erp.level_total_db, "erp_dba": erp.level_total_a_db,
-           "linear_erp_db": linear["erp_level_db"], "linear_erp_dba": linear["erp_level_dba"]}
+           "linear_erp_db": linear["erp_level_db"], "linear_erp_dba": linear["erp_level_dba"],
+           "erp_error_db": (abs(float(point["error_estimate"]["erp_db"])) if point["error_estimate"]
+                            and "erp_db" in point["error_estimate"] else float("nan"))}
     for c in contacts:
         for key in ("max_penetration_m", "peak_normal_force_N", "peak_friction_force_N",
                     "open_fraction", "slip_fraction"):

@@ -15,10 +15,11 @@ import numpy as np
 
 from sarfe.io.case import load_case
 from sarfe.io.errors import EXIT_NOT_CONVERGED
+from sarfe.pipeline.accuracy import accuracy_check
 from sarfe.pipeline.linear import build_linear_model, linear_model_key
 from sarfe.pipeline.nonlinear import NonlinearModel, nonlinear_model
 from sarfe.pipeline.outputs import replace_directory, write_outputs, results_table
-from sarfe.pipeline.points import solve_points, sweep_status
+from sarfe.pipeline.points import common_samples, solve_points, sweep_status
 from sarfe.pipeline.pruning import solve_points_pruned
 from sarfe.pipeline.postprocess import error_estimates, point_record, worst_of
 
@@ -81,8 +82,9 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
 
     clock = time.perf_counter()
     points, rows, erps, normal_w = [], [], [], []
-    estimates = error_estimates(case, stage, nl, solutions)
+    estimates = error_estimates(case, stage, nl, solutions)     # each at the N it was solved with
     timings["error_estimate_s"] = time.perf_counter() - clock
+    solutions = common_samples(nl, solutions)                    # one time grid for the files
     for index, solution in enumerate(solutions):
         point, row, erp, W = point_record(case, stage, nl, index, solution, estimates[index])
         points.append(point)
@@ -118,6 +120,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         "points": points,
         "worst": worst_of(points),
         "accuracy": accuracy,                    # None unless solver.accuracy was given
+        "accuracy_check": accuracy_check(case, points),   # estimates vs the accuracy budget
         "timings_s": timings,
         "case_data": case.data,                  # the case with every default filled in
     }
