@@ -1,7 +1,8 @@
 r"""Per-point results: ERP of the HBM solution, contact indicators, linear risk baseline.
 
 ERP: w_s = N ũ (radiating-node normal displacement harmonics) → :func:`sarfe.erp.
-equivalent_radiated_power`. Linear baseline: (K − ω² M + iω D) Û = F̂ without contacts →
+equivalent_radiated_power`. Linear baseline: (K + Gᵀ diag(k) G − ω² M + iω D) Û = F̂ with the
+contacts at their static state (preloaded pairs as springs, open ones removed) →
 :func:`sarfe.risk.linear_risk_from_contacts` and its ERP.
 """
 from __future__ import annotations
@@ -76,13 +77,40 @@ def contact_indicators(solution, nl: NonlinearModel) -> list[dict]:
     return out
 
 
+def baseline_springs(contacts) -> np.ndarray:
+    """Spring [N/m] of every row of G in the linear baseline: the contacts at their static state
+    (no static load: the rest position, u = 0). A pair is closed there when its gap g ≤ 0 (a
+    preloaded pair: g = the overclosure that carries the preload); its normal row keeps k_n. A
+    friction pair is stuck there when it is closed or carries a constant normal load N0 > 0; its
+    tangent rows keep k_t. Open pairs are removed (0)."""
+    c = contacts
+    k = np.zeros(c.row_count)
+    has_n = c.normal_row >= 0
+    closed = has_n & (c.gap <= 0)
+    k[c.normal_row[closed]] = c.normal_stiffness[closed]
+    stuck = closed | (c.normal_load > 0)
+    for col in range(2):
+        present = (c.tangent_rows[:, col] >= 0) & stuck
+        k[c.tangent_rows[present, col]] = c.tangential_stiffness[present]
+    return k
+
+
 def linear_baseline(case, stage, nl: NonlinearModel, omega):
-    """Linear response without contacts at ω: ERP and risk per named contact."""
+    """Linear response at ω of the structure with its contacts at their static state: preloaded
+    (closed) pairs as linear springs k_n, stuck friction pairs as k_t, open pairs removed
+    (:func:`baseline_springs`):
+
+        (K + Gᵀ diag(k) G − ω² M + iω D) Û = F̂   [m],
+
+    its ERP and the linear risk per named contact."""
     from sarfe.risk import linear_risk_from_contacts
 
     M, D, K = nl.model.mass, nl.model.damping, nl.model.stiffness
     dense = (lambda A: A.toarray() if sp.issparse(A) else np.asarray(A))
-    S = dense(K) - omega ** 2 * dense(M) + 1j * omega * dense(D)
+    G = sp.csr_matrix(nl.contacts.gap_map)
+    springs = (G.T @ sp.diags(baseline_springs(nl.contacts)) @ G).toarray() \
+        if nl.contacts.count else 0.0
+    S = dense(K) + springs - omega ** 2 * dense(M) + 1j * omega * dense(D)
     U1 = np.linalg.lstsq(S, nl.excitation_amplitude, rcond=None)[0]
     H = (nl.excitation.shape[0] - 1) // 2
     U = np.zeros((2 * H + 1, stage.dof_count))
