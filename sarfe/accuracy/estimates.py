@@ -15,7 +15,9 @@ measured on the quantities users read:
 
 - ``amplitude_rel``: max over contact rows of |Δ a₁| / max a₁, a₁ = first-harmonic amplitude of r = G u;
 - ``erp_db``: 10 log₁₀(P(ũ')/P(ũ)), P = Σ_k (kω)² Σ_s a_s |w_{s,k}|² (ERP ∝ normal velocity²,
-  w = E ũ the radiating normal displacements, a_s their areas; all DOFs with unit areas when no E).
+  w = E ũ the radiating normal displacements, a_s their areas; all DOFs with unit areas when no E),
+  or the same change of the A-weighted P_A (harmonic k weighted by 10^{A(kf)/10}) when larger: on
+  impacts the high harmonics carry the dB(A) level, which converges more slowly in H.
 
 Cheaper still and model-free (no solve at all) are the spectral tails
 
@@ -213,14 +215,21 @@ def _first_harmonic_amplitude(contacts, U):
     return np.hypot(G @ U[1], G @ U[2])
 
 
-def _erp_proxy(U, omega, erp_map=None, erp_areas=None):
-    """P = Σ_k (kω)² Σ_s a_s |w_{s,k}|² (proportional to the ERP of all harmonics)."""
+def _erp_proxy(U, omega, erp_map=None, erp_areas=None, a_weighted=False):
+    """P = Σ_k (kω)² Σ_s a_s |w_{s,k}|² (proportional to the ERP of all harmonics); with
+    ``a_weighted`` each harmonic k weighted by 10^{A(k f)/10}, A the A-weighting [dB] at k f,
+    f = ω / 2π (proportional to the A-weighted ERP, which on impacts the high harmonics carry)."""
     U = np.asarray(U, dtype=float)
     W = U if erp_map is None else np.asarray(U @ np.asarray(erp_map).T)
     areas = np.ones(W.shape[1]) if erp_areas is None else np.asarray(erp_areas, dtype=float)
     H = (W.shape[0] - 1) // 2
     k = np.repeat(np.arange(1, H + 1), 2)
-    return float(((k[:, None] * omega) ** 2 * W[1:] ** 2 * areas).sum())
+    weight = (k * omega) ** 2
+    if a_weighted:
+        from sarfe.erp.weighting import a_weighting_db
+
+        weight = weight * 10.0 ** (np.asarray(a_weighting_db(k * omega / (2 * np.pi))) / 10.0)
+    return float((weight[:, None] * W[1:] ** 2 * areas).sum())
 
 
 def _change(contacts, U, U_new, omega, erp_map, erp_areas, ref_amplitude=None):
@@ -242,8 +251,15 @@ def _change(contacts, U, U_new, omega, erp_map, erp_areas, ref_amplitude=None):
         whole = _erp_proxy(U, omega) * (np.sum(erp_areas) if erp_areas is not None else 1.0)
         if max(p0, p1) <= 1e-24 * whole:
             return rel, 0.0
-    db = float(10 * np.log10(p1 / p0)) if p0 > 0 and p1 > 0 else (0.0 if p0 == p1 else float("inf"))
-    return rel, db
+
+    def level_change(p0, p1):
+        return float(10 * np.log10(p1 / p0)) if p0 > 0 and p1 > 0 else (
+            0.0 if p0 == p1 else float("inf"))
+
+    db = level_change(p0, p1)
+    db_a = level_change(_erp_proxy(U, omega, erp_map, erp_areas, True),
+                        _erp_proxy(U_new, omega, erp_map, erp_areas, True))
+    return rel, (db_a if abs(db_a) > abs(db) else db)      # the larger of dB and dB(A)
 
 
 def newton_correction(model, contacts, excitation, solution, harmonics, samples_per_period,
@@ -648,6 +664,7 @@ def choose_resolution(target, model, contacts, excitation, omega, *, harmonics=3
     H, N = int(harmonics), samples_for(int(harmonics), int(samples_per_period))
     ratio = max(4.0, N / H)                 # keep N/H ≥ the starting ratio as H grows
     history, previous = [], initial
+    solved = []
     solution = estimate = None
     reason = f"round cap {max_rounds} reached"
     met = False
@@ -678,6 +695,13 @@ def choose_resolution(target, model, contacts, excitation, omega, *, harmonics=3
             reason = f"not converged at H={H}, N={N}: {solution.reason}"
             break
         previous = solution
+        solved.append((H, N, solution, estimate))
+        earlier = _smallest_sufficient(target, solved, contacts, omega, erp_map, erp_areas)
+        if earlier is not None:      # an earlier (smaller) H, N is within the budget of this one
+            H_e, N_e, solution, estimate = earlier
+            met, reason = True, (f"target met at H = {H_e}, N = {N_e}: its change to H = {H}, "
+                                 f"N = {N} plus that one's estimate")
+            return Resolution(solution, H_e, N_e, estimate, met, reason, history)
         h_ok = target.met_by(RICHARDSON * _finite(estimate.harmonics_rel),
                              RICHARDSON * abs(_finite(estimate.harmonics_db)), 0.5)
         a_ok = target.met_by(RICHARDSON * _finite(estimate.aliasing_rel),
@@ -699,6 +723,32 @@ def choose_resolution(target, model, contacts, excitation, omega, *, harmonics=3
     return Resolution(solution, H if solution is None else int(solution.harmonics),
                       N if solution is None else int(solution.samples_per_period), estimate, met,
                       reason, history)
+
+
+def _smallest_sufficient(target, solved, contacts, omega, erp_map, erp_areas):
+    """(H, N, solution, estimate) of the smallest earlier round whose measured change to the latest
+    round plus the latest one's own estimate (e(H_j) ≤ ‖ũ_j − ũ_k‖ + e(H_k)) meets half the
+    budget, or None. On impacts an estimate is not monotone in H (a raise can move the active set
+    and the estimate with it): measured against a finer solution the earlier rounds need no
+    estimate of their own, and the climb does not over-resolve."""
+    if len(solved) < 2:
+        return None
+    H_k, N_k, s_k, e_k = solved[-1]
+    if not (np.isfinite(e_k.amplitude_rel) and np.isfinite(e_k.erp_db)):
+        return None
+    U_k = np.asarray(s_k.displacement)
+    for H_j, N_j, s_j, e_j in sorted(solved[:-1], key=lambda r: (r[0], r[1])):
+        rel, db = _change(contacts, resize_harmonics(s_j.displacement, H_k), U_k, omega, erp_map,
+                          erp_areas)
+        bound_rel, bound_db = rel + e_k.amplitude_rel, abs(db) + abs(e_k.erp_db)
+        if np.isfinite(bound_rel) and np.isfinite(bound_db) and target.met_by(bound_rel,
+                                                                               bound_db, 0.5):
+            from dataclasses import replace
+            estimate = replace(e_j, amplitude_rel=float(bound_rel), erp_db=float(bound_db),
+                               notes=e_j.notes + (f"bounded by the change to H = {H_k}, N = {N_k} "
+                                                  "plus that solution's estimate",))
+            return H_j, N_j, s_j, estimate
+    return None
 
 
 def _at_least(N, need):

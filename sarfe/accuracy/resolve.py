@@ -141,12 +141,13 @@ def resolve_accuracy(problem: EstimateProblem, target, frequencies_hz, harmonics
 
 
 def apply_resolution(case_data: dict, report: dict) -> dict:
-    """Case data (a copy) with solver.harmonics / samples_per_period and reduction.mode_count set."""
+    """Case data (a copy) with solver.harmonics / samples_per_period and reduction.mode_count set,
+    ``resolution: fixed`` (chosen; ``accuracy`` stays the run's error budget)."""
     data = copy.deepcopy(case_data)
     data.setdefault("solver", {})
     data["solver"]["harmonics"] = int(report["harmonics"])
     data["solver"]["samples_per_period"] = int(report["samples_per_period"])
-    data["solver"].pop("accuracy", None)
+    data["solver"]["resolution"] = "fixed"
     if report.get("mode_count"):
         red = data.setdefault("reduction", {})
         red.pop("cutoff_hz", None)

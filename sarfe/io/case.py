@@ -403,6 +403,11 @@ def _normalize_excitation(case, data):
 
 def _normalize_solver(case, data):
     solver = data.setdefault("solver", {})
+    # no harmonics given: sarfe chooses H, N (and the mode count) for the accuracy budget
+    # (default 'balanced'), starting its screening from H = 5; given harmonics are used as they are
+    solver.setdefault("resolution", "fixed" if "harmonics" in solver else "auto")
+    if solver["resolution"] == "auto":
+        solver.setdefault("accuracy", "balanced")
     H = solver.setdefault("harmonics", 5)
     N = solver.setdefault("samples_per_period", max(64, 2 ** math.ceil(math.log2(16 * H))))
     if N < 2 * H + 1:

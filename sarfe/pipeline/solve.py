@@ -52,7 +52,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     case = load_case(case)
     timings = {}
     accuracy = None
-    if "accuracy" in case.data["solver"]:
+    if case.data["solver"]["resolution"] == "auto":
         # accuracy as an input: choose H, N (and mode count) from cheap error estimates first
         from sarfe.accuracy.resolve import apply_resolution
         from sarfe.pipeline.accuracy import resolve_case_accuracy
