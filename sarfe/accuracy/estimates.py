@@ -263,13 +263,15 @@ def _change(contacts, U, U_new, omega, erp_map, erp_areas, ref_amplitude=None):
 
 
 def newton_correction(model, contacts, excitation, solution, harmonics, samples_per_period,
-                      options=None):
+                      options=None, robust=False):
     """(1) climbing: the solution of the (H', N') problem from ũ embedded in it, H raised to H' in
     steps of ×1.5 (N ≥ 4H + 1, retried with N/H kept when a step stalls), each a
     :func:`newton_step` warm-started from the last → (2H''+1, n) [m], H'' ≤ H'. The fallback when
     one solve at H' does not converge (an impact whose active set a large raise changes a lot);
     the climb stops at the last converged H''. None when no raise converges. excitation f̃_e
-    (2H_e+1, n) [N] (resized)."""
+    (2H_e+1, n) [N] (resized). ``robust``: each raise by the engine's own solve (full line search,
+    REFINE_ITERATIONS, the full-DOF fallback) instead of :func:`newton_step` — slower, the last
+    resort."""
     H0, H_target = int(solution.harmonics), int(harmonics)
     N = int(samples_per_period)
     omega = float(solution.omega)
@@ -285,14 +287,38 @@ def newton_correction(model, contacts, excitation, solution, harmonics, samples_
         scaled = N if H_target <= H0 else _at_least(N, max(4 * H + 1, N * H / max(H0, 1)))
         refined = None
         for N_try in (first, scaled) if scaled != first else (first,):
-            refined = newton_step(model, contacts, resize_harmonics(excitation, H),
-                                  resize_harmonics(previous, H), omega, H, N_try, options)
+            if robust:
+                refined = _engine_solve(model, contacts, resize_harmonics(excitation, H),
+                                        resize_harmonics(previous, H), omega, H, N_try, options)
+            else:
+                refined = newton_step(model, contacts, resize_harmonics(excitation, H),
+                                      resize_harmonics(previous, H), omega, H, N_try, options)
             if refined is not None:
                 break
         if refined is None:
             break
         best = previous = refined
     return best
+
+
+def _engine_solve(model, contacts, excitation, U, omega, harmonics, samples_per_period, options):
+    """ũ of :func:`sarfe.hbm.solve_frequency` from U (at most REFINE_ITERATIONS), None if it fails."""
+    from dataclasses import replace
+
+    from sarfe.hbm.solve import SolverOptions, solve_frequency
+
+    import warnings
+
+    quick = replace(options or SolverOptions(), max_iterations=REFINE_ITERATIONS, stability=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            s = solve_frequency(model, contacts, excitation, omega, harmonics, samples_per_period,
+                                initial=U, options=quick)
+        except (ValueError, np.linalg.LinAlgError):
+            return None
+    U_new = np.asarray(s.displacement, dtype=float)
+    return U_new if s.converged and np.all(np.isfinite(U_new)) else None
 
 
 def newton_step(model, contacts, excitation, U, omega, harmonics, samples_per_period,
@@ -539,13 +565,15 @@ def estimate_errors(solution, model, contacts, excitation, *, erp_map=None, erp_
         U_new = newton_step(model, contacts, resize_harmonics(excitation, H_ext),
                             resize_harmonics(U, H_ext), omega, H_ext, samples_for(H_ext, N),
                             options, steps)
-        if U_new is None:   # a large raise changed the active set too much: climb ×1.5 a step
-            U_new = newton_correction(model, contacts, excitation, solution, H_ext,
-                                      samples_for(H_ext, N), options)
-            notes.append("truncation estimate: H raised in steps (one Newton solve at H' did "
-                         "not converge)")
-        if U_new is None:
-            notes.append("truncation estimate: singular Jacobian")
+        for robust in (False, True):  # a large raise changed the active set: climb ×1.5 a step
+            if U_new is None:
+                U_new = newton_correction(model, contacts, excitation, solution, H_ext,
+                                          samples_for(H_ext, N), options, robust)
+                notes.append("truncation estimate: H raised in steps (one Newton solve at H' did "
+                             "not converge)" + (", by the engine's solver" if robust else ""))
+        if U_new is None:   # unknown, not small
+            h_rel = h_db = float("inf")
+            notes.append("truncation estimate: no re-solve with more harmonics converged")
         else:
             if (U_new.shape[0] - 1) // 2 < H_ext:
                 notes.append(f"truncation estimate: H raised to {(U_new.shape[0] - 1) // 2} of "
@@ -556,10 +584,13 @@ def estimate_errors(solution, model, contacts, excitation, *, erp_map=None, erp_
     if aliasing:
         U_new = newton_step(model, contacts, resize_harmonics(excitation, H), U, omega, H, 2 * N,
                             options, steps)
-        if U_new is None:
-            U_new = newton_correction(model, contacts, excitation, solution, H, 2 * N, options)
-        if U_new is None:
-            notes.append("aliasing estimate: singular Jacobian")
+        for robust in (False, True):
+            if U_new is None:
+                U_new = newton_correction(model, contacts, excitation, solution, H, 2 * N,
+                                          options, robust)
+        if U_new is None:   # unknown, not small
+            a_rel = a_db = float("inf")
+            notes.append("aliasing estimate: no re-solve with 2N converged")
         else:
             a_rel, a_db = _change(contacts, U, U_new, omega, erp_map, erp_areas, a_ref)
 
@@ -575,8 +606,8 @@ def estimate_errors(solution, model, contacts, excitation, *, erp_map=None, erp_
             factor = mode_richardson(kept, kept - change[2])
             m_rel, m_db = factor * change[0], factor * change[1]
     factor = harmonics_richardson(H, H_ext)
-    parts_rel = [f * x for f, x in ((factor, h_rel), (RICHARDSON, a_rel)) if np.isfinite(x)]
-    parts_db = [f * abs(x) for f, x in ((factor, h_db), (RICHARDSON, a_db)) if np.isfinite(x)]
+    parts_rel = [f * x for f, x in ((factor, h_rel), (RICHARDSON, a_rel)) if not np.isnan(x)]
+    parts_db = [f * abs(x) for f, x in ((factor, h_db), (RICHARDSON, a_db)) if not np.isnan(x)]
     parts_rel += [m_rel] if np.isfinite(m_rel) else []
     parts_db += [m_db] if np.isfinite(m_db) else []
     if not getattr(solution, "converged", True):
@@ -758,7 +789,8 @@ def _at_least(N, need):
 
 
 def _finite(x):
-    return float(x) if np.isfinite(x) else 0.0
+    """NaN (a part not computed) → 0; an unknown part (inf) stays inf."""
+    return 0.0 if np.isnan(x) else float(x)
 
 
 def suggest_mode_count(mode_frequencies_hz, max_frequency_hz, harmonics, target=None,

@@ -192,7 +192,7 @@ def error_estimates(case, stage, nl, solutions, stride=ESTIMATE_STRIDE) -> list:
         merged = {"interpolated": True, "from_points": near, "notes": []}
         for key, value in computed[near[0]].items():
             if isinstance(value, (int, float)) and not isinstance(value, bool):
-                values = [computed[j][key] for j in near if np.isfinite(computed[j][key])]
+                values = [computed[j][key] for j in near if not np.isnan(computed[j][key])]
                 merged[key] = max(values) if values else float("nan")
         merged["seconds"] = 0.0
         out.append(merged)
