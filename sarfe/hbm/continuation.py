@@ -23,12 +23,14 @@ neighbouring pieces at 87° on cases/lumped_rattle.yaml, N = 256), and neither c
 next piece: Δs shrinks to ``min_step`` over near-identical points. The corners are an artefact of
 the sampling (N = 1024 has no fold there at all: the "fold" at N = 256 is itself an artefact), so
 the sweep backs up ``BACKUP`` points (they may lie on the artefact), re-solves there with 2N and
-goes on with 2N (up to 16 N; the point's ``reason`` says so). A turn of ω (a fold, or a corner
-that reverses the tangent: on cases/rattle_rig.yaml at N = 256 the sweep turned at 31.4 Hz and
-ran back down its own branch, at N = 1024 it goes on to the true fold at 33.6 Hz) is checked the
-same way once: the sweep backs up and goes on with 2N; a turn within 5 % of the band of a checked
-one is taken as a fold. A new point closer than
-``REPORT_DISTANCE`` (scaled) to the last one replaces it rather than adding a near-duplicate row.
+goes on with 2N (up to 16 N; the point's ``reason`` says so). A turn of ω at a corner (on
+cases/rattle_rig.yaml at N = 256 the sweep turned at 31.4 Hz and ran back down its own branch; at
+N = 1024 it goes on to the true fold at 33.6 Hz) is checked the same way once: where ω turns and consecutive secants z_{i+1} − z_i, z_i − z_{i−1} meet
+at more than ~80° (cosine < ``COS_CORNER``; measured: 0.02 and −0.07 at the two artefacts, 0.36–1.0
+at the true folds of the shipped cases and NLvib example 03, which the adaptive step passes
+gradually) — and, once a sweep has met one corner, at every turn of ω — the sweep backs up and goes
+on with 2N; a turn within ``FOLD_DISTANCE`` of the band of a checked one is taken as a fold. A new point closer than ``REPORT_DISTANCE`` (scaled) to the
+last one replaces it rather than adding a near-duplicate row.
 
 Band edge. A branch that turns back past ω_start is stopped there: the last point is solved at
 exactly ω_start and its ``reason`` says why (no points outside the band).
@@ -50,12 +52,14 @@ from .harmonic_set import expand_rows, harmonic_set_orders
 from .newton import SingularJacobian, newton, solve_linear
 from .residual import Evaluation, kept_rows
 from .solution import ContinuationOptions
+from .solve import (_check_omega, _solve, finalize, initial_slider, linearized_guess,
+                    make_evaluator, make_problem, slider_acceptor, solve_auto, wants_condensation)
 
 REPORT_DISTANCE = 1e-4   # scaled arclength below which a new point replaces the last one reported
 MAX_SAMPLES_FACTOR = 16  # N may be raised to 16× the requested one at corners (docstring)
-BACKUP = 3               # points dropped before re-solving with 2N at a corner
-from .solve import (_check_omega, _solve, finalize, initial_slider, linearized_guess,
-                    make_evaluator, make_problem, slider_acceptor, solve_auto, wants_condensation)
+BACKUP = 3               # points dropped before re-solving with 2N at a corner or turn
+FOLD_DISTANCE = 0.05     # a turn of ω this close (share of the band) to a checked one is a fold
+COS_CORNER = 0.2         # ω turns with consecutive secants at more than ~80°: a corner, checked
 
 
 def _bordered(jacobian, d_omega, x_scale, omega_scale, row, row_scale=1.0):
@@ -142,18 +146,19 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
     step = options.initial_step
 
     inner = {}
-    refined_at = []
+    refined_at = []                 # ω where a turn was checked with 2N
 
     def refine_samples():
-        """(k, point k re-solved with 2N) after backing up BACKUP points, or (k, None)."""
+        """(k, point k re-solved with 2N — 4N, … when that fails) after backing up BACKUP points
+        (or none), or (0, None) when no re-solve up to MAX_SAMPLES_FACTOR × N converges."""
         N_fine = 2 * problem.samples_per_period
-        if N_fine > MAX_SAMPLES_FACTOR * samples_per_period:
-            return 0, None
-        fine = replace(problem, samples_per_period=N_fine)
-        for k in dict.fromkeys((max(0, len(solutions) - 1 - BACKUP), len(solutions) - 1)):
-            point = _solve(fine, solutions[k].omega, solutions[k].displacement, so, None)
-            if point.converged:
-                return k, point
+        while N_fine <= MAX_SAMPLES_FACTOR * samples_per_period:
+            fine = replace(problem, samples_per_period=N_fine)
+            for k in dict.fromkeys((max(0, len(solutions) - 1 - BACKUP), len(solutions) - 1)):
+                point = _solve(fine, solutions[k].omega, solutions[k].displacement, so, None)
+                if point.converged:
+                    return k, point
+            N_fine *= 2
         return 0, None
 
     def evaluate_z(zz, jacobian):
@@ -180,7 +185,7 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
                 z = np.append(x / x_scale, solutions[-1].omega / span)
                 continue
             return stop("singular bordered Jacobian (tangent)")
-        corner = None
+        refined = None                 # point k re-solved with 2N (stalled step or turn of ω)
         while True:
             predicted = z + step * t
             result = _corrector(evaluate_z, z, predicted, t, step, x_scale, span, corrector, accept)
@@ -193,27 +198,32 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
                 break
             step *= 0.5
             if step < options.min_step:
-                k, corner = refine_samples()
-                if corner is None:
+                refined_at.append(z[-1] * span)
+                k, refined = refine_samples()
+                if refined is None:
                     return stop(f"step below min_step {options.min_step:g} near ω = "
                                 f"{z[-1] * span:.6g} (N = {problem.samples_per_period})")
                 break
-        if corner is None and len(solutions) > 1:
-            turn = (omega_i := z[-1] * span) - solutions[-2].omega
-            if turn * (result.x[-1] * span - omega_i) < 0 and not any(
-                    abs(omega_i - w) < 0.05 * span for w in refined_at):
-                refined_at.append(omega_i)      # a fold or a corner: seen again with 2N?
-                k, corner = refine_samples()
-        if corner is not None:        # continue with 2N from the re-solved point k
-            problem = replace(problem, samples_per_period=corner.samples_per_period)
-            full_problem = replace(full_problem, samples_per_period=corner.samples_per_period)
+        if refined is None and len(solutions) > 1:
+            omega_i = z[-1] * span
+            z_prev = np.append(to_x(solutions[-2].displacement) / x_scale,
+                               solutions[-2].omega / span)
+            ahead, behind = result.x - z, z - z_prev
+            sharp = ahead @ behind < COS_CORNER * np.linalg.norm(ahead) * np.linalg.norm(behind)
+            turned = behind[-1] * ahead[-1] < 0 and (sharp or refined_at)
+            if turned and not any(abs(omega_i - w) < FOLD_DISTANCE * span for w in refined_at):
+                refined_at.append(omega_i)      # ω turns at a corner: checked with 2N
+                k, refined = refine_samples()
+        if refined is not None:        # continue with 2N from the re-solved point k
+            problem = replace(problem, samples_per_period=refined.samples_per_period)
+            full_problem = replace(full_problem, samples_per_period=refined.samples_per_period)
             evaluate, to_x, to_displacement = make_evaluator(problem, condensed)
-            state["slider"] = initial_slider(problem, corner.displacement)
+            state["slider"] = initial_slider(problem, refined.displacement)
             del solutions[k:]
-            solutions.append(replace(corner, reason=f"{corner.reason} (N raised to "
-                                     f"{corner.samples_per_period} here: a stalled step or a turn "
+            solutions.append(replace(refined, reason=f"{refined.reason} (N raised to "
+                                     f"{refined.samples_per_period} here: a stalled step or a turn "
                                      f"of ω, checked with finer AFT sampling)"))
-            z = np.append(to_x(corner.displacement) / x_scale, corner.omega / span)
+            z = np.append(to_x(refined.displacement) / x_scale, refined.omega / span)
             if k > 0:               # orientation: the secant from the point before
                 before = solutions[k - 1]
                 previous = z - np.append(to_x(before.displacement) / x_scale, before.omega / span)
