@@ -25,14 +25,21 @@ def _say(args, text):
         print(text, flush=True)
 
 
+def _warn(line):
+    print(f"sarfe: warning: {line}", file=sys.stderr, flush=True)
+
+
 def cmd_solve(args) -> int:
     from sarfe.io.outputs.summary import pruning_line
     from sarfe.pipeline import load_case, results_table, solve_case
+    from sarfe.pipeline.checks import output_target
 
     case = load_case(args.case)
+    output_target(case, args.output, args.force)   # before any work (solve_case checks it all)
     clock = time.perf_counter()
     _say(args, f"sarfe {__version__}: solving {case.name} ({args.case})")
-    result = solve_case(case, output_dir=args.output, progress=not args.quiet)
+    result = solve_case(case, output_dir=args.output, progress=not args.quiet, force=args.force,
+                        warn=_warn)
     summary = result.summary
     if not args.quiet:
         model = summary["model"]
@@ -45,10 +52,10 @@ def cmd_solve(args) -> int:
             print(pruning)
         types = {c["name"]: c["type"] for c in summary["contacts"]}
         print(results_table(result.rows, types))
-        worst = summary.get("worst") or {}
-        if worst:
-            print(f"loudest point: {worst['erp_level_dba']:.1f} dB(A) "
-                  f"({worst['erp_level_db']:.1f} dB re 1 pW) at {worst['frequency_hz']:.2f} Hz")
+        from sarfe.io.outputs.summary import loudest_lines
+
+        for line in loudest_lines(summary.get("worst")):
+            print(line)
         print(f"results: {result.output_dir}  ({time.perf_counter() - clock:.1f} s)")
     if summary["non_converged_points"]:
         print(f"sarfe: {len(summary['non_converged_points'])} point(s) did not converge: "
@@ -61,14 +68,26 @@ def cmd_solve(args) -> int:
 
 
 def cmd_validate(args) -> int:
-    from sarfe.pipeline import check_mesh, load_case
+    """Every check `solve` makes before the heavy work (sarfe.pipeline.checks); warnings on stderr."""
+    from sarfe.pipeline import load_case
+    from sarfe.pipeline.checks import check_case
 
     case = load_case(args.case)
-    info = check_mesh(case)
+    checked = check_case(case, output_dir=args.output, force=args.force)
+    for line in checked.warnings:
+        _warn(line)
+    info = checked.info
     text = f"{args.case}: valid"
     if info:
         pairs = ", ".join(f"{k} ({v} pairs)" for k, v in info["contact_pairs"].items())
         text += f" ({info['nodes']} nodes, {info['triangles']} triangles; contacts: {pairs or 'none'})"
+        if info.get("ignored_cards"):   # deck cards named in model.fe.ignore_cards
+            text += "\n  ignored cards: " + ", ".join(
+                f"{card} ({count})" for card, count in sorted(info["ignored_cards"].items()))
+        if info.get("coincident_node_pairs"):
+            shown = ", ".join(f"{a}={b}" for a, b in info["coincident_nodes"][:10])
+            text += (f"\n  note: {info['coincident_node_pairs']} pair(s) of coincident nodes that "
+                     f"no element joins (node ids): {shown}")
     _say(args, text)
     return 0
 
@@ -125,6 +144,15 @@ def cmd_verify(args) -> int:
     return 0 if agree and hbm.converged else EXIT_NOT_CONVERGED
 
 
+def output_options(parser) -> None:
+    parser.add_argument("--output", "-o", metavar="DIR", default=None,
+                        help="result directory (default: output.directory of the case, "
+                        "results/<name>); must be absent, empty or an earlier sarfe result")
+    parser.add_argument("--force", action="store_true",
+                        help="replace an output folder that is not a sarfe result (never the "
+                        "current folder or the case file's folder)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="sarfe", description="Squeak & rattle noise of car interior panels: FE + "
@@ -141,8 +169,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("solve", help="solve a case and write results")
     common(p)
-    p.add_argument("--output", "-o", metavar="DIR", default=None,
-                   help="result directory (default: output.directory of the case, results/<name>)")
+    output_options(p)
     p.set_defaults(func=cmd_solve)
     p = sub.add_parser("verify", help="compare HBM with time integration at one frequency")
     common(p)
@@ -150,8 +177,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--tolerance", type=float, default=0.05,
                    help="relative amplitude difference accepted (default 0.05)")
     p.set_defaults(func=cmd_verify)
-    p = sub.add_parser("validate", help="check a case file (schema, mesh groups, contact pairing)")
+    p = sub.add_parser("validate", help="check a case file: everything `solve` checks before "
+                       "the heavy work (schema, numbers, mesh quality, groups, contact pairing, "
+                       "held structure, output folder)")
     common(p)
+    output_options(p)
     p.set_defaults(func=cmd_validate)
 
     for name in EXTENSION_MODULES:  # optional subcommands (study, batch)

@@ -52,6 +52,22 @@ def solve(data):
         return solve_case(copy.deepcopy(data), write=False)
 
 
+def assert_states_equal_away_from_ties(a, b):
+    """Contact states (samples, contacts) agree except at samples next to a state change, where
+    open/closed or stick/slip is a tie decided by round-off (at most one sample per change)."""
+    a, b = np.asarray(a), np.asarray(b)
+    assert a.shape == b.shape
+
+    def near_change(s):
+        change = s != np.roll(s, 1, axis=0)
+        return change | np.roll(change, -1, axis=0)
+
+    differ = a != b
+    assert not np.any(differ & ~(near_change(a) | near_change(b))), np.argwhere(differ)
+    changes = np.count_nonzero(a != np.roll(a, 1, axis=0), axis=0)
+    assert np.all(np.count_nonzero(differ, axis=0) <= np.maximum(changes, 1))
+
+
 def assert_same_solutions(pruned, full):
     """Displacements, contact forces (harmonics and samples) and states agree to 1e-6 of the peak."""
     assert len(pruned.solutions) == len(full.solutions)
@@ -62,7 +78,7 @@ def assert_same_solutions(pruned, full):
             x, y = getattr(a, field), getattr(b, field)
             assert x.shape == y.shape
             np.testing.assert_allclose(x, y, rtol=0, atol=1e-6 * np.abs(y).max(), err_msg=field)
-        np.testing.assert_array_equal(a.contact_state, b.contact_state)
+        assert_states_equal_away_from_ties(a.contact_state, b.contact_state)
         assert a.residual_norm < 1e-8
     for p, q in zip(pruned.summary["points"], full.summary["points"]):
         assert p["erp"]["power_W"] == pytest.approx(q["erp"]["power_W"], rel=1e-6)

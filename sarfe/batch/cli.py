@@ -37,6 +37,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="also write each variant's own output folder (variant_outputs/<id>/)")
     parser.add_argument("--retry-failed", action="store_true",
                         help="run variants that failed in an earlier run again")
+    parser.add_argument("--force", action="store_true",
+                        help="write into an output folder that is not a sarfe batch folder (never "
+                             "the current folder or one holding an input file)")
     parser.add_argument("--no-cache", action="store_true",
                         help="do not read/write linear stages in <output>/.cache")
 
@@ -57,7 +60,8 @@ def run(args: argparse.Namespace) -> int:
             output = default_output_dir(collect_variants(args.inputs))
         table = run_study(args.inputs, workers=args.workers, scheduler=args.scheduler, output_dir=output,
                           write_variant_outputs=args.write_variant_outputs, retry_failed=args.retry_failed,
-                          cache_linear_stages=not args.no_cache, progress=True)
+                          cache_linear_stages=not args.no_cache, progress=True,
+                          force=getattr(args, "force", False))
     except (StudyError, *case_errors) as error:
         print(f"sarfe batch: {error}", file=sys.stderr)
         return 2

@@ -5,7 +5,7 @@ Flow (``run_study``):
      ``<output>/variants`` (resume);
   2. ``load_case`` every remaining variant and group by ``linear_model_key(case)`` — a variant whose
      case is rejected is recorded as failed right away;
-  3. per group build the ``LinearStage`` once (on a worker, or read ``<output>/.cache/<key>.pkl``),
+  3. per group build the ``LinearStage`` once (on a worker, or read ``<output>/.cache/<key>.npz``),
      ``client.scatter(stage, broadcast=True)`` it and submit the group's variants with it;
   4. write each finished variant's record at once (``sarfe.batch.store``), then merge the table and
      write summary and plots (``sarfe.batch.report``).
@@ -168,7 +168,7 @@ def _variant_output(output: pathlib.Path, variant: Variant, write: bool) -> str 
 
 def _run_in_process(groups, output, stats, finish, pipeline_name, write_outputs, cache):
     for key, members in groups.items():
-        stage = store.load_stage(output, key) if cache else None
+        stage = store.load_stage(output, key, (pipeline_name,)) if cache else None
         if stage is not None:
             stats.linear_stages_from_cache += 1
         else:
@@ -202,7 +202,7 @@ def _run_dask(client, groups, output, stats, finish, pipeline_name, write_output
             pending.add(future)
 
     for key, members in groups.items():
-        stage = store.load_stage(output, key) if cache else None
+        stage = store.load_stage(output, key, (pipeline_name,)) if cache else None
         if stage is not None:
             stats.linear_stages_from_cache += 1
             submit_group(key, stage)
@@ -265,10 +265,25 @@ def default_output_dir(variants: list[Variant]) -> pathlib.Path:
     return pathlib.Path("results") / name
 
 
+def claim_output(output, study_or_cases, variants, force=False) -> pathlib.Path:
+    """Check the batch folder (module ``sarfe.io.result_folder``) and mark it as sarfe's."""
+    from sarfe.io.result_folder import check_output_folder, claim_folder, marker_info
+
+    inputs = study_or_cases if isinstance(study_or_cases, (list, tuple)) else [study_or_cases]
+    protected = [item for item in inputs if isinstance(item, (str, os.PathLike))]
+    protected += list(dict.fromkeys(str(pathlib.Path(v.case_dir) / "case") for v in variants
+                                    if getattr(v, "case_dir", None)))
+    target = check_output_folder(output, force=force, protected=protected,
+                                 what="batch output folder", write_inside=True)
+    names = list(dict.fromkeys(v.source for v in variants))
+    return claim_folder(target, marker_info("batch", names[0] if len(names) == 1 else None),
+                        force=force)
+
+
 def run_study(study_or_cases, workers: int = 2, scheduler: str | None = None, output_dir=None, *,
               client=None, write_variant_outputs: bool = False, retry_failed: bool = False,
               cache_linear_stages: bool = True, progress: bool = False,
-              pipeline: str = PIPELINE) -> pd.DataFrame:
+              pipeline: str = PIPELINE, force: bool = False) -> pd.DataFrame:
     """Solve every variant of the study file(s) / case file(s) and return the merged table.
 
     ``study_or_cases``: a study or case file path, a ``Study``, a case mapping, or a list of these.
@@ -277,6 +292,9 @@ def run_study(study_or_cases, workers: int = 2, scheduler: str | None = None, ou
     ``output_dir``: default ``results/<study name>``. Finished variants found there are not run
     again (failed ones are, with ``retry_failed``). ``pipeline``: module providing ``load_case``,
     ``linear_model_key``, ``build_linear_model``, ``solve_case`` (tests pass a stand-in).
+    The output folder follows the rules of :mod:`sarfe.io.result_folder`: absent, empty or a
+    sarfe batch folder (marker ``.sarfe-result``), never the current folder or one holding an input
+    file; anything else is a CaseError before any work unless ``force``.
 
     Returns the table (one row per variant x frequency point, see ``store.records_table``), with
     ``table.attrs['summary']`` = the dict written to ``summary.json``. Raises ``StudyError`` for an
@@ -287,7 +305,7 @@ def run_study(study_or_cases, workers: int = 2, scheduler: str | None = None, ou
     start = time.perf_counter()
     variants = collect_variants(study_or_cases)
     output = pathlib.Path(output_dir) if output_dir is not None else default_output_dir(variants)
-    output.mkdir(parents=True, exist_ok=True)
+    output = claim_output(output, study_or_cases, variants, force)
 
     done = store.read_records(output, [v.id for v in variants], include_transient=False)
     if retry_failed:

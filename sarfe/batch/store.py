@@ -1,7 +1,8 @@
 """On-disk state of a batch run under ``<output>``: resumable and crash-safe.
 
     <output>/variants/<id>.json     one finished variant (written atomically: temp file + rename)
-    <output>/.cache/<key>.pkl       linear stages keyed by ``linear_model_key`` (reused on re-runs)
+    <output>/.cache/<key>.npz       linear stages keyed by ``linear_model_key`` (reused on re-runs;
+                                    arrays + manifest + content hash, no pickle: ``stage_file``)
     <output>/results.csv|.parquet   merged table, one row per variant x frequency point
     <output>/summary.json, *.png    statistics and plots (``sarfe.batch.report``)
 
@@ -14,7 +15,6 @@ import json
 import math
 import os
 import pathlib
-import pickle
 import tempfile
 
 import numpy as np
@@ -85,21 +85,31 @@ def read_records(output, ids=None, include_transient: bool = True) -> dict[str, 
 
 
 def stage_cache_path(output, key: str) -> pathlib.Path:
-    return pathlib.Path(output) / ".cache" / f"{key}.pkl"
+    return pathlib.Path(output) / ".cache" / f"{key}.npz"
 
 
-def load_stage(output, key: str):
-    """Cached linear stage for ``key`` or None."""
+def load_stage(output, key: str, modules=()):
+    """Cached linear stage for ``key`` or None (missing, damaged, edited, for another key or
+    holding classes other than sarfe's / ``modules``': rebuilt). Never unpickles."""
+    from sarfe.batch.stage_file import StageFileError, load_stage_file
+
     path = stage_cache_path(output, key)
+    if not path.is_file():
+        return None
     try:
-        with path.open("rb") as stream:
-            return pickle.load(stream)
-    except Exception:  # missing, truncated or written by other code: rebuild
+        return load_stage_file(path, key, modules)
+    except StageFileError:
         return None
 
 
 def save_stage(output, key: str, stage) -> None:
-    atomic_write(stage_cache_path(output, key), pickle.dumps(stage, protocol=pickle.HIGHEST_PROTOCOL))
+    from sarfe.batch.stage_file import stage_bytes
+
+    try:
+        data = stage_bytes(stage, key)
+    except TypeError:  # a stage holding something a data file cannot carry: not cached
+        return
+    atomic_write(stage_cache_path(output, key), data)
 
 
 def _cell(value):

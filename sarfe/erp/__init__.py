@@ -7,6 +7,9 @@
     baffled_radiated_power(points, areas, v̂, omega), radiation_efficiency(...)  (Rayleigh reference)
     nodal_areas(points, triangles), nodal_normals(points, triangles),
     normal_displacement(U (2H+1, n, 3), normals (n, 3)), nodal_translations(U (2H+1, n_dof), nodes)
+    third_octave_levels(f_k (H,), P_k (H,)) -> ThirdOctaveSpectrum        (bands.py, IEC 61260-1)
+    erp_contributions(names, v (S, H, n), areas, omega) -> ErpContributions  (contributions.py:
+        partial ERP and coherent shares per source), ranking_lines(...)
 """
 from sarfe.erp.erp import (
     AIR_DENSITY,
@@ -17,6 +20,8 @@ from sarfe.erp.erp import (
     normal_velocity_amplitudes,
     power_level_db,
 )
+from sarfe.erp.bands import ThirdOctaveSpectrum, third_octave_levels
+from sarfe.erp.contributions import ErpContributions, erp_contributions, ranking_lines
 from sarfe.erp.rayleigh import baffled_radiated_power, radiation_efficiency
 from sarfe.erp.surface import (
     nodal_areas,
@@ -32,5 +37,6 @@ __all__ = [
     "normal_velocity_amplitudes", "power_level_db", "nodal_areas", "nodal_normals",
     "nodal_translations", "normal_displacement", "triangle_area_vectors", "a_weighting_db",
     "db_sum", "a_weighted_levels_db", "a_weighted_total_db", "baffled_radiated_power",
-    "radiation_efficiency",
+    "radiation_efficiency", "ThirdOctaveSpectrum", "third_octave_levels", "ErpContributions",
+    "erp_contributions", "ranking_lines",
 ]

@@ -2,10 +2,11 @@
 
     R(ũ, ω) = S(ω) ũ + f̃_nl(ũ) − f̃_e = 0,    f̃_nl = Gᵀ λ̃(G ũ)  (AFT, analytic Jacobian)
 
-Modules: harmonics (Fourier convention), contacts (ContactSet), unilateral / friction (laws),
-aft (forces + Jacobian), linear (S(ω), condensation), residual, newton, solve (one ω),
-continuation (pseudo-arclength in ω), stability (Hill), solution (options + result), harmonic_set
-(solve a subset of the orders, e.g. odd only, ``harmonic_set='odd' | 'auto'``).
+Modules: harmonics (Fourier convention), contacts (ContactSet), laws (one module per contact law
+and its registration: rattle, squeak, damped_impact, tabulated, the Jenkins element), aft (forces +
+Jacobian), linear (S(ω), condensation), residual, newton, solve (one ω), continuation
+(pseudo-arclength in ω), stability (Hill), solution (options + result), harmonic_set (solve a
+subset of the orders, e.g. odd only, ``harmonic_set='odd' | 'auto'``).
 
 Example (NLvib example 03)::
 

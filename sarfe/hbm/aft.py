@@ -2,23 +2,22 @@ r"""Alternating frequency–time (AFT) scheme: contact force harmonics and their
 
 For the contact displacement harmonics r̃ (2H+1, n_rows) (r = G u, rows of all contacts):
 
-    r(θ_j) = Φ r̃  (inverse real FFT, N samples)  →  λ(θ_j) by the laws  →  λ̃ = E λ  (real FFT)
+    r(θ_j) = Φ r̃, ṙ(θ_j) = ω Φ ∇ r̃ (inverse real FFT, N samples) → λ(θ_j) by the laws → λ̃ = E λ
 
-and f̃_nl = Gᵀ λ̃ harmonic by harmonic. The Jacobian ∂λ̃/∂r̃ is block diagonal over contacts (each
-contact couples its own normal/tangent rows over all harmonics); it is assembled analytically:
+and f̃_nl = Gᵀ λ̃ harmonic by harmonic. The laws are reached only through :mod:`sarfe.hbm.laws`,
+group by group (all contacts of one law at once, vectorized over contacts × samples). The
+Jacobian ∂λ̃/∂r̃ is block diagonal over contacts (each contact couples its own normal/tangent rows
+over all harmonics); it is assembled analytically:
 
-* pointwise laws (rattle, the normal part of squeak): E diag(∂λ/∂w) Φ, built from the discrete
-  Fourier coefficients of ∂λ/∂w up to order 2H with product-to-sum identities (O(H²) per contact,
-  :func:`pointwise_jacobian`);
-* 1-D Jenkins: the slider forgets its past at every slip or separation sample j(i), so
-  λ_t,i = k_t (q_i − q_j) + s_j μ λ_n,j and ∂λ_t,i/∂X = k_t (Φ_i − Φ_j) + s_j μ ∂λ_n,j/∂w Φ_j
-  (s_j = ±1 the slip direction), pushed through one FFT of the gathered rows Φ_{j(i)};
-  a contact sticking the whole period gives λ_t = k_t (q − w0) with w0 a history constant,
-  ∂w0/∂X = 0 (w0 = the periodic slider state reached from ``slider_start``);
-* 2-D Jenkins: the consistent tangent of the sample-by-sample march (see :mod:`sarfe.hbm.friction`),
-  with the periodicity condition w_N = w_0 solved for ∂w_0/∂X (zero when the contact sticks).
+* the pointwise normal part: E diag(∂λ/∂w) Φ + ω E diag(∂λ/∂ẇ) Φ ∇, built from the discrete
+  Fourier coefficients of ∂λ/∂w (∂λ/∂ẇ) up to order 2H with product-to-sum identities (O(H²) per
+  contact, :func:`pointwise_jacobian`);
+* a hysteretic tangent element (Jenkins): its own periodic march and Jacobian
+  (:func:`sarfe.hbm.laws.jenkins.periodic_forces`).
 
-The laws are displacement-only and rate-independent: ∂f̃_nl/∂ω = 0.
+Rate-dependent laws also give ∂λ̃/∂ω = E diag(∂λ/∂ẇ) Φ ∇ r̃ (``omega_derivative``) and the blocks
+E diag(∂λ/∂ẇ) Φ of Hill's damping term (``damping_blocks``); for rate-independent laws both are
+absent (∂f̃_nl/∂ω = 0).
 
 With ``kept_rows`` (a harmonic set, :mod:`sarfe.hbm.harmonic_set`) the forces are still computed on
 all 2H+1 rows, but the Jacobian blocks hold only the kept rows and columns (the Fourier basis Φ is
@@ -33,9 +32,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from . import harmonics as hm
-from .friction import (STICK, jenkins_periodic_1d, last_reset_index, slider_update,
-                       slider_update_derivatives)
-from .unilateral import normal_force
+from . import laws
 
 
 @lru_cache(maxsize=32)
@@ -82,12 +79,6 @@ def pointwise_jacobian(derivative_time: np.ndarray, harmonics: int, kept_rows=No
     return s1 * table[:, idx1] + s2 * table[:, idx2]
 
 
-@lru_cache(maxsize=32)
-def _basis(H: int, N: int):
-    E, Phi = hm.fourier_matrices(H, N)
-    return Phi
-
-
 @dataclass(frozen=True)
 class ContactForces:
     """Result of one AFT evaluation.
@@ -95,7 +86,9 @@ class ContactForces:
     force (2H+1, n_rows) [N] λ̃; force_time (N, n_rows) [N]; state (N, n_c) int8;
     blocks: list of (rows (n_g, m) int with −1 = absent, J (n_g, (2H+1)m, (2H+1)m)) with local
     ordering harmonic-major (index h·m + l), ∂λ̃/∂r̃ of each contact group [N/m];
-    slider_end (n_c, 2) [m] periodic slider state at θ_0 (nan for rattle); friction_passes int.
+    slider_end (n_c, 2) [m] periodic slider state at θ_0 (nan without a tangent element);
+    friction_passes int; omega_derivative: ∂λ̃/∂ω (2H+1, n_rows) [N s] or None (rate independent);
+    damping_blocks: like ``blocks``, E diag(∂λ/∂ṙ) Φ [N s/m] of the rate-dependent laws (Hill).
     """
 
     force: np.ndarray
@@ -104,6 +97,8 @@ class ContactForces:
     blocks: list
     slider_end: np.ndarray
     friction_passes: int
+    omega_derivative: np.ndarray = None
+    damping_blocks: list = ()
 
 
 def default_slider_start(contacts, displacement_time):
@@ -117,11 +112,12 @@ def default_slider_start(contacts, displacement_time):
 
 def contact_forces(contacts, contact_displacement, samples_per_period, slider_start=None,
                    jacobian=True, friction_tolerance=1e-12, friction_pass_cap=50,
-                   kept_rows=None) -> ContactForces:
-    r"""λ̃(r̃) for all contacts by AFT, and ∂λ̃/∂r̃ blocks when ``jacobian``.
+                   kept_rows=None, omega=None) -> ContactForces:
+    r"""λ̃(r̃, ω) for all contacts by AFT, and ∂λ̃/∂r̃ blocks when ``jacobian``.
 
     contact_displacement r̃ (2H+1, n_rows) [m]; N = samples_per_period; slider_start (n_c, 2) [m]
-    (default: q(θ_0), see :func:`default_slider_start`). Laws as in :mod:`sarfe.hbm.contacts`.
+    (default: q(θ_0), see :func:`default_slider_start`); omega [rad/s] (needed only by
+    rate-dependent laws). Laws as registered in :mod:`sarfe.hbm.laws`.
     kept_rows: coefficient rows of a harmonic set; the blocks then hold only those (P_k of them).
     """
     R = np.asarray(contact_displacement, dtype=float)
@@ -134,167 +130,84 @@ def contact_forces(contacts, contact_displacement, samples_per_period, slider_st
     lam = np.zeros((N, n_rows))
     state = np.zeros((N, n_c), np.int8)
     slider_end = np.full((n_c, 2), np.nan)
-    blocks, passes = [], 0
-    kinds = np.asarray(contacts.kind)
+    blocks, damping_blocks, passes = [], [], 0
+    omega_derivative = None
     rows_k = np.arange(2 * H + 1) if kept_rows is None else np.asarray(kept_rows)
+    P = rows_k.size
+    velocity = None
 
-    # --- rattle: λ_n = k_n max(0, w − g) -------------------------------------------------------
-    rattle = np.flatnonzero(kinds == "rattle")
-    if rattle.size:
-        rows = contacts.normal_row[rattle]
-        force, stiffness = normal_force(r[:, rows], contacts.gap[rattle],
-                                        contacts.normal_stiffness[rattle])
-        np.add.at(lam, (slice(None), rows), force)
-        state[:, rattle] = stiffness > 0
+    for law, idx, p in laws.groups(contacts):
+        normal_rows = contacts.normal_row[idx]
+        has_normal = normal_rows >= 0
+        gap = contacts.gap[idx]
+        safe = np.maximum(normal_rows, 0)
+        w = np.where(has_normal, r[:, safe], gap) if not np.all(has_normal) else r[:, normal_rows]
+        wdot = None
+        if law.velocity_dependent:
+            if omega is None:
+                raise ValueError(f"the {law.name} law depends on velocity: give omega")
+            if velocity is None:       # ṙ(θ_j) = ω Φ ∇ r̃, and ∇ r̃ for ∂λ̃/∂ω
+                slope = hm.derivative_matrix(H) @ R
+                velocity = (slope, omega * hm.time_samples(slope, N))
+            wdot = np.where(has_normal, velocity[1][:, safe], 0.0)
+        out = law.normal(p, gap, w, wdot)
+        if np.all(has_normal):
+            np.add.at(lam, (slice(None), normal_rows), out.force)
+            stiffness = out.stiffness
+        else:
+            if np.any(has_normal):
+                np.add.at(lam, (slice(None), normal_rows[has_normal]), out.force[:, has_normal])
+            stiffness = np.where(has_normal, out.stiffness, 0.0)
+        state[:, idx] = out.closed
+        damping = None
+        if out.damping is not None:
+            damping = np.where(has_normal, out.damping, 0.0)
+            if omega_derivative is None:
+                omega_derivative = np.zeros((2 * H + 1, n_rows))
+            rate = hm.harmonic_coefficients(damping * hm.time_samples(velocity[0][:, safe], N), H)
+            np.add.at(omega_derivative, (slice(None), normal_rows[has_normal]),
+                      rate[:, has_normal])
+        normal_jacobian = None
         if jacobian:
-            blocks.append((rows[:, None], pointwise_jacobian(stiffness, H, kept_rows)))
-
-    # --- squeak: normal penalty + N0, Jenkins element tangentially -----------------------------
-    squeak = np.flatnonzero(kinds == "squeak")
-    if squeak.size:
-        P = rows_k.size
-        n_rows_c = contacts.normal_row[squeak]
-        t_rows = contacts.tangent_rows[squeak]
-        has_normal = n_rows_c >= 0
-        w = np.where(has_normal, r[:, np.maximum(n_rows_c, 0)], 0.0)
-        force_n, stiff_n = normal_force(w, contacts.gap[squeak], contacts.normal_stiffness[squeak])
-        force_n = np.where(has_normal, force_n, 0.0) + contacts.normal_load[squeak]
-        stiff_n = np.where(has_normal, stiff_n, 0.0)
-        if np.any(has_normal):
-            np.add.at(lam, (slice(None), n_rows_c[has_normal]), force_n[:, has_normal])
-        mu, k_t = contacts.friction_coefficient[squeak], contacts.tangential_stiffness[squeak]
-        rho = mu * force_n / k_t                            # (N, n_s) slip radius [m]
-        J = np.zeros((squeak.size, 3 * P, 3 * P)) if jacobian else None
-        if jacobian:
-            J[:, 0::3, 0::3] = pointwise_jacobian(stiff_n, H, kept_rows)
-        one_d = t_rows[:, 1] < 0
-        # 1-D contacts: clamp scan, exact steady state in one pass
-        c1 = np.flatnonzero(one_d)
-        if c1.size:
-            rows_t = t_rows[c1, 0]
-            q = r[:, rows_t]
-            res = jenkins_periodic_1d(q, rho[:, c1], slider_start[squeak[c1], 0])
-            force_t = k_t[c1] * (q - res["slider"])
-            np.add.at(lam, (slice(None), rows_t), force_t)
-            state[:, squeak[c1]] = res["state"]
-            slider_end[squeak[c1], 0] = res["slider_end"]
-            passes = max(passes, res["passes"])
+            normal_jacobian = pointwise_jacobian(stiffness, H, kept_rows)
+            if damping is not None:
+                viscous = pointwise_jacobian(damping, H, kept_rows)
+                nabla = hm.derivative_matrix(H)[np.ix_(rows_k, rows_k)]
+                normal_jacobian = normal_jacobian + omega * viscous @ nabla
+                damping_blocks.append((np.where(has_normal, normal_rows, -1)[:, None], viscous))
+        # a tangent element acts on the contacts with tangent rows (optional for some laws)
+        with_tangent = contacts.tangent_rows[idx, 0] >= 0 if law.tangent is not None \
+            else np.zeros(idx.size, bool)
+        if not np.all(with_tangent):
             if jacobian:
-                J[c1] += _jenkins_1d_jacobian(res, mu[c1] * stiff_n[:, c1], k_t[c1], H, N, rows_k)
-        c2 = np.flatnonzero(~one_d)
-        if c2.size:
-            rows_t = t_rows[c2]
-            q = r[:, rows_t]                                # (N, n2, 2)
-            force_t, st, w_end, n_pass, J2 = _jenkins_2d(
-                q, rho[:, c2], mu[c2] * stiff_n[:, c2] / k_t[c2], k_t[c2],
-                slider_start[squeak[c2]], H, N, jacobian, friction_tolerance, friction_pass_cap,
-                rows_k)
-            np.add.at(lam, (slice(None), rows_t[:, 0]), force_t[:, :, 0])
-            np.add.at(lam, (slice(None), rows_t[:, 1]), force_t[:, :, 1])
-            state[:, squeak[c2]] = st
-            slider_end[squeak[c2]] = w_end
-            passes = max(passes, n_pass)
-            if jacobian:
-                J[c2] += J2
+                alone = ~with_tangent
+                blocks.append((np.where(has_normal, normal_rows, -1)[alone, None],
+                               normal_jacobian[alone] if np.any(with_tangent)
+                               else normal_jacobian))
+            if not np.any(with_tangent):
+                continue
+        sel = np.flatnonzero(with_tangent) if not np.all(with_tangent) else slice(None)
+        t_idx = idx[sel]
+        t_rows = contacts.tangent_rows[t_idx]
+        present = t_rows >= 0
+        q = np.where(present[None], r[:, np.maximum(t_rows, 0)], 0.0)       # (N, n_t, 2)
+        p_t = p if isinstance(sel, slice) else {k: v[sel] for k, v in p.items()}
+        force_t, st, w_end, n_pass, J_t = law.tangent.periodic_forces(
+            p_t, q, ~present[:, 1], out.force[:, sel], stiffness[:, sel], slider_start[t_idx], H,
+            N, jacobian, friction_tolerance, friction_pass_cap, rows_k)
+        for col in range(2):
+            on = present[:, col]
+            if np.any(on):
+                np.add.at(lam, (slice(None), t_rows[on, col]), force_t[:, on, col])
+        state[:, t_idx] = st
+        slider_end[t_idx] = w_end
+        passes = max(passes, n_pass)
         if jacobian:
-            rows = np.column_stack([np.where(has_normal, n_rows_c, -1), t_rows])
-            blocks.append((rows, J))
-    return ContactForces(hm.harmonic_coefficients(lam, H), lam, state, blocks, slider_end, passes)
-
-
-def _jenkins_1d_jacobian(res, mu_dlam, k_t, H, N, kept_rows):
-    """∂λ̃_(n,t)/∂(w̃, q̃) of 1-D Jenkins contacts in the local (h·3 + l) layout (l = 0 n, 1 t),
-    h over the kept coefficient rows."""
-    P = kept_rows.size
-    n = k_t.size
-    Phi = _basis(H, N)[:, kept_rows]
-    j, has = last_reset_index(res["reset"])
-    gathered = Phi[j]                                      # (N, n, P) rows Φ_{j(i)}
-    weight = np.take_along_axis(res["sign"] * mu_dlam, j, axis=0)  # s_j μ ∂λ_n/∂w at j(i)
-    memory = np.moveaxis(hm.harmonic_coefficients(gathered, H)[kept_rows], 0, 1)  # E P Φ (n, P, P)
-    normal = np.moveaxis(hm.harmonic_coefficients(weight[..., None] * gathered, H)[kept_rows], 0, 1)
-    J = np.zeros((n, 3 * P, 3 * P))
-    eye = np.eye(P)
-    J[:, 1::3, 1::3] = k_t[:, None, None] * (eye - np.where(has[:, None, None], memory, 0.0))
-    J[:, 1::3, 0::3] = np.where(has[:, None, None], normal, 0.0)
-    return J
-
-
-def _jenkins_2d(q, rho, drho_dw, k_t, start, H, N, jacobian, tolerance, pass_cap, kept_rows):
-    r"""2-D Jenkins elements marched sample by sample (vectorized over contacts).
-
-    The disk projection of the slider is not composable like the 1-D clamp, so the march over
-    samples is inherent to 2-D hysteresis. Periods are marched from ``start`` until the slider
-    state at θ_0 repeats to ``tolerance`` × (max|q| + max ρ) or ``pass_cap`` periods; between passes
-    the start is updated by Newton on the periodicity, w_0 ← w_0 + (I − A)⁻¹ (w_N − w_0) with
-    A = ∂w_N/∂w_0 (where I − A is regular, i.e. the contact slipped), so a few passes suffice even
-    when slip is rare and the plain iteration contracts slowly; a final period
-    propagates the consistent tangent: with X = local harmonics (h·3 + l),
-        dw_j = (I − P_j) dq_j + n_j dρ_j + P_j dw_{j−1},
-    and the periodicity w_N = w_0 gives ∂w_0/∂X = (I − A)⁻¹ B (A = ∂w_N/∂w_0, B = ∂w_N/∂X at
-    fixed w_0) when the contact slipped or separated; 0 (history constant) when it stuck.
-    Returns (λ_t (N, n, 2), state (N, n), w_end (n, 2), passes, J (n, 3P, 3P) or None).
-    """
-    n = q.shape[1]
-    P = kept_rows.size                                       # local harmonic rows (kept set)
-    scale = np.abs(q).max() + rho.max() + 1e-300
-    w = np.array(start, dtype=float)
-    passes = 0
-    eye = np.eye(2)
-    while True:
-        w0 = w.copy()
-        A = np.broadcast_to(eye, (n, 2, 2)).copy()        # ∂w_N/∂w_0 over the pass
-        for j in range(N):
-            w, _, Pj, _ = slider_update_derivatives(w, q[j], rho[j])
-            A = Pj @ A
-        passes += 1
-        residual = w - w0
-        if np.abs(residual).max() <= tolerance * scale or passes >= pass_cap:
-            w = w0 if np.abs(residual).max() <= tolerance * scale else w
-            break
-        # Newton on the periodicity w_N(w_0) = w_0 where it is well posed (slip: I − A regular)
-        system = eye - A
-        det = np.linalg.det(system)
-        ok = np.abs(det) > 1e-6
-        if np.any(ok):
-            w[ok] = w0[ok] + np.linalg.solve(system[ok], residual[ok][..., None])[..., 0]
-    Phi = _basis(H, N)[:, kept_rows]
-    force = np.empty((N, n, 2))
-    state = np.empty((N, n), np.int8)
-    if jacobian:
-        dw = np.zeros((n, 2, 3 * P))                        # ∂w/∂X at fixed w_0
-        dw_dw0 = np.broadcast_to(np.eye(2), (n, 2, 2)).copy()
-        dforce = np.empty((N, n, 2, 3 * P))
-        history = np.empty((N, n, 2, 2))
-        dq = np.zeros((N, 2, 3 * P))                       # ∂q_j/∂X templates
-        dq[:, 0, 1::3], dq[:, 1, 2::3] = Phi, Phi
-        dn = np.zeros((N, 3 * P))                          # ∂w_j/∂X (normal) template
-        dn[:, 0::3] = Phi
-    w_start = w.copy()
-    for j in range(N):
-        w, st, Pj, n_rho = slider_update_derivatives(w, q[j], rho[j])
-        force[j] = k_t[:, None] * (q[j] - w)
-        state[j] = st
-        if jacobian:      # dw_j = P_j (dw_{j−1} − dq_j) + dq_j + n_j dρ_j
-            dw = Pj @ (dw - dq[j]) + dq[j] + n_rho[:, :, None] * (drho_dw[j][:, None, None]
-                                                                  * dn[j][None, None, :])
-            dw_dw0 = Pj @ dw_dw0
-            dforce[j] = k_t[:, None, None] * (dq[j] - dw)
-            history[j] = dw_dw0
-    passes += 1
-    if not jacobian:
-        return force, state, w, passes, None
-    forgot = np.any(state != STICK, axis=0)
-    dw0 = np.zeros((n, 2, 3 * P))
-    if np.any(forgot):
-        system = np.eye(2) - dw_dw0[forgot]
-        dw0[forgot] = np.linalg.solve(system, dw[forgot])
-    dforce -= k_t[None, :, None, None] * np.einsum("jcab,cbx->jcax", history, dw0)
-    coeff = hm.harmonic_coefficients(dforce, H)[kept_rows]  # (P, n, 2, 3P)
-    J = np.zeros((n, 3 * P, 3 * P))
-    J[:, 1::3, :] = np.moveaxis(coeff[:, :, 0, :], 0, 1)
-    J[:, 2::3, :] = np.moveaxis(coeff[:, :, 1, :], 0, 1)
-    return force, state, w_start, passes, J
+            J_t[:, 0::3, 0::3] = normal_jacobian[sel]
+            normal_t = np.where(has_normal, normal_rows, -1)[sel]
+            blocks.append((np.column_stack([normal_t, t_rows]), J_t))
+    return ContactForces(hm.harmonic_coefficients(lam, H), lam, state, blocks, slider_end, passes,
+                         omega_derivative, damping_blocks)
 
 
 def jacobian_matrix(blocks, n_rows: int, harmonics: int, dense: bool = False, kept_rows=None):

@@ -11,14 +11,12 @@ friction contact under a constant normal load), and ``tangent_rows[c]`` holds th
 two tangential relative displacements q (−1 where absent). The local contact force λ (normal force
 positive in compression) acts on the structure as
 
-    f_nl = Gᵀ λ,    so that   M ü + D u̇ + K u + Gᵀ λ(G u) = f_e(t).
+    f_nl = Gᵀ λ,    so that   M ü + D u̇ + K u + Gᵀ λ(G u, G u̇) = f_e(t).
 
-Laws (kind):
-- ``rattle``: λ_n = k_n · max(0, w − g)                      (unilateral penalty, gap g, g < 0 = preload)
-- ``squeak``: λ_n = k_n · max(0, w − g) + N0,  and a Jenkins element tangentially: spring k_t in series
-  with a Coulomb slider of limit μ λ_n (1 or 2 tangential directions; slider in the tangent plane).
-  N0 = ``normal_load`` is a constant normal force [N], used for friction contacts with no normal DOF.
-Grounded contacts (against a rigid fixed partner) are simply rows of G that involve one node only.
+The law of each contact (``kind``, a name registered in :mod:`sarfe.hbm.laws`) states λ; its
+parameters live in one table, ``parameters`` {name: (n_c, ...) array}, filled with each parameter's
+default (or 0) for contacts whose law does not use it. Grounded contacts (against a rigid fixed
+partner) are simply rows of G that involve one node only.
 """
 from __future__ import annotations
 
@@ -27,25 +25,23 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-KINDS = ("rattle", "squeak")
+from . import laws
 
 
 @dataclass(frozen=True)
 class ContactSet:
     """Contacts acting on the kept DOFs (see module docstring for the equations).
 
-    Attributes (n_c contacts, n_rows rows of G, n_dof kept DOFs); SI units.
+    Attributes (n_c contacts, n_rows rows of G, n_dof kept DOFs); SI units. A parameter is also
+    readable as an attribute (``contacts.normal_stiffness``: the column of the table).
     """
 
     gap_map: sp.csr_matrix                 # G (n_rows, n_dof) [-]
-    kind: np.ndarray                       # (n_c,) str, 'rattle' | 'squeak'
+    kind: np.ndarray                       # (n_c,) str, the law of each contact
     normal_row: np.ndarray                 # (n_c,) int, row of w in G, −1 if none
     tangent_rows: np.ndarray               # (n_c, 2) int, rows of q1, q2 in G, −1 if absent
     gap: np.ndarray                        # (n_c,) [m], g > 0 open, g < 0 overclosure (preload)
-    normal_stiffness: np.ndarray           # (n_c,) [N/m] k_n
-    tangential_stiffness: np.ndarray       # (n_c,) [N/m] k_t (squeak only, 0 for rattle)
-    friction_coefficient: np.ndarray       # (n_c,) [-] μ (squeak only)
-    normal_load: np.ndarray                # (n_c,) [N] constant normal force N0 (squeak only)
+    parameters: dict = field(default_factory=dict)   # {name: (n_c, ...)} law parameters, SI
     names: tuple = field(default=())       # (n_c,) contact names for reports
 
     @property
@@ -56,6 +52,34 @@ class ContactSet:
     def row_count(self) -> int:
         return self.gap_map.shape[0]
 
+    def __getattr__(self, name):
+        table = self.__dict__.get("parameters") or {}
+        if name in table:
+            return table[name]
+        if name in laws.all_parameters():
+            return np.zeros(len(self.__dict__["kind"]))
+        raise AttributeError(name)
+
+    def law_parameters(self, contact_law, index) -> dict:
+        """{name: values of the contacts ``index``} of every table entry (the law picks its own)."""
+        return {name: values[index] for name, values in self.parameters.items()}
+
+    def subset(self, index, gap_map, normal_row, tangent_rows):
+        """The contacts ``index`` on re-numbered rows (see :func:`sarfe.study.scene.subset_contacts`)."""
+        idx = np.asarray(index, dtype=int)
+        names = tuple(self.names[i] for i in idx) if self.names else None
+        return make_contact_set(gap_map, np.asarray(self.kind, dtype=object)[idx], normal_row,
+                                tangent_rows, self.gap[idx], names=names,
+                                parameters={k: v[idx] for k, v in self.parameters.items()})
+
+    def scaled(self, scale):
+        """The set with every ``scaled`` parameter (contact springs, dashpots, force tables) × s."""
+        declared = laws.all_parameters()
+        table = {k: (scale * v if k in declared and declared[k].scaled else v)
+                 for k, v in self.parameters.items()}
+        return ContactSet(self.gap_map, self.kind, self.normal_row, self.tangent_rows, self.gap,
+                          table, self.names)
+
 
 def make_contact_set(
     gap_map,
@@ -63,50 +87,77 @@ def make_contact_set(
     normal_row,
     tangent_rows,
     gap,
-    normal_stiffness,
+    normal_stiffness=None,
     tangential_stiffness=None,
     friction_coefficient=None,
     normal_load=None,
     names=None,
+    parameters=None,
 ) -> ContactSet:
-    """Build and validate a :class:`ContactSet`; raises ValueError naming the bad parameter."""
+    """Build and validate a :class:`ContactSet`; raises ValueError naming the bad parameter.
+
+    Law parameters come in ``parameters`` {name: scalar or (n_c, ...)}; the keyword arguments
+    normal_stiffness … normal_load are shorthands for the entries of the same name.
+    """
     G = sp.csr_matrix(gap_map, dtype=float)
     kind = np.asarray(kind, dtype=object)
     n_c = kind.shape[0]
-
-    def per_contact(value, name, default=0.0):
-        arr = np.full(n_c, default, dtype=float) if value is None else np.broadcast_to(
-            np.asarray(value, dtype=float), (n_c,)).copy()
-        if not np.all(np.isfinite(arr)):
-            raise ValueError(f"{name} must be finite")
-        return arr
-
-    bad = [k for k in kind if k not in KINDS]
-    if bad:
-        raise ValueError(f"contact kind must be one of {KINDS}, got {bad[0]!r}")
+    for name in kind:
+        laws.law(name)                     # ValueError naming the known laws
     normal_row = np.asarray(normal_row, dtype=int).reshape(n_c)
     tangent_rows = np.asarray(tangent_rows, dtype=int).reshape(n_c, 2)
-    for name, rows in (("normal_row", normal_row), ("tangent_rows", tangent_rows)):
+    for label, rows in (("normal_row", normal_row), ("tangent_rows", tangent_rows)):
         if np.any(rows >= G.shape[0]) or np.any(rows < -1):
-            raise ValueError(f"{name} refers to a row outside gap_map ({G.shape[0]} rows)")
-    gap = per_contact(gap, "gap")
-    k_n = per_contact(normal_stiffness, "normal_stiffness")
-    k_t = per_contact(tangential_stiffness, "tangential_stiffness")
-    mu = per_contact(friction_coefficient, "friction_coefficient")
-    n0 = per_contact(normal_load, "normal_load")
-    for name, arr in (("normal_stiffness", k_n), ("tangential_stiffness", k_t),
-                      ("friction_coefficient", mu), ("normal_load", n0)):
-        if np.any(arr < 0):
-            raise ValueError(f"{name} must be >= 0, got {arr.min():g}")
-    rattle = kind == "rattle"
-    if np.any(rattle & (normal_row < 0)):
-        raise ValueError("a rattle contact needs a normal row (normal_row >= 0)")
-    if np.any(rattle & (k_n <= 0)):
-        raise ValueError("normal_stiffness of a rattle contact must be > 0")
-    squeak = kind == "squeak"
-    if np.any(squeak & (tangent_rows[:, 0] < 0)):
-        raise ValueError("a squeak contact needs at least one tangent row")
-    if np.any(squeak & (k_t <= 0)):
-        raise ValueError("tangential_stiffness of a squeak contact must be > 0")
+            raise ValueError(f"{label} refers to a row outside gap_map ({G.shape[0]} rows)")
+    given = dict(parameters or {})
+    for name, value in (("normal_stiffness", normal_stiffness),
+                        ("tangential_stiffness", tangential_stiffness),
+                        ("friction_coefficient", friction_coefficient),
+                        ("normal_load", normal_load)):
+        if value is not None:
+            given[name] = value
+    gap = np.broadcast_to(np.asarray(gap, dtype=float), (n_c,)).copy()
+    if not np.all(np.isfinite(gap)):
+        raise ValueError("gap must be finite")
+    declared = laws.all_parameters()
+    table = {}
+    for name, value in given.items():
+        arr = np.asarray(value, dtype=float)
+        arr = np.broadcast_to(arr, (n_c,) + (arr.shape[1:] if arr.ndim > 1 else ())).copy()
+        if name in declared and not np.all(np.isfinite(arr)):
+            raise ValueError(f"{name} must be finite")
+        table[name] = arr
+    for name, p in declared.items():
+        if name not in table:
+            table[name] = np.full(n_c, 0.0 if p.default is None else float(p.default))
+    for name in dict.fromkeys(kind):
+        _check_law(laws.law(name), kind == name, normal_row, tangent_rows, table)
     names = tuple(names) if names is not None else tuple(f"contact_{i}" for i in range(n_c))
-    return ContactSet(G, kind, normal_row, tangent_rows, gap, k_n, k_t, mu, n0, names)
+    return ContactSet(G, kind, normal_row, tangent_rows, gap, table, names)
+
+
+def _check_law(contact_law, mine, normal_row, tangent_rows, table):
+    """Rows and parameter bounds of the contacts ``mine`` (bool mask) of one law."""
+    name = contact_law.name
+    has_normal = normal_row >= 0
+    if contact_law.normal_dof == "required" and np.any(mine & ~has_normal):
+        raise ValueError(f"a {name} contact needs a normal row (normal_row >= 0)")
+    if contact_law.tangent_dofs == "required" and np.any(mine & (tangent_rows[:, 0] < 0)):
+        raise ValueError(f"a {name} contact needs at least one tangent row")
+    for p in contact_law.parameters:
+        applies = mine & has_normal if p.normal_part else mine
+        if p.tangent_part:
+            applies = applies & (tangent_rows[:, 0] >= 0)
+        values = table[p.name][applies]
+        if p.minimum is not None:
+            bad = values <= p.minimum if p.exclusive else values < p.minimum
+            if np.any(bad):
+                relation = ">" if p.exclusive else ">="
+                raise ValueError(f"{p.name} of a {name} contact must be {relation} "
+                                 f"{p.minimum:g}, got {values[bad].min():g}")
+        if p.maximum is not None and np.any(values > p.maximum):
+            raise ValueError(f"{p.name} of a {name} contact must be <= {p.maximum:g}, "
+                             f"got {values.max():g}")
+    if contact_law.check is not None and np.any(mine):
+        index = np.flatnonzero(mine)
+        contact_law.check({k: v[index] for k, v in table.items()})

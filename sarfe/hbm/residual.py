@@ -3,14 +3,15 @@ r"""Harmonic-balance residual and its analytic Jacobian, full or condensed to th
 Full (all kept DOFs, unknowns x = ũ.ravel(), (2H+1) n of them):
 
     R(ũ, ω) = S(ω) ũ + f̃_nl(ũ) − f̃_e,      f̃_nl = Gᵀ λ̃(G ũ)   (per harmonic)
-    ∂R/∂ũ = S(ω) + (I⊗G)ᵀ ∂λ̃/∂r̃ (I⊗G)      (sparse),    ∂R/∂ω = (∂S/∂ω) ũ
+    ∂R/∂ũ = S(ω) + (I⊗G)ᵀ ∂λ̃/∂r̃ (I⊗G)      (sparse),    ∂R/∂ω = (∂S/∂ω) ũ + (I⊗G)ᵀ ∂λ̃/∂ω
 
 Condensed (unknowns x = r̃.ravel(), (2H+1) n_rows of them, see :mod:`sarfe.hbm.linear`):
 
     R_c(r̃, ω) = r̃ − r̃_lin(ω) + C(ω) λ̃(r̃),    ∂R_c/∂r̃ = I + C ∂λ̃/∂r̃ (dense),
-    ∂R_c/∂ω = G Z⁻¹ Z' ũ(r̃)
+    ∂R_c/∂ω = G Z⁻¹ Z' ũ(r̃) + C ∂λ̃/∂ω
 
-The contact laws are displacement-only and rate-independent, so ∂f̃_nl/∂ω = 0.
+∂λ̃/∂ω = E diag(∂λ/∂ṙ) Φ ∇ r̃ comes from the rate-dependent laws through ṙ = ω ∇ r (zero, and
+skipped, when every law is rate independent; :mod:`sarfe.hbm.aft`).
 
 With a harmonic set (``Problem.harmonic_orders``, :mod:`sarfe.hbm.harmonic_set`) x holds only the
 kept coefficient rows, and R, ∂R/∂x, ∂R/∂ω are the kept rows (and columns) of the above: the
@@ -70,13 +71,13 @@ def _gap_blocks(contacts, harmonics):
     return sp.kron(sp.identity(2 * harmonics + 1), contacts.gap_map, format="csr")
 
 
-def nonlinear_force(contacts, U, samples_per_period, slider_start=None, jacobian=True):
+def nonlinear_force(contacts, U, samples_per_period, slider_start=None, jacobian=True, omega=None):
     """f̃_nl = Gᵀ λ̃(G ũ) (2H+1, n) [N], ∂f̃_nl/∂ũ (sparse, harmonic-major) and the ContactForces."""
     U = np.asarray(U, dtype=float)
     H = (U.shape[0] - 1) // 2
     G = contacts.gap_map
     R = np.asarray(G @ U.T).T
-    forces = contact_forces(contacts, R, samples_per_period, slider_start, jacobian)
+    forces = contact_forces(contacts, R, samples_per_period, slider_start, jacobian, omega=omega)
     f = np.asarray(G.T @ forces.force.T).T
     jac = None
     if jacobian:
@@ -94,7 +95,7 @@ def full_residual(problem: Problem, x, omega, slider_start=None, jacobian=True) 
     G = problem.contacts.gap_map
     forces = contact_forces(problem.contacts, np.asarray(G @ U.T).T, problem.samples_per_period,
                             slider_start, jacobian, problem.friction_tolerance,
-                            problem.friction_pass_cap, rows)
+                            problem.friction_pass_cap, rows, omega)
     f_nl = np.asarray(G.T @ forces.force.T).T
     R = apply_dynamic_stiffness(problem.model, omega, U) + f_nl - problem.excitation
     J = dR = None
@@ -105,6 +106,8 @@ def full_residual(problem: Problem, x, omega, slider_start=None, jacobian=True) 
                                       kept_rows=rows) @ GG
         S = dynamic_stiffness_matrix(problem.model, omega, problem.harmonics)
         dR = apply_dynamic_stiffness_derivative(problem.model, omega, U).ravel()
+        if forces.omega_derivative is not None:
+            dR = dR + np.asarray(G.T @ forces.omega_derivative.T).T.ravel()
         if rows is not None:     # S is block diagonal over the harmonics: keep the kept blocks
             keep = _kept_indices(rows, n)
             S, dR = S[keep][:, keep], dR[keep]
@@ -122,7 +125,8 @@ def condensed_residual(problem: Problem, condensation, x, slider_start=None,
     rows = kept_rows(problem)
     Rr = expand_rows(x, rows, problem.harmonics, n_rows)
     forces = contact_forces(problem.contacts, Rr, problem.samples_per_period, slider_start,
-                            jacobian, problem.friction_tolerance, problem.friction_pass_cap, rows)
+                            jacobian, problem.friction_tolerance, problem.friction_pass_cap, rows,
+                            condensation.omega)
     keep = None if rows is None else _kept_indices(rows, n_rows)
     force = forces.force.ravel() if keep is None else forces.force.ravel()[keep]
     r_lin = condensation.linear_response.ravel()
@@ -139,6 +143,9 @@ def condensed_residual(problem: Problem, condensation, x, slider_start=None,
         dR = condensed_omega_derivative(problem.model, condensation, U).ravel()
         if keep is not None:
             dR = dR[keep]
+        if forces.omega_derivative is not None:
+            rate = forces.omega_derivative.ravel()
+            dR = dR + C @ (rate if keep is None else rate[keep])
     reference = _reference(np.linalg.norm(condensation.linear_response), np.linalg.norm(x))
     return Evaluation(R, J, dR, forces, reference)
 

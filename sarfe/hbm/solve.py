@@ -2,8 +2,9 @@ r"""Periodic solution at one frequency: R(ũ, ω) = S(ω) ũ + f̃_nl(ũ) − f�
 
 Steps of :func:`solve_frequency`:
 1. validate the inputs (shapes, H, N; the model and contacts were validated when built);
-2. first guess: the linear response with every contact linearized at u = 0 (closed contacts as
-   springs k_n with their preload, squeak tangents stuck as springs k_t), unless ``initial`` is given;
+2. first guess: the linear response with every contact linearized at u = 0 by its law (closed
+   contacts as their springs, dashpots and preload, tangent elements stuck as springs k_t,
+   :func:`sarfe.hbm.laws.linearization`), unless ``initial`` is given;
    if Newton fails from it, homotopies provide the start, tried in turn: the contact stiffness
    (k_n·s, k_t·s, s stepped from s₀ ≤ 10⁻⁴ to 1 in log s) and then the excitation level (f̃_e·s,
    s stepped 0 → 1), each with adaptive steps warm-started by the previous one and capped at
@@ -28,10 +29,11 @@ from dataclasses import replace
 import numpy as np
 import scipy.sparse as sp
 
-from .aft import default_slider_start
+from . import laws
+from .aft import default_slider_start, jacobian_matrix
 from .harmonic_set import (AUTO_CANDIDATE, coefficient_rows, dropped_content, expand_rows,
                            harmonic_set_orders)
-from .harmonics import check_harmonics, time_samples
+from .harmonics import check_harmonics, derivative_matrix, time_samples
 from .linear import condense, dynamic_stiffness_matrix, recover_displacement
 from .newton import SingularJacobian, newton, solve_linear
 from .residual import Problem, condensed_residual, full_residual, kept_rows
@@ -92,32 +94,49 @@ def wants_condensation(problem, options) -> bool:
 
 
 def contact_row_springs(contacts) -> np.ndarray:
-    """Spring of every row of G [N/m]: k_n on normal rows, k_t on tangent rows."""
+    """Spring of every row of G [N/m]: the law's normal spring on normal rows (also where open),
+    the stuck tangent spring k_t on tangent rows (:func:`sarfe.hbm.laws.linearization`)."""
     c = contacts
+    normal, tangent = laws.linearization(c)
     springs = np.zeros(c.row_count)
     has_n = c.normal_row >= 0
-    springs[c.normal_row[has_n]] = c.normal_stiffness[has_n]
+    springs[c.normal_row[has_n]] = normal.spring[has_n]
     for col in range(2):
         present = c.tangent_rows[:, col] >= 0
-        springs[c.tangent_rows[present, col]] = c.tangential_stiffness[present]
+        springs[c.tangent_rows[present, col]] = tangent[present]
     return springs
 
 
-def linearized_guess(problem, omega) -> np.ndarray:
-    """ũ of the linear system with the contacts linearized at u = 0 (see module docstring)."""
-    c, H, n = problem.contacts, problem.harmonics, problem.model.dof_count
-    rows_k = contact_row_springs(c)
-    preload = np.zeros(c.row_count)
+def linearized_rows(contacts):
+    """(spring, dashpot [N s/m], preload [N]) per row of G of the contacts linearized at u = 0:
+    normal rows of contacts closed at u = 0 carry their law's spring, dashpot and preload (the
+    preload of a contact without a normal row has no row), tangent rows the stuck spring k_t."""
+    c = contacts
+    normal, tangent = laws.linearization(c)
+    springs, dashpots, preload = np.zeros(c.row_count), np.zeros(c.row_count), np.zeros(c.row_count)
     has_n = c.normal_row >= 0
-    closed = has_n & (c.gap <= 0)
-    rows_k[c.normal_row[has_n & ~closed]] = 0.0            # open contacts carry no spring
-    preload[c.normal_row[closed]] = -c.normal_stiffness[closed] * c.gap[closed]
-    preload[c.normal_row[has_n]] += np.where(np.asarray(c.kind)[has_n] == "squeak",
-                                             c.normal_load[has_n], 0.0)
+    closed = has_n & normal.closed
+    springs[c.normal_row[closed]] = normal.spring[closed]
+    dashpots[c.normal_row[closed]] = normal.dashpot[closed]
+    preload[c.normal_row[has_n]] = normal.preload[has_n]
+    for col in range(2):
+        present = c.tangent_rows[:, col] >= 0
+        springs[c.tangent_rows[present, col]] = tangent[present]
+    return springs, dashpots, preload
+
+
+def linearized_guess(problem, omega) -> np.ndarray:
+    """ũ of the linear system with the contacts linearized at u = 0 (see module docstring):
+    (S(ω) + (I⊗G)ᵀ (I⊗k + ω∇⊗c) (I⊗G)) ũ = f̃_e − Gᵀ p in row 0."""
+    c, H, n = problem.contacts, problem.harmonics, problem.model.dof_count
+    rows_k, rows_c, preload = linearized_rows(c)
     G = c.gap_map
     GG = sp.kron(sp.identity(2 * H + 1), G, format="csr")
     A = dynamic_stiffness_matrix(problem.model, omega, H) + GG.T @ sp.diags(
         np.tile(rows_k, 2 * H + 1)) @ GG
+    if np.any(rows_c):
+        A = A + sp.kron(sp.csr_matrix(omega * derivative_matrix(H)),
+                        G.T @ sp.diags(rows_c) @ G, format="csr")
     F = problem.excitation.copy()
     F[0] -= G.T @ preload
     rows = kept_rows(problem)
@@ -198,6 +217,16 @@ def harmonic_set_label(problem) -> str:
     return "odd" if odd is not None and np.array_equal(orders, odd) else "orders"
 
 
+def contact_damping(problem, forces):
+    """(I⊗G)ᵀ E diag(∂λ/∂ṙ) Φ (I⊗G) (sparse) of the rate-dependent laws, or None: the velocity
+    terms of the contact forces in Hill's damping matrix (:mod:`sarfe.hbm.stability`)."""
+    if not forces.damping_blocks:
+        return None
+    G, H = problem.contacts.gap_map, problem.harmonics
+    GG = sp.kron(sp.identity(2 * H + 1), G, format="csr")
+    return (GG.T @ jacobian_matrix(forces.damping_blocks, G.shape[0], H) @ GG).tocsr()
+
+
 def finalize(problem, omega, U, converged, reason, iterations, slider, options) -> HarmonicSolution:
     """Residual on all DOFs and all harmonic rows, contact fields, Hill stability → HarmonicSolution.
 
@@ -224,7 +253,8 @@ def finalize(problem, omega, U, converged, reason, iterations, slider, options) 
     stable, exponent = None, float("nan")
     if converged and options.stability:
         stable, exponent = hill_stability(problem.model, omega, problem.harmonics, ev.jacobian,
-                                          options.stability_tolerance)
+                                          options.stability_tolerance,
+                                          contact_damping=contact_damping(problem, ev.forces))
     orders = problem.harmonic_orders
     return HarmonicSolution(
         omega=float(omega), harmonics=problem.harmonics,
@@ -321,10 +351,9 @@ def soft_contact_scale(problem) -> float:
 
 
 def scaled_contacts(problem, scale):
-    """The problem with every contact spring scaled: k_n·s, k_t·s (gaps, μ, N0 unchanged)."""
-    c = problem.contacts
-    return replace(problem, contacts=replace(c, normal_stiffness=scale * c.normal_stiffness,
-                                             tangential_stiffness=scale * c.tangential_stiffness))
+    """The problem with every contact spring scaled (the laws' ``scaled`` parameters: k_n·s, k_t·s,
+    dashpots, force tables; gaps, μ, N0 unchanged)."""
+    return replace(problem, contacts=problem.contacts.scaled(scale))
 
 
 def _homotopy(problem, omega, options, kind):

@@ -3,8 +3,11 @@ r"""Hill stability of a periodic solution (Floquet exponents from the harmonic-b
 A perturbation y = e^{st} p(θ) of the periodic solution obeys the linearized periodic system; with
 p in the same truncated Fourier basis (all kept DOFs), this is the quadratic eigenproblem
 
-    ( s² M̃ + s D̃ + ∂R/∂ũ ) p̃ = 0,     M̃ = I⊗M,   D̃ = I⊗D + 2ω ∇⊗M,
+    ( s² M̃ + s D̃ + ∂R/∂ũ ) p̃ = 0,     M̃ = I⊗M,   D̃ = I⊗D + 2ω ∇⊗M + (I⊗G)ᵀ E diag(∂λ/∂ṙ) Φ (I⊗G),
     ∂R/∂ũ = S(ω) + (I⊗G)ᵀ ∂λ̃/∂r̃ (I⊗G)   (the Newton Jacobian on all DOFs),
+
+the last term of D̃ (``contact_damping``) being the velocity terms of rate-dependent contact laws
+(δṙ = s δr + ω ∂δr/∂θ; the ω∂/∂θ part is already in ∂λ̃/∂r̃),
 
 solved in first-order form [[0, I], [−∂R/∂ũ, −D̃]] z = s [[I, 0], [0, M̃]] z: densely when
 2(2H+1)n ≤ ``dense_limit``, else by sparse shift-invert (ARPACK, σ = 0) for the eigenvalues nearest
@@ -31,15 +34,18 @@ import scipy.sparse.linalg as spla
 from .linear import hill_matrices
 
 
-def floquet_exponents(model, omega, harmonics, jacobian, dense_limit=3000, max_exponents=120):
+def floquet_exponents(model, omega, harmonics, jacobian, dense_limit=3000, max_exponents=120,
+                      contact_damping=None):
     """Kept Floquet exponents s [1/s] (≥ 2n) of a solution, given ∂R/∂ũ (sparse or dense).
 
     On the sparse path at most ``max_exponents`` exponents nearest the origin are computed (all 2n
     representatives lie in the strip |Im s| ≤ ω/2, hence near 0; for 2n > max_exponents only the
-    ones of the lowest modes are checked).
+    ones of the lowest modes are checked). contact_damping: (I⊗G)ᵀ E diag(∂λ/∂ṙ) Φ (I⊗G) or None.
     """
     n = model.dof_count
     Mt, Dt = hill_matrices(model, omega, harmonics)
+    if contact_damping is not None:
+        Dt = (Dt + sp.csr_matrix(contact_damping)).tocsr()
     size = Mt.shape[0]
     keep = 2 * n
     if 2 * size <= dense_limit:
@@ -64,10 +70,12 @@ def floquet_exponents(model, omega, harmonics, jacobian, dense_limit=3000, max_e
     return values[order[in_strip]]
 
 
-def hill_stability(model, omega, harmonics, jacobian, tolerance=1e-6, dense_limit=3000):
+def hill_stability(model, omega, harmonics, jacobian, tolerance=1e-6, dense_limit=3000,
+                   contact_damping=None):
     """(stable, leading exponent max Re s [1/s]) of a periodic solution (see module docstring)."""
     try:
-        values = floquet_exponents(model, omega, harmonics, jacobian, dense_limit)
+        values = floquet_exponents(model, omega, harmonics, jacobian, dense_limit,
+                                   contact_damping=contact_damping)
     except (np.linalg.LinAlgError, RuntimeError, ValueError, spla.ArpackError):
         return None, float("nan")
     if values.size == 0:

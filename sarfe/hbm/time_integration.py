@@ -5,9 +5,9 @@ Equation (the same model as the harmonic balance, see :mod:`sarfe.hbm.contacts`)
     M ü + D u̇ + K u + Gᵀ λ(G u, history) = f_e(t),
     f_e(t) = F0 + Σ_k F_kc cos kωt + F_ks sin kωt        (F = ``excitation``, (2H+1, n_dof) [N])
 
-with the contact laws evaluated pointwise in time: the rattle penalty law
-(:func:`sarfe.hbm.unilateral.normal_force`) and, for squeak contacts, the Jenkins return map
-(:func:`sarfe.hbm.friction.slider_update`) with the slip limit μ λ_n, λ_n = k_n max(0, w − g) + N0.
+with the contact laws of :mod:`sarfe.hbm.laws` evaluated pointwise in time, λ(r₊, ṙ₊) (the same
+law functions as the AFT): the normal force of each law and, for laws with a tangent element, its
+one-step return map (:func:`sarfe.hbm.laws.jenkins.step`) driven by that normal force.
 
 Scheme: Newmark average acceleration (trapezoidal rule; implicit, unconditionally stable, second
 order, no numerical damping) with a fixed step h = T/N, N = ``steps_per_period``:
@@ -18,7 +18,9 @@ Eliminating a₊, v₊ gives  K_eff u₊ + Gᵀ λ(G u₊) = b,  K_eff = K + (2/
 once. With u_lin = K_eff⁻¹ b, B = K_eff⁻¹ Gᵀ and the contact compliance C = G B (n_rows, n_rows) the
 step reduces to a small semismooth Newton iteration on the contact rows r = G u₊ only,
 
-    R(r) = r + C λ(r) − G u_lin = 0,      J = I + C ∂λ/∂r,
+    R(r) = r + C λ(r, ṙ(r)) − G u_lin = 0,   J = I + C (∂λ/∂r + (2/h) ∂λ/∂ṙ),
+
+with the Newmark velocity of the contact rows ṙ₊ = (2/h)(r₊ − r) − ṙ (so ∂ṙ₊/∂r₊ = 2/h),
 
 followed by u₊ = u_lin − B λ. The friction history (slider positions) is updated by the exact
 return map once r has converged. Periods are run until the period-end state (u, v/ω, sliders)
@@ -40,11 +42,11 @@ import scipy.linalg as la
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .friction import SEPARATED, SLIP, STICK, slider_update
+from . import laws
 from .harmonics import harmonic_coefficients, time_samples
-from .unilateral import normal_force
 
-__all__ = ["TimeResponse", "integrate_time", "linear_harmonic_response", "period_work"]
+__all__ = ["TimeResponse", "integrate_time", "integrate_transient", "linear_harmonic_response",
+           "period_work"]
 
 DENSE_LIMIT = 3000  # models up to this many DOFs use a dense propagator (reduced models)
 
@@ -149,104 +151,111 @@ def _state_at_zero(U, omega, steps_per_period):
     return u0, v0
 
 
-class _ContactLaw:
-    """Contact forces λ(r) and ∂λ/∂r for all contacts at once (rows of G), given slider history.
+class _ContactLaws:
+    """Contact forces λ(r, ṙ) and ∂λ/∂r, ∂λ/∂ṙ for all contacts at once (rows of G), given the
+    slider history, law group by law group (:mod:`sarfe.hbm.laws`).
 
     ``forces`` evaluates the laws and keeps what ``jacobian`` needs (same r), so a converged
-    Newton step costs one force evaluation.
+    Newton step costs one force evaluation. Sliders (n_s, 2): the contacts with a tangent element,
+    in group order.
     """
 
     def __init__(self, contacts):
         self.n_rows = contacts.row_count
         self.n_c = contacts.count
-        nr = contacts.normal_row
-        has_normal = nr >= 0
-        squeak = contacts.kind == "squeak"
-        self.normal_contacts = np.flatnonzero(has_normal)
-        self.normal_rows = nr[has_normal]
-        self.normal_load_all = np.where(squeak, contacts.normal_load, 0.0)[has_normal]
-        self.gap = contacts.gap[has_normal]
-        self.k_n = contacts.normal_stiffness[has_normal]
-        self.rattle_normal = (contacts.kind == "rattle")[has_normal]
-        s = np.flatnonzero(squeak)
-        self.squeak = s
-        t_rows = contacts.tangent_rows[s]                           # (n_s, 2)
-        self.t_mask = t_rows >= 0
-        self.t_rows_safe = np.where(self.t_mask, t_rows, 0)
-        self.t_rows_used = t_rows[self.t_mask]
-        self.k_t = contacts.tangential_stiffness[s]
-        self.mu = contacts.friction_coefficient[s]
-        self.n0 = contacts.normal_load[s]
-        s_nrow = nr[s]
-        self.s_has_normal = s_nrow >= 0
-        self.s_nrow_safe = np.where(self.s_has_normal, s_nrow, 0)
-        self.s_gap, self.s_kn = contacts.gap[s], contacts.normal_stiffness[s]
-        # Jacobian scatter indices of the tangential blocks (existing directions only)
-        pair = self.t_mask[:, :, None] & self.t_mask[:, None, :]
-        self.pair = pair
-        self.pair_rows = np.broadcast_to(self.t_rows_safe[:, :, None], pair.shape)[pair]
-        self.pair_cols = np.broadcast_to(self.t_rows_safe[:, None, :], pair.shape)[pair]
-        coupled = self.t_mask & self.s_has_normal[:, None]
-        self.coupled = coupled
-        self.coupled_rows = self.t_rows_safe[coupled]
-        self.coupled_cols = np.broadcast_to(self.s_nrow_safe[:, None], coupled.shape)[coupled]
-        self.eye = np.eye(2)
+        self.velocity = laws.velocity_dependent(contacts)
+        self.groups = []
+        first = 0
+        for law, idx, p in laws.groups(contacts):
+            nr = contacts.normal_row[idx]
+            g = dict(law=law, idx=idx, p=p, gap=contacts.gap[idx], has_normal=nr >= 0,
+                     normal_safe=np.maximum(nr, 0))
+            g["normal_rows"] = nr[g["has_normal"]]
+            sel = np.flatnonzero(contacts.tangent_rows[idx, 0] >= 0) if law.tangent is not None \
+                else np.zeros(0, int)
+            g["tangent"] = sel.size > 0        # the element acts on the contacts with tangent rows
+            if g["tangent"]:
+                t_rows = contacts.tangent_rows[idx[sel]]
+                mask = t_rows >= 0
+                g.update(t_sel=sel, p_t={k: v[sel] for k, v in p.items()}, t_mask=mask,
+                         t_safe=np.where(mask, t_rows, 0), t_used=t_rows[mask],
+                         sliders=slice(first, first + sel.size))
+                first += sel.size
+                pair = mask[:, :, None] & mask[:, None, :]
+                g.update(pair=pair,
+                         pair_rows=np.broadcast_to(g["t_safe"][:, :, None], pair.shape)[pair],
+                         pair_cols=np.broadcast_to(g["t_safe"][:, None, :], pair.shape)[pair])
+                coupled = mask & g["has_normal"][sel][:, None]
+                g.update(coupled=coupled, coupled_rows=g["t_safe"][coupled],
+                         coupled_cols=np.broadcast_to(g["normal_safe"][sel][:, None],
+                                                      coupled.shape)[coupled])
+            self.groups.append(g)
+        self.slider_count = first
 
-    def forces(self, r, slider_previous):
-        """λ (n_rows,), slider (n_s, 2), state (n_c,) int8 at contact displacements r (n_rows,)."""
+    def length_floor(self, gap):
+        """Round-off floor of the contact Newton [m]: 1e-15 × the largest gap or slip length."""
+        lengths = [np.abs(gap).max(initial=0.0)]
+        for g in self.groups:
+            if g["tangent"]:
+                lengths.append(g["law"].tangent.slip_length(g["p_t"]).max(initial=0.0))
+        return 1e-15 * max(max(lengths), 1e-9)
+
+    def forces(self, r, rdot, slider_previous):
+        """λ (n_rows,), slider (n_s, 2), state (n_c,) int8 at contact displacements r (n_rows,) and
+        velocities ṙ (n_rows,) (None: all laws rate independent)."""
         lam = np.zeros(self.n_rows)
         state = np.zeros(self.n_c, dtype=np.int8)
-        self._normal_stiffness = None
-        if self.normal_rows.size:
-            force, stiff = normal_force(r[self.normal_rows], self.gap, self.k_n)
-            lam[self.normal_rows] = force + self.normal_load_all
-            state[self.normal_contacts] = (stiff > 0) & self.rattle_normal
-            self._normal_stiffness = stiff
-        slider = slider_previous
-        if self.squeak.size:
-            q = r[self.t_rows_safe] * self.t_mask
-            penetration = (r[self.s_nrow_safe] - self.s_gap) * self.s_has_normal
-            self._closed = penetration > 0.0
-            lam_n = self.s_kn * np.maximum(penetration, 0.0) + self.n0
-            slider, fstate = slider_update(slider_previous, q, self.mu * lam_n / self.k_t)
-            lam[self.t_rows_used] = (self.k_t[:, None] * (q - slider))[self.t_mask]
-            state[self.squeak] = fstate
-            self._q, self._lam_n, self._fstate, self._previous = q, lam_n, fstate, slider_previous
+        slider = slider_previous.copy() if self.slider_count else slider_previous
+        self._last = []
+        for g in self.groups:
+            has = g["has_normal"]
+            w = np.where(has, r[g["normal_safe"]], g["gap"])
+            wdot = np.where(has, rdot[g["normal_safe"]], 0.0) if rdot is not None else None
+            out = g["law"].normal(g["p"], g["gap"], w, wdot)
+            lam[g["normal_rows"]] = out.force[has]
+            state[g["idx"]] = out.closed
+            keep = {"stiffness": np.where(has, out.stiffness, 0.0),
+                    "damping": None if out.damping is None else np.where(has, out.damping, 0.0)}
+            if g["tangent"]:
+                q = r[g["t_safe"]] * g["t_mask"]
+                force_t, new, fstate, d_tq, d_tn = g["law"].tangent.step(
+                    g["p_t"], q, out.force[g["t_sel"]], slider_previous[g["sliders"]])
+                lam[g["t_used"]] = force_t[g["t_mask"]]
+                state[g["idx"][g["t_sel"]]] = fstate
+                slider[g["sliders"]] = new
+                keep.update(d_tq=d_tq, d_tn=d_tn)
+            self._last.append(keep)
         return lam, slider, state
 
-    def jacobian(self):
-        """∂λ/∂r (n_rows, n_rows) at the r of the last :meth:`forces` call (semismooth)."""
+    def jacobian(self, rate_factor=0.0):
+        """∂λ/∂r + rate_factor ∂λ/∂ṙ (n_rows, n_rows) at the r of the last :meth:`forces` call
+        (semismooth); rate_factor = ∂ṙ/∂r = 2/h in the Newmark step."""
         jac = np.zeros((self.n_rows, self.n_rows))
-        if self._normal_stiffness is not None:
-            jac[self.normal_rows, self.normal_rows] = self._normal_stiffness
-        if self.squeak.size:
-            s_vec = self._q - self._previous
-            norm = np.sqrt(np.einsum("ij,ij->i", s_vec, s_vec))
-            norm = np.where(norm > 0, norm, 1.0)
-            unit = s_vec / norm[:, None]
-            slip = self._fstate == SLIP
-            # stick: k_t I ; slip: μλ_n (I − ŝŝᵀ)/|s| ; separated: 0
-            stick_coef = self.k_t * (self._fstate == STICK)
-            slip_coef = self.mu * self._lam_n / norm * slip
-            d_tq = (stick_coef + slip_coef)[:, None, None] * self.eye \
-                - slip_coef[:, None, None] * unit[:, :, None] * unit[:, None, :]
-            jac[self.pair_rows, self.pair_cols] += d_tq[self.pair]
-            if self.coupled_rows.size:  # slip limit follows the normal force: ∂λ_t/∂w = μ k_n ŝ
-                d_tn = ((slip & self._closed) * self.mu * self.s_kn)[:, None] * unit
-                jac[self.coupled_rows, self.coupled_cols] += d_tn[self.coupled]
+        for g, keep in zip(self.groups, self._last):
+            has = g["has_normal"]
+            stiffness = keep["stiffness"]
+            if keep["damping"] is not None:
+                stiffness = stiffness + rate_factor * keep["damping"]
+            jac[g["normal_rows"], g["normal_rows"]] = stiffness[has]
+            if g["tangent"]:
+                jac[g["pair_rows"], g["pair_cols"]] += keep["d_tq"][g["pair"]]
+                if g["coupled_rows"].size:   # slip limit follows the normal force
+                    d_tn = keep["d_tn"] * stiffness[g["t_sel"], None]
+                    jac[g["coupled_rows"], g["coupled_cols"]] += d_tn[g["coupled"]]
         return jac
 
 
 def _slider_from_initial(law, r0, initial_force):
     """Slider positions w = q − λ_t/k_t from a given contact force (or w = q: unloaded spring)."""
-    n_s = law.squeak.size
-    if n_s == 0:
-        return np.zeros((0, 2))
-    q = np.where(law.t_mask, r0[law.t_rows_safe], 0.0)
-    if initial_force is None:
-        return q.copy()
-    lam_t = np.where(law.t_mask, initial_force[law.t_rows_safe], 0.0)
-    return q - lam_t / law.k_t[:, None]
+    slider = np.zeros((law.slider_count, 2))
+    for g in law.groups:
+        if not g["tangent"]:
+            continue
+        q = np.where(g["t_mask"], r0[g["t_safe"]], 0.0)
+        force = None if initial_force is None else np.where(g["t_mask"],
+                                                            initial_force[g["t_safe"]], 0.0)
+        slider[g["sliders"]] = g["law"].tangent.initial_slider(g["p_t"], q, force)
+    return slider
 
 
 class _Propagator:
@@ -310,26 +319,27 @@ def _run(model, contacts, forcing, omega, N, u, v, slider, max_periods, steady_t
         G = np.zeros((0, n))
     else:  # dense rows for small (reduced) models, sparse matvecs for big ones
         G = contacts.gap_map.toarray() if dense else sp.csr_matrix(contacts.gap_map)
-    law = _ContactLaw(contacts) if contacts is not None and contacts.count else None
+    law = _ContactLaws(contacts) if contacts is not None and contacts.count else None
     n_rows, n_c = G.shape[0], (contacts.count if contacts is not None else 0)
     prop = _Propagator(model, h, G, forcing)
     M, D, K = model.mass, model.damping, model.stiffness
     identity = np.eye(n_rows)
     if law is not None:  # round-off floor of the contact Newton [m]
-        slip_lengths = contacts.friction_coefficient * contacts.normal_load / np.maximum(
-            contacts.tangential_stiffness, 1e-300)
-        length_floor = 1e-15 * max(np.abs(contacts.gap).max(), slip_lengths.max(), 1e-9)
+        length_floor = law.length_floor(contacts.gap)
+    rate = 2.0 / h       # Newmark: ṙ₊ = (2/h)(r₊ − r) − ṙ, ∂ṙ₊/∂r₊ = 2/h
 
-    def contact(r_lin, slider_prev, r_guess):
-        """Solve r + C λ(r) = r_lin (semismooth Newton); returns λ, slider, state, r, iterations."""
+    def contact(r_lin, slider_prev, r_guess, r_start, rdot_start):
+        """Solve r + C λ(r, ṙ(r)) = r_lin (semismooth Newton); returns λ, slider, state, r,
+        iterations."""
         r = r_guess
         tolerance = 1e-12 * np.abs(r_lin).max() + length_floor
         for it in range(1, 60):
-            lam, new_slider, state = law.forces(r, slider_prev)
+            rdot = rate * (r - r_start) - rdot_start if law.velocity else None
+            lam, new_slider, state = law.forces(r, rdot, slider_prev)
             residual = r + prop.C @ lam - r_lin
             if np.abs(residual).max() <= tolerance:
                 break
-            step = np.linalg.solve(identity + prop.C @ law.jacobian(), residual)
+            step = np.linalg.solve(identity + prop.C @ law.jacobian(rate), residual)
             r = r - (0.5 * step if it > 30 else step)  # damp if cycling between active sets
         return lam, new_slider, state, r, it
 
@@ -338,7 +348,7 @@ def _run(model, contacts, forcing, omega, N, u, v, slider, max_periods, steady_t
     def restart(u, v, slider):
         """Contact forces and the consistent acceleration M a = f − K u − D v − Gᵀλ at t = 0."""
         if law is not None:
-            lam, slider, state = law.forces(G @ u, slider)
+            lam, slider, state = law.forces(G @ u, G @ v if law.velocity else None, slider)
         else:
             lam, state = np.zeros(0), np.zeros(0, dtype=np.int8)
         rhs = forcing[0] - K @ u - D @ v - G.T @ lam
@@ -372,7 +382,8 @@ def _run(model, contacts, forcing, omega, N, u, v, slider, max_periods, steady_t
             if law is not None:
                 r_lin = G @ u_lin
                 guess = r_lin - prop.C @ lam  # predictor: last step's contact force
-                lam_new, slider, state, r_new, iterations = contact(r_lin, slider, guess)
+                lam_new, slider, state, r_new, iterations = contact(
+                    r_lin, slider, guess, r_prev, G @ v if law.velocity else None)
                 worst_iterations = max(worst_iterations, iterations)
                 u_new = u_lin - prop.B @ lam_new
             else:
@@ -477,7 +488,7 @@ def integrate_time(model, contacts, excitation, omega, harmonics, steps_per_peri
             np.unique(sp.csr_matrix(contacts.gap_map).indices)
     output_dofs = np.asarray(output_dofs, dtype=int)
 
-    law = _ContactLaw(contacts) if contacts is not None and contacts.count else None
+    law = _ContactLaws(contacts) if contacts is not None and contacts.count else None
     initial_force = None
     if initial is None:
         U_init = linear_harmonic_response(model, F, omega, N)
@@ -534,6 +545,30 @@ def integrate_time(model, contacts, excitation, omega, harmonics, steps_per_peri
         contact_work=run["contact_work"],
         max_contact_iterations=int(run["iterations"]),
     )
+
+
+def integrate_transient(model, contacts, displacement, velocity, duration, steps):
+    """Free response (no excitation) from a given state over ``duration`` [s] in ``steps`` Newmark
+    steps, with the same contact handling as :func:`integrate_time` (e.g. a single impact).
+
+    displacement, velocity: u(0) [m], u̇(0) [m/s] (n_dof,). Returns a dict: time (steps,) [s]
+    t_j = j·duration/steps, displacement, velocity (steps, n_dof), contact_displacement,
+    contact_force (steps, n_rows), and the state at t = duration: final_displacement,
+    final_velocity (n_dof,).
+    """
+    n = model.dof_count
+    N = int(steps)
+    omega = 2.0 * np.pi / float(duration)
+    law = _ContactLaws(contacts) if contacts is not None and contacts.count else None
+    u0 = np.asarray(displacement, dtype=float).reshape(n)
+    v0 = np.asarray(velocity, dtype=float).reshape(n)
+    slider = _slider_from_initial(law, contacts.gap_map @ u0, None) if law is not None \
+        else np.zeros((0, 2))
+    run = _run(model, contacts, np.zeros((N, n)), omega, N, u0, v0, slider, 1, 0.0, False, None, 0)
+    u_end, v_end, _ = run["final"]
+    return {"time": np.arange(N) * (float(duration) / N), "displacement": run["u"],
+            "velocity": run["v"], "contact_displacement": run["r"], "contact_force": run["lam"],
+            "final_displacement": u_end, "final_velocity": v_end}
 
 
 def period_work(displacement_harmonics, excitation, damping, contact_displacement_harmonics,

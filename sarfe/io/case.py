@@ -22,6 +22,8 @@ from sarfe.io.schema import CASE_SCHEMA
 
 _VALIDATOR = jsonschema.Draft202012Validator(CASE_SCHEMA)
 MESH_SUFFIXES = (".msh", ".bdf", ".nas", ".dat", ".inp")
+DECK_SUFFIXES = (".bdf", ".nas", ".dat", ".fem", ".inp")
+DECK_KEYS = ("units", "ignore_cards", "supports", "node_groups", "element_groups")
 MATRIX_SUFFIXES = (".npz", ".npy", ".mtx")
 DEFAULT_ZETA = 0.02
 
@@ -213,6 +215,65 @@ def validate_schema(data, source=None, lines=None):
     raise CaseError(message, path, source, _line_of(lines, path))
 
 
+# ------------------------------------------------------------------------ numbers and plausibility
+def check_finite(data, source=None, lines=None, path=()):
+    """Raise CaseError at the first NaN or ±inf anywhere in the case (YAML ``.nan``, ``.inf``):
+    no key of a case takes a non-finite number, and the schema's range checks let NaN through."""
+    if isinstance(data, float) and not math.isfinite(data):
+        text = ".nan" if math.isnan(data) else ("-.inf" if data < 0 else ".inf")
+        raise CaseError(f"must be a finite number, got {text}", path, source,
+                        _line_of(lines or {}, path))
+    if isinstance(data, dict):
+        for key, value in data.items():
+            check_finite(value, source, lines, path + (key,))
+    elif isinstance(data, list):
+        for index, value in enumerate(data):
+            check_finite(value, source, lines, path + (index,))
+
+
+# Bounds outside which a value is a unit mistake rather than a material or a load; each message
+# says which unit the key is in.
+AUDIBLE_LIMIT_HZ = 20e3
+_MIN_E_PA, _MIN_RHO_KG_M3, _MAX_MESH_SIZE_M = 1e5, 1.0, 1.0
+
+
+def _check_plausible(case, data):
+    """Signs and orders of magnitude that the schema cannot judge (negative excitation amplitudes,
+    moduli in MPa/GPa, densities in t/mm³ or g/cm³, frequencies beyond hearing)."""
+    exc = data["excitation"]
+    for i, load in enumerate(exc.get("forces", [])):
+        if load["force_N"] < 0:
+            raise case.error(f"must be >= 0 (an amplitude), got {load['force_N']:g}; reverse the "
+                             "direction or set phase_deg: 180", ("excitation", "forces", i, "force_N"))
+    base = exc.get("base_acceleration")
+    if base is not None and base["amplitude_m_s2"] < 0:
+        raise case.error(f"must be >= 0 (an amplitude), got {base['amplitude_m_s2']:g}; reverse the "
+                         "direction or set phase_deg: 180",
+                         ("excitation", "base_acceleration", "amplitude_m_s2"))
+    frequencies = list(exc.get("frequency_hz", [])) + [exc["sweep"][k] for k in ("start_hz", "end_hz")
+                                                      if "sweep" in exc]
+    for key in ("frequency_hz", "sweep"):
+        if key in exc and max(frequencies) > AUDIBLE_LIMIT_HZ:
+            raise case.error(f"{max(frequencies):g} Hz is above the audible range (≤ "
+                             f"{AUDIBLE_LIMIT_HZ:g} Hz) that squeak and rattle noise is judged in; "
+                             "frequencies are in Hz", ("excitation", key))
+    fe = data["model"].get("fe")
+    if fe is None:
+        return
+    for name, material in fe.get("materials", {}).items():
+        p = ("model", "fe", "materials", name)
+        if material["E_Pa"] < _MIN_E_PA:
+            raise case.error(f"{material['E_Pa']:g} Pa is far too soft for a panel material — "
+                             "given in MPa or GPa? E_Pa is in pascals (steel 2.1e+11)", p + ("E_Pa",))
+        if material["rho_kg_m3"] < _MIN_RHO_KG_M3:
+            raise case.error(f"{material['rho_kg_m3']:g} kg/m³ is lighter than air — given in t/mm³ "
+                             "or g/cm³? rho_kg_m3 is in kg/m³ (steel 7850)", p + ("rho_kg_m3",))
+    generator = fe.get("generator")
+    if generator is not None and generator["mesh_size_m"] >= _MAX_MESH_SIZE_M:
+        raise case.error(f"{generator['mesh_size_m']:g} m elements are larger than a panel — given in "
+                         "mm? mesh_size_m is in metres", ("model", "fe", "generator", "mesh_size_m"))
+
+
 # ---------------------------------------------------------------------------------- normalizing
 def _only_one(case, section, path, keys, required=True):
     given = [k for k in keys if k in section]
@@ -248,7 +309,14 @@ def _normalize_model(case, data):
     if "fe" in model:
         fe = model["fe"]
         p = ("model", "fe")
-        source = _only_one(case, fe, p, ("mesh", "generator"))
+        source = _only_one(case, fe, p, ("mesh", "generator", "deck"))
+        if source == "deck":
+            _normalize_deck(case, fe, p)
+            return
+        _not_allowed(case, fe, p, DECK_KEYS, "without model.fe.deck")
+        for key in ("materials", "thickness_m", "fixed"):
+            if key not in fe:
+                raise case.error(f"missing required key (with model.fe.{source})", p + (key,))
         fe.setdefault("mesh_units", "m")
         if source == "mesh":
             mesh = case.resolve(fe["mesh"])
@@ -281,6 +349,21 @@ def _normalize_model(case, data):
         _not_allowed(case, data, (), ("reduction",), "with model.matrices (no reduction)")
 
 
+def _normalize_deck(case, fe, p):
+    """model.fe.deck: the file exists and is a deck; units, ignore_cards, fixed defaults."""
+    deck = case.resolve(fe["deck"])
+    if deck.suffix.lower() not in DECK_SUFFIXES:
+        raise case.error(f"deck file must be one of {', '.join(DECK_SUFFIXES)}, got "
+                         f"'{deck.name}'", p + ("deck",))
+    if not deck.is_file():
+        raise case.error(f"deck file not found: {deck}", p + ("deck",))
+    _not_allowed(case, fe, p, ("mesh_units",), "with model.fe.deck (use 'units')")
+    fe.setdefault("units", "SI")
+    fe.setdefault("ignore_cards", [])
+    fe.setdefault("node_groups", {})
+    fe.setdefault("element_groups", {})
+
+
 def _normalize_damping(case, data):
     if not data.get("damping"):       # absent, or {} left by normalizing a matrices damping
         if "matrices" in data["model"] and "damping" in data["model"]["matrices"]:
@@ -300,23 +383,34 @@ def _normalize_damping(case, data):
 
 
 def _normalize_contacts(case, data):
+    """Contact keys checked against the contact's law (:mod:`sarfe.hbm.laws`): its parameters (with
+    their defaults), normal / tangential DOFs it needs, keys of other laws not allowed."""
+    from sarfe.hbm import laws
+
     contacts = data.setdefault("contacts", [])
     fe = case.is_fe
     names = set()
+    every_key = set().union(*(law.keys() for law in laws.LAWS.values()))
     for i, contact in enumerate(contacts):
         p = ("contacts", i)
         if contact["name"] in names:
             raise case.error(f"duplicate contact name '{contact['name']}'", p + ("name",))
         names.add(contact["name"])
-        squeak = contact["type"] == "squeak"
+        law = laws.law(contact["type"])
+        kind = law.name
         if fe:
             _not_allowed(case, contact, p, ("normal_dof", "tangential_dofs"),
                          "with model.fe (use 'between' node groups)")
-            if "between" not in contact and "pairs" not in contact:
+            deck = "deck" in data["model"]["fe"]
+            if "from_elements" in contact and not deck:
+                raise case.error("needs model.fe.deck (CBUSH/CELAS elements of a deck)",
+                                 p + ("from_elements",))
+            if "between" not in contact and "pairs" not in contact and "from_elements" not in contact:
                 raise case.error("missing required key (node groups [a, b] or [a, ground], "
-                                 "or explicit node 'pairs')", p + ("between",))
-            if "between" in contact and "pairs" in contact:
-                raise case.error("give only one of 'between' or 'pairs'", p + ("pairs",))
+                                 "or explicit node 'pairs', or deck 'from_elements')", p + ("between",))
+            _only_one(case, contact, p, ("between", "pairs", "from_elements"))
+            if "element_axis" in contact and "from_elements" not in contact:
+                raise case.error("only with from_elements", p + ("element_axis",))
             if "between" in contact and contact["between"][0] == "ground":
                 raise case.error("the first group cannot be 'ground'", p + ("between", 0))
             contact.setdefault("pairing_tolerance_m", 1e-3)
@@ -326,11 +420,11 @@ def _normalize_contacts(case, data):
             _not_allowed(case, contact, p, ("between", "pairs", "normal", "pairing_tolerance_m"),
                          "with model.matrices (use 'normal_dof' / 'tangential_dofs')")
             has_normal = "normal_dof" in contact
-            if not squeak and not has_normal:
-                raise case.error("missing required key (a rattle contact needs a normal DOF)",
+            if law.normal_dof == "required" and not has_normal:
+                raise case.error(f"missing required key (a {kind} contact needs a normal DOF)",
                                  p + ("normal_dof",))
-            if squeak and "tangential_dofs" not in contact:
-                raise case.error("missing required key (a squeak contact needs a tangential DOF)",
+            if law.tangent_dofs == "required" and "tangential_dofs" not in contact:
+                raise case.error(f"missing required key (a {kind} contact needs a tangential DOF)",
                                  p + ("tangential_dofs",))
             for key in ("normal_dof",):
                 if isinstance(contact.get(key), int):
@@ -342,21 +436,41 @@ def _normalize_contacts(case, data):
                     "tangential_dofs", []):
                 ref.setdefault("relative_to", "ground")
                 ref.setdefault("sign", 1)
-        if not squeak:
-            _not_allowed(case, contact, p, ("tangential_stiffness_N_m", "friction_coefficient",
-                                            "tangential_dofs"), "for a rattle contact")
-        if has_normal and "normal_stiffness_N_m" not in contact:
-            raise case.error("missing required key", p + ("normal_stiffness_N_m",))
-        if not has_normal:
-            _not_allowed(case, contact, p, ("normal_stiffness_N_m", "gap_m"),
+        others = sorted(every_key - law.keys(), key=lambda k: list(contact).index(k)
+                        if k in contact else 0)
+        if law.tangent_dofs == "forbidden":
+            others.append("tangential_dofs")
+        _not_allowed(case, contact, p, others, f"for a {kind} contact")
+        normal_keys = [q.key for q in law.case_parameters() if q.normal_part]
+        tangent_keys = [q.key for q in law.tangent.PARAMETERS] if law.tangent is not None else []
+        # FE decks: a contact made of CBUSH/CELAS elements takes its springs from them
+        from_elements = {"normal_stiffness", "tangential_stiffness"} if "from_elements" in contact \
+            else set()
+        if has_normal:
+            for q in law.case_parameters():
+                key = q.key
+                if q.normal_part and q.required and key not in contact \
+                        and q.name not in from_elements:
+                    raise case.error("missing required key", p + (key,))
+        else:
+            _not_allowed(case, contact, p, tuple(normal_keys) + ("gap_m",),
                          "without a normal DOF (the normal load is the constant preload_N)")
             if "preload_N" not in contact:
                 raise case.error("missing required key (normal load of a friction contact "
                                  "without normal DOF)", p + ("preload_N",))
-        if squeak:
-            for key in ("tangential_stiffness_N_m", "friction_coefficient"):
-                if key not in contact:
-                    raise case.error("missing required key", p + (key,))
+        tangent = laws.uses_tangent(law, contact) if fe else "tangential_dofs" in contact
+        for q in law.case_parameters():
+            if q.normal_part or not q.required:
+                continue
+            if q.key in tangent_keys and not tangent or q.name in from_elements:
+                continue
+            if q.key not in contact:
+                raise case.error("missing required key", p + (q.key,))
+        if law.prepare is not None:
+            try:
+                law.prepare(contact, case.resolve)
+            except laws.LawInputError as error:
+                raise case.error(str(error), p + (error.key,)) from None
         _only_one(case, contact, p, ("gap_m", "preload_N"), required=False)
         if has_normal and "preload_N" not in contact and not fe:
             contact.setdefault("gap_m", 0.0)  # FE: default = geometric gap of each node pair
@@ -376,17 +490,24 @@ def _normalize_excitation(case, data):
     if kind == "forces":
         for i, load in enumerate(exc["forces"]):
             q = p + ("forces", i)
-            if fe:
-                _not_allowed(case, load, q, ("dof",), "with model.fe (use 'group')")
-                for key in ("group", "direction"):
+            if fe and "load_set" in load:
+                if "deck" not in data["model"]["fe"]:
+                    raise case.error("needs model.fe.deck", q + ("load_set",))
+                _not_allowed(case, load, q, ("dof", "group", "direction", "force_N"),
+                             "with load_set (the deck's forces times 'scale')")
+                load["force_N"] = float(load.setdefault("scale", 1.0))   # amplitude factor
+            elif fe:
+                _not_allowed(case, load, q, ("dof", "scale"), "with model.fe (use 'group')")
+                for key in ("group", "direction", "force_N"):
                     if key not in load:
                         raise case.error("missing required key", q + (key,))
                 load["direction"] = direction_vector(case, load["direction"], q + ("direction",))
             else:
-                _not_allowed(case, load, q, ("group", "direction"),
+                _not_allowed(case, load, q, ("group", "direction", "load_set", "scale"),
                              "with model.matrices (use 'dof')")
-                if "dof" not in load:
-                    raise case.error("missing required key", q + ("dof",))
+                for key in ("dof", "force_N"):
+                    if key not in load:
+                        raise case.error("missing required key", q + (key,))
             load.setdefault("phase_deg", 0.0)
     else:
         base = exc["base_acceleration"]
@@ -462,7 +583,8 @@ def _normalize_erp(case, data):
 def _normalize_output(case, data):
     out = data.setdefault("output", {})
     out.setdefault("directory", str(Path("results") / data["name"]))
-    default = ["summary", "response", "plots", "table"] + (["erp_vtu", "animation"] if case.is_fe else [])
+    default = ["summary", "response", "plots", "table", "report"] + (
+        ["erp_vtu", "animation"] if case.is_fe else [])
     out.setdefault("files", default)
     if "summary" not in out["files"]:
         out["files"] = ["summary"] + list(out["files"])
@@ -479,6 +601,7 @@ def normalize(case: Case) -> Case:
     _normalize_reduction(case, data)
     _normalize_erp(case, data)
     _normalize_output(case, data)
+    _check_plausible(case, data)
     return case
 
 
@@ -496,6 +619,7 @@ def load_case(path_or_dict, base_dir=None) -> Case:
         source = str(path_or_dict)
         data, lines = read_yaml(path_or_dict)
         base = Path(base_dir) if base_dir else Path(path_or_dict).resolve().parent
+    check_finite(data, source, lines)
     validate_schema(data, source, lines)
     case = Case(name=data["name"], data=data, source=source, base_dir=base, lines=lines)
     return normalize(case)

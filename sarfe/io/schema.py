@@ -41,8 +41,21 @@ MATERIAL = _object({
     "rho_kg_m3": POSITIVE,
 }, required=("E_Pa", "nu", "rho_kg_m3"))
 
+GRID_IDS = {"type": "array", "items": {"type": "integer", "minimum": 1}, "minItems": 1}
+SET_REFERENCE = {"type": ["string", "integer"], "minLength": 1, "minimum": 0}
+
 FE_MODEL = _object({
     "mesh": NAME,
+    # an engineer's own deck (Nastran .bdf/.dat/.nas/.fem, Abaqus .inp), read with its
+    # properties, supports and loads (sarfe.pipeline.deck)
+    "deck": NAME,
+    "units": {"enum": ["SI", "mm-t-s", "mm-kg-ms", "mm-kg-s", "in-lbf-s"]},
+    "ignore_cards": {"type": "array", "items": NAME, "uniqueItems": True},
+    "supports": {"type": "array", "items": SET_REFERENCE, "minItems": 1},
+    "node_groups": {"type": "object", "additionalProperties": {
+        "oneOf": [GRID_IDS, SET_REFERENCE]}},
+    "element_groups": {"type": "object", "additionalProperties": {
+        "oneOf": [GRID_IDS, SET_REFERENCE]}},
     "generator": _object({
         "name": {"enum": ["door_trim", "instrument_panel", "squeak_rig", "rattle_rig"]},
         "mesh_size_m": POSITIVE,
@@ -52,7 +65,7 @@ FE_MODEL = _object({
     "materials": {"type": "object", "minProperties": 1, "additionalProperties": MATERIAL},
     "thickness_m": {"type": "object", "minProperties": 1, "additionalProperties": POSITIVE},
     "fixed": {"type": "array", "items": NAME, "minItems": 1},
-}, required=("materials", "thickness_m", "fixed"))
+})   # materials, thickness_m and fixed are required with mesh/generator (sarfe.io.case)
 
 MATRICES_MODEL = _object({
     "mass": MATRIX,
@@ -81,37 +94,67 @@ REDUCTION = _object({
     "residual_vectors": {"type": "boolean"},
 })
 
-CONTACT = _object({
-    "name": {"type": "string", "pattern": "^[A-Za-z0-9_.-]+$"},
-    "type": {"enum": ["rattle", "squeak"]},
-    # FE models: node groups
-    "between": {"type": "array", "items": NAME, "minItems": 2, "maxItems": 2},
-    "pairing_tolerance_m": NON_NEGATIVE,
-    "pairs": {"type": "array", "minItems": 1,
-              "items": {"type": "array", "minItems": 2, "maxItems": 2,
-                        "items": {"type": ["integer", "string"], "minimum": 0,
-                                  "pattern": "^ground$"}}},
-    "normal": {"type": ["string", "array"], "pattern": "^auto$",
-               "items": NUMBER, "minItems": 3, "maxItems": 3},
-    # matrices models: DOFs
-    "normal_dof": DOF_REFERENCE,
-    "tangential_dofs": {"type": "array", "items": DOF_REFERENCE, "minItems": 1, "maxItems": 2},
-    # law
-    "gap_m": NUMBER,
-    "preload_N": NON_NEGATIVE,
-    "normal_stiffness_N_m": POSITIVE,
-    "tangential_stiffness_N_m": POSITIVE,
-    "friction_coefficient": NON_NEGATIVE,
-    "tolerance_m": NON_NEGATIVE,
-}, required=("name", "type"))
+def _law_key_schema(parameter):
+    """JSON schema of one scalar law parameter from its declaration (bounds, number)."""
+    schema = dict(NUMBER)
+    if parameter.minimum is not None:
+        schema["exclusiveMinimum" if parameter.exclusive else "minimum"] = parameter.minimum
+    if parameter.maximum is not None:
+        schema["maximum"] = parameter.maximum
+    return schema
+
+
+def contact_schema():
+    """The contact object: geometry keys, then every registered law's keys from its declaration
+    (:mod:`sarfe.hbm.laws`; which keys a type allows is checked in :mod:`sarfe.io.case`)."""
+    from sarfe.hbm import laws
+
+    law_keys = {}
+    for law in laws.LAWS.values():
+        for parameter in law.case_parameters():
+            law_keys.setdefault(parameter.key, _law_key_schema(parameter))
+        for key, schema in law.case_keys.items():
+            law_keys.setdefault(key, schema)
+    return _object({
+        "name": {"type": "string", "pattern": "^[A-Za-z0-9_.-]+$"},
+        "type": {"enum": list(laws.names())},
+        # FE models: node groups
+        "between": {"type": "array", "items": NAME, "minItems": 2, "maxItems": 2},
+        "pairing_tolerance_m": NON_NEGATIVE,
+        "pairs": {"type": "array", "minItems": 1,
+                  "items": {"type": "array", "minItems": 2, "maxItems": 2,
+                            "items": {"type": ["integer", "string"], "minimum": 0,
+                                      "pattern": "^ground$"}}},
+        "normal": {"type": ["string", "array"], "pattern": "^auto$",
+                   "items": NUMBER, "minItems": 3, "maxItems": 3},
+        # FE decks: CBUSH/CELAS element ids turned into this contact (removed from the linear
+        # model; their stiffness along element_axis is the penalty stiffness)
+        "from_elements": {"type": "array", "items": {"type": "integer", "minimum": 1},
+                          "minItems": 1, "uniqueItems": True},
+        "element_axis": {"enum": [1, 2, 3]},
+        # matrices models: DOFs
+        "normal_dof": DOF_REFERENCE,
+        "tangential_dofs": {"type": "array", "items": DOF_REFERENCE, "minItems": 1, "maxItems": 2},
+        # every law: the initial gap or a static preload, the rattle tolerance
+        "gap_m": NUMBER,
+        "preload_N": NON_NEGATIVE,
+        "tolerance_m": NON_NEGATIVE,
+        # the laws' own keys
+        **law_keys,
+    }, required=("name", "type"))
+
+
+CONTACT = contact_schema()
 
 LOAD = _object({
     "group": NAME,
+    "load_set": SET_REFERENCE,      # FE decks: a FORCE/MOMENT/DAREA/LOAD set or *CLOAD step
+    "scale": NUMBER,                # multiplies the deck's load set (default 1)
     "dof": INDEX,
     "direction": DIRECTION,
     "force_N": NUMBER,
     "phase_deg": NUMBER,
-}, required=("force_N",))
+})   # force_N is required except with load_set (sarfe.io.case)
 
 EXCITATION = _object({
     "forces": {"type": "array", "items": LOAD, "minItems": 1},
@@ -161,9 +204,10 @@ ERP = _object({
     "reference_power_W": POSITIVE,
 })
 
-OUTPUT_FILES = ["summary", "response", "erp_vtu", "animation", "plots", "table"]
+OUTPUT_FILES = ["summary", "response", "erp_vtu", "animation", "plots", "table", "report"]
 OUTPUT = _object({
     "directory": NAME,
+    "target_dba": NUMBER,   # optional target level [dB(A)]: a line in the plots and the report
     "files": {"type": "array", "items": {"enum": OUTPUT_FILES}, "uniqueItems": True},
 })
 

@@ -1,10 +1,18 @@
-"""On-demand generation of the large generated meshes with a file cache keyed by parameters.
+"""On-demand generation of generated meshes with a file cache keyed by parameters (used by
+``sarfe solve`` / ``validate`` for every ``model.fe.generator`` case).
 
 `cached_mesh("door_trim", mesh_size=0.005)` returns the mesh from
-``<cache_dir>/door_trim-<key>.msh`` if present, otherwise generates it (binary Gmsh 4.1, exact
-doubles, so a cached mesh equals a freshly generated one bit for bit) and stores it.
+``<cache_dir>/door_trim-<key>.msh`` if present and intact, otherwise generates it (binary Gmsh
+4.1, exact doubles, so a cached mesh equals a freshly generated one bit for bit) and stores it.
 The key hashes generator name, mesh size, parameters, `CACHE_VERSION` and the gmsh version.
-Cache directory: argument, else $SARFE_MESH_CACHE, else ~/.cache/sarfe/meshes.
+Cache directory: argument, else $SARFE_MESH_CACHE, else ~/.cache/sarfe/meshes (no cache, only
+generation, when it cannot be created).
+
+Integrity: ``<name>.sha256`` beside each mesh holds the SHA-256 of its bytes; a mesh whose
+checksum is missing or wrong, or that gmsh cannot read, is generated again. Both files are
+written to temporary names ``.<name>.tmp-<pid>-<random>`` and renamed into place (the mesh first,
+its checksum last), so a reader never sees half a file. Temporary files of killed runs (their PID
+gone) are removed by the next call; so are the 0-byte ``tmp*.msh`` of older versions once a day old.
 """
 from __future__ import annotations
 
@@ -12,7 +20,9 @@ import hashlib
 import importlib
 import json
 import os
-import tempfile
+import re
+import secrets
+import time
 from pathlib import Path
 
 from .generators import GENERATORS
@@ -20,6 +30,9 @@ from .io import load_mesh
 from .mesh import PanelMesh
 
 CACHE_VERSION = 1  # bump when a generator's geometry changes
+_TEMPORARY = re.compile(r"^\..+\.tmp-(?P<pid>\d+)-[0-9a-f]+(\.msh|\.sha256)$")
+_LEGACY_TEMPORARY = re.compile(r"^tmp[A-Za-z0-9_]+\.msh$")
+_LEGACY_AGE_S = 86400.0
 
 
 def cache_key(generator: str, mesh_size: float, params: dict) -> str:
@@ -38,22 +51,86 @@ def default_cache_dir() -> Path:
     return Path(env) if env else Path.home() / ".cache" / "sarfe" / "meshes"
 
 
+def file_sha256(path) -> str:
+    digest = hashlib.sha256()
+    with open(path, "rb") as handle:
+        for block in iter(lambda: handle.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def clean_stale(directory) -> list:
+    """Remove temporary files of killed cache writers in ``directory`` (module docstring)."""
+    removed = []
+    try:
+        entries = list(Path(directory).iterdir())
+    except OSError:
+        return removed
+    now = time.time()
+    for entry in entries:
+        match = _TEMPORARY.match(entry.name)
+        try:
+            if match:
+                stale = not _pid_alive(int(match["pid"]))
+            elif _LEGACY_TEMPORARY.match(entry.name):
+                info = entry.stat()
+                stale = info.st_size == 0 and now - info.st_mtime > _LEGACY_AGE_S
+            else:
+                continue
+            if stale and entry.is_file():
+                entry.unlink()
+                removed.append(entry)
+        except OSError:
+            continue
+    return removed
+
+
+def _intact(path: Path, checksum: Path) -> bool:
+    try:
+        return checksum.read_text().split()[0] == file_sha256(path)
+    except (OSError, IndexError):
+        return False
+
+
 def cached_mesh(generator: str, mesh_size: float, cache_dir=None, **params) -> PanelMesh:
-    """Mesh of `sarfe.mesh.generators.<generator>` for these parameters, generated at most once."""
+    """Mesh of `sarfe.mesh.generators.<generator>` for these parameters, generated at most once
+    (again only when the cached file is damaged)."""
     if generator not in GENERATORS:
         raise ValueError(f"unknown generator {generator!r}; available: {', '.join(GENERATORS)}")
-    directory = Path(cache_dir) if cache_dir is not None else default_cache_dir()
-    path = directory / f"{generator}-{cache_key(generator, mesh_size, params)}.msh"
-    if path.is_file():
-        return load_mesh(path)
-    directory.mkdir(parents=True, exist_ok=True)
     module = importlib.import_module(f"sarfe.mesh.generators.{generator}")
-    handle, partial = tempfile.mkstemp(suffix=".msh", dir=directory)
-    os.close(handle)
+    directory = Path(cache_dir) if cache_dir is not None else default_cache_dir()
+    name = f"{generator}-{cache_key(generator, mesh_size, params)}"
+    path, checksum = directory / f"{name}.msh", directory / f"{name}.sha256"
+    if path.is_file() and _intact(path, checksum):
+        try:
+            return load_mesh(path)
+        except Exception:  # noqa: BLE001 - unreadable despite its checksum: generate again
+            pass
+    try:
+        directory.mkdir(parents=True, exist_ok=True)
+        clean_stale(directory)
+    except OSError:  # no cache possible here: generate only
+        return module.generate(mesh_size=mesh_size, **params)
+    token = f"tmp-{os.getpid()}-{secrets.token_hex(4)}"
+    partial = directory / f".{name}.{token}.msh"
+    partial_sum = directory / f".{name}.{token}.sha256"
     try:
         mesh = module.generate(mesh_size=mesh_size, path=partial, **params)
-        os.replace(partial, path)  # atomic: concurrent workers never see half a file
+        partial_sum.write_text(f"{file_sha256(partial)}  {path.name}\n")
+        os.replace(partial, path)          # atomic: concurrent workers never see half a file
+        os.replace(partial_sum, checksum)  # last: a mesh without its checksum is not trusted
     finally:
-        if os.path.exists(partial):
-            os.remove(partial)
+        for leftover in (partial, partial_sum):
+            if leftover.exists():
+                leftover.unlink()
     return mesh

@@ -4,6 +4,10 @@
   named physical groups → node groups (all dims) and element groups (surface groups).
 * Nastran ``.bdf`` / ``.nas`` / ``.dat`` through meshio: one element group and node group per
   shell property id, named ``pid_<n>``.
+* A Nastran/Abaqus file holding anything meshio would drop (springs, masses, rigid elements,
+  midside nodes, GRID coordinate systems, parts and instances, supports, loads …) is refused
+  with a MeshError naming the cards: such a file is read as a deck (``model.fe.deck``,
+  :mod:`sarfe.pipeline.deck`) with its own properties.
 * Abaqus ``.inp`` through meshio: ``*NSET`` → node groups, ``*ELSET`` → element groups
   (element sets of non-shell elements keep only their nodes as a node group).
 
@@ -49,11 +53,13 @@ def load_mesh(path, length_unit: str = "m") -> PanelMesh:
     if fmt is None:
         raise MeshError(f"unknown mesh file type {path.suffix!r} of {path}; "
                         f"use one of {', '.join(sorted(_FORMATS))}")
+    if fmt != "gmsh":
+        _refuse_model_cards(path, fmt)
     try:
         mesh = _read_gmsh(path) if fmt == "gmsh" else _read_meshio(path, fmt)
     except MeshError:
         raise
-    except Exception as error:  # reader-specific exceptions → one line
+    except (Exception, SystemExit) as error:  # reader exceptions (meshio even exits) → one line
         message = " ".join(str(error).split()) or type(error).__name__
         raise MeshError(f"cannot read {fmt} mesh {path}: {message}") from error
     if mesh.n_triangles == 0 and mesh.tetrahedra is None:
@@ -62,16 +68,111 @@ def load_mesh(path, length_unit: str = "m") -> PanelMesh:
     return mesh if scale == 1.0 else mesh.scaled(scale)
 
 
+# what the mesh path reads from a deck (geometry; materials come from the case): anything
+# else would be dropped by meshio without a word, so it is refused (use model.fe.deck)
+_MESH_CARDS = {"GRID", "CTRIA3", "CQUAD4", "CTETRA", "PSHELL", "PSOLID", "MAT1", "ENDDATA",
+               "PARAM", "EIGRL", "BEGIN", "CEND", "SOL", "$"}
+_MESH_KEYWORDS = {"NODE", "ELEMENT", "NSET", "ELSET", "HEADING", "PREPRINT", "STEP", "END STEP",
+                  "STATIC", "FREQUENCY", "OUTPUT", "NODE OUTPUT", "ELEMENT OUTPUT"}
+_MESH_ELEMENTS = {"S3", "S3R", "S4", "S4R", "STRI3", "C3D4", "C3D10", "CPS3", "CPS4", "M3D3",
+                  "M3D4", "R3D3", "R3D4", "CAX3", "CAX4P"}   # the last four: as meshio writes
+
+
+def _refuse_model_cards(path: Path, fmt: str):
+    """MeshError naming the first card/keyword a mesh file holds that the mesh path would lose
+    (springs, masses, rigid elements, midside nodes, GRID coordinate systems, instances …)."""
+    found = {}
+    in_bulk = fmt != "nastran"
+    with open(path, encoding="utf-8", errors="replace") as handle:
+        for number, line in enumerate(handle, start=1):
+            text = line.rstrip("\n")
+            if fmt == "nastran":
+                head = text[:8].split(",")[0].strip().upper().rstrip("*")
+                if head.startswith("BEGIN"):
+                    in_bulk = True
+                    continue
+                if not in_bulk or not head or head.startswith(("$", "+", "*")) or text[:1] in " \t+*":
+                    continue
+                if head == "GRID":
+                    fields = (text.split(",") if "," in text else
+                              [text[:8]] + [text[8 + 16 * k:24 + 16 * k] for k in range(4)]
+                              if text[:8].strip().endswith("*") else
+                              [text[8 * k:8 * k + 8] for k in range(9)])
+                    cp = fields[2].strip() if len(fields) > 2 else ""
+                    if cp not in ("", "0"):
+                        raise MeshError(f"{path}:{number}: GRID in coordinate system CP={cp}: the "
+                                        "mesh reader keeps raw coordinates; read the file as "
+                                        "model.fe.deck")
+                if head not in _MESH_CARDS:
+                    found.setdefault(head, [0, number])[0] += 1
+            elif text.startswith("*") and not text.startswith("**"):
+                parts = [p.strip() for p in text[1:].split(",")]
+                keyword = " ".join(parts[0].split()).upper()
+                if keyword == "ELEMENT":
+                    kind = next((p.split("=", 1)[1].strip().upper() for p in parts[1:]
+                                 if p.upper().replace(" ", "").startswith("TYPE=")), "")
+                    if kind not in _MESH_ELEMENTS:
+                        found.setdefault(f"*ELEMENT, TYPE={kind}", [0, number])[0] += 1
+                elif keyword not in _MESH_KEYWORDS:
+                    found.setdefault(f"*{keyword}", [0, number])[0] += 1
+    if found:
+        listing = ", ".join(f"{card} ({count}, first at line {line})"
+                            for card, (count, line) in sorted(found.items()))
+        raise MeshError(f"{path}: the mesh reader keeps only nodes, shells/tetrahedra and sets; "
+                        f"it would drop {listing}: read the file as model.fe.deck")
+
+
 def _read_gmsh(path: Path) -> PanelMesh:
     with gmsh_session() as gmsh:
         gmsh.merge(os.fspath(path))
-        return mesh_from_gmsh()
+        mesh = mesh_from_gmsh()
+    return merge_repeated_elements(mesh) if _msh_major_version(path) == 2 else mesh
+
+
+def _msh_major_version(path: Path) -> int | None:
+    """Major version of a Gmsh file from its ``$MeshFormat`` header (None if absent)."""
+    with open(path, "rb") as handle:
+        head = handle.read(256).split()
+    if len(head) >= 2 and head[0] == b"$MeshFormat":
+        try:
+            return int(float(head[1]))
+        except ValueError:
+            return None
+    return None
+
+
+def merge_repeated_elements(mesh: PanelMesh) -> PanelMesh:
+    """The mesh with each repeated element (same node list) kept once, its groups merged.
+
+    MSH 2.2 writes an element once per physical group it belongs to (the format has one
+    physical tag per element line), so gmsh reads a triangle in ``skin`` and ``part_carrier``
+    as two coincident triangles: twice the stiffness, mass and radiating area.  The copies
+    are merged here; an element group then names the one kept element.
+    """
+    triangles = mesh.triangles
+    _, first, owner = np.unique(triangles, axis=0, return_index=True, return_inverse=True)
+    owner = np.asarray(owner).reshape(-1)
+    tets = mesh.tetrahedra
+    if tets is not None:
+        _, tet_first = np.unique(tets, axis=0, return_index=True)
+        tets = tets[np.sort(tet_first)]
+    if len(first) == len(triangles) and (tets is None or len(tets) == len(mesh.tetrahedra)):
+        return mesh
+    keep = np.sort(first)                       # first copies, in file order
+    new_index = np.empty(len(first), dtype=np.int64)
+    new_index[np.argsort(first)] = np.arange(len(first))   # unique row → position in `keep`
+    element_map = new_index[owner]              # every element (copy or not) → kept element
+    groups = {name: np.unique(element_map[rows]) for name, rows in mesh.element_groups.items()}
+    return PanelMesh(mesh.points, triangles[keep], mesh.node_groups, groups, tets)
 
 
 def _read_meshio(path: Path, fmt: str) -> PanelMesh:
-    import meshio
+    import meshio.abaqus
+    import meshio.nastran
 
-    data = meshio.read(os.fspath(path), file_format=fmt)
+    # the format's own reader raises meshio.ReadError; meshio.read() would print it and exit
+    reader = meshio.abaqus.read if fmt == "abaqus" else meshio.nastran.read
+    data = reader(os.fspath(path))
     triangle_blocks, tetra_blocks = [], []
     # per meshio cell block: rows of its kept elements in the concatenated triangle list
     block_rows, offset = [], 0

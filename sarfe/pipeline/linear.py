@@ -2,7 +2,7 @@ r"""The linear stage of a case: model → (reduced) M, K on the kept DOFs, conta
 DOFs, unit excitation vectors and the ERP recovery map. Everything here is independent of the
 contact law parameters, damping, force amplitudes and frequencies, so a batch over those reuses it.
 
-FE path: mesh → shell K, M (per-triangle thickness/material) → remove fixed (clip/clamp) DOFs →
+FE path (a deck file: :mod:`sarfe.pipeline.deck`, :mod:`sarfe.pipeline.deck_stage`): mesh → shell K, M (per-triangle thickness/material) → remove fixed (clip/clamp) DOFs →
 Craig–Bampton with boundary = translations of contact and excitation nodes:
 
     u = T q,  q = [q_b, q_m],  M_r = Tᵀ M T,  K_r = Tᵀ K T,  f_r = Tᵀ f,
@@ -45,6 +45,9 @@ class ContactGeometry:
     coords_a: np.ndarray
     coords_b: np.ndarray
     distances: np.ndarray      # (n_p,) [m] n·(x_b − x_a), the geometric gap (0 for ground)
+    # (n_p,) [N/m] per-pair stiffness of deck springs turned into this contact (from_elements)
+    normal_stiffness: np.ndarray | None = None
+    tangential_stiffness: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -76,6 +79,8 @@ class LinearStage:
     mode_frequencies_hz: np.ndarray = field(default_factory=lambda: np.zeros(0))
     info: dict = field(default_factory=dict)
     timings: dict = field(default_factory=dict)
+    node_ids: np.ndarray | None = None     # deck GRID / node id of each mesh point (deck path)
+    added_damping: np.ndarray | None = None  # (n_r, n_r) [N s/m] a deck's dampers (CBUSH B), reduced
 
     @property
     def dof_count(self) -> int:
@@ -108,8 +113,12 @@ def linear_model_key(case) -> str:
     data = case.data
     model = json.loads(json.dumps(data["model"]))
     for section in model.values():
-        for key in ("mesh", "mass", "stiffness", "damping"):
-            if isinstance(section.get(key), str):
+        for key in ("mesh", "deck", "mass", "stiffness", "damping"):
+            if key == "deck" and isinstance(section.get(key), str):   # with its INCLUDEs
+                from sarfe.pipeline.deck import deck_files
+                section[key] = {"file_sha256": [_file_digest(f) for f in
+                                                deck_files(case.resolve(section[key]))]}
+            elif isinstance(section.get(key), str):
                 section[key] = {"file_sha256": _file_digest(case.resolve(section[key]))}
     exc = data["excitation"]
     parts = {
@@ -117,9 +126,10 @@ def linear_model_key(case) -> str:
         "reduction": dict(data.get("reduction", {}), effective_cutoff_hz=default_cutoff_hz(case))
         if case.is_fe else None,
         "contacts": [{k: c.get(k) for k in ("name", "between", "pairs", "pairing_tolerance_m",
-                                            "normal", "normal_dof", "tangential_dofs")}
+                                            "normal", "normal_dof", "tangential_dofs",
+                                            "from_elements", "element_axis")}
                      for c in data["contacts"]],
-        "forces": [{k: f.get(k) for k in ("group", "dof", "direction")}
+        "forces": [{k: f.get(k) for k in ("group", "dof", "direction", "load_set")}
                    for f in exc.get("forces", [])],
         "base": {k: v for k, v in exc["base_acceleration"].items() if k in ("direction", "influence")}
         if "base_acceleration" in exc else None,
@@ -224,9 +234,14 @@ def _build_matrices(case: Case, progress=False) -> dict:
 
 # ------------------------------------------------------------------------------------- FE path
 def _generate_mesh(name, mesh_size, params):
-    """sarfe.mesh.generators.<name>.generate(mesh_size=..., **params) → PanelMesh."""
-    module = importlib.import_module(f"sarfe.mesh.generators.{name}")
-    return module.generate(mesh_size=mesh_size, **params)
+    """sarfe.mesh.generators.<name>.generate(mesh_size=..., **params) → PanelMesh, through the
+    checksummed mesh cache (sarfe.mesh.cache: generated once per parameter set)."""
+    from sarfe.mesh.cache import cached_mesh
+    from sarfe.mesh.generators import GENERATORS
+
+    if name not in GENERATORS:
+        importlib.import_module(f"sarfe.mesh.generators.{name}")  # ImportError names it
+    return cached_mesh(name, mesh_size, **params)
 
 
 def load_case_mesh(case: Case):
@@ -389,7 +404,7 @@ def _build_fe(case: Case, progress=False) -> dict:
     data, fe = case.data, case.data["model"]["fe"]
     timings = {}
     clock = time.perf_counter()
-    stages = _bar(progress, "linear stage", 4, unit="step")
+    stages = _bar(progress, "linear stage: mesh", 4, unit="step")
     mesh = load_case_mesh(case)
     timings["mesh_s"] = time.perf_counter() - clock
     _step(stages, "assembly")
@@ -479,7 +494,7 @@ def _build_fe(case: Case, progress=False) -> dict:
             # a cutoff below the first fixed-interface modes leaves only static condensation
             reduced = reduce(min(red["min_mode_count"], len(free) - len(boundary_positions) - 1),
                              None)
-    except (RuntimeError, ValueError, np.linalg.LinAlgError) as exc:
+    except Exception as exc:   # any solver's failure (PARDISO, CHOLMOD, ARPACK): one line
         raise case.error(f"the structure is not held (singular stiffness: {exc}); check the "
                          "fixed groups", ("model", "fe", "fixed")) from None
     finally:
@@ -539,14 +554,11 @@ def _build_fe(case: Case, progress=False) -> dict:
 
 
 def _bar(progress, description, total, unit="block"):
-    """A tqdm bar on stderr, or None (no progress wanted, or stderr is not a terminal); shared by
-    the linear stage and the frequency points."""
-    import sys
+    """A tqdm bar on a terminal, one log line per stage otherwise, None without progress
+    (:func:`sarfe.pipeline.progress.bar`); shared by the linear stage and the frequency points."""
+    from sarfe.pipeline.progress import bar
 
-    if not progress or not sys.stderr.isatty():
-        return None
-    from tqdm import tqdm
-    return tqdm(total=total, desc=description, unit=unit, leave=False)
+    return bar(progress, description, total, unit)
 
 
 def _step(bar, next_description):
@@ -565,6 +577,9 @@ def check_mesh(case) -> dict:
     if not case.is_fe:
         _build_matrices(case)
         return {}
+    if "deck" in case.data["model"]["fe"]:
+        from sarfe.pipeline.deck import check_deck
+        return check_deck(case)
     mesh = load_case_mesh(case)
     fe = case.data["model"]["fe"]
     for i, g in enumerate(fe["fixed"]):
@@ -573,20 +588,48 @@ def check_mesh(case) -> dict:
     _per_triangle(case, mesh, fe["thickness_m"], "thickness_m")
     from sarfe.erp import nodal_normals
     normals = nodal_normals(mesh.points, mesh.triangles)
-    pairs = {c["name"]: len(pair_contact(case, mesh, i, normals)[0])
-             for i, c in enumerate(case.data["contacts"])}
+    paired = [pair_contact(case, mesh, i, normals) for i in range(len(case.data["contacts"]))]
+    pairs = {c["name"]: len(p[0]) for c, p in zip(case.data["contacts"], paired)}
+    coincident = _mesh_quality(case, mesh, [(a, b) for a, b, _, _ in paired])
     for i, f in enumerate(case.data["excitation"].get("forces", [])):
         resolve_node_group(case, mesh, f["group"], ("excitation", "forces", i, "group"))
     if "surface" in case.data["erp"] and case.data["erp"]["surface"] not in mesh.element_groups:
         resolve_node_group(case, mesh, case.data["erp"]["surface"], ("erp", "surface"))
-    return {"nodes": mesh.n_nodes, "triangles": mesh.n_triangles, "contact_pairs": pairs}
+    return {"nodes": mesh.n_nodes, "triangles": mesh.n_triangles, "contact_pairs": pairs,
+            "coincident_node_pairs": len(coincident), "coincident_nodes": coincident[:50]}
+
+
+def _mesh_quality(case, mesh, contact_pairs):
+    """Duplicate and zero-area triangles are errors (0-based triangle indices); coincident nodes
+    that no contact pairs are returned (0-based node indices) for validate to list."""
+    from sarfe.mesh import quality
+
+    where = ("model", "fe", "mesh" if "mesh" in case.data["model"]["fe"] else "generator")
+    index = np.arange(mesh.n_triangles)
+    duplicates = quality.duplicate_elements(mesh.triangles, index)
+    if duplicates:
+        text = ", ".join(f"{b} (= {a})" for a, b in duplicates[:10])
+        raise case.error(f"{len(duplicates)} duplicate triangle(s) on the same nodes (0-based "
+                         f"indices): {text}", where)
+    degenerate = quality.degenerate_elements(mesh.points, mesh.triangles, index)
+    if degenerate:
+        raise case.error(f"{len(degenerate)} zero-area triangle(s) (0-based indices): "
+                         f"{', '.join(map(str, degenerate[:10]))}", where)
+    joined = [(int(a), int(b)) for pa, pb in contact_pairs for a, b in zip(pa, pb) if b >= 0]
+    extent = float(np.linalg.norm(np.ptp(mesh.points, axis=0)))
+    return [list(p) for p in quality.coincident_nodes(mesh.points, np.arange(mesh.n_nodes),
+                                                      1e-9 * extent, joined)]
 
 
 def build_linear_model(case, progress=False) -> LinearStage:
     """Linear stage of a case (module docstring); raises CaseError for mesh/group/file problems."""
     case = load_case(case)
     clock = time.perf_counter()
-    parts = _build_fe(case, progress) if case.is_fe else _build_matrices(case, progress)
+    if case.is_fe and "deck" in case.data["model"]["fe"]:
+        from sarfe.pipeline.deck_stage import build_deck_stage
+        parts = build_deck_stage(case, progress)
+    else:
+        parts = _build_fe(case, progress) if case.is_fe else _build_matrices(case, progress)
     timings = dict(parts.pop("timings", {}))
     timings["linear_stage_s"] = time.perf_counter() - clock
     return LinearStage(key=linear_model_key(case), timings=timings, **parts)

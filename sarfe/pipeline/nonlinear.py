@@ -8,6 +8,7 @@ equally over its pairs.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -31,7 +32,14 @@ class NonlinearModel:
 
 
 def damping_matrix(case: Case, stage: LinearStage):
-    """D on the kept DOFs: the matrices' own D, modal ζ (reduced eigenmodes) or α M + β K."""
+    """D on the kept DOFs: the matrices' own D, modal ζ (reduced eigenmodes) or α M + β K,
+    plus a deck's discrete dampers (CBUSH B, reduced: ``stage.info['spring_damping']``)."""
+    added = getattr(stage, "added_damping", None)
+    matrix = _case_damping(case, stage)
+    return matrix if added is None else matrix + added
+
+
+def _case_damping(case: Case, stage: LinearStage):
     damping = case.data["damping"]
     M, K = stage.mass, stage.stiffness
     if stage.damping is not None:
@@ -61,25 +69,34 @@ def _dof_row(ref, n):
 
 
 def build_contacts(case: Case, stage: LinearStage):
-    """ContactSet in the kept DOFs (one set entry per node pair, FE) and per-name groups."""
+    """ContactSet in the kept DOFs (one set entry per node pair, FE) and per-name groups.
+
+    Law parameters are read generically from each law's declaration (:mod:`sarfe.hbm.laws`): the
+    value of its case key (or its default), shared equally over the node pairs when ``split``;
+    ``preload_N`` sets the overclosure from the law's static deflection (normal DOF) or the
+    constant normal load (no normal DOF); parameters declared ``from_model`` that the case leaves
+    out (the effective mass of a normal row) are computed from the model."""
+    from sarfe.hbm import laws
     from sarfe.hbm.contacts import make_contact_set
 
     n = stage.dof_count
     rows, kind, normal_row, tangent_rows = [], [], [], []
-    gap, k_n, k_t, mu, n0, names, tolerance, groups = [], [], [], [], [], [], [], []
+    gap, names, tolerance, groups = [], [], [], []
+    table = {}
 
     def add_row(vector):
         rows.append(vector)
         return len(rows) - 1
 
     for contact in case.data["contacts"]:
-        name, squeak = contact["name"], contact["type"] == "squeak"
+        name, law = contact["name"], laws.law(contact["type"])
+        tangent = laws.uses_tangent(law, contact)
         start = len(kind)
         if stage.kind == "fe":
             geometry = stage.contacts[name]
             pairs = len(geometry.nodes_a)
             for p in range(pairs):
-                directions = geometry.frames[p] if squeak else geometry.frames[p][:1]
+                directions = geometry.frames[p] if tangent else geometry.frames[p][:1]
                 made = []
                 for e in directions:
                     vector = np.zeros(n)
@@ -90,7 +107,7 @@ def build_contacts(case: Case, stage: LinearStage):
                             vector[geometry.coords_b[p, comp]] -= e[comp]
                     made.append(add_row(vector))
                 normal_row.append(made[0])
-                tangent_rows.append(made[1:3] if squeak else [-1, -1])
+                tangent_rows.append(made[1:3] if tangent else [-1, -1])
             share = 1.0 / pairs
             has_normal = True
         else:
@@ -100,51 +117,135 @@ def build_contacts(case: Case, stage: LinearStage):
             t = [add_row(_dof_row(ref, n)) for ref in contact.get("tangential_dofs", [])]
             tangent_rows.append((t + [-1, -1])[:2])
             share = 1.0
-        stiffness = contact.get("normal_stiffness_N_m", 0.0)
+        values = {}
+        for p in law.parameters:
+            value = contact.get(p.key) if p.key else None
+            if value is None:
+                value = np.nan if p.from_model else (0.0 if p.default is None else p.default)
+            if p.normal_part and not has_normal:
+                value = 0.0
+            values[p.name] = float(value) * (share if p.split else 1.0)
+        if law.prepare is not None:
+            try:
+                values.update(law.prepare(contact, case.resolve))
+            except ValueError as error:
+                raise case.error(str(error), ("contacts", case.data["contacts"].index(contact),
+                                              "type")) from None
+        per_pair = {}                   # deck springs (from_elements): one value per node pair
+        geometry = stage.contacts.get(name) if stage.kind == "fe" else None
+        if getattr(geometry, "normal_stiffness", None) is not None:
+            if "normal_stiffness_N_m" not in contact:
+                per_pair["normal_stiffness"] = np.asarray(geometry.normal_stiffness, dtype=float)
+            if "tangential_stiffness_N_m" not in contact and "tangential_stiffness" in values:
+                per_pair["tangential_stiffness"] = np.asarray(geometry.tangential_stiffness,
+                                                              dtype=float)
         if not has_normal:
-            g, load = np.zeros(pairs), contact["preload_N"]
+            g = np.zeros(pairs)
+            values["normal_load"] = contact["preload_N"] * share
         elif "gap_m" in contact:
-            g, load = np.full(pairs, float(contact["gap_m"])), 0.0
-        elif "preload_N" in contact:
-            g, load = np.full(pairs, -contact["preload_N"] / stiffness), 0.0
+            g = np.full(pairs, float(contact["gap_m"]))
+        elif "preload_N" in contact:    # set by preload_gaps below
+            g = np.zeros(pairs)
         else:  # FE default: the geometric gap of each node pair along its normal
-            g, load = np.asarray(stage.contacts[name].distances, dtype=float), 0.0
-        for p in range(pairs):
-            kind.append(contact["type"])
-            gap.append(g[p])
-            k_n.append(stiffness * share)
-            k_t.append(contact.get("tangential_stiffness_N_m", 0.0) * share)
-            mu.append(contact.get("friction_coefficient", 0.0))
-            n0.append(load * share)
-            tolerance.append(contact["tolerance_m"])
+            g = np.asarray(stage.contacts[name].distances, dtype=float)
+        for key, value in values.items():
+            table.setdefault(key, [np.nan] * start)
+        for key in table:
+            value = values.get(key, np.nan)
+            table[key] += list(per_pair[key]) if key in per_pair else [value] * pairs
+        kind += [contact["type"]] * pairs
+        gap += list(g)
+        tolerance += [contact["tolerance_m"]] * pairs
         names += [name] if pairs == 1 else [f"{name}[{p}]" for p in range(pairs)]
         groups.append((name, contact["type"], np.arange(start, len(kind))))
     G = sp.csr_matrix(np.array(rows).reshape(len(rows), n))
     gap = np.array(gap, dtype=float)
+    normal_row = np.array(normal_row, dtype=int)
+    parameters = _parameter_table(table, kind)
+    _fill_from_model(parameters, stage.mass, G, normal_row)
+    for key, p in laws.all_parameters().items():   # parameters of the other laws: their defaults
+        if key in parameters:
+            parameters[key][np.isnan(parameters[key])] = 0.0 if p.default is None else p.default
+    contacts = make_contact_set(G, np.array(kind, dtype=object), normal_row,
+                                np.array(tangent_rows, dtype=int).reshape(-1, 2), gap,
+                                names=names, parameters=parameters)
     preloaded = [(idx, c["preload_N"]) for c, (_, _, idx) in zip(case.data["contacts"], groups)
-                 if "preload_N" in c and "gap_m" not in c and np.all(np.array(normal_row)[idx] >= 0)]
+                 if "preload_N" in c and "gap_m" not in c and np.all(normal_row[idx] >= 0)]
     if preloaded:
-        gap = preload_gaps(stage.stiffness, G, np.array(normal_row), gap, np.array(k_n), preloaded)
-    contacts = make_contact_set(G, np.array(kind, dtype=object), np.array(normal_row, dtype=int),
-                                np.array(tangent_rows, dtype=int).reshape(-1, 2), gap, k_n, k_t,
-                                mu, n0, names)
+        contacts = dataclasses.replace(contacts, gap=preload_gaps(
+            stage.stiffness, G, normal_row, gap, contacts, preloaded))
     return contacts, groups, np.array(tolerance, dtype=float)
 
 
-def preload_gaps(stiffness, gap_map, normal_row, gap, normal_stiffness, preloaded):
+def _parameter_table(table, kind):
+    """{name: (n_c, ...) array}: scalars as floats; tables (curves) padded to a common length."""
+    out = {}
+    for key, column in table.items():
+        column = column + [np.nan] * (len(kind) - len(column))
+        shapes = {np.shape(v) for v in column if np.ndim(v)}
+        if not shapes:
+            out[key] = np.array(column, dtype=float)
+            continue
+        width = max(s[0] for s in shapes)
+        rest = next(iter(shapes))[1:]
+        arr = np.full((len(column), width) + rest, np.nan)
+        for i, v in enumerate(column):
+            if np.ndim(v):
+                arr[i, :len(v)] = v
+        out[key] = arr
+    return out
+
+
+def _fill_from_model(parameters, mass, gap_map, normal_row):
+    """Parameters declared ``from_model`` and left out (NaN): the effective mass of each normal
+    row, 1/m_eff = g M⁻¹ gᵀ [kg] (g: the row of G)."""
+    from sarfe.hbm.laws import all_parameters
+
+    declared = all_parameters()
+    for key, values in parameters.items():
+        p = declared.get(key)
+        if p is None or not p.from_model:
+            continue
+        missing = np.isnan(values) & (normal_row >= 0)
+        if not np.any(missing):
+            values[np.isnan(values)] = 0.0
+            continue
+        rows = gap_map[normal_row[missing]]
+        if sp.issparse(mass):
+            import scipy.sparse.linalg as spla
+            solved = spla.spsolve(sp.csc_matrix(mass), rows.T.tocsc())
+            solved = solved.toarray() if sp.issparse(solved) else np.asarray(solved)
+        else:
+            solved = np.linalg.solve(np.asarray(mass, dtype=float), rows.T.toarray())
+        inverse = np.asarray(rows.multiply(solved.reshape(rows.shape[1], -1).T).sum(axis=1)).ravel()
+        values[missing] = 1.0 / inverse
+        values[np.isnan(values)] = 0.0
+
+
+def preload_gaps(stiffness, gap_map, normal_row, gap, contacts, preloaded):
     r"""Overclosures g that make the static solution carry the requested preloads.
 
     Static equilibrium with the preloaded contacts closed: K u + G_nᵀ λ = 0 → w = G_n u = −C λ with
-    the static compliance C = G_n K⁻¹ G_nᵀ between the paired DOFs, and λ = k_n (w − g), so
+    the static compliance C = G_n K⁻¹ G_nᵀ between the paired DOFs, and w − g = δ(λ) the law's
+    static deflection under λ (λ/k_n for the penalty law), so
 
-        g = −(λ / k_n + C λ),    λ_i = P / n_p  for the n_p node pairs of a contact with preload P.
+        g = −(δ(λ) + C λ),    λ_i = P / n_p  for the n_p node pairs of a contact with preload P.
 
     Only the preloaded contacts are assumed closed (the others open) and all are solved together.
-    A singular K (a free-floating matrices model) falls back to g = −λ / k_n.
+    A singular K (a free-floating matrices model) falls back to g = −δ(λ).
     """
-    contacts = np.concatenate([idx for idx, _ in preloaded])
+    from sarfe.hbm import laws
+
+    index = np.concatenate([idx for idx, _ in preloaded])
     force = np.concatenate([np.full(len(idx), load / len(idx)) for idx, load in preloaded])
-    rows = gap_map[normal_row[contacts]].toarray()
+    deflection = np.zeros(len(index))
+    kinds = np.asarray(contacts.kind)[index]
+    for name in dict.fromkeys(kinds):
+        law = laws.law(name)
+        sel = np.flatnonzero(kinds == name)
+        deflection[sel] = law.static_deflection(contacts.law_parameters(law, index[sel]),
+                                                force[sel])
+    rows = gap_map[normal_row[index]].toarray()
     K = stiffness.toarray() if sp.issparse(stiffness) else np.asarray(stiffness, dtype=float)
     gap = gap.copy()
     try:
@@ -152,8 +253,8 @@ def preload_gaps(stiffness, gap_map, normal_row, gap, normal_stiffness, preloade
         if not np.all(np.isfinite(compliance)):
             raise np.linalg.LinAlgError("singular")
     except np.linalg.LinAlgError:
-        compliance = np.zeros((len(contacts), len(contacts)))
-    gap[contacts] = -(force / normal_stiffness[contacts] + compliance @ force)
+        compliance = np.zeros((len(index), len(index)))
+    gap[index] = -(deflection + compliance @ force)
     return gap
 
 

@@ -1,16 +1,20 @@
 """Result files of a case (via :mod:`sarfe.io.outputs`), the console table, and the atomic move
-of the finished result directory into place."""
+of the finished result directory into place (the rules: :mod:`sarfe.io.result_folder`)."""
 from __future__ import annotations
 
 import math
-import os
 import shutil
 from pathlib import Path
 
 import numpy as np
 
+from sarfe.pipeline.result_data import contact_pair_fields, result_groups
+
 
 def write_outputs(case, stage, nl, summary, rows, solutions, erps, normal_w, directory: Path):
+    """Write the result files asked for in ``output.files`` into ``directory``; returns
+    {file kind: file name}. Everything "at the loudest point" (spectrum, contact plots, animation,
+    report maps) uses ``summary["worst"]["index"]`` (:func:`sarfe.pipeline.postprocess.loudest_point`)."""
     from sarfe.io import outputs
 
     files = case.data["output"]["files"]
@@ -30,69 +34,85 @@ def write_outputs(case, stage, nl, summary, rows, solutions, erps, normal_w, dir
             boundary_dofs=getattr(stage.reduced, "boundary_dofs", None),
             mode_frequencies_hz=stage.mode_frequencies_hz, erp=erps,
             radiating_nodes=stage.erp_nodes if stage.erp_map.shape[0] else None,
+            extra_groups=result_groups(summary["points"], nl),   # contributions, bands, …
             attributes={"case": case.name, "linear_model_key": stage.key})
         written["response"] = "response.h5"
-    frequencies = [float(s.omega) / (2 * np.pi) for s in solutions]
-    if "plots" in files:
-        if len(solutions) > 1:
-            outputs.plot_erp_sweep(directory / "erp_sweep.png", frequencies,
-                                   [e.level_total_db for e in erps],
-                                   stable=[getattr(s, "stable", None) for s in solutions],
-                                   level_a_db=[e.level_total_a_db for e in erps], title=case.name,
-                                   linear_level_db=[p["linear"]["erp_level_db"]
-                                                    for p in summary["points"]])
-        j = int(np.argmax([e.power_total for e in erps]))
-        outputs.plot_erp_spectrum(directory / "erp_spectrum.png", erps[j].frequencies_hz,
-                                  erps[j].level_db, erps[j].level_a_db,
-                                  title=f"{case.name} at {frequencies[j]:.1f} Hz")
-        if nl.contacts.count:
-            force = np.asarray(solutions[j].contact_force_time)
-            normal_rows = nl.contacts.normal_row
-            totals = [force[:, normal_rows[idx][normal_rows[idx] >= 0]].sum(axis=1)
-                      + nl.contacts.normal_load[idx].sum() for _, _, idx in nl.groups]
-            outputs.plot_contact_forces(directory / "contact_forces.png", np.stack(totals, axis=1),
-                                        names=[g[0] for g in nl.groups],
-                                        omega=solutions[j].omega,
-                                        title=f"normal contact forces at {frequencies[j]:.1f} Hz")
-        written["plots"] = "erp_sweep.png, erp_spectrum.png, contact_forces.png"
-    if stage.kind == "fe" and ("erp_vtu" in files or "animation" in files):
+    loudest = (summary.get("worst") or {}).get("index")
+    images = {}
+    if "plots" in files or "report" in files:
+        from sarfe.pipeline.figures import point_figures
+
+        plot_dir = directory if "plots" in files else directory / ".report-figures"
+        images = point_figures(case, stage, nl, summary, solutions, erps, plot_dir, loudest)
+        if "plots" in files:
+            written["plots"] = ", ".join(sorted(Path(v).name for v in images.values()))
+    maps = {}
+    if stage.kind == "fe" and ("erp_vtu" in files or "animation" in files or "report" in files):
         from sarfe.reduction.recovery import recover_displacement
 
         mesh = stage.mesh
         markers = outputs.contact_markers(mesh.n_nodes, [g.nodes_a for g in stage.contacts.values()])
-        data = []
-        for s, e, W in zip(solutions, erps, normal_w):
-            # full-field recovery only because a VTU was asked for: translations (2H+1, n, 3) [m]
-            u = recover_displacement(stage.reduced, np.asarray(s.displacement), all_dofs=True)
-            translations = u.reshape(u.shape[0], mesh.n_nodes, 6)[:, :, :3]
-            data.append(outputs.erp_point_data(mesh.n_nodes, e, W, float(s.omega),
-                                               displacement=translations,
-                                               radiating_nodes=stage.erp_nodes,
-                                               contact_marker=markers))
+        translations = {}
+
+        def nodal_translations(j):
+            # full-field recovery only because a VTU or a map was asked for: (2H+1, n, 3) [m]
+            if j not in translations:
+                u = recover_displacement(stage.reduced, np.asarray(solutions[j].displacement),
+                                         all_dofs=True)
+                translations[j] = u.reshape(u.shape[0], mesh.n_nodes, 6)[:, :, :3]
+            return translations[j]
+
+        def point_data(j):
+            force, motion = contact_pair_fields(stage, nl, solutions[j], mesh.n_nodes)
+            return outputs.erp_point_data(mesh.n_nodes, erps[j], normal_w[j],
+                                          float(solutions[j].omega),
+                                          displacement=nodal_translations(j),
+                                          radiating_nodes=stage.erp_nodes,
+                                          contact_marker=markers, contact_force=force,
+                                          contact_displacement=motion,
+                                          node_ids=getattr(stage, "node_ids", None))
+
         if "erp_vtu" in files:
+            frequencies = [float(s.omega) / (2 * np.pi) for s in solutions]
             if len(solutions) == 1:
-                outputs.write_erp_vtu(directory / "erp.vtu", mesh.points, mesh.triangles, data[0])
+                outputs.write_erp_vtu(directory / "erp.vtu", mesh.points, mesh.triangles,
+                                      point_data(0))
                 written["erp_vtu"] = "erp.vtu"
             else:
-                outputs.write_erp_sweep(directory / "erp", mesh.points, mesh.triangles, data,
+                outputs.write_erp_sweep(directory / "erp", mesh.points, mesh.triangles,
+                                        (point_data(j) for j in range(len(solutions))),
                                         frequencies)
                 written["erp_vtu"] = "erp/erp.pvd"
-        if "animation" in files:
-            j = int(np.argmax([e.power_total for e in erps]))
-            u = recover_displacement(stage.reduced, np.asarray(solutions[j].displacement),
-                                     all_dofs=True)
-            U = u.reshape(u.shape[0], mesh.n_nodes, 6)[:, :, :3]
+        if "animation" in files and loudest is not None:
             outputs.write_deflection_animation(directory / "animation", mesh.points,
-                                               mesh.triangles, U, omega=float(solutions[j].omega),
-                                               point_data={"contact_marker": markers})
+                                               mesh.triangles, nodal_translations(loudest),
+                                               omega=float(solutions[loudest].omega),
+                                               point_data={"contact_marker": markers} | (
+                                                   {"node_id": stage.node_ids}
+                                                   if getattr(stage, "node_ids", None) is not None
+                                                   else {}))
             written["animation"] = "animation/deflection.pvd"
+        if "report" in files and loudest is not None:
+            from sarfe.pipeline.figures import surface_maps
+
+            maps = surface_maps(case, mesh, point_data(loudest), nodal_translations(loudest),
+                                summary["points"][loudest], directory / ".report-figures",
+                                contact_nodes={name: int(g.nodes_a[0])
+                                               for name, g in stage.contacts.items()
+                                               if len(g.nodes_a)})
+    if "report" in files:
+        notes = {"renderer": maps.pop("renderer", None)}
+        outputs.write_report_html(directory / "report.html", summary, {**images, **maps}, notes)
+        written["report"] = "report.html"
+    shutil.rmtree(directory / ".report-figures", ignore_errors=True)
     return written
 
 
 def results_table(rows, contact_types=None, max_contacts=6) -> str:
     """Console table of the frequency points: convergence, ERP and, per contact (at most
-    ``max_contacts``), the max penetration of a rattle contact or the slip fraction of a squeak
-    contact. ``contact_types``: {name: 'rattle' | 'squeak'} (default: all rattle)."""
+    ``max_contacts``), the indicator its law declares (max penetration, or the slip fraction of a
+    friction law). ``contact_types``: {name: law name} (default: max penetration)."""
+    from sarfe.hbm.laws import table_column
     from sarfe.io.outputs import console_table
 
     columns = ["frequency_hz", "converged", "stable", "iterations", "erp_db", "erp_dba",
@@ -107,14 +127,21 @@ def results_table(rows, contact_types=None, max_contacts=6) -> str:
     names = [k[: -len(".max_penetration_m")] for k in (rows[0] if rows else {})
              if k.endswith(".max_penetration_m")]
     for name in names[:max_contacts]:
-        if (contact_types or {}).get(name) == "squeak":
+        law = (contact_types or {}).get(name)
+        if law is not None and table_column(law) == "slip_fraction":
             key, header, fmt = f"{name}.slip_fraction", f"{name} slip", ".2f"
         else:
             key, header, fmt = f"{name}.max_penetration_m", f"{name} pen [mm]", ".3f"
         columns.append(key)
         headers[key] = header
         formats[key] = fmt
+    from sarfe.io.outputs.summary import shown_level
+
     shown = [dict(row) for row in rows]
+    for row in shown:  # a motionless surface's level reads "-"
+        for key in ("erp_db", "erp_dba", "linear_erp_db"):
+            if key in row:
+                row[key] = shown_level(row[key])
     for row in shown:  # penetration in mm for reading
         for name in names:
             key = f"{name}.max_penetration_m"
@@ -126,12 +153,9 @@ def results_table(rows, contact_types=None, max_contacts=6) -> str:
     return table
 
 
-def replace_directory(temporary: Path, target: Path):
-    """Move a finished temporary directory onto ``target`` (replacing an older result)."""
-    backup = None
-    if target.exists():
-        backup = target.with_name(f".{target.name}.old-{os.getpid()}")
-        os.replace(target, backup)
-    os.replace(temporary, target)
-    if backup is not None:
-        shutil.rmtree(backup, ignore_errors=True)
+def replace_directory(temporary: Path, target: Path, force: bool = False):
+    """Move a finished temporary directory onto ``target`` (replacing an older sarfe result only;
+    the previous result is restored if the move fails): :func:`sarfe.io.result_folder.replace_directory`."""
+    from sarfe.io.result_folder import replace_directory as replace
+
+    replace(temporary, target, force=force)

@@ -230,11 +230,13 @@ def solve_points(case, nl: NonlinearModel, progress=False):
     if "sweep" in exc:
         start, end = (2 * np.pi * exc["sweep"][k] for k in ("start_hz", "end_hz"))
         if contacts.count:
-            bar = _bar(progress, "sweep", None, unit="point")
+            # the bar counts percent of the frequency range covered (so tqdm estimates the time left)
+            bar = _bar(progress, "sweep (% of the range)", 100, unit="%")
             try:
                 solutions = list(continuation(nl.model, contacts, nl.excitation, start, end, H, N,
                                            options=cont_options,
-                                           progress=(lambda done, total: bar.update(1))
+                                           progress=(lambda done, total: bar.update(
+                                               max(0, int(round(100 * done)) - bar.n)))
                                            if bar is not None else None))
                 return in_band(finish_sweep(nl, solutions, start, end, H, N, options,
                                             solver["continuation"]["initial_step"]), start, end)

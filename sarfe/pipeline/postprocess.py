@@ -1,9 +1,14 @@
-r"""Per-point results: ERP of the HBM solution, contact indicators, linear risk baseline.
+r"""Per-point results: ERP of the HBM solution, contact indicators, linear risk baseline,
+third-octave bands, the contribution of each contact, and the loudest point of a run.
 
 ERP: w_s = N ũ (radiating-node normal displacement harmonics) → :func:`sarfe.erp.
 equivalent_radiated_power`. Linear baseline: (K + Gᵀ diag(k) G − ω² M + iω D) Û = F̂ with the
 contacts at their static state (preloaded pairs as springs, open ones removed) →
-:func:`sarfe.risk.linear_risk_from_contacts` and its ERP.
+:func:`sarfe.risk.linear_risk_from_contacts` and its ERP. Bands: :func:`sarfe.erp.bands.
+third_octave_levels` of the harmonic powers (the linear baseline radiates at ω only).
+Contributions: :mod:`sarfe.pipeline.contributions`; per-period contact dynamics:
+:mod:`sarfe.pipeline.contact_dynamics`. The loudest point (:func:`loudest_point`) is the converged,
+not unstable point of highest A-weighted ERP; every artefact "at the loudest point" uses it.
 """
 from __future__ import annotations
 
@@ -58,7 +63,8 @@ def contact_indicators(solution, nl: NonlinearModel) -> list[dict]:
         normal = normal + cs.normal_load[idx].sum()
         tr = cs.tangent_rows[idx]
         friction = np.zeros(N)
-        if kind == "squeak":
+        has_tangent = bool(np.any(tr >= 0))        # a law with a tangent (friction) element
+        if has_tangent:
             t = np.where(tr >= 0, tr, 0)
             ft = force[:, t] * (tr >= 0)
             friction = np.sqrt((ft ** 2).sum(axis=2)).sum(axis=1)
@@ -68,7 +74,7 @@ def contact_indicators(solution, nl: NonlinearModel) -> list[dict]:
             "name": name, "type": kind, "pairs": int(len(idx)),
             "max_penetration_m": float(max(penetration, 0.0)) if has.any() else float("nan"),
             "peak_normal_force_N": float(normal.max()),
-            "peak_friction_force_N": float(friction.max()) if kind == "squeak" else float("nan"),
+            "peak_friction_force_N": float(friction.max()) if has_tangent else float("nan"),
             "normal_amplitude_m": float(amplitude_1),
             "open_fraction": float(np.mean(st == 0)),
             "closed_or_stick_fraction": float(np.mean(st == 1)),
@@ -77,40 +83,46 @@ def contact_indicators(solution, nl: NonlinearModel) -> list[dict]:
     return out
 
 
-def baseline_springs(contacts) -> np.ndarray:
-    """Spring [N/m] of every row of G in the linear baseline: the contacts at their static state
-    (no static load: the rest position, u = 0). A pair is closed there when its gap g ≤ 0 (a
-    preloaded pair: g = the overclosure that carries the preload); its normal row keeps k_n. A
-    friction pair is stuck there when it is closed or carries a constant normal load N0 > 0; its
-    tangent rows keep k_t. Open pairs are removed (0)."""
+def baseline_rows(contacts):
+    """(spring [N/m], dashpot [N s/m]) of every row of G in the linear baseline: the contacts at
+    their static state (no static load: the rest position, u = 0; each law's linearization,
+    :func:`sarfe.hbm.laws.linearization`). A pair closed there (g ≤ 0: a preloaded pair, g = the
+    overclosure that carries the preload) keeps its normal spring and dashpot; a friction pair
+    that carries a static normal force there (closed, or a constant normal load N0 > 0) is stuck
+    and keeps k_t on its tangent rows. Open pairs are removed (0)."""
+    from sarfe.hbm import laws
+
     c = contacts
-    k = np.zeros(c.row_count)
-    has_n = c.normal_row >= 0
-    closed = has_n & (c.gap <= 0)
-    k[c.normal_row[closed]] = c.normal_stiffness[closed]
-    stuck = closed | (c.normal_load > 0)
+    normal, tangent = laws.linearization(c)
+    springs, dashpots = np.zeros(c.row_count), np.zeros(c.row_count)
+    closed = (c.normal_row >= 0) & normal.closed
+    springs[c.normal_row[closed]] = normal.spring[closed]
+    dashpots[c.normal_row[closed]] = normal.dashpot[closed]
+    stuck = normal.preload > 0
     for col in range(2):
         present = (c.tangent_rows[:, col] >= 0) & stuck
-        k[c.tangent_rows[present, col]] = c.tangential_stiffness[present]
-    return k
+        springs[c.tangent_rows[present, col]] = tangent[present]
+    return springs, dashpots
 
 
 def linear_baseline(case, stage, nl: NonlinearModel, omega):
     """Linear response at ω of the structure with its contacts at their static state: preloaded
-    (closed) pairs as linear springs k_n, stuck friction pairs as k_t, open pairs removed
-    (:func:`baseline_springs`):
+    (closed) pairs as their linearized spring k_n (and dashpot c_n), stuck friction pairs as k_t,
+    open pairs removed (:func:`baseline_rows`):
 
-        (K + Gᵀ diag(k) G − ω² M + iω D) Û = F̂   [m],
+        (K + Gᵀ diag(k) G − ω² M + iω (D + Gᵀ diag(c) G)) Û = F̂   [m],
 
     its ERP and the linear risk per named contact."""
     from sarfe.risk import linear_risk_from_contacts
 
     M, D, K = nl.model.mass, nl.model.damping, nl.model.stiffness
     dense = (lambda A: A.toarray() if sp.issparse(A) else np.asarray(A))
-    G = sp.csr_matrix(nl.contacts.gap_map)
-    springs = (G.T @ sp.diags(baseline_springs(nl.contacts)) @ G).toarray() \
-        if nl.contacts.count else 0.0
-    S = dense(K) + springs - omega ** 2 * dense(M) + 1j * omega * dense(D)
+    springs = dashpots = 0.0
+    if nl.contacts.count:
+        G = sp.csr_matrix(nl.contacts.gap_map)
+        k, c = baseline_rows(nl.contacts)
+        springs, dashpots = (G.T @ sp.diags(k) @ G).toarray(), (G.T @ sp.diags(c) @ G).toarray()
+    S = dense(K) + springs - omega ** 2 * dense(M) + 1j * omega * (dense(D) + dashpots)
     U1 = np.linalg.lstsq(S, nl.excitation_amplitude, rcond=None)[0]
     H = (nl.excitation.shape[0] - 1) // 2
     U = np.zeros((2 * H + 1, stage.dof_count))
@@ -210,13 +222,36 @@ def harmonic_set_record(case, solution):
             "dropped_content": float(getattr(solution, "dropped_content", float("nan")))}
 
 
+def band_record(erp, linear, omega) -> dict:
+    """Third-octave bands of the point's ERP harmonics and of the linear baseline (at ω only)."""
+    from sarfe.erp.bands import third_octave_levels
+
+    f = omega / (2 * np.pi)
+    linear_power = linear.get("erp_power_W", float("nan"))
+    linear_power = linear_power if math.isfinite(linear_power) else 0.0
+    return {"nonlinear": third_octave_levels(erp.frequencies_hz, erp.power).as_dict(),
+            "linear": third_octave_levels([f], [linear_power]).as_dict()}
+
+
 def point_record(case, stage, nl, index, solution, error_estimate=False):
     """(point dict of summary.json, flat table row, ErpResult, radiating displacements W).
     ``error_estimate``: the point's estimate when computed beforehand (:func:`error_estimates`),
     False to compute it here."""
+    from sarfe.pipeline.contact_dynamics import contact_dynamics
+    from sarfe.pipeline.contributions import contributions_record
+
     omega = float(solution.omega)
     erp, W = _erp(case, stage, solution.displacement, omega)
     contacts = contact_indicators(solution, nl) if nl.contacts.count else []
+    for record, dynamics in zip(contacts, contact_dynamics(solution, nl)):
+        record.update({k: v for k, v in dynamics.items() if k != "name"})
+    contributions = contributions_record(case, stage, nl, solution)
+    if contributions.get("available"):
+        shares = {c["name"]: c for c in contributions["sources"]}
+        for record in contacts:
+            source = shares.get(record["name"], {})
+            record.update({"erp_level_dba": source.get("level_dba", float("nan")),
+                           "erp_share_a": source.get("share_a", float("nan"))})
     linear = linear_baseline(case, stage, nl, omega)
     stable = getattr(solution, "stable", None)
     point = {
@@ -229,6 +264,8 @@ def point_record(case, stage, nl, index, solution, error_estimate=False):
         "error_estimate": (_error_estimate(case, stage, nl, solution) if error_estimate is False
                            else error_estimate),
         "harmonic_set": harmonic_set_record(case, solution),
+        "bands": band_record(erp, linear, omega),
+        "contributions": contributions,
     }
     row = {"case": case.name, "point": index, "frequency_hz": point["frequency_hz"],
            "converged": point["converged"], "stable": point["stable"],
@@ -239,21 +276,47 @@ def point_record(case, stage, nl, index, solution, error_estimate=False):
                             and "erp_db" in point["error_estimate"] else float("nan"))}
     for c in contacts:
         for key in ("max_penetration_m", "peak_normal_force_N", "peak_friction_force_N",
-                    "open_fraction", "slip_fraction"):
-            row[f"{c['name']}.{key}"] = c[key]
+                    "open_fraction", "slip_fraction", "impacts_per_period", "erp_share_a"):
+            if key in c:
+                row[f"{c['name']}.{key}"] = c[key]
     for c in linear["contacts"]:
         row[f"{c['name']}.linear_rattle_risk"] = c["rattle_risk"]
     return point, row, erp, W
 
 
+def loudest_point(points) -> int | None:
+    """Index (into ``points``) of the loudest point: the highest finite A-weighted ERP among the
+    converged points that are not unstable (``stable`` true or not assessed); None if there is none.
+    """
+    candidates = [i for i, p in enumerate(points)
+                  if p["converged"] and p.get("stable") is not False
+                  and math.isfinite(p["erp"]["level_dba"])]
+    if not candidates:
+        return None
+    return max(candidates, key=lambda i: points[i]["erp"]["level_dba"])
+
+
 def worst_of(points):
+    """summary.json ``worst``: the loudest point (:func:`loudest_point`: its ``index``, frequency,
+    levels, contact ranking and bands) and per contact the sweep maxima over all points."""
     if not points:
         return {}
-    levels = [p["erp"]["level_dba"] for p in points]
-    finite = [i for i, x in enumerate(levels) if math.isfinite(x)]
-    j = max(finite, key=lambda i: levels[i]) if finite else 0
-    worst = {"erp_level_dba": levels[j], "erp_level_db": points[j]["erp"]["level_db"],
-             "frequency_hz": points[j]["frequency_hz"], "contacts": {}}
+    j = loudest_point(points)
+    if j is None:
+        worst = {"index": None, "erp_level_dba": float("nan"), "erp_level_db": float("nan"),
+                 "frequency_hz": float("nan"),
+                 "note": "no converged, not unstable point with a finite level", "contacts": {}}
+    else:
+        p = points[j]
+        contributions = p.get("contributions") or {}
+        excitation = next((s for s in contributions.get("sources", [])
+                           if s["name"] == "excitation"), None)
+        worst = {"index": p["index"], "erp_level_dba": p["erp"]["level_dba"],
+                 "erp_level_db": p["erp"]["level_db"], "frequency_hz": p["frequency_hz"],
+                 "ranking": contributions.get("ranking", []),
+                 "excitation": None if excitation is None else {
+                     "level_dba": excitation["level_dba"], "share_a": excitation["share_a"]},
+                 "bands": p.get("bands"), "contacts": {}}
     for c_index, c in enumerate(points[0]["contacts"]):
         pen = [p["contacts"][c_index]["max_penetration_m"] for p in points]
         force = [p["contacts"][c_index]["peak_normal_force_N"] for p in points]

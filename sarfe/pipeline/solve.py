@@ -5,8 +5,6 @@ directory next to the target and moved into place at the end).
 from __future__ import annotations
 
 import datetime as _dt
-import shutil
-import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -16,10 +14,12 @@ import numpy as np
 from sarfe.io.case import load_case
 from sarfe.io.errors import EXIT_NOT_CONVERGED
 from sarfe.pipeline.accuracy import accuracy_check
+from sarfe.pipeline.checks import check_case, reduced_model_warnings
 from sarfe.pipeline.linear import build_linear_model, linear_model_key
 from sarfe.pipeline.nonlinear import NonlinearModel, nonlinear_model
-from sarfe.pipeline.outputs import replace_directory, write_outputs, results_table
+from sarfe.pipeline.outputs import write_outputs, results_table
 from sarfe.pipeline.points import common_samples, solve_points, sweep_status
+from sarfe.pipeline.progress import bar as _bar
 from sarfe.pipeline.pruning import solve_points_pruned
 from sarfe.pipeline.postprocess import error_estimates, point_record, worst_of
 
@@ -38,18 +38,34 @@ class CaseResult:
     output_dir: Path | None = None
 
 
-def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=True) -> CaseResult:
+def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=True,
+               force=False, warn=None) -> CaseResult:
     """Solve a case end to end (module docstring). Returns :class:`CaseResult`.
 
     ``output_dir``: where the result files go (default ``output.directory`` of the case, relative to
-    the current directory); ``write=False`` writes nothing. Files are written into a temporary
-    directory next to the target and moved into place at the end, so a failed run leaves nothing.
+    the current directory); ``write=False`` writes nothing. Every input check of ``sarfe validate``
+    runs first (:func:`sarfe.pipeline.checks.check_case`: mesh quality, held structure, output
+    folder; ``force`` replaces a folder that is not a sarfe result); its warnings go to
+    ``warn(line)`` as found and to summary.json ``warnings``. Files are
+    written into a temporary directory next to the target and moved into place at the end, so a
+    failed run leaves the previous result as it was.
     Raises CaseError for problems in the case; a non-converged point gives ``exit_code`` 3.
     """
     from sarfe import __version__
 
     started = time.perf_counter()
     case = load_case(case)
+    bar = _bar(progress and linear_stage is None, "checking the case: mesh, groups, quality", None,
+               unit="step")
+    try:
+        checked = check_case(case, output_dir, force, write=write, mesh_checks=linear_stage is None)
+    finally:
+        if bar is not None:
+            bar.close()
+    target, warnings = checked.output, list(checked.warnings)
+    for line in warnings:
+        if warn is not None:
+            warn(line)
     timings = {}
     accuracy = None
     if case.data["solver"]["resolution"] == "auto":
@@ -72,6 +88,10 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     elif linear_stage.key != linear_model_key(case):
         raise ValueError("linear_stage was built for a different linear model (key mismatch)")
     stage = linear_stage
+    for line in reduced_model_warnings(case, stage):
+        warnings.append(line)
+        if warn is not None:
+            warn(line)
     clock = time.perf_counter()
     nl = nonlinear_model(case, stage)
     timings["setup_s"] = time.perf_counter() - clock
@@ -82,15 +102,23 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
 
     clock = time.perf_counter()
     points, rows, erps, normal_w = [], [], [], []
-    estimates = error_estimates(case, stage, nl, solutions)     # each at the N it was solved with
-    timings["error_estimate_s"] = time.perf_counter() - clock
-    solutions = common_samples(nl, solutions)                    # one time grid for the files
-    for index, solution in enumerate(solutions):
-        point, row, erp, W = point_record(case, stage, nl, index, solution, estimates[index])
-        points.append(point)
-        rows.append(row)
-        erps.append(erp)
-        normal_w.append(W)
+    bar = _bar(progress, "ERP and error estimates" if case.data["solver"].get("error_estimate", True)
+               else "ERP", len(solutions), unit="point")
+    try:
+        estimates = error_estimates(case, stage, nl, solutions)  # each at the N it was solved with
+        timings["error_estimate_s"] = time.perf_counter() - clock
+        solutions = common_samples(nl, solutions)                # one time grid for the files
+        for index, solution in enumerate(solutions):
+            point, row, erp, W = point_record(case, stage, nl, index, solution, estimates[index])
+            points.append(point)
+            rows.append(row)
+            erps.append(erp)
+            normal_w.append(W)
+            if bar is not None:
+                bar.update(1)
+    finally:
+        if bar is not None:
+            bar.close()
     timings["postprocess_s"] = time.perf_counter() - clock
     not_converged = [p["index"] for p in points if not p["converged"]]
     sweep = sweep_status(case, solutions)       # None entries without a sweep
@@ -114,13 +142,14 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         "model": dict(stage.info, kind=stage.kind, kept_dofs=int(stage.dof_count),
                       mode_frequencies_hz=np.asarray(stage.mode_frequencies_hz)[:50]),
         "solver": {k: v for k, v in case.data["solver"].items()},
-        "contacts": [{"name": name, "type": kind, "pairs": int(len(idx))}
-                     for name, kind, idx in nl.groups],
+        "contacts": [dict({"name": name, "type": kind, "pairs": int(len(idx))},
+                          **_node_pairs(stage, name)) for name, kind, idx in nl.groups],
         "contact_pruning": pruning,              # per contact: open / closed / nonlinear
         "points": points,
         "worst": worst_of(points),
         "accuracy": accuracy,                    # None unless solver.accuracy was given
         "accuracy_check": accuracy_check(case, points),   # estimates vs the accuracy budget
+        "warnings": warnings,                    # inputs far outside the model's range
         "timings_s": timings,
         "case_data": case.data,                  # the case with every default filled in
     }
@@ -128,27 +157,40 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     if not write:
         summary["timings_s"]["total_s"] = time.perf_counter() - started
         return result
-    target = Path(output_dir if output_dir is not None else case.data["output"]["directory"])
-    target = target.resolve()
-    target.parent.mkdir(parents=True, exist_ok=True)
-    temporary = Path(tempfile.mkdtemp(prefix=f".{target.name}.tmp-", dir=target.parent))
-    try:
+    from sarfe.io.outputs import write_summary_json
+    from sarfe.io.result_folder import marker_info, write_result_folder
+
+    def write_files(folder):
         clock = time.perf_counter()
         summary["timings_s"]["outputs_s"] = 0.0
         summary["timings_s"]["total_s"] = time.perf_counter() - started
-        written = write_outputs(case, stage, nl, summary, rows, solutions, erps, normal_w,
-                                 temporary)
-        summary["files"] = written
+        summary["files"] = write_outputs(case, stage, nl, summary, rows, solutions, erps,
+                                         normal_w, folder)
         summary["timings_s"]["outputs_s"] = time.perf_counter() - clock
         summary["timings_s"]["total_s"] = time.perf_counter() - started
-        from sarfe.io.outputs import write_summary_json
-        write_summary_json(temporary / "summary.json", summary)
-        replace_directory(temporary, target)
-    except BaseException:
-        shutil.rmtree(temporary, ignore_errors=True)
-        raise
+        write_summary_json(folder / "summary.json", summary)
+
+    bar = _bar(progress, "writing results", None, unit="file")
+    try:
+        write_result_folder(target, write_files, marker_info("solve", case.name), force=force)
+    finally:
+        if bar is not None:
+            bar.close()
     result.output_dir = target
     return result
+
+
+def _node_pairs(stage, name) -> dict:
+    """{"node_pairs": [[a, b], …]} of an FE contact: the deck's GRID ids (deck models) or mesh
+    node indices; b is "ground" for a contact with ground."""
+    geometry = stage.contacts.get(name) if stage.kind == "fe" else None
+    if geometry is None:
+        return {}
+    ids = getattr(stage, "node_ids", None)
+    name_of = (lambda n: int(ids[n])) if ids is not None else int   # noqa: E731
+    return {"node_pairs": [[name_of(a), "ground" if b < 0 else name_of(b)]
+                           for a, b in zip(geometry.nodes_a, geometry.nodes_b)],
+            "node_numbering": "deck ids" if ids is not None else "mesh indices"}
 
 
 __all__ = ["CaseResult", "NonlinearModel", "nonlinear_model", "results_table", "solve_case",

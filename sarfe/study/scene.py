@@ -3,15 +3,18 @@ harmonic content of a solution says which harmonics carry nothing.
 
 Contact screening (a cheap linear pass). At every ω of a grid over the sweep, the response of the
 linear model with each contact linearized at u = 0 (what :func:`sarfe.hbm.solve.linearized_guess`
-solves: preloaded contacts as springs k_n with their preload, open ones absent, squeak tangents stuck)
+solves: each law's linearization — preloaded contacts as their springs with their preload, open ones
+absent, tangent elements stuck)
 gives the relative normal motion w(θ) of every contact. With the gap g and a margin m ∈ (0, 1):
 
 - ``open``   (g > 0):  max_{ω,θ} w ≤ (1 − m) g      — never closes: λ ≡ 0, drop the contact;
-- ``closed`` (g < 0, rattle): min_{ω,θ} (w − g) ≥ m (w₀ − g), w₀ the static (mean) closure — the
-  compression never drops below m × its static value, never opens: λ = k_n (w − g) is linear,
-  add k_n gᵣᵀ gᵣ to K and k_n g gᵣᵀ to the static load f̃_e,0 (gᵣ: its row of G; exact while closed);
-- otherwise ``nonlinear`` (kept), with the reason. Squeak contacts with a normal load N0 > 0 are
-  always kept (their slider state is history dependent even when they never slip).
+- ``closed`` (g < 0, a law that is ``linear_when_closed``, e.g. rattle): min_{ω,θ} (w − g) ≥
+  m (w₀ − g), w₀ the static (mean) closure — the compression never drops below m × its static
+  value, never opens: λ = k w + p (the law's linearization: spring k, preload p) is exact,
+  add k gᵣᵀ gᵣ to K and −p gᵣᵀ to the static load f̃_e,0 (gᵣ: its row of G);
+- otherwise ``nonlinear`` (kept), with the reason. A law's ``prune_open`` may keep a contact that
+  never closes (friction under a normal load N0 > 0: its slider state is history dependent even
+  when it never slips).
 
 Because the other contacts' nonlinear response can drive a screened contact, :func:`check_pruning`
 re-checks every decision on the nonlinear solution (w of the dropped contacts is still G u); a
@@ -58,26 +61,32 @@ class PrunedProblem:
 
 def linearized_stiffness(model, contacts):
     r"""(K_lin, f_pre) of the contacts linearized at u = 0, as :func:`sarfe.hbm.solve.linearized_guess`:
-    K_lin = K + Gᵀ diag(k) G with k = k_n on the normal rows of pairs with g ≤ 0 and k_t on the
-    friction tangents (stuck); f_pre = −Gᵀ p [N], p = −k_n g on those normal rows (+ N0 of squeak
-    pairs). Dense (n, n) [N/m] if the model is dense, else sparse CSC."""
-    c = contacts
-    k = np.zeros(c.row_count)
-    preload = np.zeros(c.row_count)
-    closed = (c.normal_row >= 0) & (c.gap <= 0)
-    k[c.normal_row[closed]] = c.normal_stiffness[closed]
-    preload[c.normal_row[closed]] = -c.normal_stiffness[closed] * c.gap[closed]
-    has_n = c.normal_row >= 0
-    preload[c.normal_row[has_n]] += np.where(np.asarray(c.kind)[has_n] == "squeak",
-                                             c.normal_load[has_n], 0.0)
-    for col in range(2):
-        present = c.tangent_rows[:, col] >= 0
-        k[c.tangent_rows[present, col]] = c.tangential_stiffness[present]
-    G = sp.csr_matrix(c.gap_map)
+    K_lin = K + Gᵀ diag(k) G with k the laws' springs on the normal rows of pairs closed at u = 0
+    and k_t on the stuck tangents; f_pre = −Gᵀ p [N], p the laws' preloads on the normal rows
+    (:func:`sarfe.hbm.solve.linearized_rows`). Dense (n, n) [N/m] if the model is dense, else
+    sparse CSC."""
+    from sarfe.hbm.solve import linearized_rows
+
+    k, _, preload = linearized_rows(contacts)
+    G = sp.csr_matrix(contacts.gap_map)
     added = G.T @ sp.diags(k) @ G
     K = model.stiffness
     K = (sp.csc_matrix(K) + added).tocsc() if sp.issparse(K) else np.asarray(K) + added.toarray()
     return K, -np.asarray(G.T @ preload).ravel()
+
+
+def linearized_damping(model, contacts):
+    """D + Gᵀ diag(c) G with the laws' dashpots c of the contacts closed at u = 0 (D itself when
+    every law is rate independent) [N s/m]."""
+    from sarfe.hbm.solve import linearized_rows
+
+    c = linearized_rows(contacts)[1]
+    D = model.damping
+    if not np.any(c):
+        return D
+    G = sp.csr_matrix(contacts.gap_map)
+    added = G.T @ sp.diags(c) @ G
+    return (sp.csc_matrix(D) + added).tocsc() if sp.issparse(D) else np.asarray(D) + added.toarray()
 
 
 def _solve(A, b):
@@ -98,7 +107,7 @@ def linear_responses(model, contacts, excitation, omegas):
     real system, here harmonic by harmonic."""
     F = np.asarray(excitation, dtype=float)
     K, f_pre = linearized_stiffness(model, contacts)
-    M, D = model.mass, model.damping
+    M, D = model.mass, linearized_damping(model, contacts)
     if not sp.issparse(K):
         M, D = (A.toarray() if sp.issparse(A) else np.asarray(A) for A in (M, D))
     static = np.real(_solve(K, F[0] + f_pre))
@@ -121,6 +130,7 @@ def screen_contacts(model, contacts, excitation, omegas, margin=0.5, samples=64)
     few hundred points, or the grid plus the linear natural frequencies); margin m (module docstring).
     """
     from sarfe.hbm.harmonics import time_samples
+    from sarfe.hbm.laws import pruning_rules
 
     F = np.asarray(excitation, dtype=float)
     # the linear response has only the harmonics of the excitation: screen with those (exact)
@@ -139,6 +149,7 @@ def screen_contacts(model, contacts, excitation, omegas, margin=0.5, samples=64)
         w_max = np.maximum(w_max, np.where(has, w.max(axis=0), -np.inf))
         w_min = np.minimum(w_min, np.where(has, w.min(axis=0), np.inf))
         w_mean = np.where(has, R[0, np.where(has, c.normal_row, 0)], 0.0)   # static: same at every ω
+    may_open, may_close = pruning_rules(c)
     decisions = []
     for i in range(c.count):
         name = c.names[i] if i < len(c.names) else f"contact_{i}"
@@ -148,9 +159,9 @@ def screen_contacts(model, contacts, excitation, omegas, margin=0.5, samples=64)
             decisions.append(ContactDecision(i, name, kind, NONLINEAR, nan,
                                              "no normal row (constant normal load): kept"))
             continue
-        if kind == "squeak" and c.normal_load[i] > 0:
+        if not may_open[i]:
             decisions.append(ContactDecision(i, name, kind, NONLINEAR, nan,
-                                             "friction under a normal load: kept"))
+                                             f"{kind} law keeps it (history under a normal load)"))
             continue
         if g > 0:
             clearance = (g - w_max[i]) / g
@@ -162,7 +173,7 @@ def screen_contacts(model, contacts, excitation, omegas, margin=0.5, samples=64)
                 decisions.append(ContactDecision(
                     i, name, kind, NONLINEAR, float(clearance),
                     f"closes or comes within {margin:g} × gap (max w = {w_max[i]:.3g} m, gap {g:.3g} m)"))
-        elif g < 0 and kind == "rattle":
+        elif g < 0 and may_close[i]:
             static = w_mean[i] - g
             clearance = (w_min[i] - g) / static if static > 0 else -np.inf
             if clearance >= margin:
@@ -177,14 +188,13 @@ def screen_contacts(model, contacts, excitation, omegas, margin=0.5, samples=64)
                     f"{w_min[i] - g:.3g} m, static {static:.3g} m)"))
         else:
             decisions.append(ContactDecision(i, name, kind, NONLINEAR, 0.0,
-                                             "touching (gap 0) or preloaded friction: kept"))
+                                             "touching (gap 0), or preloaded and not linear "
+                                             "while closed: kept"))
     return tuple(decisions)
 
 
 def subset_contacts(contacts, indices):
     """ContactSet with only the contacts ``indices`` (their rows of G re-numbered)."""
-    from sarfe.hbm.contacts import make_contact_set
-
     idx = np.asarray(indices, dtype=int)
     c = contacts
     rows = kept_rows(c, idx)
@@ -193,17 +203,17 @@ def subset_contacts(contacts, indices):
     normal = remap(c.normal_row[idx]) if idx.size else np.zeros(0, int)
     tangent = remap(c.tangent_rows[idx]).reshape(-1, 2) if idx.size else np.zeros((0, 2), int)
     G = c.gap_map[rows] if rows.size else sp.csr_matrix((0, c.gap_map.shape[1]))
-    names = tuple(c.names[i] for i in idx) if c.names else None
-    return make_contact_set(G, np.asarray(c.kind, dtype=object)[idx], normal, tangent, c.gap[idx],
-                            c.normal_stiffness[idx], c.tangential_stiffness[idx],
-                            c.friction_coefficient[idx], c.normal_load[idx], names)
+    return c.subset(idx, G, normal, tangent)
 
 
 def prune_contacts(model, contacts, excitation, decisions) -> PrunedProblem:
-    """Apply decisions: drop ``open`` contacts, turn ``closed`` rattle contacts into springs.
+    """Apply decisions: drop ``open`` contacts, turn ``closed`` contacts into their law's
+    linearization (springs).
 
-    Closed: λ = k_n (w − g), w = gᵣ u → K += k_n gᵣᵀ gᵣ and f̃_e,0 += k_n g gᵣᵀ (exact while closed).
+    Closed: λ = k w + p, w = gᵣ u → K += k gᵣᵀ gᵣ and f̃_e,0 −= p gᵣᵀ (exact while closed; for the
+    penalty law k = k_n, p = −k_n g).
     """
+    from sarfe.hbm.laws import linearization
     from sarfe.hbm.model import make_linear_model
 
     F = np.asarray(excitation, dtype=float).copy()
@@ -211,9 +221,10 @@ def prune_contacts(model, contacts, excitation, decisions) -> PrunedProblem:
     closed = np.array([d.index for d in decisions if d.decision == CLOSED], dtype=int)
     if closed.size:
         G = sp.csr_matrix(contacts.gap_map[contacts.normal_row[closed]])      # rows gᵣ
-        k_n, g = contacts.normal_stiffness[closed], contacts.gap[closed]
-        add = G.T @ sp.diags(k_n) @ G
-        F[0] += np.asarray(G.T @ (k_n * g)).ravel()
+        lin = linearization(contacts)[0]
+        k, preload = lin.spring[closed], lin.preload[closed]
+        add = G.T @ sp.diags(k) @ G
+        F[0] -= np.asarray(G.T @ preload).ravel()
         K = (sp.csr_matrix(K) + add).tocsr() if sp.issparse(K) else np.asarray(K) + add.toarray()
     kept = np.array([d.index for d in decisions if d.decision == NONLINEAR], dtype=int)
     pruned_model = make_linear_model(model.mass, model.damping, K) if closed.size else model
@@ -259,13 +270,15 @@ def restore_solution(solution, model, contacts, excitation, decisions):
     r"""A HarmonicSolution of the pruned problem re-expressed with the full contact set.
 
     Kept contacts: the solver's own forces, force samples and states (a friction contact's stuck
-    offset depends on the slider history, so it is not re-evaluated). ``closed`` contacts:
-    λ = k_n (w − g), state 1; ``open``: λ = 0, state 0. Residual ‖S ũ + Gᵀλ̃ − f̃_e‖ / ‖f̃_e‖ of the
+    offset depends on the slider history, so it is not re-evaluated). ``closed`` contacts: their
+    law's linearization λ = k w + p (k_n (w − g) for the penalty law), state 1; ``open``: λ = 0,
+    state 0. Residual ‖S ũ + Gᵀλ̃ − f̃_e‖ / ‖f̃_e‖ of the
     full equations (on the solved harmonic rows when the solution used a harmonic subset).
     """
     from dataclasses import replace
 
     from sarfe.hbm.harmonics import time_samples
+    from sarfe.hbm.laws import linearization
     from sarfe.hbm.linear import apply_dynamic_stiffness
 
     U = np.asarray(solution.displacement, dtype=float)
@@ -284,10 +297,11 @@ def restore_solution(solution, model, contacts, excitation, decisions):
         state[:, kept] = solution.contact_state
     if closed.size:
         normal = contacts.normal_row[closed]
-        k_n, g = contacts.normal_stiffness[closed], contacts.gap[closed]
-        force[:, normal] = k_n * R[:, normal]
-        force[0, normal] -= k_n * g
-        force_time[:, normal] = k_n * (time_samples(R[:, normal], N) - g)
+        lin = linearization(contacts)[0]
+        k, preload = lin.spring[closed], lin.preload[closed]
+        force[:, normal] = k * R[:, normal]
+        force[0, normal] += preload
+        force_time[:, normal] = k * time_samples(R[:, normal], N) + preload
         state[:, closed] = 1
     residual = apply_dynamic_stiffness(model, solution.omega, U) + \
         np.asarray(contacts.gap_map.T @ force.T).T - F

@@ -43,7 +43,7 @@ def test_one_linear_stage_for_contact_and_excitation_variants(in_process):
     run = table.attrs["summary"]["run"]
     assert calls == {"build": 1, "solve_without_stage": 0}
     assert run["linear_models"] == 1 and run["linear_stages_built"] == 1
-    assert len(list((out / ".cache").glob("*.pkl"))) == 1
+    assert len(list((out / ".cache").glob("*.npz"))) == 1
 
 
 def test_table_outputs(in_process):

@@ -36,7 +36,7 @@ def test_linear_stage_once_per_linear_model_and_cached(tmp_path, fake_log, dask_
     run = table.attrs["summary"]["run"]
     assert fake_log("build") == 2 and fake_log("solve") == 12
     assert run["linear_models"] == 2 and run["linear_stages_built"] == 2
-    assert len(list((tmp_path / "out" / ".cache").glob("*.pkl"))) == 2
+    assert len(list((tmp_path / "out" / ".cache").glob("*.npz"))) == 2
     # a widened study in the same folder: old variants skipped, stages read from the cache
     path.write_text(path.read_text().replace("[0.2, 0.4]", "[0.2, 0.4, 0.6]"))
     table = run_study(path, workers=0, output_dir=tmp_path / "out", pipeline=FAKE)

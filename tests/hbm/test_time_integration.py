@@ -167,6 +167,26 @@ def friction_chain():
     return make_linear_model(M, 2e-4 * K + 4.0 * M, K)
 
 
+def assert_states_equal_away_from_ties(a, b):
+    """Contact states (samples, contacts) agree except at samples next to a state change.
+
+    A sample where stick and slip meet is decided by ``|trial force| > μ N0``, a tie up to
+    round-off (±1e-14 μ N0, depending on the BLAS kernel); only those may differ, and at most
+    one sample per change.
+    """
+    a, b = np.asarray(a), np.asarray(b)
+    assert a.shape == b.shape
+
+    def near_change(s):     # sample j where s changes between j-1, j or j, j+1 (periodic)
+        change = s != np.roll(s, 1, axis=0)
+        return change | np.roll(change, -1, axis=0)
+
+    differ = a != b
+    assert not np.any(differ & ~(near_change(a) | near_change(b))), np.argwhere(differ)
+    changes = np.count_nonzero(a != np.roll(a, 1, axis=0), axis=0)
+    assert np.all(np.count_nonzero(differ, axis=0) <= np.maximum(changes, 1))
+
+
 @pytest.mark.parametrize("angle", [0.0, np.pi / 5])
 def test_two_direction_friction_matches_one_direction(angle):
     """Isotropic Coulomb disk: motion along x1 only gives the 1-D result, in any tangent frame."""
@@ -181,7 +201,7 @@ def test_two_direction_friction_matches_one_direction(angle):
                          steps_per_period=N)
     assert one.steady and two.steady
     assert np.any(one.contact_state == SLIP) and np.any(one.contact_state == STICK)
-    assert np.array_equal(one.contact_state, two.contact_state)
+    assert_states_equal_away_from_ties(one.contact_state, two.contact_state)
     scale = np.abs(one.displacement_harmonics).max()
     assert np.abs(one.displacement_harmonics - two.displacement_harmonics).max() < 1e-6 * scale
     assert np.abs(two.displacement_harmonics[:, 2]).max() < 1e-9 * scale

@@ -162,7 +162,9 @@ def test_unreadable_mesh_file(tmp_path, capsys):
 def test_thickness_in_mm_by_mistake(tmp_path, capsys):
     text = edit(FE, "part_plate: 2.5e-3, part_beam: 1.5e-3", "part_plate: 2.5, part_beam: 1.5")
     code, err, _ = run_cli(tmp_path, text, capsys=capsys)
-    assert code == 2 and "model.fe.thickness_m: thickness 2.5 m is not small" in err
+    assert code == 2 and "model.fe.thickness_m.part_plate: thickness 2.5 m is not small" in err
+    code, err, _ = run_cli(tmp_path, text, command="validate", capsys=capsys)
+    assert code == 2 and "given in mm?" in err and len(err.strip().splitlines()) == 1
 
 
 def test_debug_shows_traceback(tmp_path, capsys):

@@ -39,3 +39,30 @@ def test_contact_force_and_spectrum_plots(tmp_path):
     check_png(plot_erp_spectrum(tmp_path / "spectrum.png", erp.frequencies_hz, erp.level_db,
                                 erp.level_a_db, title="harmonics"))
     check_png(plot_erp_spectrum(tmp_path / "spectrum_db.png", erp.frequencies_hz, erp.level_db))
+
+
+def test_sweep_branches_folds_jumps_and_silent_points(tmp_path):
+    """A continuation through a fold (x turns back twice) gives three monotone branches sharing the
+    fold points; a jump of 15 dB between neighbours is left open; −190 dB points are not drawn."""
+    from matplotlib.figure import Figure
+
+    from sarfe.io.outputs.plots import branch_ids, jump_starts
+
+    x = np.array([1.0, 2.0, 3.0, 2.5, 2.0, 2.6, 3.5, 4.0])
+    assert list(branch_ids(x)) == [0, 0, 0, 1, 1, 2, 2, 2]
+    y = np.array([60.0, 61.0, 62.0, 63.0, 64.0, 79.0, 80.0, 81.0])
+    assert list(np.flatnonzero(jump_starts(y))) == [5]
+    levels = np.array([60.0, 61.0, -190.0, 62.0, 63.0])
+    path = plot_erp_sweep(tmp_path / "silent.png", [1, 2, 3, 4, 5], levels,
+                          converged=[True, True, True, True, False], target_dba=55.0)
+    check_png(path)
+    # the lines drawn never reach below the plotted range (no line to the floor)
+    from sarfe.io.outputs import plots
+
+    fig = Figure()
+    ax = fig.add_subplot()
+    plots._plot_branches(ax, np.arange(5.0), np.where(levels > -100, levels, np.nan),
+                         np.ones(5, int), "C0")
+    for line in ax.get_lines():
+        ydata = np.asarray(line.get_ydata(), float)
+        assert np.nanmin(ydata) >= 60.0

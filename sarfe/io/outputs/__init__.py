@@ -23,8 +23,21 @@ response_h5.py (response.h5), vtk.py (VTU/PVD arrays), plots.py (PNGs).
                    linear_level_db=None, dynamic_range_db=80.0) -> Path
     plot_contact_forces(path, force_time (N, n), names=None, omega=None, title=None) -> Path
     plot_erp_spectrum(path, frequencies_hz (H,), level_db (H,), level_a_db=None, title=None) -> Path
+    plot_friction(path, friction_time (N, n), state (N, n), names=None, omega=None) -> Path
+    plot_third_octave(path, nominal_hz, level_dba, linear_level_dba=None, ...) -> Path
+    plot_contributions(path, names, level_dba, share_a) -> Path
+    write_report_html(path, summary, images={key: png}, notes=None) -> Path   (report.py, jinja2)
+    render_surface(path, points, triangles, values, label, ...) -> (Path, renderer)  (render.py)
 """
-from sarfe.io.outputs.plots import plot_contact_forces, plot_erp_spectrum, plot_erp_sweep
+from sarfe.io.outputs.plots import (
+    plot_contact_forces,
+    plot_contributions,
+    plot_erp_spectrum,
+    plot_erp_sweep,
+    plot_friction,
+    plot_third_octave,
+)
+from sarfe.io.outputs.report import write_report_html
 from sarfe.io.outputs.response_h5 import read_response_h5, write_response_h5
 from sarfe.io.outputs.summary import console_table, to_jsonable, write_summary_json
 from sarfe.io.outputs.vtk import (
@@ -41,5 +54,6 @@ __all__ = [
     "write_summary_json", "console_table", "to_jsonable", "write_response_h5", "read_response_h5",
     "write_erp_vtu", "erp_point_data", "contact_markers", "write_pvd", "write_erp_sweep",
     "write_deflection_animation", "period_samples", "plot_erp_sweep", "plot_contact_forces",
-    "plot_erp_spectrum",
+    "plot_erp_spectrum", "plot_friction", "plot_third_octave", "plot_contributions",
+    "write_report_html",
 ]

@@ -9,7 +9,29 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["to_jsonable", "write_summary_json", "console_table", "pruning_line", "NULL_NOTE"]
+__all__ = ["to_jsonable", "write_summary_json", "console_table", "pruning_line", "NULL_NOTE",
+           "SILENT_LEVEL_DB", "shown_level", "level_text", "loudest_lines"]
+
+# Levels below this are a motionless surface (round-off: a solve's 1e-19 m noise radiates
+# −180 dB re 1 pW): the console, table.txt and the report show them as "-"; the files keep the value.
+SILENT_LEVEL_DB = -100.0
+
+
+def shown_level(value):
+    """``value`` [dB] as a float for display, or None for no sound (None, NaN, −inf, or below
+    :data:`SILENT_LEVEL_DB`)."""
+    if value is None:
+        return None
+    value = float(value)
+    return value if math.isfinite(value) and value >= SILENT_LEVEL_DB else None
+
+
+def level_text(value, fmt: str = ".1f", unit: str = "") -> str:
+    """'93.1 dB(A)' style text of a level, '-' for no sound (:func:`shown_level`)."""
+    shown = shown_level(value)
+    if shown is None:
+        return "-"
+    return format(shown, fmt) + (f" {unit}" if unit else "")
 
 NULL_NOTE = ("null stands for a non-finite number (NaN, +inf or -inf), e.g. the dB level of zero "
              "power (-inf) or a quantity a contact does not have (NaN); see 'non_finite'")
@@ -151,3 +173,23 @@ def pruning_line(report: dict | None) -> str | None:
         groups.setdefault(c["decision"], []).append(c["name"])
     what = "; ".join(f"{', '.join(names)} {decision}" for decision, names in groups.items())
     return f"contacts: {len(linear)} of {len(report['contacts'])} solved linearly ({what})"
+
+
+def loudest_lines(worst: dict | None, count: int = 5) -> list[str]:
+    """Console lines of summary.json's ``worst``: the headline at the loudest (converged, not
+    unstable) point and the first ``count`` lines of its contact ranking."""
+    if not worst:
+        return []
+    if worst.get("index") is None:
+        return [f"loudest point: none ({worst.get('note', 'no converged, not unstable point')})"]
+    lines = [f"loudest point: {level_text(worst.get('erp_level_dba'), unit='dB(A)')} "
+             f"({level_text(worst.get('erp_level_db'), unit='dB re 1 pW')}) at "
+             f"{worst['frequency_hz']:.2f} Hz"]
+    lines += [f"  {line}" for line in (worst.get("ranking") or [])[:count]]
+    excitation = worst.get("excitation")
+    if excitation and worst.get("ranking"):
+        share = excitation.get("share_a")
+        share = "-" if share is None or not math.isfinite(share) else f"{100 * share:.0f} %"
+        lines.append(f"  (the excitation through the structure without contact forces: "
+                     f"{level_text(excitation.get('level_dba'), unit='dB(A)')}, {share})")
+    return lines

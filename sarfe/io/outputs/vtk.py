@@ -12,10 +12,21 @@ Standard ERP point arrays (:func:`erp_point_data`), n = number of mesh points:
     normal_displacement_amplitude_m (n,)   max_θ |w(θ) − w0| of the surface-normal displacement [m]
     displacement_amplitude_m        (n, 3) per component max_θ |u(θ) − u0| over one period [m]
                                            (zeros if the caller passes no nodal displacement)
+    erp_level_db_m2                 (n,)   10 log10(erp_density / 1 pW/m²) [dB re 1 pW/m²], floored
+                                           at the frame's maximum − 60 dB (non-radiating points and
+                                           silent ones sit on the floor), so ParaView's automatic
+                                           colour range shows the hot spots without tuning
     contact_marker                  (n,)   int: 0 = no contact, c+1 = node of contact c
                                            (ContactSet order; the last contact wins on shared nodes)
+    node_id                         (n,)   int: the deck's GRID / node id of each point (deck
+                                           models only)
+    contact_peak_force_N            (n,)   peak contact force magnitude over the period at both nodes
+                                           of each contact pair, 0 elsewhere (only when given)
+    contact_relative_displacement_m (n,)   max_θ |r(θ) − r0| of the pair's relative displacement
+                                           (normal and tangential rows), 0 elsewhere (only when given)
 
-Non-radiating points get 0 in the ERP arrays.
+Non-radiating points get 0 in the ERP arrays. The contact arrays make parts visible that rattle or
+rub without radiating (a clip behind the panel): colour by them, or threshold them.
 """
 from __future__ import annotations
 
@@ -27,7 +38,35 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 __all__ = ["write_erp_vtu", "write_pvd", "write_deflection_animation", "write_erp_sweep",
-           "erp_point_data", "contact_markers", "period_samples"]
+           "erp_point_data", "contact_markers", "period_samples", "contact_point_values",
+           "erp_level_db_m2", "DB_MAP_RANGE"]
+
+DB_MAP_RANGE = 60.0  # [dB] span of erp_level_db_m2 below its maximum
+
+
+def erp_level_db_m2(density_W_m2, reference_W_m2: float = 1e-12,
+                    span_db: float = DB_MAP_RANGE) -> np.ndarray:
+    """10 log10(e / e_ref) [dB re 1 pW/m²] of densities e [W/m²], floored at max − ``span_db``;
+    a frame with no radiating power at all gives zeros (the files hold no −∞)."""
+    e = np.asarray(density_W_m2, dtype=float)
+    with np.errstate(divide="ignore"):
+        level = 10.0 * np.log10(np.clip(e, 0.0, None) / reference_W_m2)
+    finite = level[np.isfinite(level)]
+    if finite.size == 0:
+        return np.zeros_like(e)
+    floor = finite.max() - span_db
+    return np.where(np.isfinite(level), np.maximum(level, floor), floor)
+
+
+def contact_point_values(n_points: int, nodes_a, nodes_b, values) -> np.ndarray:
+    """(n_points,) array holding ``values`` (n_p,) at both nodes of each contact pair (node b = −1
+    for ground is skipped); where pairs share a node the larger value wins; 0 elsewhere."""
+    out = np.zeros(int(n_points))
+    values = np.asarray(values, dtype=float)
+    for nodes in (np.asarray(nodes_a, dtype=int), np.asarray(nodes_b, dtype=int)):
+        keep = nodes >= 0
+        np.maximum.at(out, nodes[keep], np.nan_to_num(values[keep]))
+    return out
 
 
 def period_samples(harmonics, n_samples: int) -> np.ndarray:
@@ -129,7 +168,8 @@ def contact_markers(n_points: int, contact_nodes) -> np.ndarray:
 
 
 def erp_point_data(n_points: int, erp, normal_displacement, omega: float, displacement=None,
-                   radiating_nodes=None, contact_marker=None) -> dict:
+                   radiating_nodes=None, contact_marker=None, node_ids=None,
+                   contact_force=None, contact_displacement=None) -> dict:
     """The standard ERP arrays (module docstring) for :func:`write_erp_vtu`.
 
     n_points : number of mesh points n.
@@ -140,6 +180,8 @@ def erp_point_data(n_points: int, erp, normal_displacement, omega: float, displa
         ``displacement_amplitude_m`` is all zeros; ``normal_displacement_amplitude_m`` is always set).
     radiating_nodes : (n_r,) point indices of the radiating nodes (default: all n points).
     contact_marker : (n,) int, e.g. from :func:`contact_markers` (default zeros).
+    node_ids : (n,) int deck ids of the points, written as ``node_id`` (default: not written).
+    contact_force, contact_displacement : optional (n,) [N], [m] from :func:`contact_point_values`.
     """
     from sarfe.erp.erp import normal_velocity_amplitudes
 
@@ -152,6 +194,7 @@ def erp_point_data(n_points: int, erp, normal_displacement, omega: float, displa
     full = np.zeros(n)
     full[nodes] = erp.density_total
     data["erp_density_W_m2"] = full
+    data["erp_level_db_m2"] = erp_level_db_m2(full, float(getattr(erp, "reference_power", 1e-12)))
     for k in range(density.shape[0]):
         full = np.zeros(n)
         full[nodes] = density[k]
@@ -175,6 +218,12 @@ def erp_point_data(n_points: int, erp, normal_displacement, omega: float, displa
         data["displacement_amplitude_m"] = np.abs(samples).max(axis=0)
     data["contact_marker"] = (np.zeros(n, dtype=np.int32) if contact_marker is None
                               else np.asarray(contact_marker, dtype=np.int32))
+    if node_ids is not None:
+        data["node_id"] = np.asarray(node_ids, dtype=np.int64)
+    if contact_force is not None:
+        data["contact_peak_force_N"] = np.asarray(contact_force, dtype=float)
+    if contact_displacement is not None:
+        data["contact_relative_displacement_m"] = np.asarray(contact_displacement, dtype=float)
     return data
 
 

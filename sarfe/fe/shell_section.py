@@ -1,0 +1,155 @@
+"""The facet shell triangle of `sarfe.fe.shell` with a general shell section (A, B, D).
+
+Same kinematics as `sarfe.fe.shell` (Allman membrane + drilling penalty, DKT bending, 6
+DOF per node, element frame e1 along edge 1→2, e3 = normal); the section stiffness is given
+per element instead of (t, E, ν), so laminates (PCOMP via `sarfe.mesh.laminate`), orthotropic
+and anisotropic sections fit:
+    K = ∫ [B_m; B_b]ᵀ [[A, B], [B, D]] [B_m; B_b] dA
+with B_m the Allman membrane strain operator (ε⁰) and B_b the DKT curvature operator (κ);
+the membrane–bending block B couples in-plane and out-of-plane DOFs. A, B, D are given in
+the section's material axes (``material_axis``, a global vector in the element plane) and
+rotated into the element frame, Ā = T_εᵀ A T_ε. The drilling penalty uses the section's
+in-plane shear stiffness A66 for G t. Transverse shear flexibility is not modelled (DKT is a
+Kirchhoff element): a section's ``transverse_shear`` is not used.
+
+Mass: translations (m'' ∫ N_i N_j dA, m'' = mass per area [kg/m²]); rotary inertia
+I'' [kg] on the DKT rotation field; drilling I'' A/12 (1 + δ_ij), as in `sarfe.fe.shell`;
+for offset shells the first moment S'' couples in-plane translations (linear N) with the
+DKT rotations, M_uβ = S'' ∫ N_i β dA (degree-4 rule, exact).
+For an isotropic section (A = t Q, B = 0, D = t³/12 Q, m'' = ρ t, I'' = ρ t³/12) the matrices
+equal those of `sarfe.fe.shell.shell_element_matrices` to round-off.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .assembly import assemble_pair, element_dofs
+from sarfe.mesh.laminate import rotate_plane_stress
+from .shell import (_BENDING, _DEGREE4_RULE, _MEMBRANE, _MIDSIDE_RULE, BLOCK_SIZE,
+                    DRILLING_PENALTY, _allman_field, _dkt_rotation_field, _edge_geometry,
+                    _p2_gradients, _p2_values, _strain_operator, _to_global, _weighted_gram,
+                    local_frames)
+
+__all__ = ["section_shell_element_matrices", "section_shell_matrices"]
+
+
+def section_shell_element_matrices(points, triangles, membrane, coupling, bending,
+                                   material_axis, mass_per_area, rotary_inertia_per_area,
+                                   drilling_penalty=DRILLING_PENALTY, first_moment_per_area=None):
+    """Element K, M (n_el, 18, 18) in the global frame, DOFs [ux, uy, uz, rx, ry, rz] per node.
+
+    points (n, 3) [m]; triangles (n_el, 3); membrane A (n_el, 3, 3) [N/m], coupling B
+    (n_el, 3, 3) [N], bending D (n_el, 3, 3) [N·m] in the material axes, about the node plane;
+    material_axis (n_el, 3) global vector; mass_per_area m'' (n_el,) [kg/m²];
+    rotary_inertia_per_area I'' = ∫ρ z² dz about the node plane (n_el,) [kg];
+    first_moment_per_area S'' = ∫ρ z dz (n_el,) [kg/m] (offset shells; default 0): with
+    u(z) = u₀ + z β the kinetic energy is ½∫ m''|u̇₀|² + 2 S'' u̇₀·β̇ + I''|β̇|² dA.
+    """
+    triangles = np.asarray(triangles)
+    n_el = triangles.shape[0]
+    rotation, xy, area = local_frames(points, triangles)
+    axis_local = np.einsum("eij,ej->ei", rotation, np.asarray(material_axis, float))
+    angle = np.arctan2(axis_local[:, 1], axis_local[:, 0])
+    a_mat = np.asarray(membrane, float)
+    a_bar = rotate_plane_stress(a_mat, angle)
+    b_bar = rotate_plane_stress(np.asarray(coupling, float), angle)
+    d_bar = rotate_plane_stress(np.asarray(bending, float), angle)
+
+    nxt, prv = [1, 2, 0], [2, 0, 1]
+    grad_l = np.stack(
+        [xy[:, nxt, 1] - xy[:, prv, 1], xy[:, prv, 0] - xy[:, nxt, 0]], axis=2
+    ) / (2.0 * area)[:, None, None]
+    length, tangent, normal = _edge_geometry(xy)
+    points_q, weights_q = _MIDSIDE_RULE
+    strain = _strain_operator(_p2_gradients(points_q, grad_l))
+    w_area = weights_q[None, :] * area[:, None]
+
+    t_mem = _allman_field(length, normal)
+    b_mem = strain @ t_mem[:, None]  # (n_el, n_q, 3, 9)
+    t_rot = _dkt_rotation_field(length, tangent, normal)
+    b_bend = strain @ t_rot[:, None]
+    k_mem = _weighted_gram(b_mem, a_bar, w_area)
+    k_bend = _weighted_gram(b_bend, d_bar, w_area)
+    # Σ_q w_q B_m,qᵀ B̄ B_b,q as batched matmuls (a many-operand einsum is slow)
+    k_mb = None
+    if np.any(b_bar):
+        n_q = b_mem.shape[1]
+        coupled = (b_bar[:, None] @ b_bend) * w_area[:, :, None, None]
+        k_mb = (b_mem.reshape(n_el, 3 * n_q, 9).transpose(0, 2, 1)
+                @ coupled.reshape(n_el, 3 * n_q, 9))
+
+    # drilling penalty α (G t) A g gᵀ with G t = A66 of the section
+    centroid = np.full((1, 3), 1.0 / 3.0)
+    grad_c = _p2_gradients(centroid, grad_l)[:, 0]
+    spin = np.zeros((n_el, 6, 2))
+    spin[:, :, 0] = -0.5 * grad_c[..., 1]
+    spin[:, :, 1] = 0.5 * grad_c[..., 0]
+    g = -np.einsum("ea,eaj->ej", spin.reshape(n_el, 12), t_mem)
+    g[:, 2::3] += 1.0 / 3.0
+    k_mem += (drilling_penalty * a_mat[:, 2, 2] * area)[:, None, None] * g[:, :, None] * g[:, None, :]
+
+    stiffness = np.zeros((n_el, 18, 18))
+    stiffness[:, _MEMBRANE[:, None], _MEMBRANE] = k_mem
+    stiffness[:, _BENDING[:, None], _BENDING] = k_bend
+    if k_mb is not None:
+        stiffness[:, _MEMBRANE[:, None], _BENDING] = k_mb
+        stiffness[:, _BENDING[:, None], _MEMBRANE] = k_mb.transpose(0, 2, 1)
+
+    m_area = np.asarray(mass_per_area, float)
+    rotary = np.asarray(rotary_inertia_per_area, float)
+    linear = (np.ones((3, 3)) + np.eye(3)) / 12.0
+    mass = np.zeros((n_el, 3, 6, 3, 6))
+    m_trans = (m_area * area)[:, None, None] * linear
+    for c in range(3):
+        mass[:, :, c, :, c] = m_trans
+    mass[:, :, 5, :, 5] = (rotary * area)[:, None, None] * linear
+    mass = mass.reshape(n_el, 18, 18)
+    points_m, weights_m = _DEGREE4_RULE
+    values = _p2_values(points_m)
+    interp = np.zeros((len(weights_m), 2, 6, 2))
+    interp[:, 0, :, 0] = values
+    interp[:, 1, :, 1] = values
+    beta = np.einsum("qcn,enj->eqcj", interp.reshape(-1, 2, 12), t_rot)
+    m_rot = _weighted_gram(beta, np.eye(2)[None], np.broadcast_to(
+        weights_m * (rotary * area)[:, None], beta.shape[:2]))
+    mass[:, _BENDING[:, None], _BENDING] += m_rot
+    if first_moment_per_area is not None and np.any(first_moment_per_area):
+        # S'' ∫ L_i β_c dA: in-plane translation c of corner i against the DKT rotations
+        moment = np.asarray(first_moment_per_area, float)
+        weight = weights_m[None, :] * (moment * area)[:, None]  # (n_el, n_q)
+        coupling_mass = np.einsum("eq,qi,eqcj->eicj", weight, points_m, beta)
+        for i in range(3):
+            for c in range(2):
+                row = 6 * i + c
+                mass[:, row, _BENDING] += coupling_mass[:, i, c]
+                mass[:, _BENDING, row] += coupling_mass[:, i, c]
+
+    stiffness = _to_global(stiffness, rotation)
+    mass = _to_global(mass, rotation)
+    return (0.5 * (stiffness + stiffness.transpose(0, 2, 1)),
+            0.5 * (mass + mass.transpose(0, 2, 1)))
+
+
+def section_shell_matrices(points, triangles, membrane, coupling, bending, material_axis,
+                           mass_per_area, rotary_inertia_per_area,
+                           drilling_penalty=DRILLING_PENALTY, first_moment_per_area=None):
+    """Global K, M CSR (6n, 6n) of section shells; arguments as in
+    :func:`section_shell_element_matrices` (per-triangle arrays)."""
+    points = np.asarray(points, float)
+    triangles = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
+    n_el = triangles.shape[0]
+    if first_moment_per_area is None:
+        first_moment_per_area = np.zeros(n_el)
+    per_element = [np.asarray(v, float) for v in (membrane, coupling, bending, material_axis,
+                                                  mass_per_area, rotary_inertia_per_area)]
+    moment = np.asarray(first_moment_per_area, float)
+    combined = np.empty((n_el, 18, 18), dtype=complex)
+    for start in range(0, n_el, BLOCK_SIZE):
+        block = slice(start, start + BLOCK_SIZE)
+        k_e, m_e = section_shell_element_matrices(points, triangles[block],
+                                                  *[v[block] for v in per_element],
+                                                  drilling_penalty=drilling_penalty,
+                                                  first_moment_per_area=moment[block])
+        combined[block].real = k_e
+        combined[block].imag = m_e
+    return assemble_pair(combined, None, element_dofs(triangles), 6 * points.shape[0])

@@ -1,0 +1,245 @@
+r"""Everything ``sarfe solve`` checks before the heavy work, in one place, so that a case that
+passes ``sarfe validate`` does not fail on its input later.
+
+    check_case(case, output_dir=None, force=False, write=True) -> CaseCheck
+
+Errors (CaseError, exit 2, one line naming the key or the element):
+  * the case file itself (schema, non-finite numbers, signs, units: :func:`sarfe.io.case.load_case`);
+  * the mesh: readable, groups present, contacts pair (as :func:`sarfe.pipeline.linear.check_mesh`);
+  * element quality: zero-area triangles, duplicate triangles (same node set), coincident nodes
+    that neither an element nor a contact pair joins (a crack) — :mod:`sarfe.mesh.quality`;
+  * thickness plausibility: 1e-4·L < t < 0.1·L for the model size L (the bounding-box diagonal),
+    which catches a thickness given in mm;
+  * the structure is held: every connected part of the mesh holds at least one fixed node (else
+    the stiffness has rigid-body modes and the reduction cannot factorize it);
+  * the output folder: absent, empty or a sarfe result, and writable (:mod:`sarfe.io.result_folder`).
+
+Warnings (one line each, printed and written to summary.json ``warnings``) for inputs far outside
+the model's range:
+  * H·f_max above the highest frequency the mesh resolves: a bending wave of a plate,
+    λ = 2π / k with k⁴ = ω² ρ t / D and D = E t³ / (12 (1 − ν²)), needs about
+    :data:`ELEMENTS_PER_WAVELENGTH` element edges h, so f_mesh = (2π / (6 h))² √(D / (ρ t)) / 2π
+    (median over the triangles);
+  * H·f_max above ``reduction.cutoff_hz`` (the harmonics have no modes to live in);
+  * a gap larger than the structure (the contact can never close).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from sarfe.io.case import load_case
+
+ELEMENTS_PER_WAVELENGTH = 6
+COINCIDENT_TOLERANCE = 1e-7      # × model size: nodes closer than this are at the same place
+DEGENERATE_TOLERANCE = 1e-8      # area ≤ this × (longest edge)²: a zero-area triangle
+THICKNESS_RANGE = (1e-4, 0.1)    # thickness / model size
+
+
+@dataclass(frozen=True)
+class CaseCheck:
+    """What :func:`check_case` found: ``info`` for the validate line (nodes, triangles, contact
+    pairs), ``warnings`` (one-line strings), ``output`` (the checked result folder or None)."""
+
+    info: dict = field(default_factory=dict)
+    warnings: tuple = ()
+    output: object = None
+
+
+def _excitation_top_hz(case) -> float:
+    exc = case.data["excitation"]
+    if "sweep" in exc:
+        return max(exc["sweep"]["start_hz"], exc["sweep"]["end_hz"])
+    return max(exc["frequency_hz"])
+
+
+def _where(mesh, triangle) -> str:
+    x, y, z = mesh.points[mesh.triangles[triangle]].mean(axis=0)
+    return f"at ({x:.4g}, {y:.4g}, {z:.4g}) m"
+
+
+def check_element_quality(case, mesh, joined=()) -> None:
+    """Zero-area and duplicate triangles, unjoined coincident nodes → CaseError naming them."""
+    from sarfe.mesh.quality import coincident_nodes, degenerate_elements, duplicate_elements
+
+    where = ("model", "fe", "mesh") if "mesh" in case.data["model"]["fe"] else ("model", "fe",
+                                                                               "generator")
+    ids = np.arange(mesh.n_triangles)
+    bad = degenerate_elements(mesh.points, mesh.triangles, ids, DEGENERATE_TOLERANCE)
+    if bad:
+        first = bad[0]
+        raise case.error(f"{len(bad)} zero-area triangle(s): triangle {first} (nodes "
+                         f"{', '.join(map(str, mesh.triangles[first]))}) {_where(mesh, first)}"
+                         f"{'' if len(bad) == 1 else ', ' + ', '.join(map(str, bad[1:6]))}"
+                         f"{' …' if len(bad) > 6 else ''}", where)
+    twins = duplicate_elements(mesh.triangles, ids)
+    if twins:
+        kept, repeated = twins[0]
+        raise case.error(f"{len(twins)} duplicate triangle(s) (same nodes, counted twice): "
+                         f"triangle {repeated} repeats triangle {kept} (nodes "
+                         f"{', '.join(map(str, mesh.triangles[kept]))}) {_where(mesh, kept)}", where)
+    size = float(np.linalg.norm(np.ptp(mesh.points, axis=0)))
+    used = np.zeros(mesh.n_nodes, bool)
+    used[mesh.triangles.ravel()] = True
+    nodes = np.flatnonzero(used)
+    pairs = coincident_nodes(mesh.points[nodes], nodes, COINCIDENT_TOLERANCE * size,
+                             joined=[(np.searchsorted(nodes, a), np.searchsorted(nodes, b))
+                                     for a, b in joined if used[a] and b >= 0 and used[b]])
+    if pairs:
+        a, b = pairs[0]
+        x, y, z = mesh.points[a]
+        raise case.error(f"{len(pairs)} pair(s) of coincident nodes that no element or contact "
+                         f"joins (a crack): nodes {a} and {b} at ({x:.4g}, {y:.4g}, {z:.4g}) m; "
+                         "merge them or pair them in a contact", where)
+
+
+def check_thickness(case, mesh) -> None:
+    size = float(np.linalg.norm(np.ptp(mesh.points, axis=0)))
+    low, high = THICKNESS_RANGE
+    for name, t in case.data["model"]["fe"]["thickness_m"].items():
+        path = ("model", "fe", "thickness_m", name)
+        if t > high * size:
+            raise case.error(f"thickness {t:g} m is not small against the model size {size:.3g} m "
+                             "— given in mm? thickness_m is in metres", path)
+        if t < low * size:
+            raise case.error(f"thickness {t:g} m is implausibly thin for a model of {size:.3g} m "
+                             "— thickness_m is in metres (2.5 mm = 2.5e-3)", path)
+
+
+def check_held(case, mesh, fixed_nodes) -> None:
+    """Every connected part of the shell mesh holds a fixed node (no rigid-body motion left)."""
+    from sarfe.mesh import connected_components
+
+    count, labels = connected_components(mesh.n_nodes, mesh.triangles)
+    held = np.zeros(count, bool)
+    labels_fixed = labels[fixed_nodes]
+    held[labels_fixed[labels_fixed >= 0]] = True
+    if not held.all():
+        free = np.flatnonzero(~held)
+        part = free[0]
+        members = np.flatnonzero(labels == part)
+        x, y, z = mesh.points[members].mean(axis=0)
+        raise case.error(f"the structure is not held: {len(free)} of {count} connected part(s) "
+                         f"have no fixed node and can move as a rigid body (part of "
+                         f"{len(members)} nodes around ({x:.4g}, {y:.4g}, {z:.4g}) m, e.g. node "
+                         f"{members[0]}); add a fixed group on it", ("model", "fe", "fixed"))
+
+
+def bending_resolution_hz(points, triangles, thickness, young, poisson, density) -> np.ndarray:
+    """Per triangle, the frequency [Hz] whose plate bending wavelength spans
+    :data:`ELEMENTS_PER_WAVELENGTH` of its longest edge h:
+
+        k = 2π / (6 h),  f = k² √(D / (ρ t)) / 2π,  D = E t³ / (12 (1 − ν²))
+
+    points (n, 3) [m]; triangles (n_e, 3); thickness [m], young [Pa], poisson, density [kg/m³]
+    scalars or (n_e,) per triangle. Returns (n_e,)."""
+    corners = np.asarray(points, dtype=float)[np.asarray(triangles)]
+    h = np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=2).max(axis=1)
+    t = np.asarray(thickness, dtype=float)
+    bending = np.asarray(young, dtype=float) * t ** 3 / (12 * (1 - np.asarray(poisson) ** 2))
+    k = 2 * np.pi / (ELEMENTS_PER_WAVELENGTH * h)
+    return k ** 2 * np.sqrt(bending / (np.asarray(density, dtype=float) * t)) / (2 * np.pi)
+
+
+def mesh_frequency_limit_hz(case, mesh) -> float:
+    """Highest frequency [Hz] the case's mesh resolves: the median over its triangles of
+    :func:`bending_resolution_hz` with each triangle's material and thickness."""
+    from sarfe.pipeline.linear import _per_triangle
+
+    fe = case.data["model"]["fe"]
+    materials, thickness = list(fe["materials"].values()), list(fe["thickness_m"].values())
+    m = _per_triangle(case, mesh, fe["materials"], "materials")
+    t = np.asarray(thickness, dtype=float)[_per_triangle(case, mesh, fe["thickness_m"],
+                                                          "thickness_m")]
+    E, nu, rho = (np.array([mat[k] for mat in materials])[m] for k in ("E_Pa", "nu", "rho_kg_m3"))
+    return float(np.median(bending_resolution_hz(mesh.points, mesh.triangles, t, E, nu, rho)))
+
+
+def range_warnings(case, mesh=None) -> list:
+    """One-line warnings for inputs far outside the model's range (module docstring)."""
+    warnings = []
+    top = _excitation_top_hz(case)
+    H = case.data["solver"]["harmonics"]
+    if mesh is not None:
+        limit = mesh_frequency_limit_hz(case, mesh)
+        if H * top > limit:
+            warnings.append(f"excitation {top:g} Hz × {H} harmonics = {H * top:.4g} Hz is above the "
+                            f"~{limit:.4g} Hz the mesh resolves ({ELEMENTS_PER_WAVELENGTH} elements "
+                            "per bending wavelength): refine the mesh or lower the harmonics")
+        size = float(np.linalg.norm(np.ptp(mesh.points, axis=0)))
+        for i, contact in enumerate(case.data["contacts"]):
+            gap = contact.get("gap_m")
+            if gap is not None and abs(gap) > size:
+                warnings.append(f"contacts[{i}] ({contact['name']}): gap_m = {gap:g} m is larger "
+                                f"than the structure ({size:.3g} m): the contact can never close")
+    cutoff = case.data.get("reduction", {}).get("cutoff_hz")
+    if cutoff is not None and H * top > cutoff:
+        warnings.append(f"excitation {top:g} Hz × {H} harmonics = {H * top:.4g} Hz is above "
+                        f"reduction.cutoff_hz = {cutoff:g} Hz: the higher harmonics have no modes")
+    return warnings
+
+
+def reduced_model_warnings(case, stage) -> list:
+    """Warnings that need the reduced model: H·f_max above its highest fixed-interface mode."""
+    modes = np.asarray(stage.mode_frequencies_hz)
+    if stage.kind != "fe" or not modes.size or "mode_count" not in case.data.get("reduction", {}):
+        return []
+    top, H = _excitation_top_hz(case), case.data["solver"]["harmonics"]
+    if H * top > modes.max():
+        return [f"excitation {top:g} Hz × {H} harmonics = {H * top:.4g} Hz is above the highest "
+                f"kept mode ({modes.max():.4g} Hz, reduction.mode_count = {modes.size})"]
+    return []
+
+
+def output_target(case, output_dir=None, force=False):
+    """The checked result folder of a case (``output_dir`` or ``output.directory``): absent, empty
+    or a previous sarfe result (or anything but the current/case folder with ``force``), and
+    writable — else CaseError, before any work (rules: :mod:`sarfe.io.result_folder`)."""
+    from sarfe.io.result_folder import check_output_folder
+
+    target = output_dir if output_dir is not None else case.data["output"]["directory"]
+    return check_output_folder(target, force=force, protected=[case.source])
+
+
+def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True) -> CaseCheck:
+    """All checks of the module docstring. Raises CaseError at the first problem."""
+    from sarfe.erp import nodal_normals
+    from sarfe.pipeline.linear import (_build_matrices, _per_triangle, load_case_mesh,
+                                       pair_contact, resolve_node_group)
+
+    case = load_case(case)
+    output = output_target(case, output_dir, force) if write else None
+    if not mesh_checks:
+        return CaseCheck({}, tuple(range_warnings(case)), output)
+    if not case.is_fe:
+        _build_matrices(case)
+        return CaseCheck({}, tuple(range_warnings(case)), output)
+    if "deck" in case.data["model"]["fe"]:   # a Nastran/Abaqus deck: its own checks, with ids
+        from sarfe.pipeline.deck import check_deck
+        return CaseCheck(check_deck(case), tuple(range_warnings(case)), output)
+    mesh = load_case_mesh(case)
+    fe = case.data["model"]["fe"]
+    fixed = np.unique(np.concatenate([
+        resolve_node_group(case, mesh, g, ("model", "fe", "fixed", i), allow_elements=False)
+        for i, g in enumerate(fe["fixed"])]))
+    _per_triangle(case, mesh, fe["materials"], "materials")
+    _per_triangle(case, mesh, fe["thickness_m"], "thickness_m")
+    check_thickness(case, mesh)
+    normals = nodal_normals(mesh.points, mesh.triangles)
+    paired = {c["name"]: pair_contact(case, mesh, i, normals)
+              for i, c in enumerate(case.data["contacts"])}
+    for i, f in enumerate(case.data["excitation"].get("forces", [])):
+        resolve_node_group(case, mesh, f["group"], ("excitation", "forces", i, "group"))
+    if "surface" in case.data["erp"] and case.data["erp"]["surface"] not in mesh.element_groups:
+        resolve_node_group(case, mesh, case.data["erp"]["surface"], ("erp", "surface"))
+    joined = [(int(a), int(b)) for p in paired.values() for a, b in zip(p[0], p[1])]
+    check_element_quality(case, mesh, joined)
+    check_held(case, mesh, fixed)
+    info = {"nodes": mesh.n_nodes, "triangles": mesh.n_triangles,
+            "contact_pairs": {name: len(p[0]) for name, p in paired.items()}}
+    return CaseCheck(info, tuple(range_warnings(case, mesh)), output)
+
+
+__all__ = ["CaseCheck", "check_case", "output_target", "check_element_quality", "check_held", "check_thickness",
+           "bending_resolution_hz", "mesh_frequency_limit_hz", "range_warnings", "reduced_model_warnings"]

@@ -1,0 +1,85 @@
+"""Layers point one way: a lower layer of sarfe never imports a higher one (issue 12).
+
+Order: mesh < fe < reduction < hbm < erp (risk) < io, accuracy < pipeline < study, batch, cli. Every module's
+imports — module level and inside functions — are read with ``ast`` (relative imports resolved).
+"""
+import ast
+from pathlib import Path
+
+import pytest
+
+PACKAGE = Path(__file__).resolve().parents[1] / "sarfe"
+LAYERS = {"mesh": 0, "fe": 1, "reduction": 2, "hbm": 3, "erp": 4, "risk": 4, "io": 5,
+          "accuracy": 5, "pipeline": 6, "study": 7, "batch": 7, "cli": 7, "__main__": 7}
+KNOWN_CYCLE = ("pipeline", "study")    # moved below pipeline by issue 12's layer move
+# fe.modes factorizes K − σM with sarfe.reduction.linear_solvers (found by this test; the solver
+# chooser belongs below fe — outside the laws work's files, reported to the coordinator)
+KNOWN_SOLVER = ("fe", "reduction")
+KNOWN = (KNOWN_CYCLE, KNOWN_SOLVER)
+
+
+def _imports(path):
+    """Top-level sarfe parts (``hbm``, ``io`` …) imported by the module at ``path``."""
+    parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
+    package = parts[:-1] if path.name != "__init__.py" else parts[:-1]
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            names = [alias.name for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package[:len(package) - node.level + 1]
+                module = ".".join(base + ((node.module,) if node.module else ()))
+                names = [module] if node.module else [f"{module}.{a.name}" for a in node.names]
+            else:
+                names = [node.module] if node.module != "sarfe" else \
+                    [f"sarfe.{a.name}" for a in node.names]
+        else:
+            continue
+        for name in names:
+            bits = name.split(".")
+            if bits[0] == "sarfe" and len(bits) > 1:
+                found.add(bits[1])
+    return found
+
+
+def _violations():
+    out = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        parts = path.relative_to(PACKAGE).with_suffix("").parts
+        source = parts[0]
+        if source not in LAYERS:
+            continue
+        for target in _imports(path):
+            if target in LAYERS and LAYERS[target] > LAYERS[source]:
+                out.append((source, target, str(path.relative_to(PACKAGE.parent))))
+    return out
+
+
+def test_every_part_has_a_layer():
+    parts = {p.relative_to(PACKAGE).with_suffix("").parts[0] for p in PACKAGE.rglob("*.py")}
+    assert parts - {"__init__"} <= set(LAYERS), parts - set(LAYERS)
+
+
+def test_import_reader_sees_relative_and_local_imports(tmp_path):
+    assert "laws" not in LAYERS and "hbm" in _imports(PACKAGE / "pipeline" / "nonlinear.py")
+    assert _imports(PACKAGE / "hbm" / "aft.py") == {"hbm"}
+
+
+def test_no_upward_imports():
+    bad = [v for v in _violations() if v[:2] not in KNOWN]
+    assert not bad, "\n".join(f"{s} imports {t}: {f}" for s, t, f in bad)
+
+
+@pytest.mark.xfail(strict=True, reason="sarfe/fe/modes.py imports sarfe.reduction.linear_solvers "
+                   "(the sparse factorization chooser should live in fe or below)")
+def test_fe_does_not_import_reduction():
+    bad = [v for v in _violations() if v[:2] == KNOWN_SOLVER]
+    assert not bad, "\n".join(f"{s} imports {t}: {f}" for s, t, f in bad)
+
+
+@pytest.mark.xfail(strict=True, reason="sarfe/pipeline imports sarfe/study (screening, pruning, "
+                   "estimates, resolve): issue 12's layer move puts them below pipeline")
+def test_pipeline_does_not_import_study():
+    bad = [v for v in _violations() if v[:2] == KNOWN_CYCLE]
+    assert not bad, "\n".join(f"{s} imports {t}: {f}" for s, t, f in bad)
