@@ -192,7 +192,8 @@ def error_estimates(case, stage, nl, solutions, stride=ESTIMATE_STRIDE) -> list:
 
     chosen = set(eligible[::stride]) | {eligible[0], eligible[-1], max(eligible, key=amplitude)}
     computed = {i: _error_estimate(case, stage, nl, solutions[i]) for i in sorted(chosen)}
-    usable = [i for i in sorted(computed) if computed[i] is not None and "failed" not in computed[i]]
+    usable = [i for i in sorted(computed) if computed[i] is not None and "failed" not in computed[i]
+              and np.isfinite(computed[i]["amplitude_rel"])]    # (unknown: that point alone)
     out = []
     for i, s in enumerate(solutions):
         if i in computed or not s.converged or not usable:
