@@ -6,16 +6,9 @@ imports — module level and inside functions — are read with ``ast`` (relativ
 import ast
 from pathlib import Path
 
-import pytest
-
 PACKAGE = Path(__file__).resolve().parents[1] / "sarfe"
 LAYERS = {"mesh": 0, "fe": 1, "reduction": 2, "hbm": 3, "erp": 4, "risk": 4, "io": 5,
           "accuracy": 5, "pipeline": 6, "study": 7, "batch": 7, "cli": 7, "__main__": 7}
-KNOWN_CYCLE = ("pipeline", "study")    # moved below pipeline by issue 12's layer move
-# fe.modes factorizes K − σM with sarfe.reduction.linear_solvers (found by this test; the solver
-# chooser belongs below fe — outside the laws work's files, reported to the coordinator)
-KNOWN_SOLVER = ("fe", "reduction")
-KNOWN = (KNOWN_CYCLE, KNOWN_SOLVER)
 
 
 def _imports(path):
@@ -67,19 +60,17 @@ def test_import_reader_sees_relative_and_local_imports(tmp_path):
 
 
 def test_no_upward_imports():
-    bad = [v for v in _violations() if v[:2] not in KNOWN]
+    bad = _violations()
     assert not bad, "\n".join(f"{s} imports {t}: {f}" for s, t, f in bad)
 
 
-@pytest.mark.xfail(strict=True, reason="sarfe/fe/modes.py imports sarfe.reduction.linear_solvers "
-                   "(the sparse factorization chooser should live in fe or below)")
 def test_fe_does_not_import_reduction():
-    bad = [v for v in _violations() if v[:2] == KNOWN_SOLVER]
+    """fe's modal analysis factorizes K − σM with sarfe.fe.linear_solvers (moved below fe)."""
+    bad = [v for v in _violations() if v[:2] == ("fe", "reduction")]
     assert not bad, "\n".join(f"{s} imports {t}: {f}" for s, t, f in bad)
 
 
-@pytest.mark.xfail(strict=True, reason="sarfe/pipeline imports sarfe/study (screening, pruning, "
-                   "estimates, resolve): issue 12's layer move puts them below pipeline")
 def test_pipeline_does_not_import_study():
-    bad = [v for v in _violations() if v[:2] == KNOWN_CYCLE]
+    """Screening/pruning live in sarfe.hbm.pruning, estimates and resolution in sarfe.accuracy."""
+    bad = [v for v in _violations() if v[:2] == ("pipeline", "study")]
     assert not bad, "\n".join(f"{s} imports {t}: {f}" for s, t, f in bad)

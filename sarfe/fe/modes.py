@@ -28,7 +28,7 @@ def natural_frequencies(stiffness, mass, count=6, fixed=None, shift_hz=1.0, retu
     k = sp.csr_matrix(stiffness)[free][:, free]
     m = sp.csr_matrix(mass)[free][:, free]
     sigma = -(2.0 * np.pi * shift_hz) ** 2
-    from sarfe.reduction.linear_solvers import factorize  # K − σM with σ < 0 is SPD
+    from .linear_solvers import factorize  # K − σM with σ < 0 is SPD
 
     operator = factorize(k - sigma * m, structure="spd").as_operator()
     eigenvalues, vectors = sla.eigsh(k.tocsc(), count, m.tocsc(), sigma=sigma, which="LM",

@@ -65,7 +65,7 @@ class ContactSet:
         return {name: values[index] for name, values in self.parameters.items()}
 
     def subset(self, index, gap_map, normal_row, tangent_rows):
-        """The contacts ``index`` on re-numbered rows (see :func:`sarfe.study.scene.subset_contacts`)."""
+        """The contacts ``index`` on re-numbered rows (see :func:`sarfe.hbm.pruning.subset_contacts`)."""
         idx = np.asarray(index, dtype=int)
         names = tuple(self.names[i] for i in idx) if self.names else None
         return make_contact_set(gap_map, np.asarray(self.kind, dtype=object)[idx], normal_row,

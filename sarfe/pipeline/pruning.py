@@ -1,5 +1,5 @@
 r"""Contact pruning in ``sarfe solve``: contacts that never switch over the case's frequencies are
-solved linearly (``solver.prune_contacts``, default true; the library is :mod:`sarfe.study.scene`).
+solved linearly (``solver.prune_contacts``, default true; the library is :mod:`sarfe.hbm.pruning`).
 
 1. Screen (one linear pass per ω): every contact pair of the ContactSet linearized at u = 0 over
    the listed frequencies, or over a sweep's band sampled on a grid plus the natural frequencies
@@ -44,12 +44,12 @@ def pruning_options(case) -> tuple:
 
 def linearized_natural_frequencies(model, contacts) -> np.ndarray:
     r"""ω_n [rad/s] of K_lin φ = ω² M φ, K_lin = K + Gᵀ diag(k) G the stiffness the screening pass
-    solves with (:func:`sarfe.study.scene.linearized_stiffness`: closed pairs as springs k_n,
+    solves with (:func:`sarfe.hbm.pruning.linearized_stiffness`: closed pairs as springs k_n,
     friction tangents stuck, open pairs absent). Empty if M is singular (massless DOFs) or the model
     has more than MAX_DENSE_EIGEN DOFs (then the grid alone)."""
     import scipy.linalg
 
-    from sarfe.study.scene import linearized_stiffness
+    from sarfe.hbm.pruning import linearized_stiffness
 
     if model.dof_count > MAX_DENSE_EIGEN:
         return np.zeros(0)
@@ -84,7 +84,7 @@ def contact_report(decisions, groups) -> list:
     """One entry per named contact: its decision (``nonlinear`` if any of its node pairs is kept,
     else ``open`` / ``closed`` / ``open+closed``), pair counts per decision, the smallest clearance
     and the reason of the deciding pair."""
-    from sarfe.study.scene import CLOSED, NONLINEAR, OPEN
+    from sarfe.hbm.pruning import CLOSED, NONLINEAR, OPEN
 
     report = []
     for name, kind, index in groups:
@@ -116,7 +116,7 @@ def _check_samples(N):
 def check_solutions(case, nl: NonlinearModel, decisions, solutions) -> tuple:
     """(violations, unsolved): the decisions every converged pruned solution breaks, as
     {contact, frequency_hz, what}, and the indices of the points that did not converge."""
-    from sarfe.study.scene import check_pruning
+    from sarfe.hbm.pruning import check_pruning
 
     samples = _check_samples(case.data["solver"]["samples_per_period"])
     violations, unsolved = [], []
@@ -134,7 +134,7 @@ def restore_solutions(case, nl: NonlinearModel, decisions, solutions, unsolved, 
     """Pruned solutions re-expressed with the full contact set; a point that did not converge on
     the pruned model is solved again at its ω with all contacts (from the pruned state)."""
     from sarfe.pipeline.points import solve_point, solver_options
-    from sarfe.study.scene import restore_solution
+    from sarfe.hbm.pruning import restore_solution
 
     restored = []
     for index, solution in enumerate(solutions):
@@ -157,7 +157,7 @@ def solve_points_pruned(case, nl: NonlinearModel, progress=False) -> tuple:
     and restored to the full contact set (module docstring), or on the full model when pruning is
     off, removes nothing, or a decision fails. ``report`` is summary.json's ``contact_pruning``."""
     from sarfe.pipeline.points import solve_points
-    from sarfe.study.scene import NONLINEAR, prune_contacts, screen_contacts
+    from sarfe.hbm.pruning import NONLINEAR, prune_contacts, screen_contacts
 
     enabled, margin = pruning_options(case)
     report = {"enabled": enabled, "applied": False, "fallback": False, "margin": margin,

@@ -11,7 +11,7 @@ the transformation u = T q, T = [[I, 0], [Ψ, Φ]], gives K_r = Tᵀ K T and M_r
     K_r = [[K_bb + K_bi Ψ, 0], [0, Ω²]]
     M_r = [[M_bb + M_bi Ψ + Ψᵀ M_ib + Ψᵀ M_ii Ψ, (M_bi + Ψᵀ M_ii) Φ], [sym, I]]
 
-K_ii is factorized once (``sarfe.reduction.linear_solvers.factorize``) and that factor serves Ψ
+K_ii is factorized once (``sarfe.fe.linear_solvers.factorize``) and that factor serves Ψ
 (one block solve with n_b right-hand sides) and the shift-invert Lanczos iteration for Φ: by
 default a block Lanczos on K_ii⁻¹ M_ii whose steps are multi-RHS solves; alternatively
 ``scipy.sparse.linalg.eigsh`` with sigma = 0 and OPinv = K_ii⁻¹, where for a cutoff frequency the
@@ -45,7 +45,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .linear_solvers import factorize
+from sarfe.fe.linear_solvers import factorize
 
 _MODE_BLOCK = 24  # fixed-interface modes requested per Lanczos run when searching up to a cutoff
 
