@@ -278,7 +278,7 @@ def solve_setting(case):
 
     stage = build_linear_model(case)
     nl = nonlinear_model(case, stage)
-    return stage, nl, solve_points(case, nl)
+    return stage, nl, solve_points(case.config.solver, case.config.excitation, nl)
 
 
 def raise_harmonics(nl, solution, harmonics, samples_per_period):

@@ -82,7 +82,7 @@ def hbm_cpu(case, stage, prune, repeats):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             start = time.process_time()
-            solve_points_pruned(case, nl)
+            solve_points_pruned(case.config.solver, case.config.excitation, nl)
             best = min(best, time.process_time() - start)
     return best
 

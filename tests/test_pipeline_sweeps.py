@@ -101,14 +101,14 @@ def test_sweep_status_exit_code_rule():
     stop = "converged; sweep stopped: step below min_step 1e-06 near ω = 400"
     covered = ([point(f) for f in (30, 35, 40)] + [point(45, stop)]
                + [point(f, fallback) for f in np.linspace(45, 90, 10)])
-    status = sweep_status(case, covered)
+    status = sweep_status(case.config.excitation, case.config.solver.continuation, covered)
     assert status["complete"] is False and status["covered"] is True
     assert "45.00 Hz" in status["reason"] and "10 point(s)" in status["reason"]
     holed = covered[:4] + [point(f, fallback, converged=f < 60) for f in np.linspace(45, 90, 10)]
-    status = sweep_status(case, holed)
+    status = sweep_status(case.config.excitation, case.config.solver.continuation, holed)
     assert status["complete"] is False and status["covered"] is False
     assert "exit code 3" in status["reason"]
-    assert sweep_status(case, [point(f) for f in np.linspace(30, 90, 20)])["complete"] is True
+    assert sweep_status(case.config.excitation, case.config.solver.continuation, [point(f) for f in np.linspace(30, 90, 20)])["complete"] is True
 
 
 @pytest.mark.timeout(300)

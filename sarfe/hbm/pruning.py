@@ -360,7 +360,7 @@ def _linear_solution(U, omega, harmonics, samples_per_period):
                             contact_force_time=np.zeros((samples_per_period, 0)),
                             contact_state=np.zeros((samples_per_period, 0), np.int8),
                             converged=True, reason="linear (no nonlinear contact left)",
-                            iterations=0, residual_norm=0.0)
+                            iterations=0, residual_norm=0.0, method="linear")
 
 
 __all__ = ["OPEN", "CLOSED", "NONLINEAR", "ContactDecision", "PrunedProblem", "screen_contacts",

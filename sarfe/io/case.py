@@ -12,11 +12,14 @@ import difflib
 import math
 import re
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 
 import jsonschema
 import yaml
 
+from sarfe.io.config import (DEFAULT_ACCURACY, DEFAULT_ZETA, ContinuationConfig, ErpConfig,
+                              ReductionConfig, SolverConfig, default_samples_per_period)
 from sarfe.io.errors import CaseError, format_key_path
 from sarfe.io.schema import CASE_SCHEMA
 
@@ -25,7 +28,6 @@ MESH_SUFFIXES = (".msh", ".bdf", ".nas", ".dat", ".inp")
 DECK_SUFFIXES = (".bdf", ".nas", ".dat", ".fem", ".inp")
 DECK_KEYS = ("units", "ignore_cards", "supports", "node_groups", "element_groups")
 MATRIX_SUFFIXES = (".npz", ".npy", ".mtx")
-DEFAULT_ZETA = 0.02
 
 
 @dataclass(frozen=True)
@@ -41,6 +43,14 @@ class Case:
     source: str | None = None
     base_dir: Path = Path(".")
     lines: dict = field(default_factory=dict, compare=False, repr=False)
+
+    @cached_property
+    def config(self):
+        """The typed configuration (:class:`sarfe.io.config.CaseConfig`), built once from the
+        normalized ``data``."""
+        from sarfe.io.config import build_config
+
+        return build_config(self.data)
 
     @property
     def is_fe(self) -> bool:
@@ -528,23 +538,18 @@ def _normalize_solver(case, data):
     # (default 'balanced'), starting its screening from H = 5; given harmonics are used as they are
     solver.setdefault("resolution", "fixed" if "harmonics" in solver else "auto")
     if solver["resolution"] == "auto":
-        solver.setdefault("accuracy", "balanced")
-    H = solver.setdefault("harmonics", 5)
-    N = solver.setdefault("samples_per_period", max(64, 2 ** math.ceil(math.log2(16 * H))))
+        solver.setdefault("accuracy", DEFAULT_ACCURACY)
+    H = solver.setdefault("harmonics", SolverConfig.harmonics)
+    N = solver.setdefault("samples_per_period", default_samples_per_period(H))
     if N < 2 * H + 1:
         raise case.error(f"must be >= 2H+1 = {2 * H + 1} for harmonics H = {H}, got {N}",
                          ("solver", "samples_per_period"))
-    solver.setdefault("tolerance", 1e-9)
-    solver.setdefault("max_iterations", 50)
-    solver.setdefault("stability", True)
-    solver.setdefault("error_estimate", True)
-    solver.setdefault("harmonic_set", "all")
-    solver.setdefault("prune_contacts", True)
+    for key in ("tolerance", "max_iterations", "stability", "error_estimate", "harmonic_set",
+                "prune_contacts"):          # defaults: sarfe.io.config.SolverConfig
+        solver.setdefault(key, getattr(SolverConfig, key))
     cont = solver.setdefault("continuation", {})
-    cont.setdefault("initial_step", 0.02)
-    cont.setdefault("min_step", 1e-6)
-    cont.setdefault("max_step", 0.1)
-    cont.setdefault("max_points", 2000)
+    for key in ("initial_step", "min_step", "max_step", "max_points"):
+        cont.setdefault(key, getattr(ContinuationConfig, key))
     if cont["min_step"] > cont["max_step"]:
         raise case.error("must be <= max_step", ("solver", "continuation", "min_step"))
     if not cont["min_step"] <= cont["initial_step"] <= cont["max_step"]:
@@ -557,9 +562,8 @@ def _normalize_reduction(case, data):
         return
     red = data.setdefault("reduction", {})
     _only_one(case, red, ("reduction",), ("mode_count", "cutoff_hz"), required=False)
-    red.setdefault("cutoff_margin", 1.5)
-    red.setdefault("min_mode_count", 10)
-    red.setdefault("residual_vectors", True)
+    for key in ("cutoff_margin", "min_mode_count", "residual_vectors"):
+        red.setdefault(key, getattr(ReductionConfig, key))   # defaults: sarfe.io.config
 
 
 def _normalize_erp(case, data):
@@ -574,10 +578,8 @@ def _normalize_erp(case, data):
         if "dofs" in erp and len(erp["dofs"]) != len(erp["areas_m2"]):
             raise case.error(f"needs one area per DOF in erp.dofs ({len(erp['dofs'])}), got "
                              f"{len(erp['areas_m2'])}", p + ("areas_m2",))
-    erp.setdefault("rho_kg_m3", 1.204)
-    erp.setdefault("c_m_s", 343.2)
-    erp.setdefault("radiation_loss_factor", 1.0)
-    erp.setdefault("reference_power_W", 1e-12)
+    for key in ("rho_kg_m3", "c_m_s", "radiation_loss_factor", "reference_power_W"):
+        erp.setdefault(key, getattr(ErpConfig, key))          # defaults: sarfe.io.config
 
 
 def _normalize_output(case, data):

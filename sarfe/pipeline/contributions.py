@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
+from sarfe.io.config import ErpConfig
 
 EXCITATION = "excitation"
 
@@ -55,7 +56,7 @@ def _radiating(erp_map, U):
     return np.asarray(W).reshape(shape[:-1] + (W.shape[-1],))
 
 
-def point_contributions(case, stage, nl, solution):
+def point_contributions(erp: ErpConfig, stage, nl, solution):
     """:class:`sarfe.erp.contributions.ErpContributions` of one solution (sources: the excitation
     then the named contacts), or (None, reason) when it cannot be computed (no contacts, no
     radiating surface, a singular Z_k)."""
@@ -82,19 +83,18 @@ def point_contributions(case, stage, nl, solution):
     W = _radiating(stage.erp_map, parts)                                          # (S, H, n_s)
     velocity = np.moveaxis(normal_velocity(np.moveaxis(W, 1, 0), omega), 0, 1)   # (S, H, n_s)
     total = normal_velocity(_radiating(stage.erp_map, to_complex(U)[1:]), omega)
-    erp = case.data["erp"]
     names = [EXCITATION] + [name for name, _, _ in nl.groups]
     return erp_contributions(names, velocity, stage.erp_areas, omega, total_velocity=total,
-                             density=erp["rho_kg_m3"], sound_speed=erp["c_m_s"],
-                             radiation_loss_factor=erp["radiation_loss_factor"],
-                             reference_power=erp["reference_power_W"]), None
+                             density=erp.rho_kg_m3, sound_speed=erp.c_m_s,
+                             radiation_loss_factor=erp.radiation_loss_factor,
+                             reference_power=erp.reference_power_W), None
 
 
-def contributions_record(case, stage, nl, solution) -> dict:
+def contributions_record(erp: ErpConfig, stage, nl, solution) -> dict:
     """summary.json record of :func:`point_contributions` (``available`` false with a reason when
     it was not computed; a failure is reported, never raised)."""
     try:
-        result, reason = point_contributions(case, stage, nl, solution)
+        result, reason = point_contributions(erp, stage, nl, solution)
     except Exception as error:  # a diagnostic must not break a solve
         result, reason = None, f"{type(error).__name__}: {error}"
     if result is None:

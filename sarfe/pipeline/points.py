@@ -6,44 +6,49 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from types import SimpleNamespace
 
 import numpy as np
 
+from sarfe.io.config import ContinuationConfig, ExcitationConfig, SolverConfig
 from sarfe.pipeline.linear import _bar
 from sarfe.pipeline.nonlinear import NonlinearModel
 
 
-def solver_options(case):
-    """(SolverOptions, ContinuationOptions) from the case's ``solver`` section. The tolerance of
+def solver_options(solver: SolverConfig):
+    """(SolverOptions, ContinuationOptions) from the ``solver`` section (:class:`SolverConfig`; a
+    Case is also taken, for callers that hold only the case). The tolerance of
     ``harmonic_set: auto`` is the amplitude budget of ``solver.accuracy`` (default 'balanced')."""
     from sarfe.hbm import ContinuationOptions, SolverOptions
     from sarfe.accuracy.estimates import parse_accuracy
 
-    solver = case.data["solver"]
-    options = SolverOptions(tolerance=solver["tolerance"], max_iterations=solver["max_iterations"],
-                            stability=solver["stability"],
-                            harmonic_set=solver.get("harmonic_set", "all"),
+    if not isinstance(solver, SolverConfig):
+        solver = solver.config.solver
+    options = SolverOptions(tolerance=solver.tolerance, max_iterations=solver.max_iterations,
+                            stability=solver.stability, harmonic_set=solver.harmonic_set,
                             harmonic_set_tolerance=parse_accuracy(
-                                solver.get("accuracy", "balanced")).amplitude_budget())
-    cont = solver["continuation"]
-    return options, ContinuationOptions(initial_step=cont["initial_step"], min_step=cont["min_step"],
-                                        max_step=cont["max_step"], max_points=cont["max_points"],
+                                solver.accuracy_or_default).amplitude_budget())
+    cont = solver.continuation
+    return options, ContinuationOptions(initial_step=cont.initial_step, min_step=cont.min_step,
+                                        max_step=cont.max_step, max_points=cont.max_points,
                                         solver=options)
+
+
+TIME_INTEGRATION = "time integration"     # HarmonicSolution.method of a time-integration stand-in
 
 
 def time_integration_point(model, contacts, excitation, omega, harmonics, samples_per_period,
                            initial=None, max_periods=400):
-    """A HarmonicSolution look-alike from time integration: the start guess of a retry
+    """A HarmonicSolution (``method='time integration'``) from time integration: the start guess of a retry
     (``max_periods`` small, the state need not be steady) or the stand-in for a point whose
     engine call raised."""
     from sarfe.hbm.harmonics import harmonic_coefficients
+    from sarfe.hbm.solution import HarmonicSolution
     from sarfe.hbm.time_integration import integrate_time
 
     steps = max(int(samples_per_period), 256)
     response = integrate_time(model, contacts, excitation, omega, harmonics,
                               steps_per_period=steps, max_periods=max_periods, initial=initial)
-    return SimpleNamespace(
+    return HarmonicSolution(
         omega=float(omega), harmonics=int(harmonics), samples_per_period=steps,
         displacement=response.displacement_harmonics,
         contact_displacement=harmonic_coefficients(response.contact_displacement, harmonics),
@@ -54,7 +59,7 @@ def time_integration_point(model, contacts, excitation, omega, harmonics, sample
         reason="time integration reached a periodic state" if response.steady
         else "time integration did not reach a periodic state",
         iterations=int(response.periods), residual_norm=float(response.periodicity_error),
-        friction_passes=0, stable=None, floquet_exponent=float("nan"))
+        friction_passes=0, stable=None, floquet_exponent=float("nan"), method=TIME_INTEGRATION)
 
 
 def linear_solution(nl: NonlinearModel, omega, H, N):
@@ -69,7 +74,7 @@ def linear_solution(nl: NonlinearModel, omega, H, N):
         contact_displacement=np.zeros((2 * H + 1, rows)), contact_force=np.zeros((2 * H + 1, rows)),
         contact_force_time=np.zeros((N, rows)), contact_state=np.zeros((N, count), dtype=np.int8),
         converged=True, reason="linear model (no contacts): exact solution", iterations=0,
-        residual_norm=0.0)
+        residual_norm=0.0, method="linear")
 
 
 def solve_point(nl, omega, H, N, options, previous):
@@ -121,7 +126,8 @@ def in_band(solutions, start, end):
     return [s for s in solutions if lo - slack <= float(s.omega) <= hi + slack]
 
 
-def sweep_status(case, solutions) -> dict:
+def sweep_status(excitation: ExcitationConfig, continuation: ContinuationConfig,
+                 solutions) -> dict:
     """How a sweep was solved → {'complete', 'reason', 'covered'} (all None without a sweep).
 
     complete: one continuation from start to end, no stop and no point-by-point fallback.
@@ -129,15 +135,14 @@ def sweep_status(case, solutions) -> dict:
     frequencies are the band's ends (10⁻³ of its width) and no gap between neighbouring converged
     frequencies is wider than the continuation's largest step (``max_step`` of the band).
     reason: one line saying what happened (None when complete)."""
-    exc = case.data["excitation"]
-    if "sweep" not in exc:
+    if excitation.sweep is None:
         return {"complete": None, "reason": None, "covered": None}
-    start, end = exc["sweep"]["start_hz"], exc["sweep"]["end_hz"]
+    start, end = excitation.sweep.start_hz, excitation.sweep.end_hz
     lo, hi = sorted((start, end))
     span = hi - lo
-    reasons = [str(getattr(s, "reason", "")) for s in solutions]
+    reasons = [str(s.reason) for s in solutions]
     freqs = np.sort([float(s.omega) / (2 * np.pi) for s in solutions if s.converged])
-    max_gap = case.data["solver"]["continuation"]["max_step"] * span
+    max_gap = continuation.max_step * span
     covered = bool(freqs.size and freqs[0] <= lo + 1e-3 * span and freqs[-1] >= hi - 1e-3 * span
                    and np.max(np.diff(freqs), initial=0.0) <= max_gap * (1 + 1e-9))
     stopped = next((i for i, r in enumerate(reasons) if STOPPED in r), None)
@@ -185,12 +190,9 @@ def finish_sweep(nl, solutions, start, end, H, N, options, step):
     previous = next((s for s in reversed(solutions) if s.converged), None)
     for omega in np.linspace(last, end, count)[1:]:
         solution = solve_point(nl, float(omega), H, N, options, previous)
-        try:
-            solution = dataclasses.replace(solution, reason=f"{solution.reason} ({POINT_BY_POINT})")
-        except TypeError:
-            solution.reason += f" ({POINT_BY_POINT})"
+        solution = dataclasses.replace(solution, reason=f"{solution.reason} ({POINT_BY_POINT})")
         solutions.append(solution)
-        if solution.converged and not isinstance(solution, SimpleNamespace):
+        if solution.converged and solution.method != TIME_INTEGRATION:
             previous = solution
     return solutions
 
@@ -207,7 +209,7 @@ def common_samples(nl, solutions):
     out = []
     for s in solutions:
         N = int(s.samples_per_period)
-        if N == largest or isinstance(s, SimpleNamespace) or not nl.contacts.count:
+        if N == largest or s.method == TIME_INTEGRATION or not nl.contacts.count:
             out.append(s)
             continue
         _, _, forces = nonlinear_force(nl.contacts, s.displacement, largest, jacobian=False)
@@ -218,17 +220,17 @@ def common_samples(nl, solutions):
     return out
 
 
-def solve_points(case, nl: NonlinearModel, progress=False):
+def solve_points(solver: SolverConfig, excitation: ExcitationConfig, nl: NonlinearModel,
+                 progress=False):
     """HarmonicSolution per frequency point (listed frequencies in order, or a continuation)."""
     from sarfe.hbm import continuation
 
-    solver, exc = case.data["solver"], case.data["excitation"]
-    H, N = solver["harmonics"], solver["samples_per_period"]
-    options, cont_options = solver_options(case)
+    H, N = solver.harmonics, solver.samples_per_period
+    options, cont_options = solver_options(solver)
     contacts = nl.contacts
     failed = ""
-    if "sweep" in exc:
-        start, end = (2 * np.pi * exc["sweep"][k] for k in ("start_hz", "end_hz"))
+    if excitation.sweep is not None:
+        start, end = (2 * np.pi * excitation.sweep.start_hz, 2 * np.pi * excitation.sweep.end_hz)
         if contacts.count:
             # the bar counts percent of the frequency range covered (so tqdm estimates the time left)
             bar = _bar(progress, "sweep (% of the range)", 100, unit="%")
@@ -239,29 +241,26 @@ def solve_points(case, nl: NonlinearModel, progress=False):
                                                max(0, int(round(100 * done)) - bar.n)))
                                            if bar is not None else None))
                 return in_band(finish_sweep(nl, solutions, start, end, H, N, options,
-                                            solver["continuation"]["initial_step"]), start, end)
+                                            solver.continuation.initial_step), start, end)
             except Exception as error:  # fall back to a point-by-point sweep (said in reasons)
                 failed = f"{CONTINUATION_FAILED} ({type(error).__name__}: {error})"
             finally:
                 if bar is not None:
                     bar.close()
-        count = min(max(2, int(round(1.0 / solver["continuation"]["initial_step"])) + 1), 101)
+        count = min(max(2, int(round(1.0 / solver.continuation.initial_step)) + 1), 101)
         omegas = np.linspace(start, end, count)
     else:
-        omegas = 2 * np.pi * np.asarray(exc["frequency_hz"], dtype=float)
+        omegas = 2 * np.pi * np.asarray(excitation.frequency_hz, dtype=float)
     solutions, previous = [], None
     bar = _bar(progress, "frequencies", len(omegas), unit="point")
     try:
         for omega in omegas:
             solution = solve_point(nl, float(omega), H, N, options, previous)
             if failed:
-                try:
-                    solution = dataclasses.replace(solution, reason=f"{solution.reason} ({failed})")
-                except TypeError:
-                    solution.reason += f" ({failed})"
+                solution = dataclasses.replace(solution, reason=f"{solution.reason} ({failed})")
             solutions.append(solution)
-            previous = solution if getattr(solution, "converged", False) and not isinstance(
-                solution, SimpleNamespace) else None
+            previous = solution if solution.converged and \
+                solution.method != TIME_INTEGRATION else None
             if bar is not None:
                 bar.update(1)
     finally:

@@ -17,23 +17,23 @@ import math
 import numpy as np
 import scipy.sparse as sp
 
+from sarfe.io.config import CaseConfig, ErpConfig, SolverConfig
 from sarfe.pipeline.nonlinear import NonlinearModel
 
 
-def _erp(case, stage, displacement, omega):
+def _erp(erp: ErpConfig, stage, displacement, omega):
     """ErpResult of displacement harmonics (2H+1, n) at ω (zero power without radiating nodes)."""
     from sarfe.erp import equivalent_radiated_power
 
-    erp = case.data["erp"]
     W = np.asarray(displacement) @ stage.erp_map.T
     if W.shape[1] == 0:  # no radiating surface: a zero-area node keeps the shapes valid
         W, areas = np.zeros((W.shape[0], 1)), np.zeros(1)
     else:
         areas = stage.erp_areas
-    result = equivalent_radiated_power(W, omega, areas, density=erp["rho_kg_m3"],
-                                       sound_speed=erp["c_m_s"],
-                                       radiation_loss_factor=erp["radiation_loss_factor"],
-                                       reference_power=erp["reference_power_W"])
+    result = equivalent_radiated_power(W, omega, areas, density=erp.rho_kg_m3,
+                                       sound_speed=erp.c_m_s,
+                                       radiation_loss_factor=erp.radiation_loss_factor,
+                                       reference_power=erp.reference_power_W)
     return result, W
 
 
@@ -105,7 +105,7 @@ def baseline_rows(contacts):
     return springs, dashpots
 
 
-def linear_baseline(case, stage, nl: NonlinearModel, omega):
+def linear_baseline(erp: ErpConfig, stage, nl: NonlinearModel, omega):
     """Linear response at ω of the structure with its contacts at their static state: preloaded
     (closed) pairs as their linearized spring k_n (and dashpot c_n), stuck friction pairs as k_t,
     open pairs removed (:func:`baseline_rows`):
@@ -127,7 +127,7 @@ def linear_baseline(case, stage, nl: NonlinearModel, omega):
     H = (nl.excitation.shape[0] - 1) // 2
     U = np.zeros((2 * H + 1, stage.dof_count))
     U[1], U[2] = U1.real, -U1.imag
-    erp, _ = _erp(case, stage, U, omega)
+    erp, _ = _erp(erp, stage, U, omega)
     contacts = []
     if nl.contacts.count:
         R = (nl.contacts.gap_map @ U.T).T
@@ -152,13 +152,13 @@ def linear_baseline(case, stage, nl: NonlinearModel, omega):
 ESTIMATE_STRIDE = 8     # a sweep's estimate is computed at every 8th converged point (+ ends, peak)
 
 
-def _error_estimate(case, stage, nl, solution):
+def _error_estimate(solver: SolverConfig, stage, nl, solution):
     """A-posteriori error estimate of a converged point (:mod:`sarfe.accuracy.estimates`): harmonic
     truncation (H → H' and N → N' solved by condensed Newton from the point, usually 1–4
     iterations), AFT aliasing (N → 2N, likewise), modal truncation (the same on the cached coarser
     Craig–Bampton model), spectral tails. None when switched off, not converged or without
     contacts; a failure of the estimate is reported, never raised."""
-    if not case.data["solver"].get("error_estimate", True) or not solution.converged \
+    if not solver.error_estimate or not solution.converged \
             or not nl.contacts.count:
         return None
     try:
@@ -169,7 +169,7 @@ def _error_estimate(case, stage, nl, solution):
         return {"failed": f"{type(error).__name__}: {error}"}
 
 
-def error_estimates(case, stage, nl, solutions, stride=ESTIMATE_STRIDE) -> list:
+def error_estimates(config: CaseConfig, stage, nl, solutions, stride=ESTIMATE_STRIDE) -> list:
     """Per point: the error estimate dict, or None (see :func:`_error_estimate`).
 
     A sweep's points are estimated on a subset and the others take the larger estimate of their
@@ -179,11 +179,12 @@ def error_estimates(case, stage, nl, solutions, stride=ESTIMATE_STRIDE) -> list:
     solution varies smoothly along a branch between those points, so the subset costs 1/stride of
     the per-point estimates; benchmarks/results/accuracy.md measures cost and bracketing."""
     n = len(solutions)
-    if not case.data["solver"].get("error_estimate", True) or not nl.contacts.count:
+    solver = config.solver
+    if not solver.error_estimate or not nl.contacts.count:
         return [None] * n
     eligible = [i for i, s in enumerate(solutions) if s.converged]
-    if "sweep" not in case.data["excitation"] or len(eligible) <= 2 * stride:
-        return [_error_estimate(case, stage, nl, s) for s in solutions]
+    if config.excitation.sweep is None or len(eligible) <= 2 * stride:
+        return [_error_estimate(solver, stage, nl, s) for s in solutions]
     G = nl.contacts.gap_map
 
     def amplitude(i):
@@ -191,7 +192,7 @@ def error_estimates(case, stage, nl, solutions, stride=ESTIMATE_STRIDE) -> list:
         return float(np.max(np.hypot(G @ U[1], G @ U[2]), initial=0.0))
 
     chosen = set(eligible[::stride]) | {eligible[0], eligible[-1], max(eligible, key=amplitude)}
-    computed = {i: _error_estimate(case, stage, nl, solutions[i]) for i in sorted(chosen)}
+    computed = {i: _error_estimate(solver, stage, nl, solutions[i]) for i in sorted(chosen)}
     usable = [i for i in sorted(computed) if computed[i] is not None and "failed" not in computed[i]
               and np.isfinite(computed[i]["amplitude_rel"])]    # (unknown: that point alone)
     out = []
@@ -212,15 +213,15 @@ def error_estimates(case, stage, nl, solutions, stride=ESTIMATE_STRIDE) -> list:
     return out
 
 
-def harmonic_set_record(case, solution):
+def harmonic_set_record(solver: SolverConfig, solution):
     """Which harmonic orders a point was solved with (solver.harmonic_set) and the estimate η of
     what the dropped orders carry (for a full-set point: the orders outside the odd set)."""
     H = int(solution.harmonics)
-    orders = getattr(solution, "harmonic_orders", None)
-    return {"requested": case.data["solver"].get("harmonic_set", "all"),
-            "used": getattr(solution, "harmonic_set", "all"),
+    orders = solution.harmonic_orders
+    return {"requested": solver.harmonic_set,
+            "used": solution.harmonic_set,
             "orders": list(range(H + 1)) if orders is None else [int(k) for k in orders],
-            "dropped_content": float(getattr(solution, "dropped_content", float("nan")))}
+            "dropped_content": float(solution.dropped_content)}
 
 
 def band_record(erp, linear, omega) -> dict:
@@ -234,7 +235,7 @@ def band_record(erp, linear, omega) -> dict:
             "linear": third_octave_levels([f], [linear_power]).as_dict()}
 
 
-def point_record(case, stage, nl, index, solution, error_estimate=False):
+def point_record(config: CaseConfig, stage, nl, index, solution, error_estimate=False):
     """(point dict of summary.json, flat table row, ErpResult, radiating displacements W).
     ``error_estimate``: the point's estimate when computed beforehand (:func:`error_estimates`),
     False to compute it here."""
@@ -242,33 +243,33 @@ def point_record(case, stage, nl, index, solution, error_estimate=False):
     from sarfe.pipeline.contributions import contributions_record
 
     omega = float(solution.omega)
-    erp, W = _erp(case, stage, solution.displacement, omega)
+    erp, W = _erp(config.erp, stage, solution.displacement, omega)
     contacts = contact_indicators(solution, nl) if nl.contacts.count else []
     for record, dynamics in zip(contacts, contact_dynamics(solution, nl)):
         record.update({k: v for k, v in dynamics.items() if k != "name"})
-    contributions = contributions_record(case, stage, nl, solution)
+    contributions = contributions_record(config.erp, stage, nl, solution)
     if contributions.get("available"):
         shares = {c["name"]: c for c in contributions["sources"]}
         for record in contacts:
             source = shares.get(record["name"], {})
             record.update({"erp_level_dba": source.get("level_dba", float("nan")),
                            "erp_share_a": source.get("share_a", float("nan"))})
-    linear = linear_baseline(case, stage, nl, omega)
-    stable = getattr(solution, "stable", None)
+    linear = linear_baseline(config.erp, stage, nl, omega)
+    stable = solution.stable
     point = {
         "index": index, "frequency_hz": omega / (2 * np.pi), "omega_rad_s": omega,
         "converged": bool(solution.converged), "stable": None if stable is None else bool(stable),
-        "iterations": int(getattr(solution, "iterations", 0)),
-        "residual_norm": float(getattr(solution, "residual_norm", float("nan"))),
-        "reason": str(getattr(solution, "reason", "")),
+        "iterations": int(solution.iterations),
+        "residual_norm": float(solution.residual_norm),
+        "reason": str(solution.reason),
         "erp": _erp_dict(erp), "contacts": contacts, "linear": linear,
-        "error_estimate": (_error_estimate(case, stage, nl, solution) if error_estimate is False
+        "error_estimate": (_error_estimate(config.solver, stage, nl, solution) if error_estimate is False
                            else error_estimate),
-        "harmonic_set": harmonic_set_record(case, solution),
+        "harmonic_set": harmonic_set_record(config.solver, solution),
         "bands": band_record(erp, linear, omega),
         "contributions": contributions,
     }
-    row = {"case": case.name, "point": index, "frequency_hz": point["frequency_hz"],
+    row = {"case": config.name, "point": index, "frequency_hz": point["frequency_hz"],
            "converged": point["converged"], "stable": point["stable"],
            "iterations": point["iterations"], "erp_W": erp.power_total,
            "erp_db": erp.level_total_db, "erp_dba": erp.level_total_a_db,

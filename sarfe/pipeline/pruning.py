@@ -21,12 +21,13 @@ by continuation is the same curve but its adaptive points may fall at other ω.
 from __future__ import annotations
 
 import dataclasses
-from types import SimpleNamespace
 
 import numpy as np
 import scipy.sparse as sp
 
+from sarfe.io.config import ExcitationConfig, SolverConfig
 from sarfe.pipeline.nonlinear import NonlinearModel
+from sarfe.pipeline.points import TIME_INTEGRATION
 
 DEFAULT_MARGIN = 0.5
 SWEEP_GRID_POINTS = 201
@@ -34,9 +35,9 @@ MAX_LISTED = 20          # violations listed in the report (all are counted)
 MAX_DENSE_EIGEN = 3000   # DOFs up to which the linearized natural frequencies are computed (dense)
 
 
-def pruning_options(case) -> tuple:
+def pruning_options(solver: SolverConfig) -> tuple:
     """(enabled, margin m) from ``solver.prune_contacts``: true | false | {margin: m}."""
-    value = case.data["solver"].get("prune_contacts", True)
+    value = solver.prune_contacts
     if isinstance(value, dict):
         return True, float(value.get("margin", DEFAULT_MARGIN))
     return bool(value), DEFAULT_MARGIN
@@ -62,13 +63,13 @@ def linearized_natural_frequencies(model, contacts) -> np.ndarray:
     return np.sqrt(np.clip(eigenvalues, 0.0, None))
 
 
-def screening_frequencies(case, nl: NonlinearModel) -> np.ndarray:
+def screening_frequencies(excitation: ExcitationConfig, nl: NonlinearModel) -> np.ndarray:
     """ω [rad/s] of the screening pass: the listed frequencies, or for a sweep a grid of
     SWEEP_GRID_POINTS over [start, end] plus the linearized natural frequencies inside it."""
-    excitation = case.data["excitation"]
-    if "sweep" not in excitation:
-        return 2 * np.pi * np.asarray(excitation["frequency_hz"], dtype=float)
-    start, end = sorted(2 * np.pi * excitation["sweep"][k] for k in ("start_hz", "end_hz"))
+    if excitation.sweep is None:
+        return 2 * np.pi * np.asarray(excitation.frequency_hz, dtype=float)
+    start, end = sorted(2 * np.pi * hz for hz in (excitation.sweep.start_hz,
+                                                   excitation.sweep.end_hz))
     natural = linearized_natural_frequencies(nl.model, nl.contacts)
     inside = natural[(natural >= start) & (natural <= end)]
     return np.unique(np.concatenate([np.linspace(start, end, SWEEP_GRID_POINTS), inside]))
@@ -113,15 +114,15 @@ def _check_samples(N):
     return int(N) * max(1, -(-256 // int(N)))
 
 
-def check_solutions(case, nl: NonlinearModel, decisions, solutions) -> tuple:
+def check_solutions(samples_per_period, nl: NonlinearModel, decisions, solutions) -> tuple:
     """(violations, unsolved): the decisions every converged pruned solution breaks, as
     {contact, frequency_hz, what}, and the indices of the points that did not converge."""
     from sarfe.hbm.pruning import check_pruning
 
-    samples = _check_samples(case.data["solver"]["samples_per_period"])
+    samples = _check_samples(samples_per_period)
     violations, unsolved = [], []
     for index, solution in enumerate(solutions):
-        if isinstance(solution, SimpleNamespace) or not solution.converged:
+        if solution.method == TIME_INTEGRATION or not solution.converged:
             unsolved.append(index)
             continue
         hz = float(solution.omega) / (2 * np.pi)
@@ -130,7 +131,8 @@ def check_solutions(case, nl: NonlinearModel, decisions, solutions) -> tuple:
     return violations, unsolved
 
 
-def restore_solutions(case, nl: NonlinearModel, decisions, solutions, unsolved, linear) -> list:
+def restore_solutions(solver: SolverConfig, nl: NonlinearModel, decisions, solutions, unsolved,
+                      linear) -> list:
     """Pruned solutions re-expressed with the full contact set; a point that did not converge on
     the pruned model is solved again at its ω with all contacts (from the pruned state)."""
     from sarfe.pipeline.points import solve_point, solver_options
@@ -139,9 +141,9 @@ def restore_solutions(case, nl: NonlinearModel, decisions, solutions, unsolved, 
     restored = []
     for index, solution in enumerate(solutions):
         if index in unsolved:
-            H, N = (case.data["solver"][k] for k in ("harmonics", "samples_per_period"))
-            start = None if isinstance(solution, SimpleNamespace) else solution
-            restored.append(solve_point(nl, float(solution.omega), H, N, solver_options(case)[0],
+            H, N = solver.harmonics, solver.samples_per_period
+            start = None if solution.method == TIME_INTEGRATION else solution
+            restored.append(solve_point(nl, float(solution.omega), H, N, solver_options(solver)[0],
                                         start))
             continue
         solution = restore_solution(solution, nl.model, nl.contacts, nl.excitation, decisions)
@@ -152,37 +154,38 @@ def restore_solutions(case, nl: NonlinearModel, decisions, solutions, unsolved, 
     return restored
 
 
-def solve_points_pruned(case, nl: NonlinearModel, progress=False) -> tuple:
+def solve_points_pruned(solver: SolverConfig, excitation: ExcitationConfig, nl: NonlinearModel,
+                        progress=False) -> tuple:
     """(solutions, report): :func:`sarfe.pipeline.points.solve_points` on the pruned model, checked
     and restored to the full contact set (module docstring), or on the full model when pruning is
     off, removes nothing, or a decision fails. ``report`` is summary.json's ``contact_pruning``."""
     from sarfe.pipeline.points import solve_points
     from sarfe.hbm.pruning import NONLINEAR, prune_contacts, screen_contacts
 
-    enabled, margin = pruning_options(case)
+    enabled, margin = pruning_options(solver)
     report = {"enabled": enabled, "applied": False, "fallback": False, "margin": margin,
               "screened_frequencies": 0, "pairs": int(nl.contacts.count),
               "nonlinear_pairs": int(nl.contacts.count), "contacts": [], "violations": [],
               "violation_count": 0, "full_model_points_hz": []}
     if not enabled or not nl.contacts.count:
-        return solve_points(case, nl, progress=progress), report
-    omegas = screening_frequencies(case, nl)
+        return solve_points(solver, excitation, nl, progress=progress), report
+    omegas = screening_frequencies(excitation, nl)
     decisions = screen_contacts(nl.model, nl.contacts, nl.excitation, omegas, margin=margin)
     kept = sum(d.decision == NONLINEAR for d in decisions)
     report.update(screened_frequencies=int(len(omegas)), nonlinear_pairs=int(kept),
                   contacts=contact_report(decisions, nl.groups))
     if kept == nl.contacts.count:      # nothing to remove
-        return solve_points(case, nl, progress=progress), report
+        return solve_points(solver, excitation, nl, progress=progress), report
     pruned = prune_contacts(nl.model, nl.contacts, nl.excitation, decisions)
-    solutions = solve_points(case, pruned_model(nl, pruned), progress=progress)
-    violations, unsolved = check_solutions(case, nl, decisions, solutions)
+    solutions = solve_points(solver, excitation, pruned_model(nl, pruned), progress=progress)
+    violations, unsolved = check_solutions(solver.samples_per_period, nl, decisions, solutions)
     if violations:                     # a decision does not hold: solve it all again
         report.update(fallback=True, nonlinear_pairs=int(nl.contacts.count),
                       violation_count=len(violations), violations=violations[:MAX_LISTED])
-        return solve_points(case, nl, progress=progress), report
+        return solve_points(solver, excitation, nl, progress=progress), report
     report.update(applied=True, full_model_points_hz=[
         float(solutions[i].omega) / (2 * np.pi) for i in unsolved])
-    return restore_solutions(case, nl, decisions, solutions, unsolved,
+    return restore_solutions(solver, nl, decisions, solutions, unsolved,
                              linear=not pruned.contacts.count), report
 
 

@@ -68,17 +68,19 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
             warn(line)
     timings = {}
     accuracy = None
-    if case.data["solver"]["resolution"] == "auto":
+    config = case.config
+    if config.solver.resolution == "auto":
         # accuracy as an input: choose H, N (and mode count) from cheap error estimates first
         from sarfe.accuracy.resolve import apply_resolution
         from sarfe.pipeline.accuracy import resolve_case_accuracy
 
         clock = time.perf_counter()
-        report = resolve_case_accuracy(case, case.data["solver"]["accuracy"])
+        report = resolve_case_accuracy(case, config.solver.accuracy)
         accuracy = {k: report.get(k) for k in ("harmonics", "samples_per_period", "mode_count",
                                                "estimate", "met", "reason", "tuned_hz")}
-        accuracy["target"] = case.data["solver"]["accuracy"]
+        accuracy["target"] = config.solver.accuracy
         case = load_case(apply_resolution(case.data, report), base_dir=case.base_dir)
+        config = case.config
         linear_stage = None if (linear_stage is not None
                                 and linear_stage.key != linear_model_key(case)) else linear_stage
         timings["accuracy_s"] = time.perf_counter() - clock
@@ -97,19 +99,20 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     timings["setup_s"] = time.perf_counter() - clock
 
     clock = time.perf_counter()
-    solutions, pruning = solve_points_pruned(case, nl, progress=progress)
+    solutions, pruning = solve_points_pruned(config.solver, config.excitation, nl,
+                                             progress=progress)
     timings["hbm_s"] = time.perf_counter() - clock
 
     clock = time.perf_counter()
     points, rows, erps, normal_w = [], [], [], []
-    bar = _bar(progress, "ERP and error estimates" if case.data["solver"].get("error_estimate", True)
-               else "ERP", len(solutions), unit="point")
+    bar = _bar(progress, "ERP and error estimates" if config.solver.error_estimate else "ERP",
+               len(solutions), unit="point")
     try:
-        estimates = error_estimates(case, stage, nl, solutions)  # each at the N it was solved with
+        estimates = error_estimates(config, stage, nl, solutions)  # each at the N it was solved with
         timings["error_estimate_s"] = time.perf_counter() - clock
         solutions = common_samples(nl, solutions)                # one time grid for the files
         for index, solution in enumerate(solutions):
-            point, row, erp, W = point_record(case, stage, nl, index, solution, estimates[index])
+            point, row, erp, W = point_record(config, stage, nl, index, solution, estimates[index])
             points.append(point)
             rows.append(row)
             erps.append(erp)
@@ -121,7 +124,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
             bar.close()
     timings["postprocess_s"] = time.perf_counter() - clock
     not_converged = [p["index"] for p in points if not p["converged"]]
-    sweep = sweep_status(case, solutions)       # None entries without a sweep
+    sweep = sweep_status(config.excitation, config.solver.continuation, solutions)       # None entries without a sweep
     # exit code 3: a point did not converge, or the sweep fell back to point-by-point solving
     # without the band still being covered by converged points (docs/hbm.md, exit codes)
     exit_code = EXIT_NOT_CONVERGED if (not_converged or not points or (

@@ -34,11 +34,11 @@ def test_every_artefact_uses_the_loudest_converged_stable_point(lumped_case, tmp
     real = solve_module.solve_points_pruned
     chosen = {}
 
-    def tampered(case, nl, progress=False):
-        solutions, report = real(case, nl, progress=progress)
+    def tampered(solver, excitation, nl, progress=False):
+        solutions, report = real(solver, excitation, nl, progress=progress)
         from sarfe.pipeline.postprocess import _erp
 
-        dba = [_erp(case, _stage[0], s.displacement, s.omega)[0]
+        dba = [_erp(_case[0].config.erp, _stage[0], s.displacement, s.omega)[0]
                .level_total_a_db for s in solutions]
         order = np.argsort(dba)[::-1]
         solutions[order[0]] = dataclasses.replace(solutions[order[0]], converged=False,
@@ -48,12 +48,13 @@ def test_every_artefact_uses_the_loudest_converged_stable_point(lumped_case, tmp
         chosen["frequency_hz"] = float(solutions[order[2]].omega) / (2 * np.pi)
         return solutions, report
 
-    _stage = []
+    _stage, _case = [], []
     real_build = solve_module.build_linear_model
 
     def build(case, progress=False):
         stage = real_build(case, progress=progress)
         _stage.append(stage)
+        _case.append(case)
         return stage
 
     monkeypatch.setattr(solve_module, "build_linear_model", build)

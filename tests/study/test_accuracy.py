@@ -135,7 +135,7 @@ def _case_setting(name, frequencies_hz, H, N, cutoff_hz=None):
     nl = nonlinear_model(case, stage)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return stage, nl, solve_points(case, nl)
+        return stage, nl, solve_points(case.config.solver, case.config.excitation, nl)
 
 
 def _raise_to(nl, solution, H, N):
@@ -231,7 +231,7 @@ def test_coarser_model_is_the_reduction_with_fewer_modes():
         nl = nonlinear_model(case, stage)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            return stage, nl, solve_points(case, nl)[0]
+            return stage, nl, solve_points(case.config.solver, case.config.excitation, nl)[0]
 
     stage, nl, s = solved(12)
     small_stage, small_nl, small = solved(10)
