@@ -395,50 +395,47 @@ def pair_contact(case, mesh, index, normals_all):
     return a, b, frame_from_normal(normal), distance
 
 
-def _build_fe(case: Case, progress=False) -> dict:
-    from sarfe.erp import nodal_areas, nodal_normals
-    from sarfe.fe.shell import shell_matrices
-    from sarfe.reduction.craig_bampton import craig_bampton, free_dofs_system
-    from sarfe.reduction.recovery import normal_velocity_basis
+def _mesh_groups(case: Case, config, mesh) -> tuple:
+    """Linear stage, step 1 (after the mesh): the node groups the case names — fixed nodes,
+    contact pairs {name: (a, b, frames, distance)}, load nodes per force — and the radiating
+    triangles. Cheap, and the errors a user is most likely to make, so they come first."""
+    from sarfe.erp import nodal_normals
 
-    data, fe = case.data, case.data["model"]["fe"]
-    timings = {}
-    clock = time.perf_counter()
-    stages = _bar(progress, "linear stage: mesh", 4, unit="step")
-    mesh = load_case_mesh(case)
-    timings["mesh_s"] = time.perf_counter() - clock
-    _step(stages, "assembly")
-    n_nodes = mesh.n_nodes
-
-    # groups and pairing first: cheap, and the errors a user is most likely to make
+    fe = config.model.fe.data
     fixed_nodes = np.unique(np.concatenate([
         resolve_node_group(case, mesh, g, ("model", "fe", "fixed", i), allow_elements=False)
         for i, g in enumerate(fe["fixed"])]))
     normals_all = nodal_normals(mesh.points, mesh.triangles)
-    paired = {c["name"]: pair_contact(case, mesh, i, normals_all)
-              for i, c in enumerate(data["contacts"])}
-    exc = data["excitation"]
+    paired = {c.name: pair_contact(case, mesh, c.index, normals_all) for c in config.contacts}
     load_nodes = [resolve_node_group(case, mesh, f["group"], ("excitation", "forces", i, "group"))
-                  for i, f in enumerate(exc.get("forces", []))]
-    if "surface" in data["erp"]:
-        surface = data["erp"]["surface"]
-        if surface in mesh.element_groups:
-            radiating_triangles = mesh.triangles[mesh.element_groups[surface]]
-        else:
-            nodes = resolve_node_group(case, mesh, surface, ("erp", "surface"))
-            inside = np.zeros(n_nodes, bool)
-            inside[nodes] = True
-            radiating_triangles = mesh.triangles[inside[mesh.triangles].all(axis=1)]
-            if len(radiating_triangles) == 0:
-                raise case.error(f"node group '{surface}' contains no whole triangle",
-                                 ("erp", "surface"))
-    elif "skin" in mesh.element_groups:
-        radiating_triangles = mesh.triangles[mesh.element_groups["skin"]]
-    else:
-        radiating_triangles = mesh.triangles
+                  for i, f in enumerate(config.excitation.forces)]
+    return fixed_nodes, paired, load_nodes, _radiating_triangles(case, config.erp, mesh)
 
-    # assembly
-    clock = time.perf_counter()
+
+def _radiating_triangles(case: Case, erp, mesh) -> np.ndarray:
+    """Triangles (n_t, 3) of the radiating surface: erp.surface (an element group, or the whole
+    triangles of a node group), else the 'skin' group, else every triangle."""
+    surface = erp.surface
+    if surface is not None:
+        if surface in mesh.element_groups:
+            return mesh.triangles[mesh.element_groups[surface]]
+        nodes = resolve_node_group(case, mesh, surface, ("erp", "surface"))
+        inside = np.zeros(mesh.n_nodes, bool)
+        inside[nodes] = True
+        triangles = mesh.triangles[inside[mesh.triangles].all(axis=1)]
+        if len(triangles) == 0:
+            raise case.error(f"node group '{surface}' contains no whole triangle", ("erp", "surface"))
+        return triangles
+    if "skin" in mesh.element_groups:
+        return mesh.triangles[mesh.element_groups["skin"]]
+    return mesh.triangles
+
+
+def _assemble(case: Case, fe, mesh) -> tuple:
+    """Linear stage, step 2: shell stiffness and mass (6 n_nodes square, sparse) from the
+    per-triangle materials (E_Pa, nu, rho_kg_m3) and thickness_m."""
+    from sarfe.fe.shell import shell_matrices
+
     materials, thickness = fe["materials"], fe["thickness_m"]
     mat_owner = _per_triangle(case, mesh, materials, "materials")
     thick_owner = _per_triangle(case, mesh, thickness, "thickness_m")
@@ -451,11 +448,15 @@ def _build_fe(case: Case, progress=False) -> dict:
     if t.max() > 0.2 * extent:
         raise case.error(f"thickness {t.max():g} m is not small against the mesh size "
                          f"{extent:.3g} m (thickness_m is in metres)", ("model", "fe", "thickness_m"))
-    stiffness, mass = shell_matrices(mesh.points, mesh.triangles, t, young, poisson, density)
-    timings["assembly_s"] = time.perf_counter() - clock
-    _step(stages, "reduction")
+    return shell_matrices(mesh.points, mesh.triangles, t, young, poisson, density)
 
-    # constraints: fixed nodes (6 DOFs) and nodes on no triangle
+
+def _supports(mesh, fixed_nodes, stiffness, mass) -> tuple:
+    """Linear stage, step 3: hold the fixed nodes (6 DOFs) and nodes on no triangle →
+    (K_ff, M_ff, free DOF numbers, position of every DOF among the free ones or −1)."""
+    from sarfe.reduction.craig_bampton import free_dofs_system
+
+    n_nodes = mesh.n_nodes
     used = np.zeros(n_nodes, bool)
     used[mesh.triangles.ravel()] = True
     held = np.union1d(fixed_nodes, np.flatnonzero(~used))
@@ -463,50 +464,62 @@ def _build_fe(case: Case, progress=False) -> dict:
     k_ff, m_ff, free = free_dofs_system(stiffness, mass, fixed_dofs)
     position = np.full(6 * n_nodes, -1)
     position[free] = np.arange(len(free))
+    return k_ff, m_ff, free, position
 
-    # boundary = translations of contact and excitation nodes (free ones)
-    boundary_nodes = [g[0] for g in paired.values()] + [g[1][g[1] >= 0] for g in paired.values()]
-    boundary_nodes = np.unique(np.concatenate(boundary_nodes + load_nodes + [np.zeros(0, int)]))
-    boundary_positions = position[(6 * boundary_nodes[:, None] + np.arange(3)).ravel()]
-    boundary_positions = boundary_positions[boundary_positions >= 0]
 
-    base_load = None
-    if "base_acceleration" in exc:   # −M ι per unit base acceleration [N per m/s²] on the free DOFs
-        iota = np.zeros(6 * n_nodes)
-        for comp in range(3):
-            iota[6 * np.arange(n_nodes) + comp] = exc["base_acceleration"]["direction"][comp]
-        base_load = -(m_ff @ iota[free])
+def _boundary_positions(paired, load_nodes, position) -> np.ndarray:
+    """Linear stage, step 4: the Craig–Bampton boundary — translations of the contact and load
+    nodes — as positions among the free DOFs (fixed ones left out)."""
+    nodes = [g[0] for g in paired.values()] + [g[1][g[1] >= 0] for g in paired.values()]
+    nodes = np.unique(np.concatenate(nodes + load_nodes + [np.zeros(0, int)]))
+    positions = position[(6 * nodes[:, None] + np.arange(3)).ravel()]
+    return positions[positions >= 0]
 
-    clock = time.perf_counter()
-    red = data["reduction"]
-    residual = red.get("residual_vectors", True)
-    cutoff = red.get("cutoff_hz", None if "mode_count" in red else default_cutoff_hz(case))
+
+def _base_load(excitation, n_nodes, m_ff, free):
+    """−M ι per unit base acceleration [N per m/s²] on the free DOFs (None without one)."""
+    if excitation.base_acceleration is None:
+        return None
+    iota = np.zeros(6 * n_nodes)
+    for comp in range(3):
+        iota[6 * np.arange(n_nodes) + comp] = excitation.base_acceleration["direction"][comp]
+    return -(m_ff @ iota[free])
+
+
+def _reduce(case: Case, reduction, k_ff, m_ff, boundary, free, n_nodes, base_load, progress):
+    """Linear stage, step 5: Craig–Bampton reduction (mode_count, or the cutoff: given or
+    :func:`default_cutoff_hz`, at least min_mode_count modes) → (ReducedModel, cutoff_hz|None)."""
+    from sarfe.reduction.craig_bampton import craig_bampton
+
+    residual = reduction.residual_vectors
+    cutoff = reduction.cutoff_hz if reduction.cutoff_hz is not None else (
+        None if reduction.mode_count is not None else default_cutoff_hz(case))
     bar = _bar(progress, "Craig-Bampton mode blocks", None)
     try:
         def reduce(mode_count, cutoff_hz):
-            return craig_bampton(k_ff, m_ff, boundary_positions, mode_count=mode_count,
+            return craig_bampton(k_ff, m_ff, boundary, mode_count=mode_count,
                                  cutoff_hz=cutoff_hz, progress=(lambda done, total: bar.update(1))
-                                 if bar is not None else None, free_dofs=free, total_dof_count=6 * n_nodes,
-                                 residual_vectors=residual,
+                                 if bar is not None else None, free_dofs=free,
+                                 total_dof_count=6 * n_nodes, residual_vectors=residual,
                                  residual_loads=base_load if residual else None)
-        reduced = reduce(red.get("mode_count"), cutoff)
-        if "mode_count" not in red and reduced.mode_count < red["min_mode_count"]:
+        reduced = reduce(reduction.mode_count, cutoff)
+        if reduction.mode_count is None and reduced.mode_count < reduction.min_mode_count:
             # a cutoff below the first fixed-interface modes leaves only static condensation
-            reduced = reduce(min(red["min_mode_count"], len(free) - len(boundary_positions) - 1),
-                             None)
+            reduced = reduce(min(reduction.min_mode_count, len(free) - len(boundary) - 1), None)
     except Exception as exc:   # any solver's failure (PARDISO, CHOLMOD, ARPACK): one line
         raise case.error(f"the structure is not held (singular stiffness: {exc}); check the "
                          "fixed groups", ("model", "fe", "fixed")) from None
     finally:
         if bar is not None:
             bar.close()
-    timings["reduction_s"] = time.perf_counter() - clock
-    _step(stages, "contacts, loads, ERP map")
-    n_b, n_r = reduced.boundary_count, reduced.reduced_dof_count
+    return reduced, cutoff
 
-    # reduced coordinate of every translational DOF (−1 when fixed / not boundary)
+
+def _reduced_coordinates(reduced, free, n_nodes):
+    """A function: nodes (m,) → (m, 3) reduced coordinates of their translations (−1 when fixed,
+    not on the boundary, or the node is −1)."""
     coord = np.full(6 * n_nodes, -1)
-    coord[free[reduced.boundary_dofs]] = np.arange(n_b)
+    coord[free[reduced.boundary_dofs]] = np.arange(reduced.boundary_count)
 
     def coords_of(nodes):
         nodes = np.asarray(nodes)
@@ -514,13 +527,21 @@ def _build_fe(case: Case, progress=False) -> dict:
         ok = nodes >= 0
         out[ok] = coord[6 * nodes[ok, None] + np.arange(3)]
         return out
+    return coords_of
 
-    contacts = {}
-    for name, (a, b, frames, distance) in paired.items():
-        contacts[name] = ContactGeometry(name, a, b, frames, coords_of(a), coords_of(b), distance)
 
+def _contact_geometry(paired, coords_of) -> dict:
+    """Linear stage, step 6: {name: ContactGeometry} with the reduced coordinates of both sides."""
+    return {name: ContactGeometry(name, a, b, frames, coords_of(a), coords_of(b), distance)
+            for name, (a, b, frames, distance) in paired.items()}
+
+
+def _load_vectors(excitation, load_nodes, coords_of, reduced, base_load) -> tuple:
+    """Reduced load vectors: per force (n_f, n_r), unit force spread over its nodes along its
+    direction; the base-acceleration load (n_r,) projected on the reduced basis (None without)."""
+    n_b, n_r = reduced.boundary_count, reduced.reduced_dof_count
     loads = np.zeros((len(load_nodes), n_r))
-    for i, (nodes, load) in enumerate(zip(load_nodes, exc.get("forces", []))):
+    for i, (nodes, load) in enumerate(zip(load_nodes, excitation.forces)):
         c = coords_of(nodes)
         direction = np.asarray(load["direction"])
         for comp in range(3):
@@ -528,15 +549,56 @@ def _build_fe(case: Case, progress=False) -> dict:
             np.add.at(loads[i], c[ok, comp], direction[comp] / len(nodes))
     base = None
     if base_load is not None:
-        f = base_load
         base = np.zeros(n_r)
-        base[:n_b] = f[reduced.boundary_dofs]
-        base += reduced.interior_basis.T @ f[reduced.interior_dofs]
+        base[:n_b] = base_load[reduced.boundary_dofs]
+        base += reduced.interior_basis.T @ base_load[reduced.interior_dofs]
+    return loads, base
+
+
+def _erp_map(mesh, radiating_triangles, reduced) -> tuple:
+    """Linear stage, step 7: (radiating nodes, their areas [m²], normal-velocity map
+    (n_s, n_r) from reduced coordinates) of the radiating surface."""
+    from sarfe.erp import nodal_areas, nodal_normals
+    from sarfe.reduction.recovery import normal_velocity_basis
 
     erp_nodes = np.unique(radiating_triangles)
     areas = nodal_areas(mesh.points, radiating_triangles)[erp_nodes]
     normals = nodal_normals(mesh.points, radiating_triangles)[erp_nodes]
-    erp_map = normal_velocity_basis(reduced, normals, erp_nodes)
+    return erp_nodes, areas, normal_velocity_basis(reduced, normals, erp_nodes)
+
+
+def _build_fe(case: Case, progress=False) -> dict:
+    """The linear stage of an FE case: mesh and groups → assembly → supports → boundary →
+    Craig–Bampton reduction → contact geometry and loads → ERP map (one function per step)."""
+    config = case.config
+    timings = {}
+    clock = time.perf_counter()
+    stages = _bar(progress, "linear stage: mesh", 4, unit="step")
+    mesh = load_case_mesh(case)
+    timings["mesh_s"] = time.perf_counter() - clock
+    _step(stages, "assembly")
+    n_nodes = mesh.n_nodes
+    fixed_nodes, paired, load_nodes, radiating_triangles = _mesh_groups(case, config, mesh)
+
+    clock = time.perf_counter()
+    stiffness, mass = _assemble(case, config.model.fe.data, mesh)
+    timings["assembly_s"] = time.perf_counter() - clock
+    _step(stages, "reduction")
+
+    k_ff, m_ff, free, position = _supports(mesh, fixed_nodes, stiffness, mass)
+    boundary = _boundary_positions(paired, load_nodes, position)
+    base_load = _base_load(config.excitation, n_nodes, m_ff, free)
+    clock = time.perf_counter()
+    reduced, cutoff = _reduce(case, config.reduction, k_ff, m_ff, boundary, free, n_nodes,
+                              base_load, progress)
+    timings["reduction_s"] = time.perf_counter() - clock
+    _step(stages, "contacts, loads, ERP map")
+    n_b, n_r = reduced.boundary_count, reduced.reduced_dof_count
+
+    coords_of = _reduced_coordinates(reduced, free, n_nodes)
+    contacts = _contact_geometry(paired, coords_of)
+    loads, base = _load_vectors(config.excitation, load_nodes, coords_of, reduced, base_load)
+    erp_nodes, areas, erp_map = _erp_map(mesh, radiating_triangles, reduced)
 
     _step(stages, None)
     info = {"nodes": int(n_nodes), "triangles": int(mesh.n_triangles),
