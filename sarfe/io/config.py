@@ -109,13 +109,14 @@ class ReductionConfig:
 # --------------------------------------------------------------------------------------- contacts
 @dataclass(frozen=True)
 class ContactConfig:
-    """One contacts[] entry: index in the case, name, law ('kind'), and the entry's mapping
-    ``params`` (gap_m, stiffness, … — owned by the law, :mod:`sarfe.hbm.laws`)."""
+    """One contacts[] entry: index in the case, name, law (``kind``: the entry's ``type``), and the
+    entry's mapping ``params`` (gap_m, stiffness, … — owned by the law, :mod:`sarfe.hbm.laws`,
+    which reads it as the case gave it: a plain copy, not to be edited)."""
 
     index: int
     name: str
     kind: str
-    params: MappingProxyType
+    params: dict
 
     def get(self, key, default=None):
         return self.params.get(key, default)
@@ -253,7 +254,8 @@ def build_config(data: dict) -> CaseConfig:
             mode_count=red.get("mode_count"), cutoff_hz=red.get("cutoff_hz"),
             cutoff_margin=red["cutoff_margin"], min_mode_count=red["min_mode_count"],
             residual_vectors=red["residual_vectors"]),
-        contacts=tuple(ContactConfig(index=i, name=c["name"], kind=c.get("kind"), params=_frozen(c))
+        contacts=tuple(ContactConfig(index=i, name=c["name"], kind=c["type"],
+                                     params=copy.deepcopy(c))
                        for i, c in enumerate(data.get("contacts", []))),
         excitation=ExcitationConfig(
             forces=_frozen(exc.get("forces", [])), base_acceleration=_frozen(

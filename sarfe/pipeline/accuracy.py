@@ -8,6 +8,7 @@ import numpy as np
 from sarfe.accuracy.estimates import (EstimateProblem, highest_natural_frequency_hz,
                                       problem_error_estimate)
 from sarfe.accuracy.resolve import resolve_accuracy
+from sarfe.io.config import ExcitationConfig, SolverConfig
 
 
 def stage_modal_coordinates(stage):
@@ -38,12 +39,11 @@ def stage_error_estimate(solution, stage, nl):
     return problem_error_estimate(solution, accuracy_problem(stage, nl))
 
 
-def sweep_grid_hz(case, points=8) -> np.ndarray:
+def sweep_grid_hz(excitation: ExcitationConfig, points=8) -> np.ndarray:
     """[Hz]: the listed frequencies, or ``points`` evenly spaced over the sweep."""
-    exc = case.data["excitation"]
-    if "frequency_hz" in exc:
-        return np.atleast_1d(np.asarray(exc["frequency_hz"], dtype=float))
-    return np.linspace(exc["sweep"]["start_hz"], exc["sweep"]["end_hz"], int(points))
+    if excitation.frequency_hz is not None:
+        return np.atleast_1d(np.asarray(excitation.frequency_hz, dtype=float))
+    return np.linspace(excitation.sweep.start_hz, excitation.sweep.end_hz, int(points))
 
 
 def resolve_case_accuracy(case, target, points=8, start_harmonics=3, start_samples=64,
@@ -60,18 +60,16 @@ def resolve_case_accuracy(case, target, points=8, start_harmonics=3, start_sampl
     case = load_case(case)
     stage = linear_stage if linear_stage is not None else build_linear_model(case)
     nl = nonlinear_model(case, stage)
-    solver = case.data["solver"]
-    options = SolverOptions(tolerance=solver["tolerance"], max_iterations=solver["max_iterations"],
+    solver, excitation = case.config.solver, case.config.excitation
+    options = SolverOptions(tolerance=solver.tolerance, max_iterations=solver.max_iterations,
                             stability=False)
     modes = None
     f_max = None
     if stage.kind == "fe":
-        exc = case.data["excitation"]
-        f_max = max(exc["frequency_hz"]) if "frequency_hz" in exc else max(
-            exc["sweep"]["start_hz"], exc["sweep"]["end_hz"])
+        f_max = excitation.max_frequency_hz
         modes = getattr(stage.reduced, "mode_frequencies_hz", stage.mode_frequencies_hz)
-    return resolve_accuracy(accuracy_problem(stage, nl), target, sweep_grid_hz(case, points),
-                            solver["harmonics"], solver["samples_per_period"],
+    return resolve_accuracy(accuracy_problem(stage, nl), target, sweep_grid_hz(excitation, points),
+                            solver.harmonics, solver.samples_per_period,
                             start_harmonics=start_harmonics, start_samples=start_samples,
                             max_harmonics=max_harmonics, max_samples=max_samples,
                             max_points_tuned=max_points_tuned, options=options,
@@ -85,7 +83,7 @@ KNOBS = {"harmonics": "solver.harmonics", "aliasing": "solver.samples_per_period
          "modal": "reduction.cutoff_hz (or mode_count)"}
 
 
-def accuracy_check(case, points) -> dict | None:
+def accuracy_check(solver: SolverConfig, points) -> dict | None:
     """The run's error estimates against its accuracy budget (``solver.accuracy``, default
     'balanced': 1 % first-harmonic amplitude, 0.5 dB ERP) → {'met', 'target', 'point',
     'frequency_hz', 'amplitude_rel', 'erp_db', 'knob', 'warning'} or None without estimates.
@@ -96,7 +94,7 @@ def accuracy_check(case, points) -> dict | None:
     solver.harmonics, aliasing → solver.samples_per_period, modal → the reduction cutoff."""
     from sarfe.accuracy.estimates import RICHARDSON, harmonics_richardson, parse_accuracy
 
-    target = parse_accuracy(case.data["solver"].get("accuracy", "balanced"))
+    target = parse_accuracy(solver.accuracy_or_default)
     rated = [p for p in points if p["converged"] and p.get("error_estimate")
              and "failed" not in p["error_estimate"]]
     if not rated:

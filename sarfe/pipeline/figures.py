@@ -30,20 +30,21 @@ def _squeak_series(nl, solution):
     return np.stack(friction, axis=1), np.stack(states, axis=1), names
 
 
-def point_figures(case, stage, nl, summary, solutions, erps, directory: Path, loudest) -> dict:
-    """Draw the run's PNGs into ``directory``; returns {image key: path} (report keys)."""
+def point_figures(config, stage, nl, summary, solutions, erps, directory: Path, loudest) -> dict:
+    """Draw the run's PNGs into ``directory``; returns {image key: path} (report keys).
+    ``config``: the case's :class:`sarfe.io.config.CaseConfig` (name, output.target_dba)."""
     from sarfe.io import outputs
 
     directory = Path(directory)
     points = summary["points"]
-    target = case.data["output"].get("target_dba")
+    target = config.output.target_dba
     images = {}
     frequencies = [p["frequency_hz"] for p in points]
     if len(solutions) > 1:
         images["erp_sweep"] = outputs.plot_erp_sweep(
             directory / "erp_sweep.png", frequencies, [p["erp"]["level_db"] for p in points],
             stable=[p["stable"] for p in points], level_a_db=[p["erp"]["level_dba"] for p in points],
-            title=case.name, linear_level_db=[p["linear"]["erp_level_db"] for p in points],
+            title=config.name, linear_level_db=[p["linear"]["erp_level_db"] for p in points],
             converged=[p["converged"] for p in points], target_dba=target, loudest_index=loudest)
     if loudest is None:
         return images
@@ -51,14 +52,14 @@ def point_figures(case, stage, nl, summary, solutions, erps, directory: Path, lo
     at = f"{frequencies[j]:.1f} Hz"
     images["erp_spectrum"] = outputs.plot_erp_spectrum(
         directory / "erp_spectrum.png", erps[j].frequencies_hz, erps[j].level_db,
-        erps[j].level_a_db, title=f"{case.name}: ERP per harmonic at {at} (loudest point)")
+        erps[j].level_a_db, title=f"{config.name}: ERP per harmonic at {at} (loudest point)")
     bands = points[j].get("bands")
     if bands:
         images["third_octave"] = outputs.plot_third_octave(
             directory / "third_octave.png", bands["nonlinear"]["nominal_hz"],
             bands["nonlinear"]["level_dba"], linear_level_dba=bands["linear"]["level_dba"],
             linear_nominal_hz=bands["linear"]["nominal_hz"], target_dba=target,
-            title=f"{case.name}: third-octave bands at {at}")
+            title=f"{config.name}: third-octave bands at {at}")
     contributions = points[j].get("contributions") or {}
     if contributions.get("available"):
         sources = sorted(contributions["sources"],
@@ -85,7 +86,7 @@ def point_figures(case, stage, nl, summary, solutions, erps, directory: Path, lo
     return images
 
 
-def surface_maps(case, mesh, point_data, translations, point, directory: Path,
+def surface_maps(config, mesh, point_data, translations, point, directory: Path,
                  contact_nodes=None) -> dict:
     """Report renders at the loudest point: the ERP map [dB re 1 pW/m²], the deflection at the
     phase of largest displacement (exaggerated warp, colour |u| [mm]) and, when contacts move,
@@ -99,7 +100,7 @@ def surface_maps(case, mesh, point_data, translations, point, directory: Path,
     level = point_data["erp_level_db_m2"]
     jobs = [dict(path=directory / "erp_map.png", points=mesh.points, triangles=mesh.triangles,
                  values=level, label="ERP density [dB re 1 pW/m2]",
-                 title=f"{case.name}: ERP at {at}", clim=[float(level.min()), float(level.max())])]
+                 title=f"{config.name}: ERP at {at}", clim=[float(level.min()), float(level.max())])]
     frames = period_samples(translations, 24)                              # (24, n, 3)
     frame = frames[int(np.argmax(np.linalg.norm(frames, axis=2).max(axis=1)))]
     magnitude = np.linalg.norm(frame, axis=1)

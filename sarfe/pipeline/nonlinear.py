@@ -16,6 +16,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from sarfe.io.case import Case, load_case
+from sarfe.io.config import DampingConfig, ExcitationConfig
 from sarfe.pipeline.linear import LinearStage
 
 
@@ -31,26 +32,25 @@ class NonlinearModel:
     tolerance: np.ndarray         # (n_c,) [m]
 
 
-def damping_matrix(case: Case, stage: LinearStage):
+def damping_matrix(damping: DampingConfig, stage: LinearStage):
     """D on the kept DOFs: the matrices' own D, modal ζ (reduced eigenmodes) or α M + β K,
     plus a deck's discrete dampers (CBUSH B, reduced: ``stage.info['spring_damping']``)."""
     added = getattr(stage, "added_damping", None)
-    matrix = _case_damping(case, stage)
+    matrix = _case_damping(damping, stage)
     return matrix if added is None else matrix + added
 
 
-def _case_damping(case: Case, stage: LinearStage):
-    damping = case.data["damping"]
+def _case_damping(damping: DampingConfig, stage: LinearStage):
     M, K = stage.mass, stage.stiffness
     if stage.damping is not None:
         return stage.damping
-    if "rayleigh" in damping:
-        return damping["rayleigh"]["alpha_1_s"] * M + damping["rayleigh"]["beta_s"] * K
+    if damping.rayleigh is not None:
+        return damping.rayleigh["alpha_1_s"] * M + damping.rayleigh["beta_s"] * K
     from sarfe.reduction.damping import reduced_modal_damping
 
     n = M.shape[0]
-    zeta = damping.get("modal_zeta", 0.0)
-    if isinstance(zeta, list):
+    zeta = 0.0 if damping.modal_zeta is None else damping.modal_zeta
+    if isinstance(zeta, tuple):         # per mode range: ({modes: [first, last], zeta}, …)
         values = np.full(n, zeta[-1]["zeta"])
         for entry in zeta:
             first, last = entry["modes"]
@@ -88,8 +88,9 @@ def build_contacts(case: Case, stage: LinearStage):
         rows.append(vector)
         return len(rows) - 1
 
-    for contact in case.data["contacts"]:
-        name, law = contact["name"], laws.law(contact["type"])
+    for entry in case.config.contacts:
+        contact = entry.params
+        name, law = entry.name, laws.law(entry.kind)
         tangent = laws.uses_tangent(law, contact)
         start = len(kind)
         if stage.kind == "fe":
@@ -129,8 +130,7 @@ def build_contacts(case: Case, stage: LinearStage):
             try:
                 values.update(law.prepare(contact, case.resolve))
             except ValueError as error:
-                raise case.error(str(error), ("contacts", case.data["contacts"].index(contact),
-                                              "type")) from None
+                raise case.error(str(error), ("contacts", entry.index, "type")) from None
         per_pair = {}                   # deck springs (from_elements): one value per node pair
         geometry = stage.contacts.get(name) if stage.kind == "fe" else None
         if getattr(geometry, "normal_stiffness", None) is not None:
@@ -169,8 +169,9 @@ def build_contacts(case: Case, stage: LinearStage):
     contacts = make_contact_set(G, np.array(kind, dtype=object), normal_row,
                                 np.array(tangent_rows, dtype=int).reshape(-1, 2), gap,
                                 names=names, parameters=parameters)
-    preloaded = [(idx, c["preload_N"]) for c, (_, _, idx) in zip(case.data["contacts"], groups)
-                 if "preload_N" in c and "gap_m" not in c and np.all(normal_row[idx] >= 0)]
+    preloaded = [(idx, c["preload_N"]) for c, (_, _, idx) in zip(case.config.contacts, groups)
+                 if "preload_N" in c.params and "gap_m" not in c.params
+                 and np.all(normal_row[idx] >= 0)]
     if preloaded:
         contacts = dataclasses.replace(contacts, gap=preload_gaps(
             stage.stiffness, G, normal_row, gap, contacts, preloaded))
@@ -258,14 +259,13 @@ def preload_gaps(stiffness, gap_map, normal_row, gap, contacts, preloaded):
     return gap
 
 
-def excitation_amplitude(case: Case, stage: LinearStage) -> np.ndarray:
+def excitation_amplitude(excitation: ExcitationConfig, stage: LinearStage) -> np.ndarray:
     """F̂ (n,) complex [N]: f_e(θ) = Re(F̂ e^{iθ})."""
-    exc = case.data["excitation"]
     amplitude = np.zeros(stage.dof_count, dtype=complex)
-    for load, vector in zip(exc.get("forces", []), stage.load_vectors):
+    for load, vector in zip(excitation.forces, stage.load_vectors):
         amplitude += load["force_N"] * np.exp(1j * math.radians(load["phase_deg"])) * vector
-    if "base_acceleration" in exc:
-        base = exc["base_acceleration"]
+    if excitation.base_acceleration is not None:
+        base = excitation.base_acceleration
         amplitude += (base["amplitude_m_s2"] * np.exp(1j * math.radians(base["phase_deg"]))
                       * stage.base_vector)
     return amplitude
@@ -276,10 +276,11 @@ def nonlinear_model(case, stage: LinearStage) -> NonlinearModel:
     from sarfe.hbm.model import make_linear_model
 
     case = load_case(case)
-    model = make_linear_model(stage.mass, damping_matrix(case, stage), stage.stiffness)
+    model = make_linear_model(stage.mass, damping_matrix(case.config.damping, stage),
+                               stage.stiffness)
     contacts, groups, tolerance = build_contacts(case, stage)
-    H = case.data["solver"]["harmonics"]
-    amplitude = excitation_amplitude(case, stage)
+    H = case.config.solver.harmonics
+    amplitude = excitation_amplitude(case.config.excitation, stage)
     F = np.zeros((2 * H + 1, stage.dof_count))
     F[1], F[2] = amplitude.real, -amplitude.imag
     return NonlinearModel(model, contacts, F, amplitude, groups, tolerance)

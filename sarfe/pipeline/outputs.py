@@ -11,13 +11,14 @@ import numpy as np
 from sarfe.pipeline.result_data import contact_pair_fields, result_groups
 
 
-def write_outputs(case, stage, nl, summary, rows, solutions, erps, normal_w, directory: Path):
+def write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, directory: Path):
     """Write the result files asked for in ``output.files`` into ``directory``; returns
-    {file kind: file name}. Everything "at the loudest point" (spectrum, contact plots, animation,
+    {file kind: file name}. ``config``: the case's :class:`sarfe.io.config.CaseConfig`.
+    Everything "at the loudest point" (spectrum, contact plots, animation,
     report maps) uses ``summary["worst"]["index"]`` (:func:`sarfe.pipeline.postprocess.loudest_point`)."""
     from sarfe.io import outputs
 
-    files = case.data["output"]["files"]
+    files = config.output.files
     written = {}
     outputs.write_summary_json(directory / "summary.json", summary)
     written["summary"] = "summary.json"
@@ -35,7 +36,7 @@ def write_outputs(case, stage, nl, summary, rows, solutions, erps, normal_w, dir
             mode_frequencies_hz=stage.mode_frequencies_hz, erp=erps,
             radiating_nodes=stage.erp_nodes if stage.erp_map.shape[0] else None,
             extra_groups=result_groups(summary["points"], nl),   # contributions, bands, …
-            attributes={"case": case.name, "linear_model_key": stage.key})
+            attributes={"case": config.name, "linear_model_key": stage.key})
         written["response"] = "response.h5"
     loudest = (summary.get("worst") or {}).get("index")
     images = {}
@@ -43,7 +44,7 @@ def write_outputs(case, stage, nl, summary, rows, solutions, erps, normal_w, dir
         from sarfe.pipeline.figures import point_figures
 
         plot_dir = directory if "plots" in files else directory / ".report-figures"
-        images = point_figures(case, stage, nl, summary, solutions, erps, plot_dir, loudest)
+        images = point_figures(config, stage, nl, summary, solutions, erps, plot_dir, loudest)
         if "plots" in files:
             written["plots"] = ", ".join(sorted(Path(v).name for v in images.values()))
     maps = {}
@@ -95,7 +96,7 @@ def write_outputs(case, stage, nl, summary, rows, solutions, erps, normal_w, dir
         if "report" in files and loudest is not None:
             from sarfe.pipeline.figures import surface_maps
 
-            maps = surface_maps(case, mesh, point_data(loudest), nodal_translations(loudest),
+            maps = surface_maps(config, mesh, point_data(loudest), nodal_translations(loudest),
                                 summary["points"][loudest], directory / ".report-figures",
                                 contact_nodes={name: int(g.nodes_a[0])
                                                for name, g in stage.contacts.items()

@@ -124,7 +124,8 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
             bar.close()
     timings["postprocess_s"] = time.perf_counter() - clock
     not_converged = [p["index"] for p in points if not p["converged"]]
-    sweep = sweep_status(config.excitation, config.solver.continuation, solutions)       # None entries without a sweep
+    # None entries without a sweep
+    sweep = sweep_status(config.excitation, config.solver.continuation, solutions)
     # exit code 3: a point did not converge, or the sweep fell back to point-by-point solving
     # without the band still being covered by converged points (docs/hbm.md, exit codes)
     exit_code = EXIT_NOT_CONVERGED if (not_converged or not points or (
@@ -151,7 +152,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         "points": points,
         "worst": worst_of(points),
         "accuracy": accuracy,                    # None unless solver.accuracy was given
-        "accuracy_check": accuracy_check(case, points),   # estimates vs the accuracy budget
+        "accuracy_check": accuracy_check(config.solver, points),   # estimates vs the accuracy budget
         "warnings": warnings,                    # inputs far outside the model's range
         "timings_s": timings,
         "case_data": case.data,                  # the case with every default filled in
@@ -167,7 +168,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         clock = time.perf_counter()
         summary["timings_s"]["outputs_s"] = 0.0
         summary["timings_s"]["total_s"] = time.perf_counter() - started
-        summary["files"] = write_outputs(case, stage, nl, summary, rows, solutions, erps,
+        summary["files"] = write_outputs(config, stage, nl, summary, rows, solutions, erps,
                                          normal_w, folder)
         summary["timings_s"]["outputs_s"] = time.perf_counter() - clock
         summary["timings_s"]["total_s"] = time.perf_counter() - started
