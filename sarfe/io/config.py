@@ -291,4 +291,5 @@ def case_config(case) -> CaseConfig:
 __all__ = ["CaseConfig", "ModelConfig", "FeConfig", "MatricesConfig", "DampingConfig",
            "ReductionConfig", "ContactConfig", "ExcitationConfig", "SweepConfig", "SolverConfig",
            "ContinuationConfig", "ErpConfig", "OutputConfig", "build_config", "case_config",
-           "DEFAULT_ZETA", "DEFAULT_ACCURACY", "CONTINUATION_MAX_STEP", "default_samples_per_period"]
+           "DEFAULT_ZETA", "DEFAULT_ACCURACY", "CONTINUATION_MAX_STEP",
+           "default_samples_per_period"]

@@ -96,12 +96,12 @@ def _file_digest(path: Path) -> str:
     return digest.hexdigest()
 
 
-def default_cutoff_hz(case: Case) -> float:
-    """Reduction cutoff when none is given: margin · H · f_max (margin 1.5 by default)."""
-    exc = case.data["excitation"]
-    f_max = max(exc["frequency_hz"]) if "frequency_hz" in exc else max(
-        exc["sweep"]["start_hz"], exc["sweep"]["end_hz"])
-    return case.data["reduction"]["cutoff_margin"] * case.data["solver"]["harmonics"] * f_max
+def default_cutoff_hz(config) -> float:
+    """Reduction cutoff [Hz] when none is given: margin · H · f_max (margin 1.5 by default).
+    ``config``: the case's CaseConfig (or the Case)."""
+    config = getattr(config, "config", config)
+    return (config.reduction.cutoff_margin * config.solver.harmonics
+            * config.excitation.max_frequency_hz)
 
 
 def linear_model_key(case) -> str:
@@ -123,7 +123,7 @@ def linear_model_key(case) -> str:
     exc = data["excitation"]
     parts = {
         "model": model,
-        "reduction": dict(data.get("reduction", {}), effective_cutoff_hz=default_cutoff_hz(case))
+        "reduction": dict(data.get("reduction", {}), effective_cutoff_hz=default_cutoff_hz(case.config))
         if case.is_fe else None,
         "contacts": [{k: c.get(k) for k in ("name", "between", "pairs", "pairing_tolerance_m",
                                             "normal", "normal_dof", "tangential_dofs",
@@ -143,7 +143,7 @@ def linear_model_key(case) -> str:
 # ------------------------------------------------------------------------------- matrices path
 def _read_matrix(case: Case, key):
     path_key = ("model", "matrices", key)
-    value = case.data["model"]["matrices"][key]
+    value = case.config.model.matrices.entry(key)
     if not isinstance(value, str):
         rows = [len(r) for r in value]
         if any(n != len(value) for n in rows):
@@ -182,10 +182,11 @@ def _check_dof(case, dof, n, path):
 
 
 def _build_matrices(case: Case, progress=False) -> dict:
-    data = case.data
+    config = case.config
     mass = _read_matrix(case, "mass")
     stiffness = _read_matrix(case, "stiffness")
-    damping = _read_matrix(case, "damping") if "damping" in data["model"]["matrices"] else None
+    damping = _read_matrix(case, "damping") if config.model.matrices.entry("damping") is not None \
+        else None
     n = mass.shape[0]
     for key, matrix in (("stiffness", stiffness), ("damping", damping)):
         if matrix is not None and matrix.shape != (n, n):
@@ -198,7 +199,7 @@ def _build_matrices(case: Case, progress=False) -> dict:
         word = str(exc).split()[0]
         key = word if word in ("mass", "stiffness", "damping") else "mass"
         raise case.error(str(exc), ("model", "matrices", key)) from None
-    for i, contact in enumerate(data["contacts"]):
+    for i, contact in ((c.index, c.params) for c in config.contacts):
         refs = ([("normal_dof", contact["normal_dof"])] if "normal_dof" in contact else []) + [
             (("tangential_dofs", j), t) for j, t in enumerate(contact.get("tangential_dofs", []))]
         for key, ref in refs:
@@ -208,27 +209,27 @@ def _build_matrices(case: Case, progress=False) -> dict:
             if ref["relative_to"] == ref["dof"]:
                 raise case.error("a DOF cannot be relative to itself",
                                  ("contacts", i) + key + ("relative_to",))
-    exc = data["excitation"]
-    loads = np.zeros((len(exc.get("forces", [])), n))
-    for i, load in enumerate(exc.get("forces", [])):
+    exc = config.excitation
+    loads = np.zeros((len(exc.forces), n))
+    for i, load in enumerate(exc.forces):
         _check_dof(case, load["dof"], n, ("excitation", "forces", i, "dof"))
         loads[i, load["dof"]] = 1.0
     base = None
-    if "base_acceleration" in exc:
-        influence = np.asarray(exc["base_acceleration"].get("influence", np.ones(n)), dtype=float)
+    if exc.base_acceleration is not None:
+        influence = np.asarray(exc.base_acceleration.get("influence", np.ones(n)), dtype=float)
         if influence.shape != (n,):
             raise case.error(f"needs {n} entries (one per DOF), got {len(influence)}",
                              ("excitation", "base_acceleration", "influence"))
         base = -(mass @ influence)
-    erp = data["erp"]
-    dofs = np.asarray(erp.get("dofs", []), dtype=int)
+    erp = config.erp
+    dofs = np.asarray(erp.dofs or [], dtype=int)
     for j, dof in enumerate(dofs):
         _check_dof(case, int(dof), n, ("erp", "dofs", j))
     erp_map = np.zeros((len(dofs), n))
     erp_map[np.arange(len(dofs)), dofs] = 1.0
     return dict(kind="matrices", mass=mass, stiffness=stiffness, damping=damping,
                 load_vectors=loads, base_vector=base, contacts={}, erp_map=erp_map,
-                erp_areas=np.asarray(erp.get("areas_m2", []), dtype=float), erp_nodes=dofs,
+                erp_areas=np.asarray(erp.areas_m2 or [], dtype=float), erp_nodes=dofs,
                 info={"dofs": n})
 
 
@@ -248,7 +249,7 @@ def load_case_mesh(case: Case):
     """The case's PanelMesh (file or generator), in metres; errors name model.fe.mesh/generator."""
     from sarfe.mesh import load_mesh
 
-    fe = case.data["model"]["fe"]
+    fe = case.config.model.fe.data
     if "mesh" in fe:
         path = case.resolve(fe["mesh"])
         try:
@@ -340,7 +341,7 @@ def pair_contact(case, mesh, index, normals_all):
     """Node pairs and frames of contacts[index] (nearest-node pairing or explicit pairs)."""
     from scipy.spatial import cKDTree
 
-    contact = case.data["contacts"][index]
+    contact = case.config.contacts[index].params
     p = ("contacts", index)
     points = mesh.points
     if "pairs" in contact:
@@ -493,7 +494,7 @@ def _reduce(case: Case, reduction, k_ff, m_ff, boundary, free, n_nodes, base_loa
 
     residual = reduction.residual_vectors
     cutoff = reduction.cutoff_hz if reduction.cutoff_hz is not None else (
-        None if reduction.mode_count is not None else default_cutoff_hz(case))
+        None if reduction.mode_count is not None else default_cutoff_hz(case.config))
     bar = _bar(progress, "Craig-Bampton mode blocks", None)
     try:
         def reduce(mode_count, cutoff_hz):
@@ -639,24 +640,26 @@ def check_mesh(case) -> dict:
     if not case.is_fe:
         _build_matrices(case)
         return {}
-    if "deck" in case.data["model"]["fe"]:
+    config = case.config
+    if config.model.fe.is_deck:
         from sarfe.pipeline.deck import check_deck
         return check_deck(case)
     mesh = load_case_mesh(case)
-    fe = case.data["model"]["fe"]
+    fe = config.model.fe.data
     for i, g in enumerate(fe["fixed"]):
         resolve_node_group(case, mesh, g, ("model", "fe", "fixed", i), allow_elements=False)
     _per_triangle(case, mesh, fe["materials"], "materials")
     _per_triangle(case, mesh, fe["thickness_m"], "thickness_m")
     from sarfe.erp import nodal_normals
     normals = nodal_normals(mesh.points, mesh.triangles)
-    paired = [pair_contact(case, mesh, i, normals) for i in range(len(case.data["contacts"]))]
-    pairs = {c["name"]: len(p[0]) for c, p in zip(case.data["contacts"], paired)}
+    paired = [pair_contact(case, mesh, c.index, normals) for c in config.contacts]
+    pairs = {c.name: len(p[0]) for c, p in zip(config.contacts, paired)}
     coincident = _mesh_quality(case, mesh, [(a, b) for a, b, _, _ in paired])
-    for i, f in enumerate(case.data["excitation"].get("forces", [])):
+    for i, f in enumerate(config.excitation.forces):
         resolve_node_group(case, mesh, f["group"], ("excitation", "forces", i, "group"))
-    if "surface" in case.data["erp"] and case.data["erp"]["surface"] not in mesh.element_groups:
-        resolve_node_group(case, mesh, case.data["erp"]["surface"], ("erp", "surface"))
+    surface = config.erp.surface
+    if surface is not None and surface not in mesh.element_groups:
+        resolve_node_group(case, mesh, surface, ("erp", "surface"))
     return {"nodes": mesh.n_nodes, "triangles": mesh.n_triangles, "contact_pairs": pairs,
             "coincident_node_pairs": len(coincident), "coincident_nodes": coincident[:50]}
 
@@ -666,7 +669,7 @@ def _mesh_quality(case, mesh, contact_pairs):
     that no contact pairs are returned (0-based node indices) for validate to list."""
     from sarfe.mesh import quality
 
-    where = ("model", "fe", "mesh" if "mesh" in case.data["model"]["fe"] else "generator")
+    where = case.config.model.fe.where
     index = np.arange(mesh.n_triangles)
     duplicates = quality.duplicate_elements(mesh.triangles, index)
     if duplicates:
@@ -687,7 +690,7 @@ def build_linear_model(case, progress=False) -> LinearStage:
     """Linear stage of a case (module docstring); raises CaseError for mesh/group/file problems."""
     case = load_case(case)
     clock = time.perf_counter()
-    if case.is_fe and "deck" in case.data["model"]["fe"]:
+    if case.is_fe and case.config.model.fe.is_deck:
         from sarfe.pipeline.deck_stage import build_deck_stage
         parts = build_deck_stage(case, progress)
     else:
