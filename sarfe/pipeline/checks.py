@@ -48,10 +48,7 @@ class CaseCheck:
 
 
 def _excitation_top_hz(case) -> float:
-    exc = case.data["excitation"]
-    if "sweep" in exc:
-        return max(exc["sweep"]["start_hz"], exc["sweep"]["end_hz"])
-    return max(exc["frequency_hz"])
+    return case.config.excitation.max_frequency_hz
 
 
 def _where(mesh, triangle) -> str:
@@ -63,8 +60,8 @@ def check_element_quality(case, mesh, joined=()) -> None:
     """Zero-area and duplicate triangles, unjoined coincident nodes → CaseError naming them."""
     from sarfe.mesh.quality import coincident_nodes, degenerate_elements, duplicate_elements
 
-    where = ("model", "fe", "mesh") if "mesh" in case.data["model"]["fe"] else ("model", "fe",
-                                                                               "generator")
+    where = ("model", "fe", "mesh") if case.config.model.fe.source == "mesh" else ("model", "fe",
+                                                                                  "generator")
     ids = np.arange(mesh.n_triangles)
     bad = degenerate_elements(mesh.points, mesh.triangles, ids, DEGENERATE_TOLERANCE)
     if bad:
@@ -97,7 +94,7 @@ def check_element_quality(case, mesh, joined=()) -> None:
 def check_thickness(case, mesh) -> None:
     size = float(np.linalg.norm(np.ptp(mesh.points, axis=0)))
     low, high = THICKNESS_RANGE
-    for name, t in case.data["model"]["fe"]["thickness_m"].items():
+    for name, t in case.config.model.fe.data["thickness_m"].items():
         path = ("model", "fe", "thickness_m", name)
         if t > high * size:
             raise case.error(f"thickness {t:g} m is not small against the model size {size:.3g} m "
@@ -147,7 +144,7 @@ def mesh_frequency_limit_hz(case, mesh) -> float:
     :func:`bending_resolution_hz` with each triangle's material and thickness."""
     from sarfe.pipeline.linear import _per_triangle
 
-    fe = case.data["model"]["fe"]
+    fe = case.config.model.fe.data
     materials, thickness = list(fe["materials"].values()), list(fe["thickness_m"].values())
     m = _per_triangle(case, mesh, fe["materials"], "materials")
     t = np.asarray(thickness, dtype=float)[_per_triangle(case, mesh, fe["thickness_m"],
@@ -159,8 +156,9 @@ def mesh_frequency_limit_hz(case, mesh) -> float:
 def range_warnings(case, mesh=None) -> list:
     """One-line warnings for inputs far outside the model's range (module docstring)."""
     warnings = []
+    config = case.config
     top = _excitation_top_hz(case)
-    H = case.data["solver"]["harmonics"]
+    H = config.solver.harmonics
     if mesh is not None:
         limit = mesh_frequency_limit_hz(case, mesh)
         if H * top > limit:
@@ -168,12 +166,12 @@ def range_warnings(case, mesh=None) -> list:
                             f"~{limit:.4g} Hz the mesh resolves ({ELEMENTS_PER_WAVELENGTH} elements "
                             "per bending wavelength): refine the mesh or lower the harmonics")
         size = float(np.linalg.norm(np.ptp(mesh.points, axis=0)))
-        for i, contact in enumerate(case.data["contacts"]):
+        for i, contact in ((c.index, c.params) for c in config.contacts):
             gap = contact.get("gap_m")
             if gap is not None and abs(gap) > size:
                 warnings.append(f"contacts[{i}] ({contact['name']}): gap_m = {gap:g} m is larger "
                                 f"than the structure ({size:.3g} m): the contact can never close")
-    cutoff = case.data.get("reduction", {}).get("cutoff_hz")
+    cutoff = None if config.reduction is None else config.reduction.cutoff_hz
     if cutoff is not None and H * top > cutoff:
         warnings.append(f"excitation {top:g} Hz × {H} harmonics = {H * top:.4g} Hz is above "
                         f"reduction.cutoff_hz = {cutoff:g} Hz: the higher harmonics have no modes")
@@ -183,9 +181,10 @@ def range_warnings(case, mesh=None) -> list:
 def reduced_model_warnings(case, stage) -> list:
     """Warnings that need the reduced model: H·f_max above its highest fixed-interface mode."""
     modes = np.asarray(stage.mode_frequencies_hz)
-    if stage.kind != "fe" or not modes.size or "mode_count" not in case.data.get("reduction", {}):
+    reduction = case.config.reduction
+    if stage.kind != "fe" or not modes.size or reduction is None or reduction.mode_count is None:
         return []
-    top, H = _excitation_top_hz(case), case.data["solver"]["harmonics"]
+    top, H = _excitation_top_hz(case), case.config.solver.harmonics
     if H * top > modes.max():
         return [f"excitation {top:g} Hz × {H} harmonics = {H * top:.4g} Hz is above the highest "
                 f"kept mode ({modes.max():.4g} Hz, reduction.mode_count = {modes.size})"]
@@ -198,7 +197,7 @@ def output_target(case, output_dir=None, force=False):
     writable — else CaseError, before any work (rules: :mod:`sarfe.io.result_folder`)."""
     from sarfe.io.result_folder import check_output_folder
 
-    target = output_dir if output_dir is not None else case.data["output"]["directory"]
+    target = output_dir if output_dir is not None else case.config.output.directory
     return check_output_folder(target, force=force, protected=[case.source])
 
 
@@ -215,11 +214,12 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True)
     if not case.is_fe:
         _build_matrices(case)
         return CaseCheck({}, tuple(range_warnings(case)), output)
-    if "deck" in case.data["model"]["fe"]:   # a Nastran/Abaqus deck: its own checks, with ids
+    config = case.config
+    if config.model.fe.is_deck:   # a Nastran/Abaqus deck: its own checks, with ids
         from sarfe.pipeline.deck import check_deck
         return CaseCheck(check_deck(case), tuple(range_warnings(case)), output)
     mesh = load_case_mesh(case)
-    fe = case.data["model"]["fe"]
+    fe = config.model.fe.data
     fixed = np.unique(np.concatenate([
         resolve_node_group(case, mesh, g, ("model", "fe", "fixed", i), allow_elements=False)
         for i, g in enumerate(fe["fixed"])]))
@@ -227,12 +227,12 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True)
     _per_triangle(case, mesh, fe["thickness_m"], "thickness_m")
     check_thickness(case, mesh)
     normals = nodal_normals(mesh.points, mesh.triangles)
-    paired = {c["name"]: pair_contact(case, mesh, i, normals)
-              for i, c in enumerate(case.data["contacts"])}
-    for i, f in enumerate(case.data["excitation"].get("forces", [])):
+    paired = {c.name: pair_contact(case, mesh, c.index, normals) for c in config.contacts}
+    for i, f in enumerate(config.excitation.forces):
         resolve_node_group(case, mesh, f["group"], ("excitation", "forces", i, "group"))
-    if "surface" in case.data["erp"] and case.data["erp"]["surface"] not in mesh.element_groups:
-        resolve_node_group(case, mesh, case.data["erp"]["surface"], ("erp", "surface"))
+    surface = config.erp.surface
+    if surface is not None and surface not in mesh.element_groups:
+        resolve_node_group(case, mesh, surface, ("erp", "surface"))
     joined = [(int(a), int(b)) for p in paired.values() for a, b in zip(p[0], p[1])]
     check_element_quality(case, mesh, joined)
     check_held(case, mesh, fixed)
