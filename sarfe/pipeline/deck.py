@@ -36,7 +36,7 @@ def read_case_deck(case: Case):
     """The case's deck in SI, ``ignore_cards`` applied; errors name model.fe.deck."""
     from sarfe.mesh.deck import DeckError, to_si
 
-    fe = case.data["model"]["fe"]
+    fe = case.config.model.fe.data
     path = case.resolve(fe["deck"])
     try:
         if path.suffix.lower() == ".inp":
@@ -53,7 +53,7 @@ def read_case_deck(case: Case):
 def apply_ignore_cards(case: Case, deck):
     """Move the cards named in ``ignore_cards`` from ``unsupported`` to ``ignored``; any card
     left unsupported is an error listing every such card with its count."""
-    ignore = {card_key(c): c for c in case.data["model"]["fe"]["ignore_cards"]}
+    ignore = {card_key(c): c for c in case.config.model.fe.data["ignore_cards"]}
     unsupported, ignored = {}, dict(deck.ignored)
     for card, count in deck.unsupported.items():
         (ignored if card_key(card) in ignore else unsupported)[card] = count
@@ -97,7 +97,7 @@ def deck_files(path, seen=None) -> list:
 def _ids_or_set(case, deck, value, path, kind):
     """Node indices (kind 'node') or element ids (kind 'element') of a group definition:
     an id list, or a deck set name / number."""
-    if isinstance(value, list):
+    if isinstance(value, (list, tuple)):
         if kind == "node":
             return _node_indices(case, deck, value, path)
         known = np.concatenate([deck.shells.element_ids, deck.springs.element_ids,
@@ -130,7 +130,7 @@ def deck_panel_mesh(case: Case, deck):
     element group), element groups = triangles of deck element sets + ``element_groups``."""
     from sarfe.mesh import PanelMesh
 
-    fe = case.data["model"]["fe"]
+    fe = case.config.model.fe.data
     shells = deck.shells
     node_groups = {name: np.asarray(nodes) for name, nodes in deck.node_sets.items()}
     element_groups = {}
@@ -153,7 +153,7 @@ def apply_overrides(case: Case, deck, mesh):
     """Shell sections of the element groups named in ``materials`` / ``thickness_m`` replaced by
     isotropic ones: A = t Q, B = 0, D = t³/12 Q, ρ t (later keys win; the deck's own elsewhere).
     A thickness alone keeps the deck's material (A, B, D and mass scaled by t'/t, (t'/t)³)."""
-    fe = case.data["model"]["fe"]
+    fe = case.config.model.fe.data
     materials, thickness = fe.get("materials", {}), fe.get("thickness_m", {})
     if not materials and not thickness:
         return deck
@@ -220,7 +220,7 @@ def springs_to_contacts(case: Case, deck):
     springs = deck.springs
     remove = np.zeros(len(springs.element_ids), dtype=bool)
     contacts = {}
-    for i, contact in enumerate(case.data["contacts"]):
+    for i, contact in ((c.index, c.params) for c in case.config.contacts):
         if "from_elements" not in contact:
             continue
         p = ("contacts", i, "from_elements")
@@ -313,13 +313,14 @@ def prepare_deck(case: Case) -> PreparedDeck:
     if free:
         raise case.error("the structure is not held after the supports: " + "; ".join(free)
                          + " (check model.fe.supports / fixed)", ("model", "fe", "supports"))
-    notes = {"deck": str(case.resolve(case.data["model"]["fe"]["deck"])),
-             "units": case.data["model"]["fe"]["units"],
+    fe = case.config.model.fe.data
+    notes = {"deck": str(case.resolve(fe["deck"])),
+             "units": fe["units"],
              "ignored_cards": dict(deck.ignored),
              "ignored_mass_kg": ignored_mass(case, deck.ignored),
              "coincident_nodes": [list(p) for p in quality["coincident_nodes"][:50]],
              "coincident_node_pairs": len(quality["coincident_nodes"]),
-             "support_sets": [str(s) for s in case.data["model"]["fe"].get("supports", [])]
+             "support_sets": [str(s) for s in fe.get("supports", [])]
              or sorted(deck.supports),
              "contact_elements": {k: v.element_ids.tolist() for k, v in element_contacts.items()},
              "deck_notes": list(deck.notes)}
@@ -339,7 +340,7 @@ def check_deck(case: Case) -> dict:
     prepared = prepare_deck(case)
     mesh, work = prepared.mesh, prepared.case
     pairs = {name: len(p[0]) for name, p in contact_pairs(prepared).items()}
-    for i, f in enumerate(case.data["excitation"].get("forces", [])):
+    for i, f in enumerate(case.config.excitation.forces):
         if "load_set" in f:
             if str(f["load_set"]) not in prepared.deck.loads:
                 raise case.error(f"load set '{f['load_set']}' not in the deck (available: "

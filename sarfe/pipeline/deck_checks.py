@@ -65,7 +65,7 @@ def support_mask(case: Case, deck, mesh) -> np.ndarray:
     always) and the ``fixed`` node groups (all six components)."""
     from sarfe.pipeline.linear import resolve_node_group
 
-    fe = case.data["model"]["fe"]
+    fe = case.config.model.fe.data
     chosen = [str(s) for s in fe.get("supports", [])] or sorted(deck.supports)
     if "permanent" in deck.supports and "permanent" not in chosen:
         chosen.append("permanent")
@@ -178,7 +178,7 @@ def ignored_mass(case: Case, ignored: dict) -> dict:
     None per card for an Abaqus file (not computed)."""
     if not ignored:
         return {}
-    fe = case.data["model"]["fe"]
+    fe = case.config.model.fe.data
     path = case.resolve(fe["deck"])
     if path.suffix.lower() == ".inp":
         return {card: None for card in ignored}

@@ -83,22 +83,22 @@ def contact_pairs(prepared) -> dict:
     deck, mesh = prepared.deck, prepared.mesh
     normals = nodal_normals(mesh.points, mesh.triangles)
     paired = {}
-    for i, contact in enumerate(prepared.case.data["contacts"]):
-        e = prepared.element_contacts.get(contact["name"])
+    for contact in prepared.case.config.contacts:
+        e = prepared.element_contacts.get(contact.name)
         if e is None:
-            paired[contact["name"]] = pair_contact(prepared.case, mesh, i, normals)
+            paired[contact.name] = pair_contact(prepared.case, mesh, contact.index, normals)
             continue
         distance = np.zeros(len(e.nodes_a))
         b = e.nodes_b >= 0
         distance[b] = np.einsum("ij,ij->i", e.frames[b, 0],
                                 deck.points[e.nodes_b[b]] - deck.points[e.nodes_a[b]])
-        paired[contact["name"]] = (e.nodes_a, e.nodes_b, e.frames, distance)
+        paired[contact.name] = (e.nodes_a, e.nodes_b, e.frames, distance)
     return paired
 
 
 def radiating_triangles(case: Case, mesh) -> np.ndarray:
     """Triangles of the ERP surface: every shell, or the element group erp.surface."""
-    surface = case.data["erp"].get("surface")
+    surface = case.config.erp.surface
     if surface is None:
         return mesh.triangles
     if surface not in mesh.element_groups:
@@ -127,18 +127,19 @@ def _craig_bampton(case: Case, k_ff, m_ff, boundary_positions, residual_loads):
     from sarfe.pipeline.linear import default_cutoff_hz
     from sarfe.reduction.craig_bampton import craig_bampton
 
-    red = case.data["reduction"]
-    use_residuals = red.get("residual_vectors", True)
-    cutoff = red.get("cutoff_hz", None if "mode_count" in red else default_cutoff_hz(case))
+    red = case.config.reduction
+    use_residuals = red.residual_vectors
+    cutoff = red.cutoff_hz if red.cutoff_hz is not None else (
+        None if red.mode_count is not None else default_cutoff_hz(case.config))
     loads = np.stack(residual_loads, axis=1) if residual_loads and use_residuals else None
     try:
         def reduce(mode_count, cutoff_hz):
             return craig_bampton(k_ff, m_ff, boundary_positions, mode_count=mode_count,
                                  cutoff_hz=cutoff_hz, residual_vectors=use_residuals,
                                  residual_loads=loads)
-        reduced = reduce(red.get("mode_count"), cutoff)
-        if "mode_count" not in red and reduced.mode_count < red["min_mode_count"]:
-            reduced = reduce(min(red["min_mode_count"],
+        reduced = reduce(red.mode_count, cutoff)
+        if red.mode_count is None and reduced.mode_count < red.min_mode_count:
+            reduced = reduce(min(red.min_mode_count,
                                  k_ff.shape[0] - len(boundary_positions) - 1), None)
     except Exception as error:   # any solver's failure (PARDISO, CHOLMOD, ARPACK): one line
         raise case.error(f"the structure is not held (singular stiffness: "
@@ -158,13 +159,12 @@ def build_deck_stage(case: Case, progress=False) -> dict:
     stages = _bar(progress, "linear stage", 4, unit="step")
     prepared = prepare_deck(case)
     deck, mesh, work = prepared.deck, prepared.mesh, prepared.case
-    data = case.data
     timings["deck_s"] = time.perf_counter() - clock
 
     # contacts and loads first: the errors a user is most likely to make
     paired = contact_pairs(prepared)
-    exc = data["excitation"]
-    forces = exc.get("forces", [])
+    exc = case.config.excitation
+    forces = exc.forces
     group_nodes = [None if "load_set" in f else
                    resolve_node_group(work, mesh, f["group"], ("excitation", "forces", i, "group"))
                    for i, f in enumerate(forces)]
@@ -206,8 +206,8 @@ def build_deck_stage(case: Case, progress=False) -> dict:
     boundary_positions = boundary_positions[boundary_positions >= 0]
 
     base_load = None
-    if "base_acceleration" in exc:   # rigid translation ι in the kept (CD) DOFs; −M ι
-        direction = np.asarray(exc["base_acceleration"]["direction"], dtype=float)
+    if exc.base_acceleration is not None:   # rigid translation ι in the kept (CD) DOFs; −M ι
+        direction = np.asarray(exc.base_acceleration["direction"], dtype=float)
         local = np.einsum("nij,j->ni", deck.displacement_frames, direction)
         iota = np.where(system.dof_components < 3,
                         local[system.dof_nodes, np.minimum(system.dof_components, 2)], 0.0)
