@@ -64,6 +64,8 @@ class ContinuationOptions:
     its reason). corrector_iterations: Newton cap of one corrector (a failed corrector halves Δs,
     so a low cap is cheaper than a long struggle; the corrector also uses at most 3 line-search
     halvings). solver: SolverOptions of the correctors.
+    The defaults are those of a library call; ``sarfe solve`` always passes the case's
+    ``solver.continuation`` (defaults in :class:`sarfe.io.config.ContinuationConfig`, max_step 0.1).
     """
 
     initial_step: float = 0.02

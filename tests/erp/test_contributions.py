@@ -12,6 +12,7 @@ from sarfe.hbm.contacts import make_contact_set
 from sarfe.hbm.linear import to_complex
 from sarfe.hbm.model import make_linear_model
 from sarfe.pipeline.contact_dynamics import contact_dynamics
+from sarfe.io.config import ErpConfig
 from sarfe.pipeline.contributions import point_contributions, source_displacements
 
 H, N = 9, 256
@@ -20,7 +21,7 @@ ERP = {"rho_kg_m3": 1.204, "c_m_s": 343.2, "radiation_loss_factor": 1.0,
 
 
 def _case_stage_nl(model, contacts, F, groups, erp_map, areas):
-    case = SimpleNamespace(data={"erp": ERP})
+    case = ErpConfig(**ERP)            # the case's erp section (sarfe.io.config)
     stage = SimpleNamespace(erp_map=np.asarray(erp_map, dtype=float), erp_areas=np.asarray(areas))
     nl = SimpleNamespace(model=model, contacts=contacts, excitation=F, groups=groups)
     return case, stage, nl
