@@ -93,6 +93,7 @@ class HarmonicSolution:
     the orders outside the set (outside the odd set, for an 'auto' solution that used all orders)
     carry, see :func:`sarfe.hbm.harmonic_set.dropped_content` (nan if not computed).
     Residual_norm and stability: residual of the kept rows; Hill stability of the full set.
+    stability_note: why ``stable`` is None although stability was computed ('' otherwise).
     """
 
     omega: float
@@ -113,6 +114,7 @@ class HarmonicSolution:
     harmonic_orders: tuple = None
     harmonic_set: str = "all"
     dropped_content: float = float("nan")
+    stability_note: str = ""
 
     def amplitude(self, dof: int, harmonic: int = 1) -> float:
         """Amplitude √(u_kc² + u_ks²) of harmonic k of one DOF [m] (k = 0: the mean)."""

@@ -39,6 +39,7 @@ from .newton import SingularJacobian, newton, solve_linear
 from .residual import Problem, condensed_residual, full_residual, kept_rows
 from .solution import HarmonicSolution, SolverOptions
 from .stability import hill_stability
+from .stability_contacts import ContactOperator
 
 
 def make_problem(model, contacts, excitation, harmonics, samples_per_period, options=None,
@@ -250,11 +251,13 @@ def finalize(problem, omega, U, converged, reason, iterations, slider, options) 
     elif converged and residual > options.full_tolerance:
         converged = False
         reason = f"full residual {residual:.3g} above full_tolerance {options.full_tolerance:g}"
-    stable, exponent = None, float("nan")
+    stable, exponent, note = None, float("nan"), ""
     if converged and options.stability:
-        stable, exponent = hill_stability(problem.model, omega, problem.harmonics, ev.jacobian,
-                                          options.stability_tolerance,
-                                          contact_damping=contact_damping(problem, ev.forces))
+        result = hill_stability(problem.model, omega, problem.harmonics, ev.jacobian,
+                                options.stability_tolerance,
+                                contact_damping=contact_damping(problem, ev.forces),
+                                operator=ContactOperator(full, U, omega, ev.forces))
+        stable, exponent, note = result.stable, result.leading, result.note
     orders = problem.harmonic_orders
     return HarmonicSolution(
         omega=float(omega), harmonics=problem.harmonics,
@@ -263,7 +266,7 @@ def finalize(problem, omega, U, converged, reason, iterations, slider, options) 
         contact_force_time=ev.forces.force_time, contact_state=ev.forces.state,
         converged=bool(converged), reason=reason, iterations=int(iterations),
         residual_norm=residual, friction_passes=int(ev.forces.friction_passes),
-        stable=stable, floquet_exponent=exponent,
+        stable=stable, floquet_exponent=exponent, stability_note=note,
         harmonic_orders=None if orders is None else tuple(int(k) for k in orders),
         harmonic_set=harmonic_set_label(problem), dropped_content=eta)
 
