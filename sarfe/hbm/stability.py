@@ -24,7 +24,7 @@ grows or decays with e^{st} meanwhile, so its term is 𝒥(s), and the eigenprob
 
     T(s) p̃ = ( s² M̃ + s D̃ + S(ω) + (I⊗G)ᵀ 𝒥(s) (I⊗G) ) p̃ = 0;
 
-the kinks of the normal laws are integrated on 8N samples. The exponents of the frozen problem
+the normal laws keep their N-sampled Jacobian. The exponents of the frozen problem
 (𝒥(0), the harmonic-map Jacobian) are the starting points; the leading ones are refined by
 successive linear problems (:func:`refine_exponent`) until the largest real part belongs to a
 refined exponent. The verdict is ``None`` with a note when it cannot be trusted: the refinement did
