@@ -27,6 +27,9 @@ class SolverOptions:
         G S_k⁻¹ Gᵀ (Newton on the contact rows only). 'auto' condenses when that system is smaller
         than the full one and at most ``max_condensed_size`` unknowns.
     stability: compute Hill stability of the converged solution.
+    stability_method: 'full' (the Hill eigenproblem on all DOFs, :mod:`sarfe.hbm.stability`),
+        'condensed' (its roots on the contact rows, :mod:`sarfe.hbm.stability_condensed`) or
+        'auto': condensed when the full Hill matrix exceeds ``CONDENSED_ABOVE`` (2(2H+1)n rows).
     friction_tolerance, friction_pass_cap: 2-D slider march, stop when the slider state repeats to
         friction_tolerance × (max |q| + max ρ), at most friction_pass_cap periods.
     harmonic_set: None | 'all' | 'odd' | 'auto' | a list of orders: the harmonic orders solved for
@@ -46,6 +49,7 @@ class SolverOptions:
     max_condensed_size: int = 2000
     stability: bool = True
     stability_tolerance: float = 1e-6
+    stability_method: str = "auto"
     friction_tolerance: float = 1e-12
     friction_pass_cap: int = 50
     harmonic_set: object = None

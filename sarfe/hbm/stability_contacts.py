@@ -146,10 +146,14 @@ class ContactOperator:
             out.append((g["rows"], J))
         return out
 
-    def correction(self, s):
-        """(I⊗G)ᵀ [𝒥(s) − 𝒥_AFT] (I⊗G) (sparse CSR, complex when s is)."""
+    def rows_correction(self, s):
+        """𝒥(s) − 𝒥_AFT on the contact rows ((2H+1) n_rows square, sparse, harmonic-major)."""
         J = self._fixed.astype(complex)
         for rows, block in self.blocks_at(s):
             J = J + jacobian_matrix([(rows, block.real)], self.n_rows, self.H) \
                 + 1j * jacobian_matrix([(rows, block.imag)], self.n_rows, self.H)
-        return (self.GG.T @ J @ self.GG).tocsr()
+        return J.tocsr()
+
+    def correction(self, s):
+        """(I⊗G)ᵀ [𝒥(s) − 𝒥_AFT] (I⊗G) (sparse CSR, complex when s is)."""
+        return (self.GG.T @ self.rows_correction(s) @ self.GG).tocsr()
