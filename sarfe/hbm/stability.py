@@ -109,9 +109,12 @@ def _select(values, omega, keep):
 def _nearest(Mt, Dt, jacobian, target, dense, count=3):
     """Eigenvalues of the frozen pencil nearest ``target`` (complex allowed)."""
     A, B = _first_order(Mt, Dt, jacobian, dense)
-    if dense:
+    if dense and A.shape[0] <= 64:
         values = np.linalg.eigvals(A)
         return values[np.argsort(np.abs(values - target))[:count]]
+    if dense:      # shift-invert on a dense LU: the few values near the target, not all of them
+        return spla.eigs(A.astype(complex), k=count, sigma=target, which="LM",
+                         return_eigenvectors=False)
     return spla.eigs(A.astype(complex), k=count, M=B.astype(complex), sigma=target, which="LM",
                      return_eigenvectors=False)
 
