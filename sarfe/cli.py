@@ -106,11 +106,11 @@ def cmd_verify(args) -> int:
     stage = build_linear_model(case, progress=not args.quiet)
     nl = nonlinear_model(case, stage)
     hbm, tim, check, rows = verify_point(case, stage, nl, 2 * np.pi * args.frequency_hz,
-                                         args.tolerance, args.tolerance_db, args.periods)
+                                         args.tolerance, args.tolerance_db)
     print(f"verify {case.name} at {args.frequency_hz:g} Hz: HBM (H={hbm.harmonics}, "
           f"N={hbm.samples_per_period}, converged={hbm.converged}) vs time integration "
           f"({tim.steps_per_period} steps/period, {tim.periods} periods, steady={tim.steady})"
-          + ("" if check is None else f"; perturbation of {check.periods} periods"))
+          + ("" if check is None else f"; monodromy from {check.periods} perturbed periods"))
     for line in format_rows(rows):
         print(line)
     bad = [r.label for r in rows if not r.agree]
@@ -152,8 +152,6 @@ def build_parser() -> argparse.ArgumentParser:
                    help="relative amplitude/ERP difference accepted (default 0.05)")
     p.add_argument("--tolerance-db", type=float, default=0.5,
                    help="ERP dB(A) difference accepted (default 0.5)")
-    p.add_argument("--periods", type=int, default=30,
-                   help="periods of the perturbed time integration (stability check, default 30)")
     p.set_defaults(func=cmd_verify)
     p = sub.add_parser("validate", help="check a case file: everything `solve` checks before "
                        "the heavy work (schema, numbers, mesh quality, groups, contact pairing, "

@@ -7,8 +7,9 @@ Compared, each with its own tolerance (a row per comparison, printed by the CLI)
   k = 1 is the plain relative error) ≤ ``tolerance``;
 - the first-harmonic normal amplitude of each named contact and of the largest DOF ≤ ``tolerance``;
 - the ERP total [W] (relative) ≤ ``tolerance`` and its level in dB(A) (absolute) ≤ ``tolerance_db``;
-- the stability verdict: Hill's ``stable`` against a perturbed time integration started on the HBM
-  orbit (:func:`sarfe.hbm.stability_check.perturbation_check`: the perturbation decays or grows);
+- the stability verdict: Hill's ``stable`` against the time integrator's own verdict
+  (:func:`sarfe.hbm.stability_check.perturbation_check`: the monodromy of the period map around
+  the orbit, i.e. whether perturbations of the orbit decay or grow over a period);
   a Hill verdict of None (uncertain) is reported, not counted as a disagreement.
 
 The time integration of the response starts independently from the linear periodic solution.
@@ -38,7 +39,7 @@ def _relative(a, b):
     return abs(a - b) / max(abs(b), 1e-300)
 
 
-def verify_point(case, stage, nl, omega, tolerance=0.05, tolerance_db=0.5, periods=30):
+def verify_point(case, stage, nl, omega, tolerance=0.05, tolerance_db=0.5):
     """(hbm solution, time response, perturbation check, [Comparison]) at ω [rad/s]."""
     from sarfe.hbm.stability_check import perturbation_check
     from sarfe.hbm.time_integration import integrate_time
@@ -85,12 +86,12 @@ def verify_point(case, stage, nl, omega, tolerance=0.05, tolerance_db=0.5, perio
                            diff <= tolerance_db))
     check = None
     if hbm.converged:
-        check = perturbation_check(nl.model, nl.contacts, nl.excitation, hbm, periods=periods,
-                                   steps_per_period=max(256, N))
+        check = perturbation_check(nl.model, nl.contacts, nl.excitation, hbm,
+                                   steps_per_period=max(512, 4 * N))
         verdict = {True: "stable", False: "unstable", None: "uncertain"}[hbm.stable]
         note = getattr(hbm, "stability_note", "")
         rows.append(Comparison(
-            f"stability (Hill {hbm.floquet_exponent:.3g} 1/s vs decay rate {check.rate:.3g} 1/s)"
+            f"stability (Hill {hbm.floquet_exponent:.3g} 1/s vs time int. {check.rate:.3g} 1/s)"
             + (f" [{note}]" if note else ""), verdict, "stable" if check.stable else "unstable",
             None, None, "", hbm.stable is None or hbm.stable == check.stable))
     return hbm, tim, check, rows
