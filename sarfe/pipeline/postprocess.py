@@ -258,6 +258,8 @@ def point_record(case, stage, nl, index, solution, error_estimate=False):
     point = {
         "index": index, "frequency_hz": omega / (2 * np.pi), "omega_rad_s": omega,
         "converged": bool(solution.converged), "stable": None if stable is None else bool(stable),
+        "stability_note": str(getattr(solution, "stability_note", "")),
+        "floquet_exponent_1_s": float(getattr(solution, "floquet_exponent", float("nan"))),
         "iterations": int(getattr(solution, "iterations", 0)),
         "residual_norm": float(getattr(solution, "residual_norm", float("nan"))),
         "reason": str(getattr(solution, "reason", "")),
