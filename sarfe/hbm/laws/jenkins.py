@@ -14,6 +14,18 @@ states: separation (λ_n = 0: ρ = 0, the slider follows, λ_t = 0), stick (w_j 
 slip (the projection is active, |λ_t| = μ λ_n). In one tangential direction the projection is a
 clamp, w_j = clip(w_{j−1}, q_j − ρ_j, q_j + ρ_j).
 
+Gauge of the periodic state. Where the slider slips (or the contact separates) during the period,
+its periodic state is fixed by q̃ and λ̃_n. A contact that sticks the whole period has a whole
+interval (a convex set in 2-D) of periodic slider positions — the mean tangential force is a
+history constant, and a Jacobian with ∂w/∂q̃ = 0 leaves the periodic solutions a continuum that a
+Newton corrector or a continuation cannot follow. The periodic state is therefore taken as the one
+reached by marching from the slider relaxed on average, w_start = q̄ (mean of q over the period):
+1-D: w_0 = clip(q̄, A, B) with [A, B] the interval of periodic starts; a stuck contact carries
+zero mean tangential force, a contact whose interval does not hold q̄ rests on the nearest edge
+(the mean force a slowly creeping slider would settle to). This makes λ_t a continuous, piecewise
+smooth function of q̃ and λ̃_n alone (the ``slider_start`` of a call is not used), continuous
+through stick ↔ slip transitions, and the Jacobian regular in stick.
+
 The element provides (vectorized over contacts, driven by the law's normal force λ_n(θ)):
 - :func:`periodic_forces`: the periodic steady state over one period and its AFT Jacobian (1-D:
   exact clamp composition without a sample loop; 2-D: the march with its consistent tangent);
@@ -93,8 +105,8 @@ def jenkins_periodic_1d(tangential_displacement, slip_radius, slider_start):
     on w_end again (it only confirms): 2 passes.
 
     q: (N, n) [m], ρ = μ λ_n / k_t: (N, n) [m], slider_start: (n,) [m].
-    Returns dict with slider w (N, n), state (N, n) int8, reset (N, n) bool (slip or separation:
-    the history is erased there), sign (N, n) ∈ {+1, −1, 0} with λ_t = sign·μλ_n at a slip sample
+    Returns dict with slider w (N, n), state (N, n) int8, reset (N, n) bool (slip, separation or
+    the slider resting on a slip bound: the history is erased there), sign (N, n) ∈ {+1, −1, 0} with λ_t = sign·μλ_n at a slip sample
     (+1: w clamped at q − ρ), slider_end (n,), passes = 2.
     """
     q = np.asarray(tangential_displacement, dtype=float)
@@ -104,11 +116,14 @@ def jenkins_periodic_1d(tangential_displacement, slip_radius, slider_start):
     slider_end = np.clip(slider_start, A[-1], B[-1])
     slider = np.clip(slider_end, A, B)
     previous = np.concatenate([slider_end[None], slider[:-1]], axis=0)
-    below, above = previous < lower, previous > upper
+    # ≤: a slider resting exactly on a bound (a start clamped to the edge of the periodic
+    # interval) follows that bound, like a slip sample
+    below, above = previous <= lower, previous >= upper
     separated = rho <= 0.0
     sign = np.where(separated, 0, np.where(below, 1, np.where(above, -1, 0))).astype(np.int8)
     reset = separated | below | above
-    state = np.where(separated, SEPARATED, np.where(below | above, SLIP, STICK)).astype(np.int8)
+    slipping = (previous < lower) | (previous > upper)
+    state = np.where(separated, SEPARATED, np.where(slipping, SLIP, STICK)).astype(np.int8)
     return {"slider": slider, "state": state, "reset": reset, "sign": sign,
             "slider_end": slider_end, "passes": 2}
 
@@ -164,7 +179,8 @@ def periodic_forces(p, q, one_d, normal_force, normal_stiffness, slider_start, H
 
     p: parameters (tangential_stiffness k_t, friction_coefficient μ; (n,) each); q (N, n, 2) [m]
     tangential displacements, one_d (n,) bool: only the first direction exists; normal_force λ_n (N, n) [N], normal_stiffness ∂λ_n/∂w (N, n) [N/m]; slider_start (n, 2);
-    kept_rows: coefficient rows of the Jacobian (P of them).
+    kept_rows: coefficient rows of the Jacobian (P of them). slider_start is not used: the periodic
+    state is fixed by the gauge (module docstring), so it is a function of q and λ_n alone.
     Returns (λ_t (N, n, 2), state (N, n) int8, slider_end (n, 2), passes, J (n, 3P, 3P) or None)
     with J in the local layout (h·3 + l), l = 0 normal, 1, 2 tangents; its tangential rows only.
     """
@@ -179,9 +195,9 @@ def periodic_forces(p, q, one_d, normal_force, normal_stiffness, slider_start, H
     J = np.zeros((n, 3 * P, 3 * P)) if jacobian else None
     passes = 0
     c1 = np.flatnonzero(one_d)
-    if c1.size:                      # 1-D: clamp scan, exact steady state in one pass
+    if c1.size:                      # 1-D: clamp scan, exact steady state
         qc = q_all[:, c1, 0]
-        res = jenkins_periodic_1d(qc, rho[:, c1], slider_start[c1, 0])
+        res = jenkins_periodic_1d(qc, rho[:, c1], qc.mean(axis=0))     # gauge: see above
         force[:, c1, 0] = k_t[c1] * (qc - res["slider"])
         state[:, c1] = res["state"]
         slider_end[c1, 0] = res["slider_end"]
@@ -192,7 +208,7 @@ def periodic_forces(p, q, one_d, normal_force, normal_stiffness, slider_start, H
     if c2.size:
         force_t, st, w_end, n_pass, J2 = _march_2d(
             q_all[:, c2], rho[:, c2], mu[c2] * normal_stiffness[:, c2] / k_t[c2], k_t[c2],
-            slider_start[c2], H, N, jacobian, tolerance, pass_cap, kept_rows)
+            q_all[:, c2].mean(axis=0), H, N, jacobian, tolerance, pass_cap, kept_rows)
         force[:, c2] = force_t
         state[:, c2] = st
         slider_end[c2] = w_end
@@ -209,7 +225,8 @@ def _jacobian_1d(res, mu_dlam, k_t, H, N, kept_rows):
     The slider forgets its past at every slip or separation sample j(i), so
     λ_t,i = k_t (q_i − q_j) + s_j μ λ_n,j and ∂λ_t,i/∂X = k_t (Φ_i − Φ_j) + s_j μ ∂λ_n,j/∂w Φ_j
     (s_j = ±1 the slip direction), pushed through one FFT of the gathered rows Φ_{j(i)}; a contact
-    sticking the whole period gives λ_t = k_t (q − w0) with w0 a history constant, ∂w0/∂X = 0."""
+    sticking the whole period has the gauge slider w0 = q̄ (mean of q over the period), so
+    λ_t = k_t (q − q̄) and ∂λ̃_t/∂q̃ = k_t (I − e₀ Φ̄) (Φ̄ = mean row of Φ: the mean row drops out)."""
     P = kept_rows.size
     n = k_t.size
     Phi = _basis(H, N)[:, kept_rows]
@@ -218,9 +235,11 @@ def _jacobian_1d(res, mu_dlam, k_t, H, N, kept_rows):
     weight = np.take_along_axis(res["sign"] * mu_dlam, j, axis=0)  # s_j μ ∂λ_n/∂w at j(i)
     memory = np.moveaxis(hm.harmonic_coefficients(gathered, H)[kept_rows], 0, 1)  # E P Φ (n, P, P)
     normal = np.moveaxis(hm.harmonic_coefficients(weight[..., None] * gathered, H)[kept_rows], 0, 1)
+    mean_row = np.outer(hm.harmonic_coefficients(np.ones((N, 1)), H)[kept_rows, 0],
+                        Phi.mean(axis=0))                  # E 1 Φ̄: ∂(q̄ per sample)/∂q̃
     J = np.zeros((n, 3 * P, 3 * P))
     eye = np.eye(P)
-    J[:, 1::3, 1::3] = k_t[:, None, None] * (eye - np.where(has[:, None, None], memory, 0.0))
+    J[:, 1::3, 1::3] = k_t[:, None, None] * (eye - np.where(has[:, None, None], memory, mean_row))
     J[:, 1::3, 0::3] = np.where(has[:, None, None], normal, 0.0)
     return J
 
@@ -237,7 +256,8 @@ def _march_2d(q, rho, drho_dw, k_t, start, H, N, jacobian, tolerance, pass_cap, 
     propagates the consistent tangent: with X = local harmonics (h·3 + l),
         dw_j = (I − P_j) dq_j + n_j dρ_j + P_j dw_{j−1},
     and the periodicity w_N = w_0 gives ∂w_0/∂X = (I − A)⁻¹ B (A = ∂w_N/∂w_0, B = ∂w_N/∂X at
-    fixed w_0) when the contact slipped or separated; 0 (history constant) when it stuck.
+    fixed w_0) when the contact slipped or separated; ∂q̄/∂X when it stuck (``start`` = q̄, the
+    gauge of the module docstring).
     Returns (λ_t (N, n, 2), state (N, n), w_end (n, 2), passes, J (n, 3P, 3P) or None).
     """
     n = q.shape[1]
@@ -290,7 +310,7 @@ def _march_2d(q, rho, drho_dw, k_t, start, H, N, jacobian, tolerance, pass_cap, 
     if not jacobian:
         return force, state, w, passes, None
     forgot = np.any(state != STICK, axis=0)
-    dw0 = np.zeros((n, 2, 3 * P))
+    dw0 = np.broadcast_to(dq.mean(axis=0), (n, 2, 3 * P)).copy()   # stuck: w_0 = q̄
     if np.any(forgot):
         system = np.eye(2) - dw_dw0[forgot]
         dw0[forgot] = np.linalg.solve(system, dw[forgot])
