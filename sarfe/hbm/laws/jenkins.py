@@ -245,7 +245,8 @@ def _jacobian_1d(res, mu_dlam, k_t, H, N, kept_rows):
 
 
 def _march_2d(q, rho, drho_dw, k_t, start, H, N, jacobian, tolerance, pass_cap, kept_rows):
-    r"""2-D Jenkins elements marched sample by sample (vectorized over contacts).
+    r"""2-D Jenkins elements marched sample by sample (compiled kernels over contacts × samples,
+    :mod:`.jenkins_march`).
 
     The disk projection of the slider is not composable like the 1-D clamp, so the march over
     samples is inherent to 2-D hysteresis. Periods are marched from ``start`` until the slider
@@ -260,59 +261,27 @@ def _march_2d(q, rho, drho_dw, k_t, start, H, N, jacobian, tolerance, pass_cap, 
     gauge of the module docstring).
     Returns (λ_t (N, n, 2), state (N, n), w_end (n, 2), passes, J (n, 3P, 3P) or None).
     """
+    from . import jenkins_march as march    # numba is imported (and the kernels loaded) on first use
     n = q.shape[1]
     P = kept_rows.size                                       # local harmonic rows (kept set)
     scale = np.abs(q).max() + rho.max() + 1e-300
-    w = np.array(start, dtype=float)
-    passes = 0
-    eye = np.eye(2)
-    while True:
-        w0 = w.copy()
-        A = np.broadcast_to(eye, (n, 2, 2)).copy()        # ∂w_N/∂w_0 over the pass
-        for j in range(N):
-            w, _, Pj, _ = slider_update_derivatives(w, q[j], rho[j])
-            A = Pj @ A
-        passes += 1
-        residual = w - w0
-        if np.abs(residual).max() <= tolerance * scale or passes >= pass_cap:
-            w = w0 if np.abs(residual).max() <= tolerance * scale else w
-            break
-        # Newton on the periodicity w_N(w_0) = w_0 where it is well posed (slip: I − A regular)
-        system = eye - A
-        det = np.linalg.det(system)
-        ok = np.abs(det) > 1e-6
-        if np.any(ok):
-            w[ok] = w0[ok] + np.linalg.solve(system[ok], residual[ok][..., None])[..., 0]
-    Phi = _basis(H, N)[:, kept_rows]
-    force = np.empty((N, n, 2))
-    state = np.empty((N, n), np.int8)
-    if jacobian:
-        dw = np.zeros((n, 2, 3 * P))                        # ∂w/∂X at fixed w_0
-        dw_dw0 = np.broadcast_to(np.eye(2), (n, 2, 2)).copy()
-        dforce = np.empty((N, n, 2, 3 * P))
-        history = np.empty((N, n, 2, 2))
-        dq = np.zeros((N, 2, 3 * P))                       # ∂q_j/∂X templates
-        dq[:, 0, 1::3], dq[:, 1, 2::3] = Phi, Phi
-        dn = np.zeros((N, 3 * P))                          # ∂w_j/∂X (normal) template
-        dn[:, 0::3] = Phi
-    w_start = w.copy()
-    for j in range(N):
-        w, st, Pj, n_rho = slider_update_derivatives(w, q[j], rho[j])
-        force[j] = k_t[:, None] * (q[j] - w)
-        state[j] = st
-        if jacobian:      # dw_j = P_j (dw_{j−1} − dq_j) + dq_j + n_j dρ_j
-            dw = Pj @ (dw - dq[j]) + dq[j] + n_rho[:, :, None] * (drho_dw[j][:, None, None]
-                                                                  * dn[j][None, None, :])
-            dw_dw0 = Pj @ dw_dw0
-            dforce[j] = k_t[:, None, None] * (dq[j] - dw)
-            history[j] = dw_dw0
+    q = np.ascontiguousarray(q, dtype=float)
+    rho = np.ascontiguousarray(rho, dtype=float)
+    w_start, passes = march.periodic_start(q, rho, np.array(start, dtype=float),
+                                           tolerance * scale, pass_cap)
+    Phi = np.ascontiguousarray(_basis(H, N)[:, kept_rows])
+    force, state, dforce, history, dw = march.final_pass(
+        q, rho, np.ascontiguousarray(drho_dw, dtype=float), np.asarray(k_t, dtype=float),
+        w_start, Phi, jacobian)
     passes += 1
     if not jacobian:
-        return force, state, w, passes, None
+        return force, state, w_start, passes, None
+    dq_mean = np.zeros((2, 3 * P))                          # ∂q̄/∂X (the stuck gauge w_0 = q̄)
+    dq_mean[0, 1::3] = dq_mean[1, 2::3] = Phi.mean(axis=0)
     forgot = np.any(state != STICK, axis=0)
-    dw0 = np.broadcast_to(dq.mean(axis=0), (n, 2, 3 * P)).copy()   # stuck: w_0 = q̄
+    dw0 = np.broadcast_to(dq_mean, (n, 2, 3 * P)).copy()
     if np.any(forgot):
-        system = np.eye(2) - dw_dw0[forgot]
+        system = np.eye(2) - history[-1, forgot]
         dw0[forgot] = np.linalg.solve(system, dw[forgot])
     dforce -= k_t[None, :, None, None] * np.einsum("jcab,cbx->jcax", history, dw0)
     coeff = hm.harmonic_coefficients(dforce, H)[kept_rows]  # (P, n, 2, 3P)
