@@ -84,3 +84,41 @@ def test_compiled_march_jacobian_matches_finite_differences(amplitude):
                 analytic = J[c, :, 3 * h + l].reshape(2 * H + 1, 3)[:, 1:]
                 assert np.abs(analytic - column[:, c]).max() < 1e-5 * max(
                     1.0, np.abs(column[:, c]).max()), (h, l, c)
+
+
+@pytest.mark.parametrize("mean_normal", [1.6, 1.2])
+def test_one_direction_gauge_and_jacobian(mean_normal):
+    """1-D stuck contact under a varying normal load: the periodic slider is q̄ clipped to the
+    interval [A, B] of periodic starts (1.6: q̄ inside, zero mean force; 1.2: q̄ below A, the slider
+    rests on the edge A); the Jacobian matches central differences in both cases."""
+    from sarfe.hbm.laws.jenkins import compose_clamps
+    p = {"tangential_stiffness": np.ones(1), "friction_coefficient": np.ones(1)}
+    Q = np.zeros((2 * H + 1, 1, 2))
+    Q[1, 0, 0], Q[4, 0, 0] = 1.0, 0.3
+    L = np.zeros((2 * H + 1, 1))
+    L[0], L[1], L[2] = mean_normal, -0.5, 0.3
+
+    def evaluate(Q, L, jacobian=False):
+        q = hm.time_samples(Q.reshape(2 * H + 1, -1), N).reshape(N, 1, 2)
+        return periodic_forces(p, q, np.ones(1, bool), hm.time_samples(L, N), 10.0 * np.ones((N, 1)),
+                               None, H, N, jacobian, 1e-12, 50, np.arange(2 * H + 1))
+    q = hm.time_samples(Q[:, :, 0], N)
+    rho = hm.time_samples(L, N)
+    A, B = compose_clamps(q - rho, q + rho)
+    force, state, slider_end, _, J = evaluate(Q, L, True)
+    assert np.all(state == STICK) and A[-1, 0] < B[-1, 0]
+    assert slider_end[0, 0] == pytest.approx(np.clip(q.mean(), A[-1, 0], B[-1, 0]), abs=1e-14)
+    assert force[:, 0, 0].mean() == pytest.approx(q.mean() - slider_end[0, 0], abs=1e-12)
+    step = 1e-7
+    for h in range(2 * H + 1):
+        for l in (0, 1):
+            plus, minus = (Q.copy(), L.copy()), (Q.copy(), L.copy())
+            if l == 1:
+                plus[0][h, 0, 0] += step
+                minus[0][h, 0, 0] -= step
+            else:                                   # λ_n = λ_n0 + 10 w
+                plus[1][h] += 10 * step
+                minus[1][h] -= 10 * step
+            column = (hm.harmonic_coefficients(evaluate(*plus)[0][:, 0, 0], H)
+                      - hm.harmonic_coefficients(evaluate(*minus)[0][:, 0, 0], H)) / (2 * step)
+            assert np.abs(column - J[0, 1::3, 3 * h + l]).max() < 1e-6
