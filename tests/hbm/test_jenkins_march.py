@@ -1,7 +1,7 @@
 """The compiled 2-D Jenkins march equals the sample-by-sample return map (issue 15).
 
 Reference: periods marched with the pointwise return map w_j = q_j + Proj_{|x| ≤ ρ_j}(w_{j−1} − q_j)
-(:func:`sarfe.hbm.laws.jenkins.slider_update`, plain numpy) from the gauge start q̄ until the
+(:func:`sarfe.hbm.laws.jenkins.slider_update`, plain numpy) from the gauge start w = 0 until the
 slider at θ_0 repeats; the compiled kernels must give the same periodic forces and states to
 round-off, and their Jacobian must match finite differences of the forces.
 """
@@ -31,7 +31,7 @@ def displacement(amplitude):
 
 def reference_march(q, normal):
     rho = PARAMETERS["friction_coefficient"] * normal / PARAMETERS["tangential_stiffness"]
-    w = q.mean(axis=0)
+    w = np.zeros((n, 2))
     for _ in range(20000):
         start = w.copy()
         slider = np.empty_like(q)
@@ -54,10 +54,11 @@ def test_compiled_march_equals_pointwise_return_map(amplitude):
     force, state, _, _, _ = forces(q, normal)
     expected = reference_march(q, normal)
     assert np.abs(force - expected).max() <= 1e-9 * np.abs(expected).max()
-    if amplitude == 0.05:               # stuck contacts carry zero mean tangential force (gauge)
+    if amplitude == 0.05:               # stuck contacts keep the spring of assembly: λ_t = k_t q
         stuck = np.all(state == STICK, axis=0)
         assert stuck[:-1].all()
-        assert np.abs(force[:, stuck].mean(axis=0)).max() < 1e-12
+        k_t = PARAMETERS["tangential_stiffness"][stuck]
+        assert np.abs(force[:, stuck] - k_t[None, :, None] * q[:, stuck]).max() < 1e-14
 
 
 @pytest.mark.parametrize("amplitude", [0.05, 0.5])
@@ -86,15 +87,16 @@ def test_compiled_march_jacobian_matches_finite_differences(amplitude):
                     1.0, np.abs(column[:, c]).max()), (h, l, c)
 
 
-@pytest.mark.parametrize("mean_normal", [1.6, 1.2])
-def test_one_direction_gauge_and_jacobian(mean_normal):
-    """1-D stuck contact under a varying normal load: the periodic slider is q̄ clipped to the
-    interval [A, B] of periodic starts (1.6: q̄ inside, zero mean force; 1.2: q̄ below A, the slider
-    rests on the edge A); the Jacobian matches central differences in both cases."""
+@pytest.mark.parametrize("mean_normal, offset", [(1.6, 0.0), (1.2, 0.0), (1.6, -1.2)])
+def test_one_direction_gauge_and_jacobian(mean_normal, offset):
+    """1-D stuck contact under a varying normal load: the periodic slider is the assembly position
+    0 clipped to the interval [A, B] of periodic starts (1.6: 0 inside, λ_t = k_t q; 1.2: 0 below
+    A, the slider rests on the edge A; offset −1.2: a static tangential displacement beyond the
+    interval, 0 above B); the Jacobian matches central differences in each case."""
     from sarfe.hbm.laws.jenkins import compose_clamps
     p = {"tangential_stiffness": np.ones(1), "friction_coefficient": np.ones(1)}
     Q = np.zeros((2 * H + 1, 1, 2))
-    Q[1, 0, 0], Q[4, 0, 0] = 1.0, 0.3
+    Q[0, 0, 0], Q[1, 0, 0], Q[4, 0, 0] = offset, 1.0, 0.3
     L = np.zeros((2 * H + 1, 1))
     L[0], L[1], L[2] = mean_normal, -0.5, 0.3
 
@@ -107,8 +109,9 @@ def test_one_direction_gauge_and_jacobian(mean_normal):
     A, B = compose_clamps(q - rho, q + rho)
     force, state, slider_end, _, J = evaluate(Q, L, True)
     assert np.all(state == STICK) and A[-1, 0] < B[-1, 0]
-    assert slider_end[0, 0] == pytest.approx(np.clip(q.mean(), A[-1, 0], B[-1, 0]), abs=1e-14)
-    assert force[:, 0, 0].mean() == pytest.approx(q.mean() - slider_end[0, 0], abs=1e-12)
+    assert (A[-1, 0] < 0 < B[-1, 0]) == (mean_normal == 1.6 and offset == 0.0)
+    assert slider_end[0, 0] == pytest.approx(np.clip(0.0, A[-1, 0], B[-1, 0]), abs=1e-14)
+    assert np.abs(force[:, 0, 0] - (q[:, 0] - slider_end[0, 0])).max() < 1e-12
     step = 1e-7
     for h in range(2 * H + 1):
         for l in (0, 1):

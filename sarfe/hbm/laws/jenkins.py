@@ -16,15 +16,18 @@ clamp, w_j = clip(w_{j−1}, q_j − ρ_j, q_j + ρ_j).
 
 Gauge of the periodic state. Where the slider slips (or the contact separates) during the period,
 its periodic state is fixed by q̃ and λ̃_n. A contact that sticks the whole period has a whole
-interval (a convex set in 2-D) of periodic slider positions — the mean tangential force is a
-history constant, and a Jacobian with ∂w/∂q̃ = 0 leaves the periodic solutions a continuum that a
-Newton corrector or a continuation cannot follow. The periodic state is therefore taken as the one
-reached by marching from the slider relaxed on average, w_start = q̄ (mean of q over the period):
-1-D: w_0 = clip(q̄, A, B) with [A, B] the interval of periodic starts; a stuck contact carries
-zero mean tangential force, a contact whose interval does not hold q̄ rests on the nearest edge
-(the mean force a slowly creeping slider would settle to). This makes λ_t a continuous, piecewise
-smooth function of q̃ and λ̃_n alone (the ``slider_start`` of a call is not used), continuous
-through stick ↔ slip transitions, and the Jacobian regular in stick.
+interval (a convex set in 2-D) of periodic slider positions: its mean tangential force is a
+history constant. Taking it from a warm start (the last evaluation's slider) made the residual
+depend on the path of the iterations, not only on the unknowns — a continuation corrector landed
+on a solution with another mean and rejected it. The periodic state is therefore the one reached
+by marching from the slider position at assembly, w_start = 0 (q is measured from the undeformed
+state): in 1-D w_0 = clip(0, A, B) with [A, B] the interval of periodic starts. A contact that
+never slips keeps the spring it was assembled with (λ_t = k_t q: it carries its share of any static
+load, exactly what a start from rest gives when the contact never slips), and one whose interval
+does not hold 0 rests on the nearest edge — dragged by slip just as far as needed. λ_t is then a
+continuous, piecewise smooth function of q̃ and λ̃_n alone (the ``slider_start`` of a call is not
+used), continuous through stick ↔ slip transitions, and the Jacobian is k_t I in stick (regular
+even where the contact is the only restraint).
 
 The element provides (vectorized over contacts, driven by the law's normal force λ_n(θ)):
 - :func:`periodic_forces`: the periodic steady state over one period and its AFT Jacobian (1-D:
@@ -197,7 +200,7 @@ def periodic_forces(p, q, one_d, normal_force, normal_stiffness, slider_start, H
     c1 = np.flatnonzero(one_d)
     if c1.size:                      # 1-D: clamp scan, exact steady state
         qc = q_all[:, c1, 0]
-        res = jenkins_periodic_1d(qc, rho[:, c1], qc.mean(axis=0))     # gauge: see above
+        res = jenkins_periodic_1d(qc, rho[:, c1], np.zeros(c1.size))   # gauge w = 0: see above
         force[:, c1, 0] = k_t[c1] * (qc - res["slider"])
         state[:, c1] = res["state"]
         slider_end[c1, 0] = res["slider_end"]
@@ -208,7 +211,7 @@ def periodic_forces(p, q, one_d, normal_force, normal_stiffness, slider_start, H
     if c2.size:
         force_t, st, w_end, n_pass, J2 = _march_2d(
             q_all[:, c2], rho[:, c2], mu[c2] * normal_stiffness[:, c2] / k_t[c2], k_t[c2],
-            q_all[:, c2].mean(axis=0), H, N, jacobian, tolerance, pass_cap, kept_rows)
+            np.zeros((c2.size, 2)), H, N, jacobian, tolerance, pass_cap, kept_rows)
         force[:, c2] = force_t
         state[:, c2] = st
         slider_end[c2] = w_end
@@ -225,8 +228,8 @@ def _jacobian_1d(res, mu_dlam, k_t, H, N, kept_rows):
     The slider forgets its past at every slip or separation sample j(i), so
     λ_t,i = k_t (q_i − q_j) + s_j μ λ_n,j and ∂λ_t,i/∂X = k_t (Φ_i − Φ_j) + s_j μ ∂λ_n,j/∂w Φ_j
     (s_j = ±1 the slip direction), pushed through one FFT of the gathered rows Φ_{j(i)}; a contact
-    sticking the whole period has the gauge slider w0 = q̄ (mean of q over the period), so
-    λ_t = k_t (q − q̄) and ∂λ̃_t/∂q̃ = k_t (I − e₀ Φ̄) (Φ̄ = mean row of Φ: the mean row drops out)."""
+    sticking the whole period keeps the gauge slider w0 = 0 (module docstring): λ_t = k_t q,
+    ∂w0/∂X = 0."""
     P = kept_rows.size
     n = k_t.size
     Phi = _basis(H, N)[:, kept_rows]
@@ -235,11 +238,9 @@ def _jacobian_1d(res, mu_dlam, k_t, H, N, kept_rows):
     weight = np.take_along_axis(res["sign"] * mu_dlam, j, axis=0)  # s_j μ ∂λ_n/∂w at j(i)
     memory = np.moveaxis(hm.harmonic_coefficients(gathered, H)[kept_rows], 0, 1)  # E P Φ (n, P, P)
     normal = np.moveaxis(hm.harmonic_coefficients(weight[..., None] * gathered, H)[kept_rows], 0, 1)
-    mean_row = np.outer(hm.harmonic_coefficients(np.ones((N, 1)), H)[kept_rows, 0],
-                        Phi.mean(axis=0))                  # E 1 Φ̄: ∂(q̄ per sample)/∂q̃
     J = np.zeros((n, 3 * P, 3 * P))
     eye = np.eye(P)
-    J[:, 1::3, 1::3] = k_t[:, None, None] * (eye - np.where(has[:, None, None], memory, mean_row))
+    J[:, 1::3, 1::3] = k_t[:, None, None] * (eye - np.where(has[:, None, None], memory, 0.0))
     J[:, 1::3, 0::3] = np.where(has[:, None, None], normal, 0.0)
     return J
 
@@ -257,8 +258,8 @@ def _march_2d(q, rho, drho_dw, k_t, start, H, N, jacobian, tolerance, pass_cap, 
     propagates the consistent tangent: with X = local harmonics (h·3 + l),
         dw_j = (I − P_j) dq_j + n_j dρ_j + P_j dw_{j−1},
     and the periodicity w_N = w_0 gives ∂w_0/∂X = (I − A)⁻¹ B (A = ∂w_N/∂w_0, B = ∂w_N/∂X at
-    fixed w_0) when the contact slipped or separated; ∂q̄/∂X when it stuck (``start`` = q̄, the
-    gauge of the module docstring).
+    fixed w_0) when the contact slipped or separated; 0 when it stuck (``start`` = 0, the gauge of
+    the module docstring).
     Returns (λ_t (N, n, 2), state (N, n), w_end (n, 2), passes, J (n, 3P, 3P) or None).
     """
     from . import jenkins_march as march    # numba is imported (and the kernels loaded) on first use
@@ -276,10 +277,8 @@ def _march_2d(q, rho, drho_dw, k_t, start, H, N, jacobian, tolerance, pass_cap, 
     passes += 1
     if not jacobian:
         return force, state, w_start, passes, None
-    dq_mean = np.zeros((2, 3 * P))                          # ∂q̄/∂X (the stuck gauge w_0 = q̄)
-    dq_mean[0, 1::3] = dq_mean[1, 2::3] = Phi.mean(axis=0)
     forgot = np.any(state != STICK, axis=0)
-    dw0 = np.broadcast_to(dq_mean, (n, 2, 3 * P)).copy()
+    dw0 = np.zeros((n, 2, 3 * P))                           # stuck: w_0 = 0, the gauge
     if np.any(forgot):
         system = np.eye(2) - history[-1, forgot]
         dw0[forgot] = np.linalg.solve(system, dw[forgot])
