@@ -19,16 +19,22 @@ contact rows, C_k = G Z_k⁻¹ Gᵀ (n_rows × n_rows), so that r̃ = G ũ satis
     R_c(r̃) = r̃ − r̃_lin + C λ̃(r̃) = 0,    r̃_lin = G S⁻¹ f̃_e,
 
 with (2H+1) n_rows unknowns instead of (2H+1) n. The DOFs are recovered afterwards from
-ũ_k = Z_k⁻¹ (f̃_k − Gᵀ λ̃_k). Z_k is factorized once per harmonic and frequency (dense LU, or
-SuperLU when the model is sparse). A singular Z_k (undamped resonance, free-floating structure at
-k = 0) makes :func:`condense` return None so that the caller falls back to the full residual.
+ũ_k = Z_k⁻¹ (f̃_k − Gᵀ λ̃_k). For a dense (reduced) model with n ≤ 3000 whose damping is
+diagonal in its undamped modes (modal ζ, Rayleigh, none), Z_k⁻¹ = K⁻¹ + V diag(q_k) Vᵀ with the
+modes V and the Cholesky factor of K computed once per model (:mod:`sarfe.hbm.modal`), so a sweep
+point costs no factorization; otherwise Z_k is factorized once per harmonic and frequency (dense
+LU, or SuperLU when the model is sparse). A singular Z_k (undamped resonance, free-floating
+structure at k = 0) makes :func:`condense` return None so that the caller falls back to the full
+residual.
 
 With a harmonic set (:mod:`sarfe.hbm.harmonic_set`) only the kept orders k are factorized and C,
 r̃_lin, Y_k hold only their blocks (dropped orders: zero), so the cost falls with the kept count.
 """
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import scipy.linalg as sla
@@ -36,6 +42,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .harmonics import derivative_matrix
+from .modal import ModalBasis, cached_modal_basis
 
 
 def apply_dynamic_stiffness(model, omega: float, U: np.ndarray) -> np.ndarray:
@@ -68,13 +75,43 @@ def apply_dynamic_stiffness_derivative(model, omega: float, U: np.ndarray) -> np
 def dynamic_stiffness_matrix(model, omega: float, harmonics: int) -> sp.csr_matrix:
     """Sparse block-diagonal S(ω) of size (2H+1)n, harmonic-major (for the uncondensed Newton).
 
-    S = I⊗K − ω² diag(k²)⊗M + ω ∇⊗D  (∇ = :func:`derivative_matrix`, sparse Kronecker products).
+    S = I⊗K − ω² diag(k²)⊗M + ω ∇⊗D  (∇ = :func:`derivative_matrix`). The three Kronecker
+    products are built once per (model, H) on one sparsity pattern (:func:`_dynamic_stiffness_parts`),
+    so each call only forms the values a₀ + ω b₁ + ω² b₂.
     """
+    pattern, a0, b1, b2 = _dynamic_stiffness_parts(model, int(harmonics))
+    return sp.csr_matrix((a0 + omega * b1 + omega**2 * b2, pattern.indices.copy(),
+                          pattern.indptr.copy()), shape=pattern.shape)
+
+
+_STIFFNESS_PARTS: dict = {}
+
+
+def _dynamic_stiffness_parts(model, harmonics):
+    """(pattern, a₀, b₁, b₂): the union sparsity pattern of I⊗K, ∇⊗D, diag(k²)⊗M and the values of
+    I⊗K, ∇⊗D and −diag(k²)⊗M on it; cached per model object (id, dropped when it is collected)."""
+    per_model = _STIFFNESS_PARTS.get(id(model))
+    if per_model is not None and harmonics in per_model:
+        return per_model[harmonics]
     K, M, D = (sp.csr_matrix(a) for a in (model.stiffness, model.mass, model.damping))
     P = 2 * harmonics + 1
     orders = np.concatenate(([0], np.repeat(np.arange(1, harmonics + 1), 2)))
-    return (sp.kron(sp.identity(P), K) - omega**2 * sp.kron(sp.diags(orders**2.0), M)
-            + omega * sp.kron(sp.csr_matrix(derivative_matrix(harmonics)), D)).tocsr()
+    terms = (sp.kron(sp.identity(P), K, format="csr"),
+             sp.kron(sp.csr_matrix(derivative_matrix(harmonics)), D, format="csr"),
+             -sp.kron(sp.diags(orders**2.0), M, format="csr"))
+    pattern = sum(abs(t) for t in terms).tocsr()
+    pattern.sort_indices()
+    rows = np.repeat(np.arange(pattern.shape[0]), np.diff(pattern.indptr))
+    values = [np.asarray(t[rows, pattern.indices]).ravel() for t in terms]
+    parts = (pattern, *values)
+    if per_model is None:
+        try:
+            weakref.finalize(model, _STIFFNESS_PARTS.pop, id(model), None)
+        except TypeError:                  # not weak-referenceable: do not cache
+            return parts
+        per_model = _STIFFNESS_PARTS[id(model)] = {}
+    per_model[harmonics] = parts
+    return parts
 
 
 def hill_matrices(model, omega: float, harmonics: int):
@@ -117,36 +154,63 @@ class Condensation:
     """Dynamic compliance of the contact rows at one ω (see module docstring).
 
     compliance: C (P, P) real, P = (2H+1) n_rows, harmonic-major, block diagonal over harmonics
-    [m/N]; linear_response: r̃_lin (2H+1, n_rows) [m]; admittance: Y_k = Z_k⁻¹ Gᵀ (m, n, n_rows)
-    complex; forced: y_k = Z_k⁻¹ f_k (m, n) complex; orders: the m kept orders k (all 0 … H, or a
-    harmonic set: then P counts the kept rows only and r̃_lin is zero in the dropped rows).
+    [m/N]; linear_response: r̃_lin (2H+1, n_rows) [m]; forced: y_k = Z_k⁻¹ f_k (m, n) complex;
+    orders: the m kept orders k (all 0 … H, or a harmonic set: then P counts the kept rows only
+    and r̃_lin is zero in the dropped rows); admittance: Y_k = Z_k⁻¹ Gᵀ (m, n, n_rows) complex —
+    stored on the factorization path (``solved_admittance``), formed on first use on the modal path
+    (``modal``: Y_k = K⁻¹Gᵀ + V diag(q_k) (GV)ᵀ). Use :meth:`apply_admittance` /
+    :meth:`apply_admittance_transpose` to act with Y without forming it.
     """
 
     omega: float
     compliance: np.ndarray
     linear_response: np.ndarray
-    admittance: np.ndarray
     forced: np.ndarray
     orders: np.ndarray = None
+    solved_admittance: np.ndarray = None
+    modal: ModalCompliance = None
+
+    @cached_property
+    def admittance(self) -> np.ndarray:
+        if self.solved_admittance is not None:
+            return self.solved_admittance
+        m = self.modal
+        return m.static_admittance[None] + np.einsum("nj,kj,rj->knr", m.basis.modes,
+                                                     m.receptance, m.gap_modes, optimize=True)
+
+    def apply_admittance(self, L: np.ndarray) -> np.ndarray:
+        """Y_k λ_k (m, n) complex for complex λ (m, n_rows) of the kept orders."""
+        if self.modal is None:
+            return np.einsum("knm,km->kn", self.solved_admittance, L)
+        m = self.modal
+        return L @ m.static_admittance.T + (m.receptance * (L @ m.gap_modes)) @ m.basis.modes.T
+
+    def apply_admittance_transpose(self, V: np.ndarray) -> np.ndarray:
+        """Y_kᵀ v_k = G Z_k⁻¹ v_k (m, n_rows) complex for complex v (m, n) (Z_k symmetric)."""
+        if self.modal is None:
+            return np.einsum("knm,kn->km", self.solved_admittance, V)
+        m = self.modal
+        return V @ m.static_admittance + (m.receptance * (V @ m.basis.modes)) @ m.gap_modes.T
 
 
-def condense(model, gap_map, excitation: np.ndarray, omega: float,
-             orders=None) -> Condensation | None:
-    """Solve Z_k(ω) [Gᵀ, f_k] for the kept orders k (``orders``, default 0…H), build C = G Z⁻¹ Gᵀ
-    (kept rows only) and r̃_lin; None if a Z_k is singular.
+@dataclass(frozen=True)
+class ModalCompliance:
+    """The modal factors of one condensation, Y_k = K⁻¹Gᵀ + V diag(q_k) (GV)ᵀ: basis
+    (:class:`ModalBasis`), receptance q_kj (m, n_modes) complex (dynamic part, at the kept orders
+    and ω), gap_modes GV (n_rows, n_modes), static_admittance K⁻¹Gᵀ (n, n_rows)."""
 
-    Dense models: one batched LAPACK solve over the kept harmonics (singular when LAPACK says so or
-    when ‖Z_k‖ max|Z_k⁻¹ b| > 10¹³ max|b|); sparse models: one SuperLU per kept harmonic.
-    """
-    F = np.asarray(excitation, dtype=float)
-    H = (F.shape[0] - 1) // 2
-    G = sp.csr_matrix(gap_map)
-    n_rows, n = G.shape
-    k = np.arange(H + 1) if orders is None else np.asarray(orders, dtype=int)
-    Gd = G.toarray()
+    basis: ModalBasis
+    receptance: np.ndarray
+    gap_modes: np.ndarray
+    static_admittance: np.ndarray
+
+
+def _solve_factorized(model, Gd, forces, k, omega):
+    """(Y, y) = Z_k⁻¹ [Gᵀ, f_k] by one factorization per kept order, or None if a Z_k is singular."""
+    n_rows, n = Gd.shape
     rhs = np.empty((k.size, n, n_rows + 1), dtype=complex)
     rhs[:, :, :n_rows] = Gd.T
-    rhs[:, :, n_rows] = to_complex(F)[k]
+    rhs[:, :, n_rows] = forces
     if sp.issparse(model.stiffness):
         solution = np.empty_like(rhs)
         K, M, D = (sp.csc_matrix(a, dtype=complex)
@@ -170,8 +234,60 @@ def condense(model, gap_map, excitation: np.ndarray, omega: float,
             return None
     if not np.all(np.isfinite(solution)):
         return None
-    Y, y = solution[:, :, :n_rows], solution[:, :, n_rows]
-    Ck = Gd @ Y                                            # (m, n_rows, n_rows)
+    return solution[:, :, :n_rows], solution[:, :, n_rows]
+
+
+def _modal_basis_for(model, modal):
+    if modal is None or modal is False:
+        return None
+    if isinstance(modal, ModalBasis):
+        return modal
+    if modal in ("auto", True):
+        return cached_modal_basis(model)
+    raise ValueError(f"modal must be 'auto', a ModalBasis, True, False or None, got {modal!r}")
+
+
+def condense(model, gap_map, excitation: np.ndarray, omega: float,
+             orders=None, modal="auto") -> Condensation | None:
+    """C = G Z_k⁻¹ Gᵀ (kept rows only), r̃_lin and y_k = Z_k⁻¹ f_k for the kept orders k (``orders``,
+    default 0…H); None if a Z_k is singular.
+
+    Modal path (``modal`` = 'auto' and :func:`sarfe.hbm.modal.cached_modal_basis` applies — a
+    dense model (e.g. Craig–Bampton), n ≤ 3000, K positive definite and D diagonal in the undamped
+    modes — or ``modal`` = a ModalBasis of this model): C_k = G K⁻¹ Gᵀ + (GV) diag(q_k) (GV)ᵀ, y_k = K⁻¹ f_k + V (q_k ⊙ Vᵀ f_k), no
+    factorization per point (the eigen-solve and the Cholesky factor of K are computed once per
+    model, at its second condensation, and cached: the first one is factorized). Otherwise (``modal`` = False / None, or the basis does not apply):
+    dense models, one batched LAPACK solve of Z_k [Gᵀ, f_k] over the kept harmonics (singular when
+    LAPACK says so or when ‖Z_k‖ max|Z_k⁻¹ b| > 10¹³ max|b|); sparse models, one SuperLU per kept
+    harmonic.
+    """
+    F = np.asarray(excitation, dtype=float)
+    H = (F.shape[0] - 1) // 2
+    G = sp.csr_matrix(gap_map)
+    n_rows, n = G.shape
+    k = np.arange(H + 1) if orders is None else np.asarray(orders, dtype=int)
+    Gd = G.toarray()
+    forces = to_complex(F)[k]                               # (m, n)
+    basis = _modal_basis_for(model, modal)
+    if basis is not None:
+        if basis.singular(k, omega):
+            return None
+        g = basis.dynamic_receptance(k, omega)              # (m, n_modes)
+        gap_modes = Gd @ basis.modes                        # (n_rows, n_modes)
+        static = basis.static_solve(Gd.T)                   # K⁻¹Gᵀ (n, n_rows)
+        y = basis.static_solve(forces.T).T + (g * (forces @ basis.modes)) @ basis.modes.T
+        Ck = (Gd @ static)[None] + np.einsum("rj,kj,sj->krs", gap_modes, g, gap_modes,
+                                             optimize=True)
+        factors = dict(modal=ModalCompliance(basis, g, gap_modes, static))
+    else:
+        solved = _solve_factorized(model, Gd, forces, k, omega)
+        if solved is None:
+            return None
+        Y, y = solved
+        Ck = Gd @ Y                                         # (m, n_rows, n_rows)
+        factors = dict(solved_admittance=Y)
+    if not (np.all(np.isfinite(Ck)) and np.all(np.isfinite(y))):
+        return None
     # kept rows (orders sorted) in harmonic-major order: the mean if kept, then (cos, sin) per k
     mean = k == 0
     first = int(mean.any())
@@ -186,7 +302,8 @@ def condense(model, gap_map, excitation: np.ndarray, omega: float,
     lin = np.zeros((H + 1, n_rows), dtype=complex)
     lin[k] = y @ Gd.T
     r_lin = from_complex(lin)
-    return Condensation(float(omega), C.reshape(P_k * n_rows, P_k * n_rows), r_lin, Y, y, k)
+    return Condensation(float(omega), C.reshape(P_k * n_rows, P_k * n_rows), r_lin, y, k,
+                        **factors)
 
 
 def _kept_orders(condensation, H):
@@ -200,7 +317,7 @@ def recover_displacement(condensation: Condensation, contact_force: np.ndarray) 
     k = _kept_orders(condensation, H)
     L = to_complex(np.asarray(contact_force, dtype=float))[k]
     z = np.zeros((H + 1, condensation.forced.shape[1]), dtype=complex)
-    z[k] = condensation.forced - np.einsum("knm,km->kn", condensation.admittance, L)
+    z[k] = condensation.forced - condensation.apply_admittance(L)
     return from_complex(z)
 
 
@@ -213,6 +330,6 @@ def condensed_omega_derivative(model, condensation: Condensation, U: np.ndarray)
     z = to_complex(U)[orders]
     dz = (-2 * k**2 * condensation.omega * np.asarray(model.mass @ z.T).T
           + 1j * k * np.asarray(model.damping @ z.T).T)
-    out = np.zeros((H + 1, condensation.admittance.shape[2]), dtype=complex)
-    out[orders] = np.einsum("knm,kn->km", condensation.admittance, dz)
+    out = np.zeros((H + 1, condensation.linear_response.shape[1]), dtype=complex)
+    out[orders] = condensation.apply_admittance_transpose(dz)
     return from_complex(out)

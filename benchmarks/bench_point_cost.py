@@ -1,0 +1,269 @@
+"""HBM seconds per point vs FE size and vs contact pairs × H (issue 15, P4) → results/point_cost.md|json.
+
+1. FE size: cases/door_trim.yaml (4 rattle + 2 squeak contacts) at mesh 15, 10 and 5 mm, H = 5,
+   N = 64, frequencies 40, 60, 80 Hz, error estimate and Hill stability off (Newton + recovery +
+   ERP only). Whole `sarfe solve` processes (OPENBLAS_NUM_THREADS=1); per point =
+   (hbm_s + postprocess_s) / points from summary.json → timings_s, beside the linear stage and
+   the reduced model size; the sizes are run in turn ``--repeats`` times (15 10 5 15 10 5) and the
+   fastest run of each size is reported (all runs in the JSON). The 5 mm run (≈ 200k DOF; mesh + Craig–Bampton dominate, ~2–4 min) is
+   skipped with --quick; the whole bench stays under 10 min with it on this 2-core machine.
+2. Lumped chain (:func:`chain_problem`: coupled unit oscillators, each against a stop that closes):
+   seconds per point and per Newton iteration of a 5-frequency stepped sweep (each point from
+   the previous one; the first is a cold start), stability off, vs pairs (1 … 64, H = 5) and vs
+   H (3 … 20, 8 pairs). Exponents p of t ∝ x^p by least squares in log–log.
+
+3. Condensation path on the 10 mm door trim's reduced model (in process): seconds per
+   ``condense`` call (factorization per harmonic vs the modal path, and the one-off modal basis)
+   at H = 5 and 15, and seconds per point (3 stepped frequencies, stability off) with each path.
+
+Run: python benchmarks/bench_point_cost.py [--quick]
+"""
+import argparse
+import json
+import os
+import pathlib
+import platform
+import subprocess
+import sys
+import tempfile
+import time
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import numpy as np  # noqa: E402
+
+HERE = pathlib.Path(__file__).resolve().parent
+ROOT = HERE.parent
+sys.path.insert(0, str(ROOT))
+import scipy.sparse as sp  # noqa: E402
+
+from sarfe.hbm import (SolverOptions, make_contact_set, make_linear_model,  # noqa: E402
+                       solve_frequency)
+
+MESH_SIZES_M = (0.015, 0.010, 0.005)
+FREQUENCIES_HZ = (40.0, 60.0, 80.0)
+ENV = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1",
+           MPLBACKEND="Agg", PYTHONPATH=str(ROOT))
+
+
+def door_case(mesh_size, directory):
+    text = (ROOT / "cases" / "door_trim.yaml").read_text()
+    text = text.replace("mesh_size_m: 0.015", f"mesh_size_m: {mesh_size}")
+    text = text.replace("frequency_hz: [40.0, 52.0, 67.0, 80.0]",
+                        f"frequency_hz: {list(FREQUENCIES_HZ)}")
+    text = text.replace("  harmonics: 3\n", "  harmonics: 5\n  error_estimate: false\n"
+                        "  stability: false\n")
+    path = pathlib.Path(directory) / f"door_{mesh_size * 1e3:g}mm.yaml"
+    path.write_text(text)
+    return path
+
+
+def door_point_cost(mesh_size, directory):
+    case = door_case(mesh_size, directory)
+    output = pathlib.Path(directory) / f"out_{mesh_size * 1e3:g}mm"
+    start = time.perf_counter()
+    done = subprocess.run([sys.executable, "-m", "sarfe.cli", "solve", str(case), "-o", str(output),
+                           "--quiet"], env=ENV, cwd=ROOT, capture_output=True, text=True)
+    wall = time.perf_counter() - start
+    if done.returncode not in (0, 3):
+        raise RuntimeError(f"door trim {mesh_size} m failed: {done.stderr[-2000:]}")
+    summary = json.loads((output / "summary.json").read_text())
+    t, model, points = summary["timings_s"], summary["model"], summary["points"]
+    count = len(points)
+    return {"mesh_size_m": mesh_size, "free_dofs": model["free_dofs"],
+            "reduced_dofs": model["reduced_dofs"], "points": count,
+            "nonlinear_pairs": (summary.get("contact_pruning") or {}).get("nonlinear_pairs"),
+            "newton_iterations": int(sum(p["iterations"] for p in points)),
+            "linear_stage_s": t["linear_stage_s"], "hbm_s": t["hbm_s"],
+            "postprocess_s": t["postprocess_s"], "outputs_s": t["outputs_s"],
+            "seconds_per_point": (t["hbm_s"] + t["postprocess_s"]) / count,
+            "process_wall_s": wall}
+
+
+def chain_problem(pairs, harmonics, force=1.0, normal_stiffness=10.0):
+    """``pairs`` unit masses on ground springs (1.2 N/m minus the couplings) coupled by 0.1 N/m
+    springs, D = 0.03 K, each against a stop (gap 1 m, k_n = ``normal_stiffness``); force
+    ``force``·(1 + 0.2 sin j) on mass j. Stepped through Ω = 0.5 … 0.6 every stop closes."""
+    n = pairs
+    coupling = 0.1 * np.ones(max(n - 1, 0))
+    diagonal = 1.2 * np.ones(n)
+    if n > 1:
+        diagonal[[0, -1]] -= 0.1
+    else:
+        diagonal[:] = 1.0
+    K = sp.diags([diagonal, -coupling, -coupling], [0, 1, -1], format="csr")
+    model = make_linear_model(sp.identity(n, format="csr"), 0.03 * K, K)
+    rows = np.arange(pairs)
+    G = sp.csr_matrix((np.ones(pairs), (rows, rows)), shape=(pairs, n))
+    contacts = make_contact_set(G, ["rattle"] * pairs, rows, -np.ones((pairs, 2)), 1.0,
+                                normal_stiffness)
+    N = max(128, 1 << int(np.ceil(np.log2(8 * harmonics))))
+    F = np.zeros((2 * harmonics + 1, n))
+    F[1] = force * (1 + 0.2 * np.sin(np.arange(n)))
+    return model, contacts, F, N
+
+
+def chain_point_cost(pairs, harmonics, points=5, repeat=3):
+    model, contacts, F, N = chain_problem(pairs, harmonics)
+    options = SolverOptions(stability=False)
+    omegas = np.linspace(0.5, 0.6, points)
+    best = None
+    for _ in range(repeat):
+        start = time.perf_counter()
+        previous, converged, iterations = None, 0, 0
+        for omega in omegas:
+            solution = solve_frequency(model, contacts, F, omega, harmonics, N, initial=previous,
+                                       options=options)
+            converged += solution.converged
+            iterations += solution.iterations
+            previous = solution.displacement if solution.converged else None
+        elapsed = time.perf_counter() - start
+        if best is None or elapsed < best[0]:
+            best = (elapsed, converged, iterations)
+    elapsed, converged, iterations = best
+    return {"pairs": pairs, "harmonics": harmonics, "samples": N, "dofs": model.dof_count,
+            "unknowns": (2 * harmonics + 1) * contacts.row_count, "converged": int(converged),
+            "newton_iterations": int(iterations), "seconds_per_point": float(elapsed / points),
+            "seconds_per_iteration": float(elapsed / max(iterations, 1))}
+
+
+def condensation_paths(directory, mesh_size=0.010):
+    """Section 3 of the module docstring."""
+    import sarfe.hbm.linear as linear
+    from sarfe.hbm.modal import modal_basis
+    from sarfe.pipeline import load_case
+    from sarfe.pipeline.linear import build_linear_model
+    from sarfe.pipeline.nonlinear import nonlinear_model
+
+    case = load_case(door_case(mesh_size, directory))
+    nl = nonlinear_model(case, build_linear_model(case))
+    model, contacts = nl.model, nl.contacts
+    start = time.perf_counter()
+    basis = modal_basis(model)
+    out = {"mesh_size_m": mesh_size, "reduced_dofs": model.dof_count,
+           "contact_rows": contacts.row_count, "modal_basis_s": time.perf_counter() - start,
+           "modal_applies": basis is not None, "condense": []}
+    if basis is None:
+        return out
+    omega = 2 * np.pi * 60.0
+    for H in (5, 15):
+        F = np.zeros((2 * H + 1, model.dof_count))
+        F[1], F[2] = nl.excitation_amplitude.real, -nl.excitation_amplitude.imag
+        row = {"harmonics": H}
+        for name, modal in (("factorization", False), ("modal", basis)):
+            times = []
+            for _ in range(3):
+                t0 = time.perf_counter()
+                linear.condense(model, contacts.gap_map, F, omega, modal=modal)
+                times.append(time.perf_counter() - t0)
+            row[f"{name}_s"] = min(times)
+        out["condense"].append(row)
+    options = SolverOptions(stability=False)
+    H, N = 5, 64
+    original = linear.cached_modal_basis
+    for name, chooser in (("factorization", lambda m: None), ("modal", original)):
+        linear.cached_modal_basis = chooser
+        try:
+            start, previous = time.perf_counter(), None
+            for f in FREQUENCIES_HZ:
+                s = solve_frequency(model, contacts, nl.excitation, 2 * np.pi * f, H, N,
+                                    initial=previous, options=options)
+                previous = s.displacement if s.converged else None
+            out[f"{name}_seconds_per_point"] = (time.perf_counter() - start) / len(FREQUENCIES_HZ)
+        finally:
+            linear.cached_modal_basis = original
+    return out
+
+
+def exponent(x, t):
+    return float(np.polyfit(np.log(np.asarray(x, float)), np.log(np.asarray(t, float)), 1)[0])
+
+
+def write(results):
+    (HERE / "results").mkdir(exist_ok=True)
+    (HERE / "results" / "point_cost.json").write_text(json.dumps(results, indent=2))
+    lines = ["# HBM seconds per point vs FE size and vs contact pairs × H (issue 15, P4)", "",
+             f"Machine: {results['machine']}, {results['cpu_count']} cores, load average at start "
+             f"{results['load_average'][0]:.2f}; OPENBLAS_NUM_THREADS=1. Bench wall "
+             f"{results['bench_wall_s']:.0f} s.", "",
+             "## Door trim (H = 5, N = 64, 3 frequencies, estimate and stability off)", "",
+             f"Fastest of {len(results['door_trim_all_seconds_per_point'])} alternated runs per "
+             f"size; all runs, s / point: {results['door_trim_all_seconds_per_point']}.", "",
+             "| mesh | free DOFs | reduced DOFs | nonlinear pairs | Newton its | linear stage s | "
+             "HBM s | post s | s / point | process s |", "|---|---|---|---|---|---|---|---|---|---|"]
+    for r in results["door_trim"]:
+        lines.append(f"| {r['mesh_size_m'] * 1e3:g} mm | {r['free_dofs']} | {r['reduced_dofs']} | "
+                     f"{r['nonlinear_pairs']} | {r['newton_iterations']} | "
+                     f"{r['linear_stage_s']:.1f} | {r['hbm_s']:.2f} | {r['postprocess_s']:.2f} | "
+                     f"{r['seconds_per_point']:.3f} | {r['process_wall_s']:.1f} |")
+    door = results["door_trim"]
+    if len(door) > 1:
+        per = np.array([r["seconds_per_point"] for r in door])
+        lines += ["", f"Spread of s / point over the mesh sizes: max/min = {per.max() / per.min():.2f} "
+                  f"(target: flat within 20 %, i.e. ≤ 1.2); exponent vs free DOFs "
+                  f"{exponent([r['free_dofs'] for r in door], per):.2f}."]
+    lines += ["", "## Lumped chain (coupled oscillators against stops, 5-point stepped sweep, stability off)", "",
+              "| pairs | H | N | DOFs | unknowns | converged | Newton its | s / point | ms / iteration |",
+              "|---|---|---|---|---|---|---|---|---|"]
+    for r in results["chain_pairs"] + results["chain_harmonics"]:
+        lines.append(f"| {r['pairs']} | {r['harmonics']} | {r['samples']} | {r['dofs']} | "
+                     f"{r['unknowns']} | {r['converged']}/5 | {r['newton_iterations']} | "
+                     f"{r['seconds_per_point']:.4f} | {1e3 * r['seconds_per_iteration']:.2f} |")
+    lines += ["", f"Fitted exponents, per point: t ∝ pairs^{results['exponent_pairs']:.2f} (H = 5), "
+              f"t ∝ H^{results['exponent_harmonics']:.2f} (8 pairs; N grows with H); per Newton "
+              f"iteration: pairs^{results['exponent_pairs_iteration']:.2f}, "
+              f"H^{results['exponent_harmonics_iteration']:.2f}. The iteration counts vary with "
+              "the problem (cold start, homotopy), so the per-iteration exponents isolate the cost "
+              "of one residual + Jacobian + solve."]
+    c = results.get("condensation")
+    if c:
+        lines += ["", f"## Condensation path, door trim {c['mesh_size_m'] * 1e3:g} mm "
+                  f"({c['reduced_dofs']} reduced DOFs, {c['contact_rows']} contact rows)", "",
+                  f"Modal basis (eigh + Cholesky, once per model): {c['modal_basis_s']:.3f} s.", "",
+                  "| H | condense, factorization s | condense, modal s |", "|---|---|---|"]
+        lines += [f"| {r['harmonics']} | {r['factorization_s']:.4f} | {r['modal_s']:.4f} |"
+                  for r in c["condense"]]
+        if "modal_seconds_per_point" in c:
+            lines += ["", f"Seconds per point (H = 5, N = 64, stability off, in process): "
+                      f"factorization {c['factorization_seconds_per_point']:.3f}, "
+                      f"modal {c['modal_seconds_per_point']:.3f}."]
+    (HERE / "results" / "point_cost.md").write_text("\n".join(lines) + "\n")
+    print("\n".join(lines))
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="skip the 5 mm door trim")
+    parser.add_argument("--repeats", type=int, default=2, help="door-trim runs per size, alternated")
+    args, _ = parser.parse_known_args()   # run_all.py passes its own arguments
+    start = time.perf_counter()
+    results = {"machine": platform.platform(), "python": platform.python_version(),
+               "cpu_count": os.cpu_count(), "load_average": os.getloadavg()}
+    sizes = MESH_SIZES_M[:-1] if args.quick else MESH_SIZES_M
+    with tempfile.TemporaryDirectory() as directory:
+        runs = [[door_point_cost(size, directory) for size in sizes]       # 15 10 5 15 10 5
+                for _ in range(args.repeats)]
+        results["door_trim"] = [min(same, key=lambda r: r["seconds_per_point"])
+                                for same in zip(*runs)]
+        results["door_trim_all_seconds_per_point"] = [[r["seconds_per_point"] for r in run]
+                                                      for run in runs]
+        results["condensation"] = condensation_paths(directory)
+    results["chain_pairs"] = [chain_point_cost(p, 5) for p in (1, 4, 16, 64)]
+    results["chain_harmonics"] = [chain_point_cost(8, h) for h in (3, 5, 10, 20)]
+    results["exponent_pairs"] = exponent([r["pairs"] for r in results["chain_pairs"]],
+                                         [r["seconds_per_point"] for r in results["chain_pairs"]])
+    results["exponent_harmonics"] = exponent(
+        [r["harmonics"] for r in results["chain_harmonics"]],
+        [r["seconds_per_point"] for r in results["chain_harmonics"]])
+    results["exponent_pairs_iteration"] = exponent(
+        [r["pairs"] for r in results["chain_pairs"]],
+        [r["seconds_per_iteration"] for r in results["chain_pairs"]])
+    results["exponent_harmonics_iteration"] = exponent(
+        [r["harmonics"] for r in results["chain_harmonics"]],
+        [r["seconds_per_iteration"] for r in results["chain_harmonics"]])
+    results["bench_wall_s"] = time.perf_counter() - start
+    write(results)
+
+
+if __name__ == "__main__":
+    main()
