@@ -109,8 +109,8 @@ def jenkins_periodic_1d(tangential_displacement, slip_radius, slider_start):
 
     q: (N, n) [m], ρ = μ λ_n / k_t: (N, n) [m], slider_start: (n,) [m].
     Returns dict with slider w (N, n), state (N, n) int8, reset (N, n) bool (slip, separation or
-    the slider resting on a slip bound: the history is erased there), sign (N, n) ∈ {+1, −1, 0} with λ_t = sign·μλ_n at a slip sample
-    (+1: w clamped at q − ρ), slider_end (n,), passes = 2.
+    the slider resting on a slip bound: the history is erased there), sign (N, n) ∈ {+1, −1, 0}
+    with λ_t = sign·μλ_n at a reset sample (+1: w at q − ρ), slider_end (n,), passes = 2.
     """
     q = np.asarray(tangential_displacement, dtype=float)
     rho = np.maximum(np.asarray(slip_radius, dtype=float), 0.0)
