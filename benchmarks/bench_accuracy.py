@@ -2,7 +2,7 @@
 
 1. HBM vs the built-in time integrator at equal accuracy (1 % and 0.1 % first-harmonic amplitude at
    the contacts, against a fine HBM reference checked by time integration): wall-time ratio.
-   HBM: :func:`sarfe.study.accuracy.choose_resolution` from H = 2, N = 32 (cold, the cost of the
+   HBM: :func:`sarfe.accuracy.estimates.choose_resolution` from H = 2, N = 32 (cold, the cost of the
    whole adaptive loop, estimates included). Time integration: steps per period doubled from 128
    until the error is below the target (cost of the successful run only, started from the linear
    periodic solution as ``integrate_time`` does by default).
@@ -52,7 +52,7 @@ def amplitude_error(contacts, U, U_ref):
 def load_problem(name):
     """(label, model, contacts, excitation (2·40+1, n), erp_map, erp_areas, modal_dofs, frequencies)."""
     from sarfe.pipeline import build_linear_model, load_case, nonlinear_model
-    from sarfe.study.accuracy import resize_harmonics
+    from sarfe.accuracy.estimates import resize_harmonics
 
     if name.startswith("lumped_chain"):
         from sarfe.study.lumped import lumped_problem
@@ -77,7 +77,7 @@ def load_problem(name):
 
 def reference(prob, omega, H=40, N=4096, initial=None):
     from sarfe.hbm import SolverOptions, solve_frequency
-    from sarfe.study.accuracy import resize_harmonics
+    from sarfe.accuracy.estimates import resize_harmonics
 
     return solve_frequency(prob["model"], prob["contacts"], resize_harmonics(prob["excitation"], H),
                            omega, H, N, initial=None if initial is None else
@@ -88,7 +88,7 @@ def nonlinear_points(prob, count=2):
     """Frequencies where a stepped HBM sweep (H = 5, N = 128, warm starts) converges with an active
     contact (force > 0), each with its H = 40, N = 4096 reference (started from it)."""
     from sarfe.hbm import SolverOptions, solve_frequency
-    from sarfe.study.accuracy import resize_harmonics
+    from sarfe.accuracy.estimates import resize_harmonics
 
     found, previous = [], None
     F = resize_harmonics(prob["excitation"], 5)
@@ -114,7 +114,7 @@ def nonlinear_points(prob, count=2):
 def hbm_vs_time(prob, f, ref, targets=(1e-2, 1e-3), max_steps=4096):
     from sarfe.hbm import SolverOptions
     from sarfe.hbm.time_integration import integrate_time
-    from sarfe.study.accuracy import choose_resolution, resize_harmonics
+    from sarfe.accuracy.estimates import choose_resolution, resize_harmonics
 
     omega = 2 * np.pi * f
     rows = []
@@ -161,7 +161,7 @@ def hbm_smallest_sufficient(prob, omega, ref, target):
     least 64) whose cold-start solve meets the target against the reference; the cost of that solve
     only."""
     from sarfe.hbm import SolverOptions, solve_frequency
-    from sarfe.study.accuracy import resize_harmonics
+    from sarfe.accuracy.estimates import resize_harmonics
 
     for H in HARMONIC_LADDER:
         N = max(64, 16 * H)
@@ -188,7 +188,7 @@ def cost_scaling(quick=False):
     """Seconds per Newton iteration (warm solve from 0.8 × the converged solution, best of 2) of
     chains with a rattle contact on every mass: vs H (8 contacts) and vs n_c (H = 5, N = 128)."""
     from sarfe.hbm import SolverOptions, solve_frequency
-    from sarfe.study.accuracy import resize_harmonics
+    from sarfe.accuracy.estimates import resize_harmonics
     from sarfe.study.lumped import lumped_problem
 
     options = SolverOptions(stability=False)
@@ -287,7 +287,7 @@ def raise_harmonics(nl, solution, harmonics, samples_per_period):
     N/2 (impacts converge on some paths only); when none converges the climb ends there
     ((None, None) when the first step fails)."""
     from sarfe.hbm import SolverOptions, solve_frequency
-    from sarfe.study.accuracy import resize_harmonics
+    from sarfe.accuracy.estimates import resize_harmonics
 
     options = SolverOptions(stability=False, max_iterations=100)
     H, previous, chain = int(solution.harmonics), solution, []
@@ -315,9 +315,10 @@ def raise_harmonics(nl, solution, harmonics, samples_per_period):
 
 
 def true_errors(stage, solution, ref_stage, ref):
-    """(relative first-harmonic amplitude error at the contact rows, ERP level error [dB]) of
+    """(relative first-harmonic amplitude error at the contact rows, the larger ERP level error of
+    dB and dB(A) [dB]) of
     ``solution`` against ``ref`` (each with its own stage's ERP map: the models may differ)."""
-    from sarfe.study.accuracy import _erp_proxy
+    from sarfe.accuracy.estimates import _erp_proxy
 
     def amplitudes(s):
         R = np.asarray(s.contact_displacement)
@@ -325,9 +326,14 @@ def true_errors(stage, solution, ref_stage, ref):
 
     a, b = amplitudes(solution), amplitudes(ref)
     rel = float(np.max(np.abs(a - b)) / max(b.max(), 1e-300))
-    p = _erp_proxy(solution.displacement, solution.omega, stage.erp_map, stage.erp_areas)
-    q = _erp_proxy(ref.displacement, ref.omega, ref_stage.erp_map, ref_stage.erp_areas)
-    return rel, float(abs(10 * np.log10(p / q))) if p > 0 and q > 0 else float("nan")
+    levels = []
+    for weighted in (False, True):   # the estimate bounds the larger of the dB and dB(A) errors
+        p = _erp_proxy(solution.displacement, solution.omega, stage.erp_map, stage.erp_areas,
+                       weighted)
+        q = _erp_proxy(ref.displacement, ref.omega, ref_stage.erp_map, ref_stage.erp_areas,
+                       weighted)
+        levels.append(float(abs(10 * np.log10(p / q))) if p > 0 and q > 0 else float("nan"))
+    return rel, max(levels)
 
 
 def shipped_solutions(name, spec):
@@ -363,7 +369,7 @@ def shipped_solutions(name, spec):
 
 def shipped_table(solved):
     """Rows: case, f, setting, estimate (the pipeline's stage_error_estimate), true error."""
-    from sarfe.study.accuracy import stage_error_estimate
+    from sarfe.pipeline.accuracy import stage_error_estimate
 
     rows = []
     ref = solved["reference"]
@@ -467,7 +473,7 @@ def shipped_markdown(rows):
              "ratio = estimate / true (≥ 1: bracketed). ref H: the highest H the reference reached "
              "(raised ×1.25 a step); floor: its amplitude / ERP change over that last step. "
              "* = the case's own H, N. Parts: raw changes H → H', N → 2N and the modal part (4) "
-             "(sarfe/study/accuracy.py).", "",
+             "(sarfe/accuracy/estimates.py).", "",
              "| case | f [Hz] | H, N | modes + RV | amp. estimate | amp. true | ratio | "
              "ERP est. [dB] | ERP true [dB] | ratio | H, N, modal parts (amp.) | ref H, floor | "
              "bracketed |", "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]

@@ -60,9 +60,10 @@ def cmd_solve(args) -> int:
     if summary["non_converged_points"]:
         print(f"sarfe: {len(summary['non_converged_points'])} point(s) did not converge: "
               f"{summary['non_converged_points']} (see summary.json)", file=sys.stderr)
+    if (summary.get("accuracy_check") or {}).get("warning"):
+        print(f"sarfe: {summary['accuracy_check']['warning']}", file=sys.stderr)
     if summary.get("sweep_complete") is False:
-        print(f"sarfe: the sweep stopped at {summary['points'][-1]['frequency_hz']:.2f} Hz before "
-              f"its end ({summary['sweep_stop_reason']})", file=sys.stderr)
+        print(f"sarfe: {summary['sweep_stop_reason']}", file=sys.stderr)
     return result.exit_code
 
 
@@ -156,7 +157,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="sarfe", description="Squeak & rattle noise of car interior panels: FE + "
         "Craig–Bampton + harmonic balance with contact + equivalent radiated power.",
-        epilog="exit codes: 0 ok, 2 case-file error, 3 a point did not converge, 1 internal error")
+        epilog="exit codes: 0 ok, 2 case-file error, 3 a point did not converge or an incomplete "
+               "sweep left part of its band without converged points, 1 internal error")
     parser.add_argument("--version", action="version", version=f"sarfe {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
 

@@ -89,9 +89,10 @@ def test_spring_becomes_contact_with_its_stiffness(tmp_path):
     assert point["contacts"][0]["open_fraction"] == 0.0
     assert point["erp"]["level_db"] == pytest.approx(kept.summary["points"][0]["erp"]["level_db"],
                                                      abs=0.01)
-    # without the spring in the linear model the plate's response differs (it is removed)
-    assert as_contact.summary["points"][0]["linear"]["erp_level_db"] != pytest.approx(
-        point["erp"]["level_db"], abs=0.05)
+    # the linear baseline keeps a preloaded (closed) contact as its spring (issue 13 item 7): the
+    # spring never opens here, so the baseline is the same linear structure as the solve
+    assert as_contact.summary["points"][0]["linear"]["erp_level_db"] == pytest.approx(
+        point["erp"]["level_db"], abs=0.01)
 
 
 def test_unsupported_keyword_is_refused_then_ignored(tmp_path):

@@ -16,6 +16,25 @@ from z_i (branch jumping) counts as failed. The last point is solved at exactly 
 condensed contact-row vector or all DOFs (see :mod:`sarfe.hbm.solve`); the linear solution with
 contacts linearized at u = 0 is the first guess.
 
+Corners. With N AFT samples a penalty or friction force is piecewise linear in ũ, so the branch is
+piecewise smooth with a corner wherever one sample enters or leaves contact. Near a fold, where
+∂R/∂x is nearly singular, one more sample in contact turns the branch by up to ~90° (tangents of
+neighbouring pieces at 87° on cases/lumped_rattle.yaml, N = 256), and neither corrector reaches the
+next piece: Δs shrinks to ``min_step`` over near-identical points. The corners are an artefact of
+the sampling (N = 1024 has no fold there at all: the "fold" at N = 256 is itself an artefact), so
+the sweep backs up ``BACKUP`` points (they may lie on the artefact), re-solves there with 2N and
+goes on with 2N (up to 16 N; the point's ``reason`` says so). A turn of ω at a corner (on
+cases/rattle_rig.yaml at N = 256 the sweep turned at 31.4 Hz and ran back down its own branch; at
+N = 1024 it goes on to the true fold at 33.6 Hz) is checked the same way once: where ω turns and consecutive secants z_{i+1} − z_i, z_i − z_{i−1} meet
+at more than ~80° (cosine < ``COS_CORNER``; measured: 0.02 and −0.07 at the two artefacts, 0.36–1.0
+at the true folds of the shipped cases and NLvib example 03, which the adaptive step passes
+gradually) — and, once a sweep has met one corner, at every turn of ω — the sweep backs up and goes
+on with 2N; a turn within ``FOLD_DISTANCE`` of the band of a checked one is taken as a fold. A new point closer than ``REPORT_DISTANCE`` (scaled) to the
+last one replaces it rather than adding a near-duplicate row.
+
+Band edge. A branch that turns back past ω_start is stopped there: the last point is solved at
+exactly ω_start and its ``reason`` says why (no points outside the band).
+
 Harmonic sets (``harmonic_set`` or ``options.solver.harmonic_set``, :mod:`sarfe.hbm.harmonic_set`):
 x holds the kept coefficient rows only. With 'auto' the sweep starts on the odd set (unless the
 first point needs all orders) and switches to all orders for the rest of the sweep at the first
@@ -35,6 +54,12 @@ from .residual import Evaluation, kept_rows
 from .solution import ContinuationOptions
 from .solve import (_check_omega, _solve, finalize, initial_slider, linearized_guess,
                     make_evaluator, make_problem, slider_acceptor, solve_auto, wants_condensation)
+
+REPORT_DISTANCE = 1e-4   # scaled arclength below which a new point replaces the last one reported
+MAX_SAMPLES_FACTOR = 16  # N may be raised to 16× the requested one at corners (docstring)
+BACKUP = 3               # points dropped before re-solving with 2N at a corner or turn
+FOLD_DISTANCE = 0.05     # a turn of ω this close (share of the band) to a checked one is a fold
+COS_CORNER = 0.2         # ω turns with consecutive secants at more than ~80°: a corner, checked
 
 
 def _bordered(jacobian, d_omega, x_scale, omega_scale, row, row_scale=1.0):
@@ -121,6 +146,20 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
     step = options.initial_step
 
     inner = {}
+    refined_at = []                 # ω where a turn was checked with 2N
+
+    def refine_samples():
+        """(k, point k re-solved with 2N — 4N, … when that fails) after backing up BACKUP points
+        (or none), or (0, None) when no re-solve up to MAX_SAMPLES_FACTOR × N converges."""
+        N_fine = 2 * problem.samples_per_period
+        while N_fine <= MAX_SAMPLES_FACTOR * samples_per_period:
+            fine = replace(problem, samples_per_period=N_fine)
+            for k in dict.fromkeys((max(0, len(solutions) - 1 - BACKUP), len(solutions) - 1)):
+                point = _solve(fine, solutions[k].omega, solutions[k].displacement, so, None)
+                if point.converged:
+                    return k, point
+            N_fine *= 2
+        return 0, None
 
     def evaluate_z(zz, jacobian):
         e = evaluate(zz[:-1] * x_scale, zz[-1] * span, jacobian, state["slider"])
@@ -146,6 +185,7 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
                 z = np.append(x / x_scale, solutions[-1].omega / span)
                 continue
             return stop("singular bordered Jacobian (tangent)")
+        refined = None                 # point k re-solved with 2N (stalled step or turn of ω)
         while True:
             predicted = z + step * t
             result = _corrector(evaluate_z, z, predicted, t, step, x_scale, span, corrector, accept)
@@ -158,7 +198,42 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
                 break
             step *= 0.5
             if step < options.min_step:
-                return stop(f"step below min_step {options.min_step:g} near ω = {z[-1] * span:.6g}")
+                refined_at.append(z[-1] * span)
+                k, refined = refine_samples()
+                if refined is None:
+                    return stop(f"step below min_step {options.min_step:g} near ω = "
+                                f"{z[-1] * span:.6g} (N = {problem.samples_per_period})")
+                break
+        if refined is None and len(solutions) > 1:
+            omega_i = z[-1] * span
+            z_prev = np.append(to_x(solutions[-2].displacement) / x_scale,
+                               solutions[-2].omega / span)
+            ahead, behind = result.x - z, z - z_prev
+            sharp = ahead @ behind < COS_CORNER * np.linalg.norm(ahead) * np.linalg.norm(behind)
+            turned = behind[-1] * ahead[-1] < 0 and (sharp or refined_at)
+            if turned and not any(abs(omega_i - w) < FOLD_DISTANCE * span for w in refined_at):
+                refined_at.append(omega_i)      # ω turns at a corner: checked with 2N
+                k, refined = refine_samples()
+        if refined is not None:        # continue with 2N from the re-solved point k
+            problem = replace(problem, samples_per_period=refined.samples_per_period)
+            full_problem = replace(full_problem, samples_per_period=refined.samples_per_period)
+            evaluate, to_x, to_displacement = make_evaluator(problem, condensed)
+            state["slider"] = initial_slider(problem, refined.displacement)
+            del solutions[k:]
+            solutions.append(replace(refined, reason=f"{refined.reason} (N raised to "
+                                     f"{refined.samples_per_period} here: a stalled step or a turn "
+                                     f"of ω, checked with finer AFT sampling)"))
+            z = np.append(to_x(refined.displacement) / x_scale, refined.omega / span)
+            if k > 0:               # orientation: the secant from the point before
+                before = solutions[k - 1]
+                previous = z - np.append(to_x(before.displacement) / x_scale, before.omega / span)
+                previous /= max(np.linalg.norm(previous), 1e-300)
+            else:
+                previous = np.zeros_like(z)
+                previous[-1] = direction
+            inner.clear()
+            step = options.initial_step
+            continue
         z_new = result.x
         omega_new = z_new[-1] * span
         U_new = to_displacement(z_new[:-1] * x_scale, omega_new, result.evaluation)
@@ -192,18 +267,34 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
                 t[-1] = direction
             z_new = np.append(x / x_scale, full.omega / span)
             point = full
-        solutions.append(point)
+        if direction * (omega_new - omega_start) < 0:     # turned back out of the band
+            return _band_edge(problem, solutions, point, omega_start, so, state["slider"])
+        if full is not None or np.linalg.norm(z_new - z) >= REPORT_DISTANCE:
+            solutions.append(point)     # (a step shrunk to a corner adds no reported point)
+        else:
+            solutions[-1] = point
         if progress is not None:
             progress(float(np.clip(direction * (omega_new - omega_start) / span, 0, 1)), 1.0)
         if len(solutions) >= options.max_points:
             return stop(f"max_points {options.max_points} reached")
-        if direction * (omega_new - omega_start) < -span:
-            return stop("the branch turned back beyond omega_start")
         previous, z = t, z_new
         if result.iterations <= options.target_iterations:
             step = min(step * options.step_growth, options.max_step)
         else:
             step = max(step * 0.5, options.min_step)
+
+
+def _band_edge(problem, solutions, point, omega_start, options, slider):
+    """The branch turned back past ω_start at ``point``: solved at exactly ω_start instead (start:
+    the secant between the last reported point and ``point``) and the sweep stops there, saying so."""
+    last = solutions[-1]
+    fraction = (omega_start - last.omega) / (point.omega - last.omega)
+    guess = last.displacement + fraction * (point.displacement - last.displacement)
+    edge = _solve(problem, omega_start, guess, options, slider)
+    reason = (f"the branch turned back past the start of the band ({omega_start:.6g} rad/s): "
+              "sweep stopped at the band edge")
+    solutions.append(replace(edge, reason=f"{edge.reason}; sweep stopped: {reason}"))
+    return solutions
 
 
 def _corrector(evaluate_z, z, predicted, t, step, x_scale, span, options, accept):

@@ -341,7 +341,9 @@ def _normalize_model(case, data):
                                      f"got '{path.name}'", p + (key,))
                 if not path.is_file():
                     raise case.error(f"matrix file not found: {path}", p + (key,))
-        if "damping" in mat and "damping" in data:
+        # an empty damping section is what normalizing a case with its own damping matrix leaves
+        # (so a normalized case, e.g. after solver.accuracy chose H, loads again)
+        if "damping" in mat and data.get("damping"):
             raise case.error("give either model.matrices.damping or a damping section, not both",
                              ("damping",))
         _not_allowed(case, data, (), ("reduction",), "with model.matrices (no reduction)")
@@ -363,7 +365,7 @@ def _normalize_deck(case, fe, p):
 
 
 def _normalize_damping(case, data):
-    if "damping" not in data:
+    if not data.get("damping"):       # absent, or {} left by normalizing a matrices damping
         if "matrices" in data["model"] and "damping" in data["model"]["matrices"]:
             data["damping"] = {}
             return
@@ -522,6 +524,11 @@ def _normalize_excitation(case, data):
 
 def _normalize_solver(case, data):
     solver = data.setdefault("solver", {})
+    # no harmonics given: sarfe chooses H, N (and the mode count) for the accuracy budget
+    # (default 'balanced'), starting its screening from H = 5; given harmonics are used as they are
+    solver.setdefault("resolution", "fixed" if "harmonics" in solver else "auto")
+    if solver["resolution"] == "auto":
+        solver.setdefault("accuracy", "balanced")
     H = solver.setdefault("harmonics", 5)
     N = solver.setdefault("samples_per_period", max(64, 2 ** math.ceil(math.log2(16 * H))))
     if N < 2 * H + 1:

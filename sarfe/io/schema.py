@@ -175,9 +175,12 @@ SOLVER = _object({
     "tolerance": {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1},
     "max_iterations": {"type": "integer", "minimum": 1},
     "stability": {"type": "boolean"},
-    # accuracy as an input (sarfe.study.resolve): a preset or a target; H, N, modes are chosen
+    # accuracy as an input (sarfe.accuracy.resolve): a preset or a target, the error budget of the
+    # run; with resolution 'auto' (the default when no harmonics are given) H, N, modes are chosen
+    # for it, with 'fixed' the given H, N are used and an estimate above it is warned about
     "accuracy": {"oneOf": [{"enum": ["fast", "balanced", "fine"]},
                            _object({"erp_db": POSITIVE, "amplitude_rel": POSITIVE})]},
+    "resolution": {"enum": ["auto", "fixed"]},
     "error_estimate": {"type": "boolean"},   # per-point error estimate (≈2 Newton steps a point)
     "harmonic_set": {"enum": ["all", "odd", "auto"]},   # orders solved for (sarfe.hbm.harmonic_set)
     # contacts that never switch over the frequencies solved linearly (sarfe.pipeline.pruning)

@@ -120,6 +120,10 @@ def results_table(rows, contact_types=None, max_contacts=6) -> str:
     headers = {"frequency_hz": "f [Hz]", "erp_db": "ERP [dB]", "erp_dba": "ERP [dB(A)]",
                "linear_erp_db": "linear [dB]", "iterations": "iter"}
     formats = {"frequency_hz": ".2f", "erp_db": ".1f", "erp_dba": ".1f", "linear_erp_db": ".1f"}
+    if any(math.isfinite(row.get("erp_error_db", float("nan"))) for row in rows):
+        # the error estimate of the ERP level (summary.json points[].error_estimate.erp_db)
+        columns.insert(columns.index("erp_dba") + 1, "erp_error_db")
+        headers["erp_error_db"], formats["erp_error_db"] = "±dB", ".2f"
     names = [k[: -len(".max_penetration_m")] for k in (rows[0] if rows else {})
              if k.endswith(".max_penetration_m")]
     for name in names[:max_contacts]:

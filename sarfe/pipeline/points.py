@@ -18,7 +18,7 @@ def solver_options(case):
     """(SolverOptions, ContinuationOptions) from the case's ``solver`` section. The tolerance of
     ``harmonic_set: auto`` is the amplitude budget of ``solver.accuracy`` (default 'balanced')."""
     from sarfe.hbm import ContinuationOptions, SolverOptions
-    from sarfe.study.accuracy import parse_accuracy
+    from sarfe.accuracy.estimates import parse_accuracy
 
     solver = case.data["solver"]
     options = SolverOptions(tolerance=solver["tolerance"], max_iterations=solver["max_iterations"],
@@ -108,6 +108,59 @@ def solve_point(nl, omega, H, N, options, previous):
     return solution
 
 
+STOPPED = "sweep stopped:"        # in the reason of the point where a continuation stopped
+POINT_BY_POINT = "point-by-point after the continuation stopped"
+CONTINUATION_FAILED = "point-by-point: the continuation failed"
+
+
+def in_band(solutions, start, end):
+    """The solutions whose ω lies in the requested band [start, end] [rad/s] (either order; a
+    relative 10⁻⁹ of the band's width of round-off allowed): points outside it are no results."""
+    lo, hi = sorted((start, end))
+    slack = 1e-9 * (hi - lo)
+    return [s for s in solutions if lo - slack <= float(s.omega) <= hi + slack]
+
+
+def sweep_status(case, solutions) -> dict:
+    """How a sweep was solved → {'complete', 'reason', 'covered'} (all None without a sweep).
+
+    complete: one continuation from start to end, no stop and no point-by-point fallback.
+    covered: the band is still covered by converged points — the lowest and highest converged
+    frequencies are the band's ends (10⁻³ of its width) and no gap between neighbouring converged
+    frequencies is wider than the continuation's largest step (``max_step`` of the band).
+    reason: one line saying what happened (None when complete)."""
+    exc = case.data["excitation"]
+    if "sweep" not in exc:
+        return {"complete": None, "reason": None, "covered": None}
+    start, end = exc["sweep"]["start_hz"], exc["sweep"]["end_hz"]
+    lo, hi = sorted((start, end))
+    span = hi - lo
+    reasons = [str(getattr(s, "reason", "")) for s in solutions]
+    freqs = np.sort([float(s.omega) / (2 * np.pi) for s in solutions if s.converged])
+    max_gap = case.data["solver"]["continuation"]["max_step"] * span
+    covered = bool(freqs.size and freqs[0] <= lo + 1e-3 * span and freqs[-1] >= hi - 1e-3 * span
+                   and np.max(np.diff(freqs), initial=0.0) <= max_gap * (1 + 1e-9))
+    stopped = next((i for i, r in enumerate(reasons) if STOPPED in r), None)
+    fallback = sum(POINT_BY_POINT in r or CONTINUATION_FAILED in r for r in reasons)
+    reached = bool(solutions) and abs(float(solutions[-1].omega) / (2 * np.pi) - end) <= 1e-3 * span
+    if stopped is None and not fallback and reached:
+        return {"complete": True, "reason": None, "covered": covered}
+    if any(CONTINUATION_FAILED in r for r in reasons):
+        what = reasons[0].split(CONTINUATION_FAILED, 1)[1].strip(" ()")
+        text = f"the continuation failed ({what}); {fallback} point(s) solved point by point"
+    elif stopped is not None:
+        where = float(solutions[stopped].omega) / (2 * np.pi)
+        why = reasons[stopped].split(STOPPED, 1)[1].strip()
+        text = (f"the continuation stopped at {where:.2f} Hz ({why})"
+                + (f"; {fallback} point(s) solved point by point from there" if fallback else ""))
+    else:
+        text = "the sweep did not reach the end of its band"
+    text = (f"sweep not complete: {text}; "
+            + ("the band is still covered by converged points" if covered
+               else "the band is NOT covered by converged points (exit code 3)"))
+    return {"complete": False, "reason": text, "covered": covered}
+
+
 def finish_sweep(nl, solutions, start, end, H, N, options, step):
     """Repair a continuation result: a point whose corrector failed is re-solved at its fixed ω
     (starting from it); a sweep that stopped before ``end`` is completed point by point
@@ -133,14 +186,36 @@ def finish_sweep(nl, solutions, start, end, H, N, options, step):
     for omega in np.linspace(last, end, count)[1:]:
         solution = solve_point(nl, float(omega), H, N, options, previous)
         try:
-            solution = dataclasses.replace(
-                solution, reason=f"{solution.reason} (point-by-point after the continuation stopped)")
+            solution = dataclasses.replace(solution, reason=f"{solution.reason} ({POINT_BY_POINT})")
         except TypeError:
-            solution.reason += " (point-by-point after the continuation stopped)"
+            solution.reason += f" ({POINT_BY_POINT})"
         solutions.append(solution)
         if solution.converged and not isinstance(solution, SimpleNamespace):
             previous = solution
     return solutions
+
+
+def common_samples(nl, solutions):
+    """Solutions with one N: a continuation raises N at corners of its branch (sarfe.hbm.
+    continuation), but the result files hold one time grid (applied after the error estimates,
+    which use the N each point was solved with). Points solved with fewer samples get
+    their contact time histories (force, state) re-sampled by the AFT at the largest N used
+    (harmonics unchanged; the ``reason`` says so)."""
+    from sarfe.hbm.residual import nonlinear_force
+
+    largest = max((int(s.samples_per_period) for s in solutions), default=0)
+    out = []
+    for s in solutions:
+        N = int(s.samples_per_period)
+        if N == largest or isinstance(s, SimpleNamespace) or not nl.contacts.count:
+            out.append(s)
+            continue
+        _, _, forces = nonlinear_force(nl.contacts, s.displacement, largest, jacobian=False)
+        out.append(dataclasses.replace(
+            s, samples_per_period=largest, contact_force_time=forces.force_time,
+            contact_state=forces.state,
+            reason=f"{s.reason} (solved with N = {N}; time histories at N = {largest})"))
+    return out
 
 
 def solve_points(case, nl: NonlinearModel, progress=False):
@@ -151,6 +226,7 @@ def solve_points(case, nl: NonlinearModel, progress=False):
     H, N = solver["harmonics"], solver["samples_per_period"]
     options, cont_options = solver_options(case)
     contacts = nl.contacts
+    failed = ""
     if "sweep" in exc:
         start, end = (2 * np.pi * exc["sweep"][k] for k in ("start_hz", "end_hz"))
         if contacts.count:
@@ -162,12 +238,10 @@ def solve_points(case, nl: NonlinearModel, progress=False):
                                            progress=(lambda done, total: bar.update(
                                                max(0, int(round(100 * done)) - bar.n)))
                                            if bar is not None else None))
-                return finish_sweep(nl, solutions, start, end, H, N, options,
-                                     solver["continuation"]["initial_step"])
-            except Exception as error:  # fall back to a point-by-point sweep
-                import warnings
-                warnings.warn(f"continuation failed ({type(error).__name__}: {error}); "
-                              "sweeping point by point instead", RuntimeWarning, stacklevel=2)
+                return in_band(finish_sweep(nl, solutions, start, end, H, N, options,
+                                            solver["continuation"]["initial_step"]), start, end)
+            except Exception as error:  # fall back to a point-by-point sweep (said in reasons)
+                failed = f"{CONTINUATION_FAILED} ({type(error).__name__}: {error})"
             finally:
                 if bar is not None:
                     bar.close()
@@ -180,6 +254,11 @@ def solve_points(case, nl: NonlinearModel, progress=False):
     try:
         for omega in omegas:
             solution = solve_point(nl, float(omega), H, N, options, previous)
+            if failed:
+                try:
+                    solution = dataclasses.replace(solution, reason=f"{solution.reason} ({failed})")
+                except TypeError:
+                    solution.reason += f" ({failed})"
             solutions.append(solution)
             previous = solution if getattr(solution, "converged", False) and not isinstance(
                 solution, SimpleNamespace) else None

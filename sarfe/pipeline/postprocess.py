@@ -2,7 +2,8 @@ r"""Per-point results: ERP of the HBM solution, contact indicators, linear risk 
 third-octave bands, the contribution of each contact, and the loudest point of a run.
 
 ERP: w_s = N ũ (radiating-node normal displacement harmonics) → :func:`sarfe.erp.
-equivalent_radiated_power`. Linear baseline: (K − ω² M + iω D) Û = F̂ without contacts →
+equivalent_radiated_power`. Linear baseline: (K + Gᵀ diag(k) G − ω² M + iω D) Û = F̂ with the
+contacts at their static state (preloaded pairs as springs, open ones removed) →
 :func:`sarfe.risk.linear_risk_from_contacts` and its ERP. Bands: :func:`sarfe.erp.bands.
 third_octave_levels` of the harmonic powers (the linear baseline radiates at ω only).
 Contributions: :mod:`sarfe.pipeline.contributions`; per-period contact dynamics:
@@ -82,13 +83,46 @@ def contact_indicators(solution, nl: NonlinearModel) -> list[dict]:
     return out
 
 
+def baseline_rows(contacts):
+    """(spring [N/m], dashpot [N s/m]) of every row of G in the linear baseline: the contacts at
+    their static state (no static load: the rest position, u = 0; each law's linearization,
+    :func:`sarfe.hbm.laws.linearization`). A pair closed there (g ≤ 0: a preloaded pair, g = the
+    overclosure that carries the preload) keeps its normal spring and dashpot; a friction pair
+    that carries a static normal force there (closed, or a constant normal load N0 > 0) is stuck
+    and keeps k_t on its tangent rows. Open pairs are removed (0)."""
+    from sarfe.hbm import laws
+
+    c = contacts
+    normal, tangent = laws.linearization(c)
+    springs, dashpots = np.zeros(c.row_count), np.zeros(c.row_count)
+    closed = (c.normal_row >= 0) & normal.closed
+    springs[c.normal_row[closed]] = normal.spring[closed]
+    dashpots[c.normal_row[closed]] = normal.dashpot[closed]
+    stuck = normal.preload > 0
+    for col in range(2):
+        present = (c.tangent_rows[:, col] >= 0) & stuck
+        springs[c.tangent_rows[present, col]] = tangent[present]
+    return springs, dashpots
+
+
 def linear_baseline(case, stage, nl: NonlinearModel, omega):
-    """Linear response without contacts at ω: ERP and risk per named contact."""
+    """Linear response at ω of the structure with its contacts at their static state: preloaded
+    (closed) pairs as their linearized spring k_n (and dashpot c_n), stuck friction pairs as k_t,
+    open pairs removed (:func:`baseline_rows`):
+
+        (K + Gᵀ diag(k) G − ω² M + iω (D + Gᵀ diag(c) G)) Û = F̂   [m],
+
+    its ERP and the linear risk per named contact."""
     from sarfe.risk import linear_risk_from_contacts
 
     M, D, K = nl.model.mass, nl.model.damping, nl.model.stiffness
     dense = (lambda A: A.toarray() if sp.issparse(A) else np.asarray(A))
-    S = dense(K) - omega ** 2 * dense(M) + 1j * omega * dense(D)
+    springs = dashpots = 0.0
+    if nl.contacts.count:
+        G = sp.csr_matrix(nl.contacts.gap_map)
+        k, c = baseline_rows(nl.contacts)
+        springs, dashpots = (G.T @ sp.diags(k) @ G).toarray(), (G.T @ sp.diags(c) @ G).toarray()
+    S = dense(K) + springs - omega ** 2 * dense(M) + 1j * omega * (dense(D) + dashpots)
     U1 = np.linalg.lstsq(S, nl.excitation_amplitude, rcond=None)[0]
     H = (nl.excitation.shape[0] - 1) // 2
     U = np.zeros((2 * H + 1, stage.dof_count))
@@ -115,20 +149,67 @@ def linear_baseline(case, stage, nl: NonlinearModel, omega):
             "erp_level_dba": float(erp.level_total_a_db), "contacts": contacts}
 
 
+ESTIMATE_STRIDE = 8     # a sweep's estimate is computed at every 8th converged point (+ ends, peak)
+
+
 def _error_estimate(case, stage, nl, solution):
-    """Cheap a-posteriori error estimate of a converged point (sarfe.study.accuracy): harmonic
-    truncation (one Newton step with more harmonics), AFT aliasing (N doubled), modal truncation,
-    spectral tails. None when switched off, not converged or without contacts; a failure of the
-    estimate is reported, never raised."""
+    """A-posteriori error estimate of a converged point (:mod:`sarfe.accuracy.estimates`): harmonic
+    truncation (H → H' and N → N' solved by condensed Newton from the point, usually 1–4
+    iterations), AFT aliasing (N → 2N, likewise), modal truncation (the same on the cached coarser
+    Craig–Bampton model), spectral tails. None when switched off, not converged or without
+    contacts; a failure of the estimate is reported, never raised."""
     if not case.data["solver"].get("error_estimate", True) or not solution.converged \
             or not nl.contacts.count:
         return None
     try:
-        from sarfe.study.accuracy import stage_error_estimate
+        from sarfe.pipeline.accuracy import stage_error_estimate
 
         return stage_error_estimate(solution, stage, nl).as_dict()
     except Exception as error:  # an estimate must not break a solve
         return {"failed": f"{type(error).__name__}: {error}"}
+
+
+def error_estimates(case, stage, nl, solutions, stride=ESTIMATE_STRIDE) -> list:
+    """Per point: the error estimate dict, or None (see :func:`_error_estimate`).
+
+    A sweep's points are estimated on a subset and the others take the larger estimate of their
+    two estimated neighbours in continuation order (``interpolated: true``, ``from_points``): every
+    ``stride``-th converged point, the first and last, and the point with the largest first-harmonic
+    contact amplitude (the resonance, where the error peaks). The error of a harmonic-balance
+    solution varies smoothly along a branch between those points, so the subset costs 1/stride of
+    the per-point estimates; benchmarks/results/accuracy.md measures cost and bracketing."""
+    n = len(solutions)
+    if not case.data["solver"].get("error_estimate", True) or not nl.contacts.count:
+        return [None] * n
+    eligible = [i for i, s in enumerate(solutions) if s.converged]
+    if "sweep" not in case.data["excitation"] or len(eligible) <= 2 * stride:
+        return [_error_estimate(case, stage, nl, s) for s in solutions]
+    G = nl.contacts.gap_map
+
+    def amplitude(i):
+        U = np.asarray(solutions[i].displacement)
+        return float(np.max(np.hypot(G @ U[1], G @ U[2]), initial=0.0))
+
+    chosen = set(eligible[::stride]) | {eligible[0], eligible[-1], max(eligible, key=amplitude)}
+    computed = {i: _error_estimate(case, stage, nl, solutions[i]) for i in sorted(chosen)}
+    usable = [i for i in sorted(computed) if computed[i] is not None and "failed" not in computed[i]
+              and np.isfinite(computed[i]["amplitude_rel"])]    # (unknown: that point alone)
+    out = []
+    for i, s in enumerate(solutions):
+        if i in computed or not s.converged or not usable:
+            out.append(computed.get(i) if s.converged else None)
+            continue
+        below = [j for j in usable if j < i]
+        above = [j for j in usable if j > i]
+        near = ([below[-1]] if below else []) + ([above[0]] if above else [])
+        merged = {"interpolated": True, "from_points": near, "notes": []}
+        for key, value in computed[near[0]].items():
+            if isinstance(value, (int, float)) and not isinstance(value, bool):
+                values = [computed[j][key] for j in near if not np.isnan(computed[j][key])]
+                merged[key] = max(values) if values else float("nan")
+        merged["seconds"] = 0.0
+        out.append(merged)
+    return out
 
 
 def harmonic_set_record(case, solution):
@@ -153,7 +234,10 @@ def band_record(erp, linear, omega) -> dict:
             "linear": third_octave_levels([f], [linear_power]).as_dict()}
 
 
-def point_record(case, stage, nl, index, solution):
+def point_record(case, stage, nl, index, solution, error_estimate=False):
+    """(point dict of summary.json, flat table row, ErpResult, radiating displacements W).
+    ``error_estimate``: the point's estimate when computed beforehand (:func:`error_estimates`),
+    False to compute it here."""
     from sarfe.pipeline.contact_dynamics import contact_dynamics
     from sarfe.pipeline.contributions import contributions_record
 
@@ -178,7 +262,8 @@ def point_record(case, stage, nl, index, solution):
         "residual_norm": float(getattr(solution, "residual_norm", float("nan"))),
         "reason": str(getattr(solution, "reason", "")),
         "erp": _erp_dict(erp), "contacts": contacts, "linear": linear,
-        "error_estimate": _error_estimate(case, stage, nl, solution),
+        "error_estimate": (_error_estimate(case, stage, nl, solution) if error_estimate is False
+                           else error_estimate),
         "harmonic_set": harmonic_set_record(case, solution),
         "bands": band_record(erp, linear, omega),
         "contributions": contributions,
@@ -187,7 +272,9 @@ def point_record(case, stage, nl, index, solution):
            "converged": point["converged"], "stable": point["stable"],
            "iterations": point["iterations"], "erp_W": erp.power_total,
            "erp_db": erp.level_total_db, "erp_dba": erp.level_total_a_db,
-           "linear_erp_db": linear["erp_level_db"], "linear_erp_dba": linear["erp_level_dba"]}
+           "linear_erp_db": linear["erp_level_db"], "linear_erp_dba": linear["erp_level_dba"],
+           "erp_error_db": (abs(float(point["error_estimate"]["erp_db"])) if point["error_estimate"]
+                            and "erp_db" in point["error_estimate"] else float("nan"))}
     for c in contacts:
         for key in ("max_penetration_m", "peak_normal_force_N", "peak_friction_force_N",
                     "open_fraction", "slip_fraction", "impacts_per_period", "erp_share_a"):

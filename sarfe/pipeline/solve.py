@@ -13,20 +13,22 @@ import numpy as np
 
 from sarfe.io.case import load_case
 from sarfe.io.errors import EXIT_NOT_CONVERGED
+from sarfe.pipeline.accuracy import accuracy_check
 from sarfe.pipeline.checks import check_case, reduced_model_warnings
 from sarfe.pipeline.linear import build_linear_model, linear_model_key
 from sarfe.pipeline.nonlinear import NonlinearModel, nonlinear_model
 from sarfe.pipeline.outputs import write_outputs, results_table
-from sarfe.pipeline.points import solve_points
+from sarfe.pipeline.points import common_samples, solve_points, sweep_status
 from sarfe.pipeline.progress import bar as _bar
 from sarfe.pipeline.pruning import solve_points_pruned
-from sarfe.pipeline.postprocess import point_record, worst_of
+from sarfe.pipeline.postprocess import error_estimates, point_record, worst_of
 
 
 @dataclass
 class CaseResult:
     """Result of :func:`solve_case`: ``summary`` (= summary.json), ``rows`` (one flat dict per
-    frequency point), ``exit_code`` (0 all converged, 3 some point did not converge),
+    frequency point), ``exit_code`` (0 all converged, 3 some point did not converge or an
+    incomplete sweep left part of its band without converged points),
     ``solutions`` (HarmonicSolution per point), ``output_dir`` (None if nothing was written)."""
 
     summary: dict
@@ -66,9 +68,10 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
             warn(line)
     timings = {}
     accuracy = None
-    if "accuracy" in case.data["solver"]:
+    if case.data["solver"]["resolution"] == "auto":
         # accuracy as an input: choose H, N (and mode count) from cheap error estimates first
-        from sarfe.study.resolve import apply_resolution, resolve_case_accuracy
+        from sarfe.accuracy.resolve import apply_resolution
+        from sarfe.pipeline.accuracy import resolve_case_accuracy
 
         clock = time.perf_counter()
         report = resolve_case_accuracy(case, case.data["solver"]["accuracy"])
@@ -102,8 +105,11 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     bar = _bar(progress, "ERP and error estimates" if case.data["solver"].get("error_estimate", True)
                else "ERP", len(solutions), unit="point")
     try:
+        estimates = error_estimates(case, stage, nl, solutions)  # each at the N it was solved with
+        timings["error_estimate_s"] = time.perf_counter() - clock
+        solutions = common_samples(nl, solutions)                # one time grid for the files
         for index, solution in enumerate(solutions):
-            point, row, erp, W = point_record(case, stage, nl, index, solution)
+            point, row, erp, W = point_record(case, stage, nl, index, solution, estimates[index])
             points.append(point)
             rows.append(row)
             erps.append(erp)
@@ -115,12 +121,11 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
             bar.close()
     timings["postprocess_s"] = time.perf_counter() - clock
     not_converged = [p["index"] for p in points if not p["converged"]]
-    sweep = case.data["excitation"].get("sweep")
-    sweep_complete = None
-    if sweep and points:
-        span = abs(sweep["end_hz"] - sweep["start_hz"])
-        sweep_complete = abs(points[-1]["frequency_hz"] - sweep["end_hz"]) <= 1e-3 * span
-    exit_code = EXIT_NOT_CONVERGED if (not_converged or not points or sweep_complete is False) else 0
+    sweep = sweep_status(case, solutions)       # None entries without a sweep
+    # exit code 3: a point did not converge, or the sweep fell back to point-by-point solving
+    # without the band still being covered by converged points (docs/hbm.md, exit codes)
+    exit_code = EXIT_NOT_CONVERGED if (not_converged or not points or (
+        sweep["complete"] is False and not sweep["covered"])) else 0
     summary = {
         "sarfe_version": __version__,
         "case": case.name,
@@ -129,8 +134,9 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         "exit_code": exit_code,
         "all_converged": not not_converged and bool(points),
         "non_converged_points": not_converged,
-        "sweep_complete": sweep_complete,        # None without a sweep; False → exit code 3
-        "sweep_stop_reason": (points[-1]["reason"] if sweep_complete is False else None),
+        "sweep_complete": sweep["complete"],     # None without a sweep; False: see the reason
+        "sweep_stop_reason": sweep["reason"],
+        "sweep_covered": sweep["covered"],       # False with an incomplete sweep → exit code 3
         "engine": "harmonic balance",
         "linear_model_key": stage.key,
         "model": dict(stage.info, kind=stage.kind, kept_dofs=int(stage.dof_count),
@@ -142,6 +148,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         "points": points,
         "worst": worst_of(points),
         "accuracy": accuracy,                    # None unless solver.accuracy was given
+        "accuracy_check": accuracy_check(case, points),   # estimates vs the accuracy budget
         "warnings": warnings,                    # inputs far outside the model's range
         "timings_s": timings,
         "case_data": case.data,                  # the case with every default filled in

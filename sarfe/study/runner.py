@@ -15,7 +15,7 @@ largest first-harmonic normal amplitude at the contacts [m]; errors against the 
 every grid point converged in both (max over points): |ΔL| [dB], |ΔL_A| [dB], relative force and
 amplitude errors; cost: wall time [s] (linear stage included when rebuilt), Newton iterations,
 peak traced memory [MB] (tracemalloc, numpy buffers included); the a-posteriori estimate
-(:func:`sarfe.study.accuracy.estimate_errors`, max over the grid, not timed).
+(:func:`sarfe.accuracy.estimates.estimate_errors`, max over the grid, not timed).
 The linear stage is built once and reused for harmonics / samples / penalty variants.
 """
 from __future__ import annotations
@@ -201,7 +201,7 @@ def branch_guesses(case, stage, baseline_points):
     from sarfe.hbm.time_integration import linear_harmonic_response
     from sarfe.pipeline import nonlinear_model
 
-    from .accuracy import resize_harmonics
+    from sarfe.accuracy import resize_harmonics
 
     nl = nonlinear_model(case, stage)
     H = int(case.data["solver"]["harmonics"])
@@ -227,7 +227,7 @@ def attach_estimates(case, stage, points):
     """estimate_errors at every converged grid point (adds estimate_amplitude_rel / _erp_db)."""
     from sarfe.pipeline import nonlinear_model
 
-    from .accuracy import stage_error_estimate
+    from sarfe.pipeline.accuracy import stage_error_estimate
 
     nl = nonlinear_model(case, stage)
     for p in points:

@@ -374,7 +374,7 @@ def harmonic_content(solution, threshold=1e-3) -> dict:
     of the energy of harmonics k ≥ 1 (the mean separately, relative to all). ``needed_harmonics``:
     smallest K with the energy above K below threshold² (amplitude share < threshold).
     """
-    from sarfe.study.accuracy import harmonic_energy
+    from sarfe.accuracy.estimates import harmonic_energy
 
     out = {"orders": list(range(int(solution.harmonics) + 1))}
     groups = {"displacement": solution.displacement,
