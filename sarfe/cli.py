@@ -93,55 +93,31 @@ def cmd_validate(args) -> int:
 
 
 def cmd_verify(args) -> int:
-    """Time integration of one point against the harmonic balance (first-harmonic amplitudes)."""
+    """Time integration of one point against the harmonic balance: every harmonic up to H, contact
+    and largest-DOF amplitudes, ERP total and dB(A), and the stability verdict (a perturbation of
+    the HBM orbit decays or grows), each with its tolerance (:mod:`sarfe.pipeline.verify`)."""
     import numpy as np
 
-    from sarfe.hbm.time_integration import integrate_time
     from sarfe.pipeline import build_linear_model, load_case, nonlinear_model
+    from sarfe.pipeline.verify import format_rows, verify_point
 
     if not args.frequency_hz > 0:
         raise CaseError(f"--frequency-hz must be > 0, got {args.frequency_hz}", source=args.case)
     case = load_case(args.case)
     stage = build_linear_model(case, progress=not args.quiet)
     nl = nonlinear_model(case, stage)
-    solver = case.data["solver"]
-    H, N = solver["harmonics"], solver["samples_per_period"]
-    omega = 2 * np.pi * args.frequency_hz
-    from sarfe.pipeline.points import solve_point, solver_options
-
-    options, _ = solver_options(case)
-    # HBM as in `sarfe solve` (a failed Newton is retried from a short time integration);
-    # the time integration below starts independently from the linear periodic solution.
-    hbm = solve_point(nl, omega, H, N, options, None)
-    steps = max(512, 4 * N)
-    tim = integrate_time(nl.model, nl.contacts, nl.excitation, omega, H, steps_per_period=steps)
-    U_h, U_t = np.asarray(hbm.displacement), np.asarray(tim.displacement_harmonics)
-    amp_h, amp_t = np.hypot(U_h[1], U_h[2]), np.hypot(U_t[1], U_t[2])
-    rows = []
-    for name, _, idx in nl.groups:
-        nr = nl.contacts.normal_row[idx]
-        nr = nr[nr >= 0]
-        if nr.size:
-            G = nl.contacts.gap_map[nr]
-            a_h = np.hypot(G @ U_h[1], G @ U_h[2]).max()
-            a_t = np.hypot(G @ U_t[1], G @ U_t[2]).max()
-            rows.append((f"contact {name} (normal)", a_h, a_t))
-    j = int(np.argmax(amp_h))
-    rows.append((f"largest DOF ({j})", amp_h[j], amp_t[j]))
-    print(f"verify {case.name} at {args.frequency_hz:g} Hz: HBM (H={H}, N={N}, "
-          f"converged={hbm.converged}) vs time integration ({steps} steps/period, "
-          f"{tim.periods} periods, steady={tim.steady})")
-    width = max(len(r[0]) for r in rows)
-    print(f"{'first-harmonic amplitude [m]':<{width}}  {'HBM':>11}  {'time int.':>11}  {'diff':>7}")
-    worst = 0.0
-    for label, a_h, a_t in rows:
-        diff = abs(a_h - a_t) / max(abs(a_t), 1e-300)
-        worst = max(worst, diff if a_t > 1e-15 else 0.0)
-        print(f"{label:<{width}}  {a_h:11.4e}  {a_t:11.4e}  {100 * diff:6.2f}%")
-    agree = worst <= args.tolerance
-    print(f"{'agree' if agree else 'DIFFER'}: largest difference {100 * worst:.2f} % "
-          f"(tolerance {100 * args.tolerance:g} %)")
-    return 0 if agree and hbm.converged else EXIT_NOT_CONVERGED
+    hbm, tim, check, rows = verify_point(case, stage, nl, 2 * np.pi * args.frequency_hz,
+                                         args.tolerance, args.tolerance_db)
+    print(f"verify {case.name} at {args.frequency_hz:g} Hz: HBM (H={hbm.harmonics}, "
+          f"N={hbm.samples_per_period}, converged={hbm.converged}) vs time integration "
+          f"({tim.steps_per_period} steps/period, {tim.periods} periods, steady={tim.steady})"
+          + ("" if check is None else f"; monodromy from {check.periods} perturbed periods"))
+    for line in format_rows(rows):
+        print(line)
+    bad = [r.label for r in rows if not r.agree]
+    print("agree: every comparison within its tolerance" if not bad
+          else f"DIFFER: {len(bad)} of {len(rows)} comparisons outside tolerance")
+    return 0 if not bad and hbm.converged else EXIT_NOT_CONVERGED
 
 
 def output_options(parser) -> None:
@@ -175,7 +151,9 @@ def build_parser() -> argparse.ArgumentParser:
     common(p)
     p.add_argument("--frequency-hz", type=float, required=True, metavar="F")
     p.add_argument("--tolerance", type=float, default=0.05,
-                   help="relative amplitude difference accepted (default 0.05)")
+                   help="relative amplitude/ERP difference accepted (default 0.05)")
+    p.add_argument("--tolerance-db", type=float, default=0.5,
+                   help="ERP dB(A) difference accepted (default 0.5)")
     p.set_defaults(func=cmd_verify)
     p = sub.add_parser("validate", help="check a case file: everything `solve` checks before "
                        "the heavy work (schema, numbers, mesh quality, groups, contact pairing, "

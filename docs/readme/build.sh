@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
-# Rebuild README.md from docs/: head, case-file reference, outputs, then the library parts.
+# Rebuild README.md from docs/readme/: the two commands and command line (head.md), a compact
+# case-file reference (reference.md) and the outputs with how to open them (outputs.md). The full
+# texts live in docs/*.md, linked from the README; keep the README under ~400 lines.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 {
   cat docs/readme/head.md
-  sed -e 's/^# Case files/## Case-file reference/' -e 's/^## /### /' docs/case-file.md | sed -e 's/^### Case-file reference/## Case-file reference/'
   echo
-  cat docs/outputs.md
-  for part in meshes fe reduction hbm verification study batch benchmarks dependencies; do
-    if [ -f "docs/$part.md" ]; then echo; cat "docs/$part.md"; fi
-  done
+  cat docs/readme/reference.md
+  echo
+  cat docs/readme/outputs.md
 } > README.md
+wc -l README.md

@@ -27,6 +27,9 @@ class SolverOptions:
         G S_k⁻¹ Gᵀ (Newton on the contact rows only). 'auto' condenses when that system is smaller
         than the full one and at most ``max_condensed_size`` unknowns.
     stability: compute Hill stability of the converged solution.
+    stability_method: 'full' (the Hill eigenproblem on all DOFs, :mod:`sarfe.hbm.stability`),
+        'condensed' (its roots on the contact rows, :mod:`sarfe.hbm.stability_condensed`) or
+        'auto': condensed when the full Hill matrix exceeds ``CONDENSED_ABOVE`` (2(2H+1)n rows).
     friction_tolerance, friction_pass_cap: 2-D slider march, stop when the slider state repeats to
         friction_tolerance × (max |q| + max ρ), at most friction_pass_cap periods.
     harmonic_set: None | 'all' | 'odd' | 'auto' | a list of orders: the harmonic orders solved for
@@ -46,6 +49,7 @@ class SolverOptions:
     max_condensed_size: int = 2000
     stability: bool = True
     stability_tolerance: float = 1e-6
+    stability_method: str = "auto"
     friction_tolerance: float = 1e-12
     friction_pass_cap: int = 50
     harmonic_set: object = None
@@ -95,6 +99,7 @@ class HarmonicSolution:
     the orders outside the set (outside the odd set, for an 'auto' solution that used all orders)
     carry, see :func:`sarfe.hbm.harmonic_set.dropped_content` (nan if not computed).
     Residual_norm and stability: residual of the kept rows; Hill stability of the full set.
+    stability_note: why ``stable`` is None although stability was computed ('' otherwise).
     method: how the point was obtained — 'harmonic balance' (the Newton solve), 'linear' (exact
     solution without nonlinear contacts) or 'time integration' (the stand-in for a point whose
     engine call raised: iterations = periods integrated, residual_norm = periodicity error).
@@ -118,6 +123,7 @@ class HarmonicSolution:
     harmonic_orders: tuple = None
     harmonic_set: str = "all"
     dropped_content: float = float("nan")
+    stability_note: str = ""
     method: str = "harmonic balance"
 
     def amplitude(self, dof: int, harmonic: int = 1) -> float:

@@ -39,6 +39,10 @@ from .newton import SingularJacobian, newton, solve_linear
 from .residual import Problem, condensed_residual, full_residual, kept_rows
 from .solution import HarmonicSolution, SolverOptions
 from .stability import hill_stability
+from .stability_condensed import condensed_stability
+from .stability_contacts import ContactOperator
+
+CONDENSED_ABOVE = 3000   # Hill matrix rows 2(2H+1)n above which 'auto' stability is condensed
 
 
 def make_problem(model, contacts, excitation, harmonics, samples_per_period, options=None,
@@ -198,13 +202,14 @@ def initial_slider(problem, U):
 
 
 def slider_acceptor(state):
-    """accept(evaluation) for Newton: warm-start the slider at the last periodic state."""
+    """accept(evaluation) for Newton: keep the last periodic slider state (reported, passed on).
+
+    The friction forces are a function of the unknowns alone (the slider gauge of
+    :mod:`sarfe.hbm.laws.jenkins`): the slider start is not a hidden state, so the residual never
+    changes between Newton iterations and no evaluation is redone (returns False)."""
     def accept(evaluation):
-        new = evaluation.forces.slider_end
-        old = state["slider"]
-        changed = not np.allclose(np.nan_to_num(new), np.nan_to_num(old), rtol=0, atol=0)
-        state["slider"] = new
-        return changed
+        state["slider"] = evaluation.forces.slider_end
+        return False
     return accept
 
 
@@ -225,6 +230,21 @@ def contact_damping(problem, forces):
     G, H = problem.contacts.gap_map, problem.harmonics
     GG = sp.kron(sp.identity(2 * H + 1), G, format="csr")
     return (GG.T @ jacobian_matrix(forces.damping_blocks, G.shape[0], H) @ GG).tocsr()
+
+
+def stability(problem, omega, U, ev, options):
+    """Hill stability of a converged orbit by ``options.stability_method`` (StabilityResult)."""
+    operator = ContactOperator(problem, U, omega, ev.forces)
+    method = options.stability_method
+    if method == "auto":
+        size = 2 * (2 * problem.harmonics + 1) * problem.model.dof_count
+        method = "condensed" if size > CONDENSED_ABOVE and problem.contacts.count else "full"
+    if method == "condensed":
+        return condensed_stability(problem.model, problem.contacts, omega, problem.harmonics,
+                                   ev.forces, operator, tolerance=options.stability_tolerance)
+    return hill_stability(problem.model, omega, problem.harmonics, ev.jacobian,
+                          options.stability_tolerance,
+                          contact_damping=contact_damping(problem, ev.forces), operator=operator)
 
 
 def finalize(problem, omega, U, converged, reason, iterations, slider, options) -> HarmonicSolution:
@@ -250,11 +270,10 @@ def finalize(problem, omega, U, converged, reason, iterations, slider, options) 
     elif converged and residual > options.full_tolerance:
         converged = False
         reason = f"full residual {residual:.3g} above full_tolerance {options.full_tolerance:g}"
-    stable, exponent = None, float("nan")
+    stable, exponent, note = None, float("nan"), ""
     if converged and options.stability:
-        stable, exponent = hill_stability(problem.model, omega, problem.harmonics, ev.jacobian,
-                                          options.stability_tolerance,
-                                          contact_damping=contact_damping(problem, ev.forces))
+        result = stability(full, omega, U, ev, options)
+        stable, exponent, note = result.stable, result.leading, result.note
     orders = problem.harmonic_orders
     return HarmonicSolution(
         omega=float(omega), harmonics=problem.harmonics,
@@ -263,7 +282,7 @@ def finalize(problem, omega, U, converged, reason, iterations, slider, options) 
         contact_force_time=ev.forces.force_time, contact_state=ev.forces.state,
         converged=bool(converged), reason=reason, iterations=int(iterations),
         residual_norm=residual, friction_passes=int(ev.forces.friction_passes),
-        stable=stable, floquet_exponent=exponent,
+        stable=stable, floquet_exponent=exponent, stability_note=note,
         harmonic_orders=None if orders is None else tuple(int(k) for k in orders),
         harmonic_set=harmonic_set_label(problem), dropped_content=eta)
 

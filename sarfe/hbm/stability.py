@@ -17,15 +17,24 @@ truncation artefacts; following Krack & Gross (2019, §3.6) we keep the 2n with 
 the strip |Im s| ≤ 1.01 ω/2 (at a period-doubling the two exponents of a real multiplier pair and
 their conjugates all sit near Im s = ±ω/2, ~0.2 % off with truncation, and compete for two places;
 without this the unstable one was dropped on NLvib example 03). The solution is stable when the
-largest real part of the kept exponents ≤ tolerance · ω. For the hysteretic Jenkins element the
-Jacobian of the harmonic map is the linearization used (stick = spring k_t).
+largest real part of the kept exponents ≤ tolerance · ω. 
+Nonsmooth contacts (:mod:`sarfe.hbm.stability_contacts`): the Newton Jacobian is not Hill's
+operator for them. A Jenkins element remembers the perturbation of its last slip sample, which
+grows or decays with e^{st} meanwhile, so its term is 𝒥(s), and the eigenproblem is nonlinear in s:
 
-Caveat (nonsmooth contact): the AFT Jacobian jumps when a sample crosses a kink, so det ∂R/∂ũ can
-change sign without a fold; on NLvib 03 two of ~30 points of the unstable middle branch come out
-"stable" (leading exponent ≈ −0.004/s). Time integration agreed with the verdict at the points
-checked away from bifurcations (Ω = 0.598 unstable, 0.702 stable, 0.7035 middle unstable).
+    T(s) p̃ = ( s² M̃ + s D̃ + S(ω) + (I⊗G)ᵀ 𝒥(s) (I⊗G) ) p̃ = 0;
+
+the normal laws keep their N-sampled Jacobian. The exponents of the frozen problem
+(𝒥(0), the harmonic-map Jacobian) are the starting points; the leading ones are refined by
+successive linear problems (:func:`refine_exponent`) until the largest real part belongs to a
+refined exponent. The verdict is ``None`` with a note when it cannot be trusted: the refinement did
+not converge, or the leading exponent lies within the band |Re s| ≤ ``uncertain_band`` · ω of 0
+(a fold or bifurcation within the truncation error).
 """
+
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
@@ -34,55 +43,157 @@ import scipy.sparse.linalg as spla
 from .linear import hill_matrices
 
 
+@dataclass(frozen=True)
+class StabilityResult:
+    """stable (True | False | None: uncertain), leading max Re s [1/s] (nan if not computed),
+    note (why the verdict is None, or '' ), exponents: the kept exponents (complex, 1/s)."""
+
+    stable: object
+    leading: float
+    note: str
+    exponents: np.ndarray
+
+
 def floquet_exponents(model, omega, harmonics, jacobian, dense_limit=3000, max_exponents=120,
                       contact_damping=None):
-    """Kept Floquet exponents s [1/s] (≥ 2n) of a solution, given ∂R/∂ũ (sparse or dense).
+    """Kept Floquet exponents s [1/s] (≥ 2n) of the frozen problem, given ∂R/∂ũ (sparse or dense).
 
     On the sparse path at most ``max_exponents`` exponents nearest the origin are computed (all 2n
     representatives lie in the strip |Im s| ≤ ω/2, hence near 0; for 2n > max_exponents only the
     ones of the lowest modes are checked). contact_damping: (I⊗G)ᵀ E diag(∂λ/∂ṙ) Φ (I⊗G) or None.
     """
     n = model.dof_count
-    Mt, Dt = hill_matrices(model, omega, harmonics)
-    if contact_damping is not None:
-        Dt = (Dt + sp.csr_matrix(contact_damping)).tocsr()
+    Mt, Dt = _hill(model, omega, harmonics, contact_damping)
     size = Mt.shape[0]
     keep = 2 * n
-    if 2 * size <= dense_limit:
-        Minv = np.kron(np.eye(2 * harmonics + 1), np.linalg.inv(_dense(model.mass)))
-        J = _dense(jacobian)
-        A = np.block([[np.zeros((size, size)), np.eye(size)],
-                      [-Minv @ J, -Minv @ _dense(Dt)]])
+    dense = 2 * size <= dense_limit
+    A, B = _first_order(Mt, Dt, jacobian, dense)
+    if dense:
         values = np.linalg.eigvals(A)
     else:
-        A = sp.bmat([[None, sp.identity(size)], [-sp.csr_matrix(jacobian), -Dt]], format="csc")
-        B = sp.block_diag([sp.identity(size), Mt], format="csc")
         keep = min(keep, max_exponents)
         count = min(2 * size - 2, keep + max(20, keep // 2))
         values = spla.eigs(A, k=count, M=B, sigma=0.0, which="LM", return_eigenvectors=False)
+    return _select(values, omega, keep)
+
+
+def _hill(model, omega, harmonics, contact_damping):
+    Mt, Dt = hill_matrices(model, omega, harmonics)
+    if contact_damping is not None:
+        Dt = (Dt + sp.csr_matrix(contact_damping)).tocsr()
+    return Mt, Dt
+
+
+def _first_order(Mt, Dt, jacobian, dense):
+    """(A, B) of the first-order Hill pencil A z = s B z (dense: B⁻¹A as A, B None)."""
+    size = Mt.shape[0]
+    if dense:
+        Minv = np.linalg.inv(_dense(Mt))
+        A = np.block([[np.zeros((size, size)), np.eye(size)],
+                      [-Minv @ _dense(jacobian), -Minv @ _dense(Dt)]])
+        return A, None
+    A = sp.bmat([[None, sp.identity(size)], [-sp.csr_matrix(jacobian), -Dt]], format="csc")
+    B = sp.block_diag([sp.identity(size), Mt], format="csc")
+    return A, B
+
+
+def _select(values, omega, keep):
+    """The ``keep`` values with the smallest |Im s| and every other one in |Im s| ≤ 1.01 ω/2."""
     values = values[np.isfinite(values)]
     order = np.argsort(np.abs(values.imag), kind="stable")
-    # the 2n with the smallest |Im s|, and every other one in the strip |Im s| ≤ ω/2: at a
-    # period-doubling both exponents of a real multiplier pair sit at Im s = ±ω/2 and compete with
-    # their conjugates for the same places
     in_strip = np.abs(values.imag[order]) <= 0.5 * abs(omega) * (1 + 1e-2)
     in_strip[:keep] = True
     return values[order[in_strip]]
 
 
+def _nearest(Mt, Dt, jacobian, target, dense, count=3):
+    """Eigenvalues of the frozen pencil nearest ``target`` (complex allowed)."""
+    A, B = _first_order(Mt, Dt, jacobian, dense)
+    if dense and A.shape[0] <= 64:
+        values = np.linalg.eigvals(A)
+        return values[np.argsort(np.abs(values - target))[:count]]
+    if dense:      # shift-invert on a dense LU: the few values near the target, not all of them
+        return spla.eigs(A.astype(complex), k=count, sigma=target, which="LM",
+                         return_eigenvectors=False)
+    return spla.eigs(A.astype(complex), k=count, M=B.astype(complex), sigma=target, which="LM",
+                     return_eigenvectors=False)
+
+
+def refine_exponent(Mt, Dt, jacobian, operator, s0, dense, iterations=30, tolerance=1e-9):
+    r"""Solve the nonlinear Hill problem T(s) p = 0, T(s) = s²M̃ + sD̃ + ∂R/∂ũ + C(s), from s0.
+
+    Successive linear problems: s_{k+1} = the eigenvalue of the pencil frozen at C(s_k) nearest
+    s_k. Returns (s, converged)."""
+    s = complex(s0)
+    for _ in range(iterations):
+        J = (sp.csr_matrix(jacobian) + operator.correction(s)) if not dense else \
+            _dense(jacobian) + operator.correction(s).toarray()
+        new = _nearest(Mt, Dt, J, s, dense, count=1)[0]
+        if abs(new - s) <= tolerance * max(abs(new), 1.0):
+            return new, True
+        s = new
+    return s, False
+
+
 def hill_stability(model, omega, harmonics, jacobian, tolerance=1e-6, dense_limit=3000,
-                   contact_damping=None):
-    """(stable, leading exponent max Re s [1/s]) of a periodic solution (see module docstring)."""
+                   contact_damping=None, operator=None, uncertain_band=1e-4, max_refined=12):
+    """Hill stability of a periodic solution (module docstring) → :class:`StabilityResult`.
+
+    operator: a :class:`sarfe.hbm.stability_contacts.ContactOperator` (the contact term at s), or
+    None (the frozen problem on ``jacobian`` alone, smooth laws)."""
     try:
+        if operator is not None:
+            jacobian = sp.csr_matrix(jacobian) + operator.correction(0.0).real
         values = floquet_exponents(model, omega, harmonics, jacobian, dense_limit,
                                    contact_damping=contact_damping)
-    except (np.linalg.LinAlgError, RuntimeError, ValueError, spla.ArpackError):
-        return None, float("nan")
-    if values.size == 0:
-        return None, float("nan")
+        if values.size == 0:
+            return StabilityResult(None, float("nan"), "no Floquet exponent found", values)
+        note = ""
+        if operator is not None and operator.has_memory:
+            values, note = _refine_leading(model, omega, harmonics, jacobian, contact_damping,
+                                           operator, values, dense_limit, max_refined)
+    except (np.linalg.LinAlgError, RuntimeError, ValueError, spla.ArpackError) as error:
+        return StabilityResult(None, float("nan"), f"eigen-solve failed: {error}", np.zeros(0))
     leading = float(values.real.max())
-    return bool(leading <= tolerance * abs(omega)), leading
+    if note:
+        return StabilityResult(None, leading, note, values)
+    if abs(leading) <= uncertain_band * abs(omega):
+        return StabilityResult(None, leading, f"leading Floquet exponent {leading:.3g} 1/s within "
+                               f"±{uncertain_band:g}·ω of 0 (near a fold or bifurcation)", values)
+    return StabilityResult(bool(leading <= tolerance * abs(omega)), leading, "", values)
+
+
+def _refine_leading(model, omega, harmonics, jacobian, contact_damping, operator, values,
+                    dense_limit, max_refined):
+    """Refine the frozen exponents on the nonlinear problem, largest real part first, until the
+    largest real part is a refined one. Returns (values, note)."""
+    Mt, Dt = _hill(model, omega, harmonics, contact_damping)
+    dense = 2 * Mt.shape[0] <= dense_limit
+    values = np.array(values, dtype=complex)
+    refined = np.zeros(values.size, bool)
+    for _ in range(max_refined):
+        upper = np.flatnonzero(values.imag >= 0)
+        open_ = upper[~refined[upper]]
+        if open_.size == 0:
+            break
+        lead = upper[np.argmax(values.real[upper])]
+        if refined[lead]:
+            break
+        i = open_[np.argmax(values.real[open_])]
+        s, converged = refine_exponent(Mt, Dt, jacobian, operator, values[i], dense)
+        if not converged:
+            return values, (f"Hill exponent {values[i]:.4g} 1/s did not converge on the "
+                            "nonlinear (friction memory) eigenproblem")
+        mirror = np.flatnonzero(np.abs(values - np.conj(values[i])) <= 1e-12 * max(abs(values[i]), 1))
+        values[i] = s
+        refined[i] = True
+        for m in mirror:
+            if m != i:
+                values[m], refined[m] = np.conj(s), True
+    else:
+        return values, "Hill exponents: refinement budget exhausted before the leading one"
+    return values, ""
 
 
 def _dense(matrix):
-    return matrix.toarray() if sp.issparse(matrix) else np.asarray(matrix, dtype=float)
+    return matrix.toarray() if sp.issparse(matrix) else np.asarray(matrix)

@@ -22,9 +22,12 @@ from sarfe.pipeline.nonlinear import NonlinearModel
 
 
 def _erp(erp: ErpConfig, stage, displacement, omega):
-    """ErpResult of displacement harmonics (2H+1, n) at ω (zero power without radiating nodes)."""
+    """ErpResult of displacement harmonics (2H+1, n) at ω (zero power without radiating nodes).
+    ``erp``: the case's :class:`ErpConfig` (a Case is also taken, for sarfe.pipeline.verify)."""
     from sarfe.erp import equivalent_radiated_power
 
+    if not isinstance(erp, ErpConfig):
+        erp = erp.config.erp
     W = np.asarray(displacement) @ stage.erp_map.T
     if W.shape[1] == 0:  # no radiating surface: a zero-area node keeps the shapes valid
         W, areas = np.zeros((W.shape[0], 1)), np.zeros(1)
@@ -259,12 +262,14 @@ def point_record(config: CaseConfig, stage, nl, index, solution, error_estimate=
     point = {
         "index": index, "frequency_hz": omega / (2 * np.pi), "omega_rad_s": omega,
         "converged": bool(solution.converged), "stable": None if stable is None else bool(stable),
+        "stability_note": str(solution.stability_note),
+        "floquet_exponent_1_s": float(solution.floquet_exponent),
         "iterations": int(solution.iterations),
         "residual_norm": float(solution.residual_norm),
         "reason": str(solution.reason),
         "erp": _erp_dict(erp), "contacts": contacts, "linear": linear,
-        "error_estimate": (_error_estimate(config.solver, stage, nl, solution) if error_estimate is False
-                           else error_estimate),
+        "error_estimate": (_error_estimate(config.solver, stage, nl, solution)
+                           if error_estimate is False else error_estimate),
         "harmonic_set": harmonic_set_record(config.solver, solution),
         "bands": band_record(erp, linear, omega),
         "contributions": contributions,

@@ -14,6 +14,21 @@ states: separation (λ_n = 0: ρ = 0, the slider follows, λ_t = 0), stick (w_j 
 slip (the projection is active, |λ_t| = μ λ_n). In one tangential direction the projection is a
 clamp, w_j = clip(w_{j−1}, q_j − ρ_j, q_j + ρ_j).
 
+Gauge of the periodic state. Where the slider slips (or the contact separates) during the period,
+its periodic state is fixed by q̃ and λ̃_n. A contact that sticks the whole period has a whole
+interval (a convex set in 2-D) of periodic slider positions: its mean tangential force is a
+history constant. Taking it from a warm start (the last evaluation's slider) made the residual
+depend on the path of the iterations, not only on the unknowns — a continuation corrector landed
+on a solution with another mean and rejected it. The periodic state is therefore the one reached
+by marching from the slider position at assembly, w_start = 0 (q is measured from the undeformed
+state): in 1-D w_0 = clip(0, A, B) with [A, B] the interval of periodic starts. A contact that
+never slips keeps the spring it was assembled with (λ_t = k_t q: it carries its share of any static
+load, exactly what a start from rest gives when the contact never slips), and one whose interval
+does not hold 0 rests on the nearest edge — dragged by slip just as far as needed. λ_t is then a
+continuous, piecewise smooth function of q̃ and λ̃_n alone (the ``slider_start`` of a call is not
+used), continuous through stick ↔ slip transitions, and the Jacobian is k_t I in stick (regular
+even where the contact is the only restraint).
+
 The element provides (vectorized over contacts, driven by the law's normal force λ_n(θ)):
 - :func:`periodic_forces`: the periodic steady state over one period and its AFT Jacobian (1-D:
   exact clamp composition without a sample loop; 2-D: the march with its consistent tangent);
@@ -93,9 +108,9 @@ def jenkins_periodic_1d(tangential_displacement, slip_radius, slider_start):
     on w_end again (it only confirms): 2 passes.
 
     q: (N, n) [m], ρ = μ λ_n / k_t: (N, n) [m], slider_start: (n,) [m].
-    Returns dict with slider w (N, n), state (N, n) int8, reset (N, n) bool (slip or separation:
-    the history is erased there), sign (N, n) ∈ {+1, −1, 0} with λ_t = sign·μλ_n at a slip sample
-    (+1: w clamped at q − ρ), slider_end (n,), passes = 2.
+    Returns dict with slider w (N, n), state (N, n) int8, reset (N, n) bool (slip, separation or
+    the slider resting on a slip bound: the history is erased there), sign (N, n) ∈ {+1, −1, 0}
+    with λ_t = sign·μλ_n at a reset sample (+1: w at q − ρ), slider_end (n,), passes = 2.
     """
     q = np.asarray(tangential_displacement, dtype=float)
     rho = np.maximum(np.asarray(slip_radius, dtype=float), 0.0)
@@ -104,11 +119,14 @@ def jenkins_periodic_1d(tangential_displacement, slip_radius, slider_start):
     slider_end = np.clip(slider_start, A[-1], B[-1])
     slider = np.clip(slider_end, A, B)
     previous = np.concatenate([slider_end[None], slider[:-1]], axis=0)
-    below, above = previous < lower, previous > upper
+    # ≤: a slider resting exactly on a bound (a start clamped to the edge of the periodic
+    # interval) follows that bound, like a slip sample
+    below, above = previous <= lower, previous >= upper
     separated = rho <= 0.0
     sign = np.where(separated, 0, np.where(below, 1, np.where(above, -1, 0))).astype(np.int8)
     reset = separated | below | above
-    state = np.where(separated, SEPARATED, np.where(below | above, SLIP, STICK)).astype(np.int8)
+    slipping = (previous < lower) | (previous > upper)
+    state = np.where(separated, SEPARATED, np.where(slipping, SLIP, STICK)).astype(np.int8)
     return {"slider": slider, "state": state, "reset": reset, "sign": sign,
             "slider_end": slider_end, "passes": 2}
 
@@ -164,7 +182,8 @@ def periodic_forces(p, q, one_d, normal_force, normal_stiffness, slider_start, H
 
     p: parameters (tangential_stiffness k_t, friction_coefficient μ; (n,) each); q (N, n, 2) [m]
     tangential displacements, one_d (n,) bool: only the first direction exists; normal_force λ_n (N, n) [N], normal_stiffness ∂λ_n/∂w (N, n) [N/m]; slider_start (n, 2);
-    kept_rows: coefficient rows of the Jacobian (P of them).
+    kept_rows: coefficient rows of the Jacobian (P of them). slider_start is not used: the periodic
+    state is fixed by the gauge (module docstring), so it is a function of q and λ_n alone.
     Returns (λ_t (N, n, 2), state (N, n) int8, slider_end (n, 2), passes, J (n, 3P, 3P) or None)
     with J in the local layout (h·3 + l), l = 0 normal, 1, 2 tangents; its tangential rows only.
     """
@@ -179,9 +198,9 @@ def periodic_forces(p, q, one_d, normal_force, normal_stiffness, slider_start, H
     J = np.zeros((n, 3 * P, 3 * P)) if jacobian else None
     passes = 0
     c1 = np.flatnonzero(one_d)
-    if c1.size:                      # 1-D: clamp scan, exact steady state in one pass
+    if c1.size:                      # 1-D: clamp scan, exact steady state
         qc = q_all[:, c1, 0]
-        res = jenkins_periodic_1d(qc, rho[:, c1], slider_start[c1, 0])
+        res = jenkins_periodic_1d(qc, rho[:, c1], np.zeros(c1.size))   # gauge w = 0: see above
         force[:, c1, 0] = k_t[c1] * (qc - res["slider"])
         state[:, c1] = res["state"]
         slider_end[c1, 0] = res["slider_end"]
@@ -192,7 +211,7 @@ def periodic_forces(p, q, one_d, normal_force, normal_stiffness, slider_start, H
     if c2.size:
         force_t, st, w_end, n_pass, J2 = _march_2d(
             q_all[:, c2], rho[:, c2], mu[c2] * normal_stiffness[:, c2] / k_t[c2], k_t[c2],
-            slider_start[c2], H, N, jacobian, tolerance, pass_cap, kept_rows)
+            np.zeros((c2.size, 2)), H, N, jacobian, tolerance, pass_cap, kept_rows)
         force[:, c2] = force_t
         state[:, c2] = st
         slider_end[c2] = w_end
@@ -209,7 +228,8 @@ def _jacobian_1d(res, mu_dlam, k_t, H, N, kept_rows):
     The slider forgets its past at every slip or separation sample j(i), so
     λ_t,i = k_t (q_i − q_j) + s_j μ λ_n,j and ∂λ_t,i/∂X = k_t (Φ_i − Φ_j) + s_j μ ∂λ_n,j/∂w Φ_j
     (s_j = ±1 the slip direction), pushed through one FFT of the gathered rows Φ_{j(i)}; a contact
-    sticking the whole period gives λ_t = k_t (q − w0) with w0 a history constant, ∂w0/∂X = 0."""
+    sticking the whole period keeps the gauge slider w0 = 0 (module docstring): λ_t = k_t q,
+    ∂w0/∂X = 0."""
     P = kept_rows.size
     n = k_t.size
     Phi = _basis(H, N)[:, kept_rows]
@@ -226,7 +246,8 @@ def _jacobian_1d(res, mu_dlam, k_t, H, N, kept_rows):
 
 
 def _march_2d(q, rho, drho_dw, k_t, start, H, N, jacobian, tolerance, pass_cap, kept_rows):
-    r"""2-D Jenkins elements marched sample by sample (vectorized over contacts).
+    r"""2-D Jenkins elements marched sample by sample (compiled kernels over contacts × samples,
+    :mod:`.jenkins_march`).
 
     The disk projection of the slider is not composable like the 1-D clamp, so the march over
     samples is inherent to 2-D hysteresis. Periods are marched from ``start`` until the slider
@@ -237,62 +258,29 @@ def _march_2d(q, rho, drho_dw, k_t, start, H, N, jacobian, tolerance, pass_cap, 
     propagates the consistent tangent: with X = local harmonics (h·3 + l),
         dw_j = (I − P_j) dq_j + n_j dρ_j + P_j dw_{j−1},
     and the periodicity w_N = w_0 gives ∂w_0/∂X = (I − A)⁻¹ B (A = ∂w_N/∂w_0, B = ∂w_N/∂X at
-    fixed w_0) when the contact slipped or separated; 0 (history constant) when it stuck.
+    fixed w_0) when the contact slipped or separated; 0 when it stuck (``start`` = 0, the gauge of
+    the module docstring).
     Returns (λ_t (N, n, 2), state (N, n), w_end (n, 2), passes, J (n, 3P, 3P) or None).
     """
+    from . import jenkins_march as march    # numba is imported (and the kernels loaded) on first use
     n = q.shape[1]
     P = kept_rows.size                                       # local harmonic rows (kept set)
     scale = np.abs(q).max() + rho.max() + 1e-300
-    w = np.array(start, dtype=float)
-    passes = 0
-    eye = np.eye(2)
-    while True:
-        w0 = w.copy()
-        A = np.broadcast_to(eye, (n, 2, 2)).copy()        # ∂w_N/∂w_0 over the pass
-        for j in range(N):
-            w, _, Pj, _ = slider_update_derivatives(w, q[j], rho[j])
-            A = Pj @ A
-        passes += 1
-        residual = w - w0
-        if np.abs(residual).max() <= tolerance * scale or passes >= pass_cap:
-            w = w0 if np.abs(residual).max() <= tolerance * scale else w
-            break
-        # Newton on the periodicity w_N(w_0) = w_0 where it is well posed (slip: I − A regular)
-        system = eye - A
-        det = np.linalg.det(system)
-        ok = np.abs(det) > 1e-6
-        if np.any(ok):
-            w[ok] = w0[ok] + np.linalg.solve(system[ok], residual[ok][..., None])[..., 0]
-    Phi = _basis(H, N)[:, kept_rows]
-    force = np.empty((N, n, 2))
-    state = np.empty((N, n), np.int8)
-    if jacobian:
-        dw = np.zeros((n, 2, 3 * P))                        # ∂w/∂X at fixed w_0
-        dw_dw0 = np.broadcast_to(np.eye(2), (n, 2, 2)).copy()
-        dforce = np.empty((N, n, 2, 3 * P))
-        history = np.empty((N, n, 2, 2))
-        dq = np.zeros((N, 2, 3 * P))                       # ∂q_j/∂X templates
-        dq[:, 0, 1::3], dq[:, 1, 2::3] = Phi, Phi
-        dn = np.zeros((N, 3 * P))                          # ∂w_j/∂X (normal) template
-        dn[:, 0::3] = Phi
-    w_start = w.copy()
-    for j in range(N):
-        w, st, Pj, n_rho = slider_update_derivatives(w, q[j], rho[j])
-        force[j] = k_t[:, None] * (q[j] - w)
-        state[j] = st
-        if jacobian:      # dw_j = P_j (dw_{j−1} − dq_j) + dq_j + n_j dρ_j
-            dw = Pj @ (dw - dq[j]) + dq[j] + n_rho[:, :, None] * (drho_dw[j][:, None, None]
-                                                                  * dn[j][None, None, :])
-            dw_dw0 = Pj @ dw_dw0
-            dforce[j] = k_t[:, None, None] * (dq[j] - dw)
-            history[j] = dw_dw0
+    q = np.ascontiguousarray(q, dtype=float)
+    rho = np.ascontiguousarray(rho, dtype=float)
+    w_start, passes = march.periodic_start(q, rho, np.array(start, dtype=float),
+                                           tolerance * scale, pass_cap)
+    Phi = np.ascontiguousarray(_basis(H, N)[:, kept_rows])
+    force, state, dforce, history, dw = march.final_pass(
+        q, rho, np.ascontiguousarray(drho_dw, dtype=float), np.asarray(k_t, dtype=float),
+        w_start, Phi, jacobian)
     passes += 1
     if not jacobian:
-        return force, state, w, passes, None
+        return force, state, w_start, passes, None
     forgot = np.any(state != STICK, axis=0)
-    dw0 = np.zeros((n, 2, 3 * P))
+    dw0 = np.zeros((n, 2, 3 * P))                           # stuck: w_0 = 0, the gauge
     if np.any(forgot):
-        system = np.eye(2) - dw_dw0[forgot]
+        system = np.eye(2) - history[-1, forgot]
         dw0[forgot] = np.linalg.solve(system, dw[forgot])
     dforce -= k_t[None, :, None, None] * np.einsum("jcab,cbx->jcax", history, dw0)
     coeff = hm.harmonic_coefficients(dforce, H)[kept_rows]  # (P, n, 2, 3P)

@@ -1,0 +1,89 @@
+r"""Hill stability without the eigen-solve of the full reduced Hill matrix: Hill's problem on a
+bounded Ritz basis that keeps the contacts exact.
+
+Hill's operator (:mod:`sarfe.hbm.stability`) is T(s) = T_lin(s) + (I⊗G)ᵀ 𝒥(s) (I⊗G): the linear
+structure, block diagonal over the harmonics, plus the contact term on the (2H+1)·n_rows contact
+rows (the AFT Jacobian, the Jenkins memory at s, s × the contact damping of rate-dependent laws).
+The exponents that decide stability are those nearest the imaginary axis; they live in the
+low-frequency motion of the structure loaded by the contacts. With u = Ψ q,
+
+    Ψ = orth[ Φ_m , K̄⁻¹ Gᵀ ],   K̄ = K + Gᵀ 𝒥̄ G   (𝒥̄: mean contact stiffness, harmonic 0),
+
+Φ_m the modes of (M, K̄) up to 2(H+1)ω (10 … 40 of them) and K̄⁻¹Gᵀ the static responses to unit
+contact forces (the local flexibility a stiff contact sees), T(s) is projected to
+(I⊗Ψ)ᵀ T(s) (I⊗Ψ): the same Hill problem — frozen exponents, friction-memory refinement, strip
+selection, notes — of order 2(2H+1)(m + n_rows), whatever the FE and reduced model size. The
+contacts act on G Ψ exactly; only the linear structure's high modes are truncated (their static
+part is kept by the attachment vectors). When m + n_rows ≥ n, Ψ = I and the result is the full one.
+Measured against the full Hill method in tests/hbm/test_stability_condensed.py and
+benchmarks/bench_stability.py.
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as la
+import scipy.sparse as sp
+
+
+def _dense(matrix):
+    return matrix.toarray() if sp.issparse(matrix) else np.asarray(matrix)
+
+
+def ritz_basis(model, gap_map, mean_jacobian, omega, harmonics, max_modes=40, min_modes=10):
+    r"""Ψ (n, r), orthonormal columns: the modes of the averaged linearization (M, K + Gᵀ 𝒥̄ G)
+    up to 2(H+1)ω (at least ``min_modes``, at most ``max_modes``) and the static responses
+    K̄⁻¹ Gᵀ to unit contact forces (the contacts' local flexibility); Ψ = I when r ≥ n."""
+    M, K = (_dense(a).astype(float) for a in (model.mass, model.stiffness))
+    n = M.shape[0]
+    G = _dense(gap_map).astype(float)
+    if min_modes + G.shape[0] >= n:
+        return np.eye(n)
+    K = K + G.T @ np.real(_dense(mean_jacobian)) @ G
+    K = 0.5 * (K + K.T)
+    values, vectors = la.eigh(K, M)
+    frequencies = np.sqrt(np.abs(values))
+    m = int(np.clip(np.count_nonzero(frequencies <= 2 * (harmonics + 1) * abs(omega)),
+                    min_modes, max_modes))
+    static = la.solve(K, G.T)
+    basis, _ = la.qr(np.hstack([vectors[:, :m], static]), mode="economic")
+    return basis if basis.shape[1] < n else np.eye(n)
+
+
+class _ProjectedOperator:
+    """The contact term's s-dependence (:class:`ContactOperator`) seen in the Ritz basis."""
+
+    def __init__(self, operator, gap_projected, harmonics):
+        self.operator, self.has_memory = operator, operator.has_memory
+        self.GG = sp.kron(sp.identity(2 * harmonics + 1), sp.csr_matrix(gap_projected),
+                          format="csr")
+
+    def correction(self, s):
+        return (self.GG.T @ self.operator.rows_correction(s) @ self.GG).tocsr()
+
+
+def condensed_stability(model, contacts, omega, harmonics, forces, operator=None, tolerance=1e-6,
+                        max_modes=40):
+    """Hill stability on the Ritz basis of :func:`ritz_basis` → StabilityResult (the exponents,
+    verdict and notes of :func:`sarfe.hbm.stability.hill_stability` on the projected problem).
+
+    forces: the AFT :class:`ContactForces` of the orbit (all harmonic rows); operator: the
+    :class:`ContactOperator` (friction memory), or None."""
+    from .aft import jacobian_matrix
+    from .model import make_linear_model
+    from .linear import dynamic_stiffness_matrix
+    from .stability import hill_stability
+
+    nr, H = contacts.row_count, int(harmonics)
+    base = jacobian_matrix(forces.blocks, nr, H)
+    basis = ritz_basis(model, contacts.gap_map, base[:nr, :nr].toarray(), omega, H, max_modes)
+    project = lambda a: basis.T @ _dense(a) @ basis  # noqa: E731
+    reduced = make_linear_model(project(model.mass), project(model.damping),
+                                project(model.stiffness))
+    G_p = _dense(contacts.gap_map) @ basis
+    GG = sp.kron(sp.identity(2 * H + 1), sp.csr_matrix(G_p), format="csr")
+    jacobian = dynamic_stiffness_matrix(reduced, omega, H) + GG.T @ base @ GG
+    damping = (GG.T @ jacobian_matrix(forces.damping_blocks, nr, H) @ GG).tocsr() \
+        if forces.damping_blocks else None
+    projected = None if operator is None else _ProjectedOperator(operator, G_p, H)
+    return hill_stability(reduced, omega, H, jacobian.tocsr(), tolerance,
+                          contact_damping=damping, operator=projected)

@@ -1,0 +1,159 @@
+r"""The contact term of Hill's eigenproblem: the linearized periodic contact forces at exponent s.
+
+A perturbation δr(t) = e^{st} p(θ) of the contact displacements (p periodic) changes the contact
+forces by δλ(t) = e^{st} 𝒥(s) p. For a pointwise law 𝒥 is the AFT Jacobian E diag(∂λ/∂w) Φ,
+independent of s. Two things make the harmonic-map Jacobian of the Newton solver the wrong operator
+for stability:
+
+1. **Memory (Jenkins tangent element).** The slider obeys ẇ = 0 in stick, so the linearized slider
+   keeps the perturbation of the last slip sample j(i): δw_i = e^{−s(t_i − t_j)}·(…)_j. With the
+   Floquet factor the linearized return map of one sample is
+
+       ŵ_j = P_j (e^{−sh} ŵ_{j−1} − p̂_j) + p̂_j + n_j dρ_j,    δλ̂_t,j = k_t (p̂_j − ŵ_j),
+
+   and periodicity ŵ_{−1} = ŵ_{N−1} gives ŵ_{−1} = (I − e^{−sT} A)⁻¹ B(s), A = Π P_j (P_j, n_j of
+   :func:`sarfe.hbm.laws.jenkins.slider_update_derivatives`; h = T/N). The harmonic-map Jacobian is
+   this at s = 0: it treats the memory as if the perturbation did not grow or decay, which on the
+   squeak rig turned an orbit that time integration finds attracting into Re s ≈ +128…+180 1/s.
+   𝒥(s) is complex for complex s and depends on s non-polynomially (a nonlinear eigenproblem).
+2. **Kinks (unilateral springs, stick/slip normal forces).** The sampled ∂λ/∂w jumps at a contact
+   crossing, quantized to one sample; near a fold det ∂R/∂ũ can change sign by this alone. The
+   normal part can be re-evaluated on ``refine`` × N samples (default 1: off — on NLvib example
+   03 the 8N Jacobian of the N-sampled orbit disagreed more often with time integration than the
+   N-sampled one, the orbit and its Jacobian must come from the same discrete system).
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from . import harmonics as hm
+from . import laws
+from .aft import jacobian_matrix, pointwise_jacobian
+from .laws.jenkins import slider_update_derivatives
+
+
+def _normal_part(law, p, contacts, idx, R, omega, N):
+    """λ_n (N, n_g), ∂λ_n/∂w (N, n_g) [N/m], ∂λ_n/∂ẇ or None, rows (n_g,) (−1: no normal row)."""
+    rows = contacts.normal_row[idx]
+    has = rows >= 0
+    gap = contacts.gap[idx]
+    r = hm.time_samples(R, N)
+    w = np.where(has, r[:, np.maximum(rows, 0)], gap)
+    wdot = None
+    if law.velocity_dependent:
+        slope = hm.derivative_matrix((R.shape[0] - 1) // 2) @ R
+        wdot = np.where(has, omega * hm.time_samples(slope, N)[:, np.maximum(rows, 0)], 0.0)
+    out = law.normal(p, gap, w, wdot)
+    stiffness = np.where(has, out.stiffness, 0.0)
+    damping = None if out.damping is None else np.where(has, out.damping, 0.0)
+    return out.force, stiffness, damping, rows
+
+
+def _memory_block(s, omega, q, rho, drho, k_t, start, H, N):
+    r"""δλ̃_t/δ(local harmonics) at exponent s (complex), (n, 2, 3P) per sample summed by E:
+    returns (n, 2·(2H+1) rows [t1 then t2 per harmonic], 3(2H+1)) complex, local layout h·3 + l."""
+    n = q.shape[1]
+    P = 2 * H + 1
+    Phi = hm.fourier_matrices(H, N)[1]
+    decay = np.exp(-s * 2.0 * np.pi / (omega * N))
+    dq = np.zeros((N, 2, 3 * P))
+    dq[:, 0, 1::3], dq[:, 1, 2::3] = Phi, Phi
+    dn = np.zeros((N, 3 * P))
+    dn[:, 0::3] = Phi
+    w = np.array(start, dtype=float)
+    dw = np.zeros((n, 2, 3 * P), complex)
+    dw_dw0 = np.broadcast_to(np.eye(2, dtype=complex), (n, 2, 2)).copy()
+    dforce = np.empty((N, n, 2, 3 * P), complex)
+    history = np.empty((N, n, 2, 2), complex)
+    for j in range(N):    # the 2-D return map is a march (as in the AFT's own 2-D friction)
+        w, _, Pj, n_rho = slider_update_derivatives(w, q[j], rho[j])
+        dw = Pj @ (decay * dw - dq[j]) + dq[j] + n_rho[:, :, None] * (drho[j][:, None, None]
+                                                                      * dn[j][None, None, :])
+        dw_dw0 = decay * (Pj @ dw_dw0)
+        dforce[j] = k_t[:, None, None] * (dq[j] - dw)
+        history[j] = dw_dw0
+    system = np.eye(2) - dw_dw0
+    regular = np.abs(np.linalg.det(system)) > 1e-9
+    dw0 = np.zeros((n, 2, 3 * P), complex)
+    if np.any(regular):
+        dw0[regular] = np.linalg.solve(system[regular], dw[regular])
+    dforce -= k_t[None, :, None, None] * np.einsum("jcab,cbx->jcax", history, dw0)
+    coeff = hm.harmonic_coefficients(dforce.real, H) + 1j * hm.harmonic_coefficients(dforce.imag, H)
+    return coeff   # (P, n, 2, 3P)
+
+
+class ContactOperator:
+    r"""s ↦ (I⊗G)ᵀ [𝒥(s) − 𝒥_AFT] (I⊗G) on all DOFs (sparse, complex): the correction of the Newton
+    Jacobian ∂R/∂ũ that turns it into Hill's operator at exponent s (module docstring).
+
+    problem: :class:`sarfe.hbm.residual.Problem` (all harmonic rows); U (2H+1, n) [m]; omega
+    [rad/s]; forces: the :class:`ContactForces` of the AFT at U (its blocks and slider state).
+    ``has_memory``: some contact has a Jenkins element (the correction depends on s);
+    ``refine``: oversampling of the normal parts.
+    """
+
+    def __init__(self, problem, U, omega, forces, refine=1):
+        contacts, H, N = problem.contacts, problem.harmonics, problem.samples_per_period
+        G = contacts.gap_map
+        self.H, self.omega = H, float(omega)
+        self.n_rows = G.shape[0]
+        self.GG = sp.kron(sp.identity(2 * H + 1), G, format="csr")
+        R = np.asarray(G @ np.asarray(U).T).T
+        r = hm.time_samples(R, N)
+        fine = max(int(refine), 1) * N
+        self.static, self.memory = [], []
+        for law, idx, p in laws.groups(contacts):
+            _, stiffness, damping, rows = _normal_part(law, p, contacts, idx, R, omega, fine)
+            block = pointwise_jacobian(stiffness, H)
+            if damping is not None:
+                block = block + omega * pointwise_jacobian(damping, H) @ hm.derivative_matrix(H)
+            with_tangent = contacts.tangent_rows[idx, 0] >= 0 if law.tangent is not None \
+                else np.zeros(idx.size, bool)
+            alone = ~with_tangent
+            if np.any(alone):
+                self.static.append((rows[alone, None], block[alone]))
+            if not np.any(with_tangent):
+                continue
+            sel = np.flatnonzero(with_tangent)
+            t_idx = idx[sel]
+            t_rows = contacts.tangent_rows[t_idx]
+            present = t_rows >= 0
+            q = np.where(present[None], r[:, np.maximum(t_rows, 0)], 0.0)
+            force_n, stiff_n, _, _ = _normal_part(law, {k: v[sel] for k, v in p.items()},
+                                                 contacts, t_idx, R, omega, N)
+            k_t = p["tangential_stiffness"][sel]
+            mu = p["friction_coefficient"][sel]
+            start = np.nan_to_num(forces.slider_end[t_idx])
+            normal = np.zeros((sel.size, 3 * (2 * H + 1), 3 * (2 * H + 1)))
+            normal[:, 0::3, 0::3] = block[sel]
+            self.memory.append(dict(rows=np.column_stack([rows[sel], t_rows]), normal=normal,
+                                    q=q, rho=mu * force_n / k_t, drho=mu * stiff_n / k_t,
+                                    k_t=k_t, start=start, N=N))
+        self.has_memory = bool(self.memory)
+        base = jacobian_matrix(forces.blocks, self.n_rows, H)
+        self._fixed = jacobian_matrix(self.static, self.n_rows, H) - base
+
+    def blocks_at(self, s):
+        """The tangent-group blocks (rows, 𝒥(s)) — complex — for jacobian_matrix."""
+        out = []
+        for g in self.memory:
+            coeff = _memory_block(s, self.omega, g["q"], g["rho"], g["drho"], g["k_t"],
+                                  g["start"], self.H, g["N"])
+            J = g["normal"].astype(complex)
+            J[:, 1::3, :] = np.moveaxis(coeff[:, :, 0, :], 0, 1)
+            J[:, 2::3, :] = np.moveaxis(coeff[:, :, 1, :], 0, 1)
+            out.append((g["rows"], J))
+        return out
+
+    def rows_correction(self, s):
+        """𝒥(s) − 𝒥_AFT on the contact rows ((2H+1) n_rows square, sparse, harmonic-major)."""
+        J = self._fixed.astype(complex)
+        for rows, block in self.blocks_at(s):
+            J = J + jacobian_matrix([(rows, block.real)], self.n_rows, self.H) \
+                + 1j * jacobian_matrix([(rows, block.imag)], self.n_rows, self.H)
+        return J.tocsr()
+
+    def correction(self, s):
+        """(I⊗G)ᵀ [𝒥(s) − 𝒥_AFT] (I⊗G) (sparse CSR, complex when s is)."""
+        return (self.GG.T @ self.rows_correction(s) @ self.GG).tocsr()

@@ -1,0 +1,93 @@
+"""The condensed stability method (Hill on a bounded Ritz basis, sarfe.hbm.stability_condensed)
+against the full Hill method: same verdicts on NLvib example 03 over a sweep through both folds,
+on the squeak rig (friction memory) and on the shipped cases."""
+import numpy as np
+import pytest
+
+from sarfe.hbm import ContinuationOptions, SolverOptions, continuation, solve_frequency
+from sarfe.hbm.residual import Problem, full_residual
+from sarfe.hbm.solve import contact_damping
+from sarfe.hbm.stability import hill_stability
+from sarfe.hbm.stability_condensed import condensed_stability, ritz_basis
+from sarfe.hbm.stability_contacts import ContactOperator
+
+
+def both(model, contacts, F, s):
+    H, N = s.harmonics, s.samples_per_period
+    problem = Problem(model, contacts, F, H, N)
+    ev = full_residual(problem, s.displacement.ravel(), s.omega)
+    op = ContactOperator(problem, s.displacement, s.omega, ev.forces)
+    full = hill_stability(model, s.omega, H, ev.jacobian,
+                          contact_damping=contact_damping(problem, ev.forces), operator=op)
+    cond = condensed_stability(model, contacts, s.omega, H, ev.forces, op)
+    return full, cond
+
+
+def test_example03_sweep_verdicts_equal():
+    """Every point of the NLvib 03 sweep (H = 11, N = 512; lower branch, the 1:3 region, the
+    peak, the middle branch, past the second fold): condensed verdict = full verdict."""
+    from tests.hbm.test_solver import example03
+    model, contacts, F = example03()
+    H, N = 11, 512
+    sols = continuation(model, contacts, F[:2 * H + 1], 0.5, 0.8, H, N,
+                        options=ContinuationOptions(max_step=0.3,
+                                                    solver=SolverOptions(stability=False)))
+    verdicts = []
+    for s in sols[::3]:
+        full, cond = both(model, contacts, F[:2 * H + 1], s)
+        assert cond.stable is full.stable
+        assert cond.leading == pytest.approx(full.leading, abs=1e-6)
+        verdicts.append(full.stable)
+    assert True in verdicts and False in verdicts
+
+
+def test_ritz_basis_is_identity_for_small_models_and_bounded_for_big():
+    from tests.hbm.test_solver import chain
+    model = chain(60)
+    import scipy.sparse as sp
+    G = sp.csr_matrix(([1.0], ([0], [30])), shape=(1, 60))
+    basis = ritz_basis(model, G, np.array([[0.0]]), 0.01, 3)
+    assert basis.shape == (60, 11)           # 10 modes (min) + 1 static response
+    np.testing.assert_allclose(basis.T @ basis, np.eye(11), atol=1e-10)
+    assert ritz_basis(chain(8), sp.csr_matrix(np.eye(8)[:1]), np.zeros((1, 1)), 1.0, 3).shape == (8, 8)
+
+
+def test_squeak_rig_condensed_equals_full(squeak_rig):
+    """28 reduced DOFs → 10 + modes + 3 static responses: the leading exponent within 1e-4."""
+    nl, sols = squeak_rig
+    for s in sols:
+        full, cond = both(nl.model, nl.contacts, nl.excitation, s)
+        assert cond.stable is full.stable is True
+        assert cond.leading == pytest.approx(full.leading, rel=1e-4)
+
+
+@pytest.fixture(scope="module")
+def squeak_rig():
+    from tests.hbm.test_stability import squeak_rig as fixture
+    return fixture.__wrapped__()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["lumped_rattle", "rattle_rig", "rattle_rig_deck", "squeak_rig",
+                                  "door_trim", "instrument_panel"])
+def test_shipped_cases_condensed_equals_full(name):
+    """Shipped cases at their own settings (H ≤ 5): every solved point, both methods."""
+    from sarfe.pipeline import build_linear_model, load_case, nonlinear_model
+    from sarfe.pipeline.points import solve_point, solver_options
+    case = load_case(f"cases/{name}.yaml")
+    nl = nonlinear_model(case, build_linear_model(case, progress=False))
+    H = min(case.data["solver"]["harmonics"], 5)
+    N = case.data["solver"]["samples_per_period"]
+    options, _ = solver_options(case)
+    excitation = case.data["excitation"]
+    if "sweep" in excitation:
+        a, b = excitation["sweep"]["start_hz"], excitation["sweep"]["end_hz"]
+        freqs = list(np.linspace(a, b, 5))
+    else:
+        freqs = list(excitation["frequency_hz"])
+    for f in freqs[:5]:
+        s = solve_point(nl, 2 * np.pi * f, H, N, options, None)
+        if not s.converged:
+            continue
+        full, cond = both(nl.model, nl.contacts, nl.excitation[:2 * H + 1], s)
+        assert cond.stable is full.stable, (f, full, cond)
