@@ -15,6 +15,7 @@ import pytest
 from sarfe.pipeline import load_case, solve_case
 from sarfe.pipeline.nonlinear import nonlinear_model
 from sarfe.pipeline.linear import build_linear_model
+from state_checks import assert_states_equal_away_from_ties
 
 FREQUENCIES_HZ = [40.0, 48.0, 50.0, 55.0, 70.0]
 
@@ -50,22 +51,6 @@ def solve(data):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return solve_case(copy.deepcopy(data), write=False)
-
-
-def assert_states_equal_away_from_ties(a, b):
-    """Contact states (samples, contacts) agree except at samples next to a state change, where
-    open/closed or stick/slip is a tie decided by round-off (at most one sample per change)."""
-    a, b = np.asarray(a), np.asarray(b)
-    assert a.shape == b.shape
-
-    def near_change(s):
-        change = s != np.roll(s, 1, axis=0)
-        return change | np.roll(change, -1, axis=0)
-
-    differ = a != b
-    assert not np.any(differ & ~(near_change(a) | near_change(b))), np.argwhere(differ)
-    changes = np.count_nonzero(a != np.roll(a, 1, axis=0), axis=0)
-    assert np.all(np.count_nonzero(differ, axis=0) <= np.maximum(changes, 1))
 
 
 def assert_same_solutions(pruned, full):

@@ -34,6 +34,7 @@ import time
 from pathlib import Path
 
 from sarfe.io.errors import CaseError
+from sarfe.mesh.cache import pid_alive
 
 MARKER = ".sarfe-result"
 # files a sarfe result of a version before the marker consisted of (recognized as a result)
@@ -170,19 +171,6 @@ def check_output_folder(target, *, force: bool = False, protected=(), what: str 
 
 # ------------------------------------------------------------------------------- stale debris
 _TEMP_NAME = re.compile(r"^\.(?P<name>.+)\.(?P<kind>tmp|old)-(?P<pid>\d+)-[0-9a-z]+$")
-
-
-def pid_alive(pid: int) -> bool:
-    """True when a process ``pid`` exists on this machine (or we may not signal it)."""
-    if pid <= 0:
-        return False
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
 
 
 def _stale(entry: Path) -> bool:

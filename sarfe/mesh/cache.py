@@ -59,7 +59,10 @@ def file_sha256(path) -> str:
     return digest.hexdigest()
 
 
-def _pid_alive(pid: int) -> bool:
+def pid_alive(pid: int) -> bool:
+    """True when a process ``pid`` exists on this machine (or we may not signal it)."""
+    if pid <= 0:
+        return False
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
@@ -81,7 +84,7 @@ def clean_stale(directory) -> list:
         match = _TEMPORARY.match(entry.name)
         try:
             if match:
-                stale = not _pid_alive(int(match["pid"]))
+                stale = not pid_alive(int(match["pid"]))
             elif _LEGACY_TEMPORARY.match(entry.name):
                 info = entry.stat()
                 stale = info.st_size == 0 and now - info.st_mtime > _LEGACY_AGE_S

@@ -8,6 +8,7 @@ from sarfe.hbm.contacts import make_contact_set
 from sarfe.hbm.friction import SLIP, STICK
 from sarfe.hbm.model import make_linear_model
 from sarfe.hbm.time_integration import integrate_time, linear_harmonic_response
+from state_checks import assert_states_equal_away_from_ties
 
 
 def first_amplitude(U, dof):
@@ -165,26 +166,6 @@ def friction_chain():
     M = np.diag([1.0, 0.4, 0.4])
     K = np.array([[2e4, -1e4, 0.0], [-1e4, 1e4, 0.0], [0.0, 0.0, 1e4]])
     return make_linear_model(M, 2e-4 * K + 4.0 * M, K)
-
-
-def assert_states_equal_away_from_ties(a, b):
-    """Contact states (samples, contacts) agree except at samples next to a state change.
-
-    A sample where stick and slip meet is decided by ``|trial force| > μ N0``, a tie up to
-    round-off (±1e-14 μ N0, depending on the BLAS kernel); only those may differ, and at most
-    one sample per change.
-    """
-    a, b = np.asarray(a), np.asarray(b)
-    assert a.shape == b.shape
-
-    def near_change(s):     # sample j where s changes between j-1, j or j, j+1 (periodic)
-        change = s != np.roll(s, 1, axis=0)
-        return change | np.roll(change, -1, axis=0)
-
-    differ = a != b
-    assert not np.any(differ & ~(near_change(a) | near_change(b))), np.argwhere(differ)
-    changes = np.count_nonzero(a != np.roll(a, 1, axis=0), axis=0)
-    assert np.all(np.count_nonzero(differ, axis=0) <= np.maximum(changes, 1))
 
 
 @pytest.mark.parametrize("angle", [0.0, np.pi / 5])
