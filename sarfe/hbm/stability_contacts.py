@@ -30,7 +30,7 @@ import scipy.sparse as sp
 from . import harmonics as hm
 from . import laws
 from .aft import jacobian_matrix, pointwise_jacobian
-from .laws.jenkins import slider_update_derivatives
+from .laws.jenkins import last_reset_index, slider_update_derivatives
 
 
 def _normal_part(law, p, contacts, idx, R, omega, N):
@@ -50,10 +50,11 @@ def _normal_part(law, p, contacts, idx, R, omega, N):
     return out.force, stiffness, damping, rows
 
 
-def _memory_block(s, omega, q, rho, drho, k_t, start, H, N):
+def _memory_block(s, omega, P_march, n_rho_march, drho, k_t, H, N):
     r"""δλ̃_t/δ(local harmonics) at exponent s (complex), (n, 2, 3P) per sample summed by E:
-    returns (n, 2·(2H+1) rows [t1 then t2 per harmonic], 3(2H+1)) complex, local layout h·3 + l."""
-    n = q.shape[1]
+    returns (P, n, 2, 3P) complex, local layout h·3 + l; P_march, n_rho_march from
+    :func:`_slider_march`."""
+    n = P_march.shape[1]
     P = 2 * H + 1
     Phi = hm.fourier_matrices(H, N)[1]
     decay = np.exp(-s * 2.0 * np.pi / (omega * N))
@@ -61,13 +62,12 @@ def _memory_block(s, omega, q, rho, drho, k_t, start, H, N):
     dq[:, 0, 1::3], dq[:, 1, 2::3] = Phi, Phi
     dn = np.zeros((N, 3 * P))
     dn[:, 0::3] = Phi
-    w = np.array(start, dtype=float)
     dw = np.zeros((n, 2, 3 * P), complex)
     dw_dw0 = np.broadcast_to(np.eye(2, dtype=complex), (n, 2, 2)).copy()
     dforce = np.empty((N, n, 2, 3 * P), complex)
     history = np.empty((N, n, 2, 2), complex)
-    for j in range(N):    # the 2-D return map is a march (as in the AFT's own 2-D friction)
-        w, _, Pj, n_rho = slider_update_derivatives(w, q[j], rho[j])
+    for j in range(N):    # 2-D: the linearized march (1-D sliders: _memory_block_1d)
+        Pj, n_rho = P_march[j], n_rho_march[j]
         dw = Pj @ (decay * dw - dq[j]) + dq[j] + n_rho[:, :, None] * (drho[j][:, None, None]
                                                                       * dn[j][None, None, :])
         dw_dw0 = decay * (Pj @ dw_dw0)
@@ -81,6 +81,40 @@ def _memory_block(s, omega, q, rho, drho, k_t, start, H, N):
     dforce -= k_t[None, :, None, None] * np.einsum("jcab,cbx->jcax", history, dw0)
     coeff = hm.harmonic_coefficients(dforce.real, H) + 1j * hm.harmonic_coefficients(dforce.imag, H)
     return coeff   # (P, n, 2, 3P)
+
+
+def _slider_march(q, rho, start):
+    """The slider states of one period marched from ``start``: ∂w_j/∂w_{j−1} = P_j (N, n, 2, 2)
+    and ∂w_j/∂ρ_j = n_j (N, n, 2). They do not depend on s: computed once per solution."""
+    N, n = q.shape[0], q.shape[1]
+    P, n_rho = np.empty((N, n, 2, 2)), np.empty((N, n, 2))
+    w = np.array(start, dtype=float)
+    for j in range(N):    # the 2-D return map is a march (as in the AFT's own 2-D friction)
+        w, _, P[j], n_rho[j] = slider_update_derivatives(w, q[j], rho[j])
+    return P, n_rho
+
+
+def _memory_block_1d(s, omega, P, n_rho, drho, k_t, H, N):
+    r""":func:`_memory_block` for sliders with one tangent direction, without a sample loop.
+
+    In 1-D the linearized return map has P_j ∈ {0, 1} (slip or separation: 0, the history is
+    reset; stick: 1), so ŵ_i = e^{−s h d(i)} b_{j(i)}, b_j = p̂_j + n_j dρ_j ŵ_n,j, with j(i) the
+    last reset sample at or before i (cyclic, :func:`last_reset_index`) and d(i) = (i − j(i)) mod N
+    — the periodic solution of the march; ŵ = 0 for a contact that never resets (regular where
+    e^{−sT} ≠ 1). Only the first tangent row is filled (the second is absent for these contacts)."""
+    P_count = 2 * H + 1
+    Phi = hm.fourier_matrices(H, N)[1]
+    reset = P[:, :, 0, 0] == 0.0
+    j, has = last_reset_index(reset)
+    distance = (np.arange(N)[:, None] - j) % N
+    weight = np.exp(-s * 2.0 * np.pi / (omega * N) * distance) * has[None, :]      # (N, n)
+    gathered = Phi[j]                                                                # (N, n, P)
+    slope = np.take_along_axis(n_rho[:, :, 0] * drho, j, axis=0)                    # n_j dρ_j
+    n = P.shape[1]
+    dforce = np.zeros((N, n, 2, 3 * P_count), complex)
+    dforce[:, :, 0, 1::3] = k_t[None, :, None] * (Phi[:, None, :] - weight[..., None] * gathered)
+    dforce[:, :, 0, 0::3] = -k_t[None, :, None] * (weight * slope)[..., None] * gathered
+    return hm.harmonic_coefficients(dforce.real, H) + 1j * hm.harmonic_coefficients(dforce.imag, H)
 
 
 class ContactOperator:
@@ -127,9 +161,10 @@ class ContactOperator:
             start = np.nan_to_num(forces.slider_end[t_idx])
             normal = np.zeros((sel.size, 3 * (2 * H + 1), 3 * (2 * H + 1)))
             normal[:, 0::3, 0::3] = block[sel]
+            march = _slider_march(q, mu * force_n / k_t, start)
             self.memory.append(dict(rows=np.column_stack([rows[sel], t_rows]), normal=normal,
-                                    q=q, rho=mu * force_n / k_t, drho=mu * stiff_n / k_t,
-                                    k_t=k_t, start=start, N=N))
+                                    march=march, drho=mu * stiff_n / k_t, k_t=k_t, N=N,
+                                    one_d=bool(np.all(t_rows[:, 1] < 0))))
         self.has_memory = bool(self.memory)
         base = jacobian_matrix(forces.blocks, self.n_rows, H)
         self._fixed = jacobian_matrix(self.static, self.n_rows, H) - base
@@ -138,8 +173,8 @@ class ContactOperator:
         """The tangent-group blocks (rows, 𝒥(s)) — complex — for jacobian_matrix."""
         out = []
         for g in self.memory:
-            coeff = _memory_block(s, self.omega, g["q"], g["rho"], g["drho"], g["k_t"],
-                                  g["start"], self.H, g["N"])
+            block = _memory_block_1d if g["one_d"] else _memory_block
+            coeff = block(s, self.omega, *g["march"], g["drho"], g["k_t"], self.H, g["N"])
             J = g["normal"].astype(complex)
             J[:, 1::3, :] = np.moveaxis(coeff[:, :, 0, :], 0, 1)
             J[:, 2::3, :] = np.moveaxis(coeff[:, :, 1, :], 0, 1)
