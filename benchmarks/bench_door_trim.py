@@ -15,6 +15,7 @@ error (max over points of ‖Û₁ − Û₁,ref‖ / ‖Û₁,ref‖) is at mos
 
 Writes benchmarks/results/door_trim.md and .json. Whole script < 12 min (timeouts).
 """
+import dataclasses
 import json
 import os
 import pathlib
@@ -171,19 +172,34 @@ def hbm_vs_time():
         U = np.asarray(U)
         return U[1] - 1j * U[2]
 
-    ref = [first(solve_point(nl, w, 30, 1024, options, None).displacement) for w in omegas]
+    F = np.asarray(nl.excitation)                  # (2H+1, n) at the case's H: pad to H = 30
+    F30 = np.zeros((61, F.shape[1]))
+    F30[:F.shape[0]] = F
+    ref_nl = dataclasses.replace(nl, excitation=F30)
+    ref = [first(solve_point(ref_nl, w, 30, 1024, options, None).displacement) for w in omegas]
 
-    def err(Us):
-        return float(max(np.linalg.norm(first(U) - r) / np.linalg.norm(r) for U, r in zip(Us, ref)))
+    def errs(Us):
+        return [float(np.linalg.norm(first(U) - r) / np.linalg.norm(r)) for U, r in zip(Us, ref)]
 
-    start = time.perf_counter()
-    sols = [solve_point(nl, w, H, N, options, None) for w in omegas]
-    t_hbm = time.perf_counter() - start
-    e_hbm = err([s.displacement for s in sols])
-    out = {"model_dofs": int(nl.model.K.shape[0]) if hasattr(nl.model, "K") else None,
-           "frequencies_hz": freqs.tolist(), "hbm": {"harmonics": H, "samples": N, "s": t_hbm,
-           "error": e_hbm, "converged": sum(bool(s.converged) for s in sols)}, "time": []}
-    target = max(e_hbm, 1e-2)
+    out = {"model_dofs": int(F.shape[1]), "frequencies_hz": freqs.tolist(), "hbm_scan": [],
+           "time": []}
+    target = 1e-2
+    for H in (case.data["solver"]["harmonics"], 15, 20):     # the cheapest H within 1 %
+        NH = max(N, 1 << int(np.ceil(np.log2(8 * H))))
+        FH = np.zeros((2 * H + 1, F.shape[1]))
+        FH[:min(F.shape[0], 2 * H + 1)] = F[:2 * H + 1]
+        nlH = dataclasses.replace(nl, excitation=FH)
+        start = time.perf_counter()
+        sols = [solve_point(nlH, w, H, NH, options, None) for w in omegas]
+        t = time.perf_counter() - start
+        e = errs([s.displacement for s in sols])
+        out["hbm_scan"].append({"harmonics": H, "samples": NH, "s": t, "error": max(e),
+                                "errors": e, "converged": sum(bool(s.converged) for s in sols)})
+        if max(e) <= target:
+            break
+    out["hbm"] = out["hbm_scan"][-1]
+    t_hbm = out["hbm"]["s"]
+    target = max(target, out["hbm"]["error"])
     for steps in (64, 128, 256, 512, 1024):
         if left() < 60:
             break
@@ -191,10 +207,11 @@ def hbm_vs_time():
         rs = [integrate_time(nl.model, nl.contacts, nl.excitation, w, H, steps_per_period=steps,
                              steady_tolerance=1e-6) for w in omegas]
         t = time.perf_counter() - start
-        e = err([r.displacement_harmonics for r in rs])
-        out["time"].append({"steps_per_period": steps, "s": t, "error": e,
-                            "periods": [int(r.periods) for r in rs]})
-        if e <= target:
+        e = errs([r.displacement_harmonics for r in rs])
+        out["time"].append({"steps_per_period": steps, "s": t, "error": max(e), "errors": e,
+                            "periods": [int(r.periods) for r in rs],
+                            "steady": sum(bool(r.steady) for r in rs)})
+        if max(e) <= target:
             break
     ok = [row for row in out["time"] if row["error"] <= target]
     out["target_error"] = target
@@ -269,12 +286,19 @@ def write(results):
     h = results.get("hbm_vs_time")
     if h:
         L += ["", "## HBM vs time integration, rattle rig reduced model, 10 points 24–40 Hz", "",
-              f"Reference: HBM H = 30, N = 1024. HBM H = {h['hbm']['harmonics']}, N = "
-              f"{h['hbm']['samples']}: {h['hbm']['s']:.2f} s for 10 points, error "
-              f"{h['hbm']['error']:.1e}, converged {h['hbm']['converged']}/10.", "",
-              "| steps/period | s (10 points) | error | periods |", "|---|---|---|---|"]
+              f"{h['model_dofs']} reduced DOFs. Reference: HBM H = 30, N = 1024 (padded excitation). "
+              "Error = max over the 10 points of ‖Û₁ − Û₁,ref‖ / ‖Û₁,ref‖. The HBM H is the "
+              "cheapest of (case H, 15, 20) within 1 % of the reference (chosen against the "
+              "reference, not by the run's own estimate).", "",
+              "| HBM H | N | s (10 points) | error | converged |", "|---|---|---|---|---|"]
+        for r in h["hbm_scan"]:
+            L.append(f"| {r['harmonics']} | {r['samples']} | {r['s']:.2f} | {r['error']:.1e} | "
+                     f"{r['converged']}/10 |")
+        L += ["", "| time int. steps/period | s (10 points) | error | steady | periods |",
+              "|---|---|---|---|---|"]
         for r in h["time"]:
-            L.append(f"| {r['steps_per_period']} | {r['s']:.2f} | {r['error']:.1e} | {r['periods']} |")
+            L.append(f"| {r['steps_per_period']} | {r['s']:.2f} | {r['error']:.1e} | "
+                     f"{r['steady']}/10 | {r['periods']} |")
         L += ["", f"Ratio time integration / HBM at error ≤ {h['target_error']:.1e}: "
               f"{fmt(h['ratio'], '.1f')}× (target ≥ 20×)."]
     (RESULTS / "door_trim.md").write_text("\n".join(L) + "\n")
