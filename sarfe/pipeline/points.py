@@ -105,11 +105,11 @@ def solve_point(nl, omega, H, N, options, previous):
             return retry
     except Exception:
         pass
-    if solution is None:
-        guess.converged = False
-        guess.reason = (f"HBM engine failed ({type(error).__name__}: {error}); values are the "
-                        "time-integration state after 40 periods")
-        return guess
+    if solution is None:        # HarmonicSolution is frozen: a new one, reported not converged
+        return dataclasses.replace(
+            guess, converged=False,
+            reason=(f"HBM engine failed ({type(error).__name__}: {error}); values are the "
+                    "time-integration state after 40 periods"))
     return solution
 
 
