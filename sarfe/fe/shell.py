@@ -203,6 +203,63 @@ _MEMBRANE = (6 * np.arange(3)[:, None] + np.array([0, 1, 5])).ravel()
 _BENDING = (6 * np.arange(3)[:, None] + np.array([2, 3, 4])).ravel()
 
 
+def element_kinematics(points, triangles):
+    """What every facet-shell element needs of its geometry (this element and
+    :mod:`sarfe.fe.shell_section`): rotation (n_el, 3, 3) to the element frame, area (n_el,) [m²],
+    area-coordinate gradients ∇L (n_el, 3, 2) [1/m], edge length/tangent/normal, the P2 strain
+    operator at the midside points (n_el, 3, 3, 12) and the rule's weights × area (n_el, 3)."""
+    rotation, xy, area = local_frames(points, triangles)
+    # ∇L_i = (y_j − y_k, x_k − x_j) / (2A), (i, j, k) cyclic
+    nxt, prv = [1, 2, 0], [2, 0, 1]
+    grad_l = np.stack(
+        [xy[:, nxt, 1] - xy[:, prv, 1], xy[:, prv, 0] - xy[:, nxt, 0]], axis=2
+    ) / (2.0 * area)[:, None, None]
+    length, tangent, normal = _edge_geometry(xy)
+    points_q, weights_q = _MIDSIDE_RULE
+    strain = _strain_operator(_p2_gradients(points_q, grad_l))  # (n_el, 3, 3, 12)
+    w_area = weights_q[None, :] * area[:, None]  # (n_el, n_q)
+    return rotation, area, grad_l, length, tangent, normal, strain, w_area
+
+
+def drilling_vector(grad_l, t_mem):
+    """g (n_el, 9) of the drilling penalty, g·q = mean(θz) − ω(centroid), ω = (v,x − u,y)/2."""
+    n_el = grad_l.shape[0]
+    centroid = np.full((1, 3), 1.0 / 3.0)
+    grad_c = _p2_gradients(centroid, grad_l)[:, 0]  # (n_el, 6, 2)
+    spin = np.zeros((n_el, 6, 2))
+    spin[:, :, 0] = -0.5 * grad_c[..., 1]  # ω = (v,x − u,y)/2
+    spin[:, :, 1] = 0.5 * grad_c[..., 0]
+    g = -np.einsum("ea,eaj->ej", spin.reshape(n_el, 12), t_mem)
+    g[:, 2::3] += 1.0 / 3.0
+    return g
+
+
+def consistent_mass(area, mass_per_area, rotary_inertia_per_area, t_rot):
+    """Element mass (n_el, 18, 18) in the element frame (module docstring): translations
+    m'' A/12 (1 + δ_ij), drilling I'' A/12 (1 + δ_ij), rotary inertia I'' ∫ β·β dA on the DKT
+    rotation field (degree-4 rule); m'' [kg/m²], I'' [kg] per element. Also returns the rotation
+    field β at the rule's points (n_el, n_q, 2, 9)."""
+    n_el = area.shape[0]
+    linear = (np.ones((3, 3)) + np.eye(3)) / 12.0
+    mass = np.zeros((n_el, 3, 6, 3, 6))
+    m_trans = (mass_per_area * area)[:, None, None] * linear
+    m_drill = (rotary_inertia_per_area * area)[:, None, None] * linear
+    for c in range(3):
+        mass[:, :, c, :, c] = m_trans
+    mass[:, :, 5, :, 5] = m_drill
+    mass = mass.reshape(n_el, 18, 18)
+    points_m, weights_m = _DEGREE4_RULE
+    values = _p2_values(points_m)  # (n_q, 6)
+    interp = np.zeros((len(weights_m), 2, 6, 2))
+    interp[:, 0, :, 0] = values
+    interp[:, 1, :, 1] = values
+    beta = np.einsum("qcn,enj->eqcj", interp.reshape(-1, 2, 12), t_rot)  # (n_el, n_q, 2, 9)
+    m_rot = _weighted_gram(beta, np.eye(2)[None], np.broadcast_to(
+        weights_m * (rotary_inertia_per_area * area)[:, None], beta.shape[:2]))
+    mass[:, _BENDING[:, None], _BENDING] += m_rot
+    return mass, beta
+
+
 def shell_element_matrices(points, triangles, thickness, young, poisson, density,
                            drilling_penalty=DRILLING_PENALTY, local=False):
     """Element stiffness and mass matrices, each (n_el, 18, 18).
@@ -219,30 +276,15 @@ def shell_element_matrices(points, triangles, thickness, young, poisson, density
     nu = _as_element_array(poisson, n_el, "poisson")
     rho = _as_element_array(density, n_el, "density")
 
-    rotation, xy, area = local_frames(points, triangles)
-    # ∇L_i = (y_j − y_k, x_k − x_j) / (2A), (i, j, k) cyclic
-    nxt, prv = [1, 2, 0], [2, 0, 1]
-    grad_l = np.stack(
-        [xy[:, nxt, 1] - xy[:, prv, 1], xy[:, prv, 0] - xy[:, nxt, 0]], axis=2
-    ) / (2.0 * area)[:, None, None]
-    length, tangent, normal = _edge_geometry(xy)
-
-    points_q, weights_q = _MIDSIDE_RULE
-    strain = _strain_operator(_p2_gradients(points_q, grad_l))  # (n_el, 3, 3, 12)
+    rotation, area, grad_l, length, tangent, normal, strain, w_area = element_kinematics(
+        points, triangles)
     d_plane = _plane_stress(e, nu)
-    w_area = weights_q[None, :] * area[:, None]  # (n_el, n_q)
 
     # membrane: Allman + drilling penalty
     t_mem = _allman_field(length, normal)
     b_mem = strain @ t_mem[:, None]  # (n_el, n_q, 3, 9)
     k_mem = _weighted_gram(b_mem, d_plane, w_area * t[:, None])
-    centroid = np.full((1, 3), 1.0 / 3.0)
-    grad_c = _p2_gradients(centroid, grad_l)[:, 0]  # (n_el, 6, 2)
-    spin = np.zeros((n_el, 6, 2))
-    spin[:, :, 0] = -0.5 * grad_c[..., 1]  # ω = (v,x − u,y)/2
-    spin[:, :, 1] = 0.5 * grad_c[..., 0]
-    g = -np.einsum("ea,eaj->ej", spin.reshape(n_el, 12), t_mem)
-    g[:, 2::3] += 1.0 / 3.0
+    g = drilling_vector(grad_l, t_mem)
     shear_modulus = e / (2.0 * (1.0 + nu))
     k_mem += (drilling_penalty * shear_modulus * t * area)[:, None, None] * g[:, :, None] * g[:, None, :]
 
@@ -257,23 +299,7 @@ def shell_element_matrices(points, triangles, thickness, young, poisson, density
     stiffness[:, _BENDING[:, None], _BENDING] = k_bend
 
     # mass: linear consistent translations, DKT rotary inertia, small drilling inertia
-    linear = (np.ones((3, 3)) + np.eye(3)) / 12.0
-    mass = np.zeros((n_el, 3, 6, 3, 6))
-    m_trans = (rho * t * area)[:, None, None] * linear
-    m_drill = (rho * t**3 / 12.0 * area)[:, None, None] * linear
-    for c in range(3):
-        mass[:, :, c, :, c] = m_trans
-    mass[:, :, 5, :, 5] = m_drill
-    mass = mass.reshape(n_el, 18, 18)
-    points_m, weights_m = _DEGREE4_RULE
-    values = _p2_values(points_m)  # (n_q, 6)
-    interp = np.zeros((len(weights_m), 2, 6, 2))
-    interp[:, 0, :, 0] = values
-    interp[:, 1, :, 1] = values
-    beta = np.einsum("qcn,enj->eqcj", interp.reshape(-1, 2, 12), t_rot)  # (n_el, n_q, 2, 9)
-    m_rot = _weighted_gram(beta, np.eye(2)[None], np.broadcast_to(
-        weights_m * (rho * t**3 / 12.0 * area)[:, None], beta.shape[:2]))
-    mass[:, _BENDING[:, None], _BENDING] += m_rot
+    mass, _ = consistent_mass(area, rho * t, rho * t**3 / 12.0, t_rot)
 
     if not local:
         stiffness = _to_global(stiffness, rotation)

@@ -25,10 +25,9 @@ import numpy as np
 
 from .assembly import assemble_pair, element_dofs
 from sarfe.mesh.laminate import rotate_plane_stress
-from .shell import (_BENDING, _DEGREE4_RULE, _MEMBRANE, _MIDSIDE_RULE, BLOCK_SIZE,
-                    DRILLING_PENALTY, _allman_field, _dkt_rotation_field, _edge_geometry,
-                    _p2_gradients, _p2_values, _strain_operator, _to_global, _weighted_gram,
-                    local_frames)
+from .shell import (_BENDING, _DEGREE4_RULE, _MEMBRANE, BLOCK_SIZE, DRILLING_PENALTY,
+                    _allman_field, _dkt_rotation_field, _to_global, _weighted_gram,
+                    consistent_mass, drilling_vector, element_kinematics)
 
 __all__ = ["section_shell_element_matrices", "section_shell_matrices"]
 
@@ -47,22 +46,14 @@ def section_shell_element_matrices(points, triangles, membrane, coupling, bendin
     """
     triangles = np.asarray(triangles)
     n_el = triangles.shape[0]
-    rotation, xy, area = local_frames(points, triangles)
+    rotation, area, grad_l, length, tangent, normal, strain, w_area = element_kinematics(
+        points, triangles)
     axis_local = np.einsum("eij,ej->ei", rotation, np.asarray(material_axis, float))
     angle = np.arctan2(axis_local[:, 1], axis_local[:, 0])
     a_mat = np.asarray(membrane, float)
     a_bar = rotate_plane_stress(a_mat, angle)
     b_bar = rotate_plane_stress(np.asarray(coupling, float), angle)
     d_bar = rotate_plane_stress(np.asarray(bending, float), angle)
-
-    nxt, prv = [1, 2, 0], [2, 0, 1]
-    grad_l = np.stack(
-        [xy[:, nxt, 1] - xy[:, prv, 1], xy[:, prv, 0] - xy[:, nxt, 0]], axis=2
-    ) / (2.0 * area)[:, None, None]
-    length, tangent, normal = _edge_geometry(xy)
-    points_q, weights_q = _MIDSIDE_RULE
-    strain = _strain_operator(_p2_gradients(points_q, grad_l))
-    w_area = weights_q[None, :] * area[:, None]
 
     t_mem = _allman_field(length, normal)
     b_mem = strain @ t_mem[:, None]  # (n_el, n_q, 3, 9)
@@ -79,13 +70,7 @@ def section_shell_element_matrices(points, triangles, membrane, coupling, bendin
                 @ coupled.reshape(n_el, 3 * n_q, 9))
 
     # drilling penalty α (G t) A g gᵀ with G t = A66 of the section
-    centroid = np.full((1, 3), 1.0 / 3.0)
-    grad_c = _p2_gradients(centroid, grad_l)[:, 0]
-    spin = np.zeros((n_el, 6, 2))
-    spin[:, :, 0] = -0.5 * grad_c[..., 1]
-    spin[:, :, 1] = 0.5 * grad_c[..., 0]
-    g = -np.einsum("ea,eaj->ej", spin.reshape(n_el, 12), t_mem)
-    g[:, 2::3] += 1.0 / 3.0
+    g = drilling_vector(grad_l, t_mem)
     k_mem += (drilling_penalty * a_mat[:, 2, 2] * area)[:, None, None] * g[:, :, None] * g[:, None, :]
 
     stiffness = np.zeros((n_el, 18, 18))
@@ -97,25 +82,11 @@ def section_shell_element_matrices(points, triangles, membrane, coupling, bendin
 
     m_area = np.asarray(mass_per_area, float)
     rotary = np.asarray(rotary_inertia_per_area, float)
-    linear = (np.ones((3, 3)) + np.eye(3)) / 12.0
-    mass = np.zeros((n_el, 3, 6, 3, 6))
-    m_trans = (m_area * area)[:, None, None] * linear
-    for c in range(3):
-        mass[:, :, c, :, c] = m_trans
-    mass[:, :, 5, :, 5] = (rotary * area)[:, None, None] * linear
-    mass = mass.reshape(n_el, 18, 18)
-    points_m, weights_m = _DEGREE4_RULE
-    values = _p2_values(points_m)
-    interp = np.zeros((len(weights_m), 2, 6, 2))
-    interp[:, 0, :, 0] = values
-    interp[:, 1, :, 1] = values
-    beta = np.einsum("qcn,enj->eqcj", interp.reshape(-1, 2, 12), t_rot)
-    m_rot = _weighted_gram(beta, np.eye(2)[None], np.broadcast_to(
-        weights_m * (rotary * area)[:, None], beta.shape[:2]))
-    mass[:, _BENDING[:, None], _BENDING] += m_rot
+    mass, beta = consistent_mass(area, m_area, rotary, t_rot)
     if first_moment_per_area is not None and np.any(first_moment_per_area):
         # S'' ∫ L_i β_c dA: in-plane translation c of corner i against the DKT rotations
         moment = np.asarray(first_moment_per_area, float)
+        points_m, weights_m = _DEGREE4_RULE
         weight = weights_m[None, :] * (moment * area)[:, None]  # (n_el, n_q)
         coupling_mass = np.einsum("eq,qi,eqcj->eicj", weight, points_m, beta)
         for i in range(3):
