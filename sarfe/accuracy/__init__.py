@@ -3,12 +3,14 @@ case layer (plain arrays in, numbers out).
 
 Modules: estimates (a-posteriori error estimates of one solution, the adaptive choice of H, N at
 one frequency, the mode-count rule), resolve (a sweep's accuracy target → H, N, mode count).
+Exports load on first use (:mod:`sarfe.lazy`).
 """
-from .estimates import (PRESETS, AccuracyTarget, ErrorEstimate, EstimateProblem, Resolution,
-                        choose_resolution, estimate_errors, parse_accuracy, problem_error_estimate,
-                        resize_harmonics, suggest_mode_count)
-from .resolve import apply_resolution, resolve_accuracy
+from sarfe.lazy import lazy_exports
 
-__all__ = ["PRESETS", "AccuracyTarget", "ErrorEstimate", "EstimateProblem", "Resolution",
-           "choose_resolution", "estimate_errors", "parse_accuracy", "problem_error_estimate",
-           "resize_harmonics", "suggest_mode_count", "apply_resolution", "resolve_accuracy"]
+_EXPORTS = {name: ".estimates" for name in (
+    "PRESETS", "AccuracyTarget", "ErrorEstimate", "EstimateProblem", "Resolution",
+    "choose_resolution", "estimate_errors", "parse_accuracy", "problem_error_estimate",
+    "resize_harmonics", "suggest_mode_count")}
+_EXPORTS.update({"apply_resolution": ".resolve", "resolve_accuracy": ".resolve"})
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
+__all__ = list(_EXPORTS)

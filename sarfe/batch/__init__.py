@@ -3,11 +3,14 @@
 ``run_study(study_or_cases, workers=2, scheduler=None, output_dir=None) -> pandas.DataFrame``
 (``sarfe.batch.runner``); study files and variants: ``sarfe.batch.study``; parameter paths:
 ``sarfe.batch.paths``; resumable on-disk state: ``sarfe.batch.store``; statistics, plots and the CI
-gate: ``sarfe.batch.report``; the ``sarfe batch`` subcommand: ``sarfe.batch.cli``.
+gate: ``sarfe.batch.report``; the ``sarfe batch`` subcommand: ``sarfe.batch.cli``. Exports load on
+first use (:mod:`sarfe.lazy`: pandas and dask only when a batch runs).
 """
-from sarfe.batch.report import GATE_EXIT_CODE, evaluate_gate
-from sarfe.batch.runner import run_study
-from sarfe.batch.study import StudyError, Variant, collect_variants, load_study
+from sarfe.lazy import lazy_exports
 
+_EXPORTS = {"GATE_EXIT_CODE": ".report", "evaluate_gate": ".report", "run_study": ".runner",
+            "StudyError": ".study", "Variant": ".study", "collect_variants": ".study",
+            "load_study": ".study"}
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
 __all__ = ["run_study", "load_study", "collect_variants", "evaluate_gate", "Variant", "StudyError",
            "GATE_EXIT_CODE"]

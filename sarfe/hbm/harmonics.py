@@ -26,17 +26,12 @@ import warnings
 
 import numpy as np
 
-try:  # pyFFTW with its planner cache; numpy.fft when it is missing
-    import pyfftw
-    import pyfftw.interfaces.numpy_fft as _fft
+# numpy.fft (pocketfft): as fast as pyFFTW's cached interfaces for the AFT's sizes (N = 256 … 4096,
+# a few columns: 12-75 µs per transform, benchmarks/results/peer.md) and nothing to import —
+# pyfftw.interfaces imports dask.array, 0.24 s of every run's start.
+import numpy.fft as _fft
 
-    pyfftw.interfaces.cache.enable()
-    pyfftw.interfaces.cache.set_keepalive_time(60.0)
-    FFT_BACKEND = "pyfftw"
-except ImportError:  # pragma: no cover - exercised only without pyfftw
-    import numpy.fft as _fft
-
-    FFT_BACKEND = "numpy"
+FFT_BACKEND = "numpy"
 
 __all__ = [
     "coefficient_count",

@@ -22,7 +22,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import scipy.io
 import scipy.sparse as sp
 
 from sarfe.io.case import Case, load_case
@@ -154,6 +153,8 @@ def _read_matrix(case: Case, key):
     try:
         suffix = path.suffix.lower()
         if suffix == ".mtx":
+            import scipy.io   # Matrix Market files only
+
             matrix = sp.csr_matrix(scipy.io.mmread(str(path)))
         elif suffix == ".npy":
             matrix = np.load(path, allow_pickle=False)

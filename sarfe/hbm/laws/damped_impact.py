@@ -28,7 +28,6 @@ import math
 from functools import lru_cache
 
 import numpy as np
-from scipy.optimize import brentq
 
 from .contract import ContactLaw, LawInputError, Linearization, NormalForce, Parameter
 from .rattle import NORMAL_STIFFNESS
@@ -71,6 +70,8 @@ def damping_ratio(restitution: float) -> float:
     upper = 1.0
     while restitution_of_damping_ratio(upper) > e:
         upper *= 2.0
+    from scipy.optimize import brentq   # scipy.optimize: 0.1 s of import, only for this law
+
     return brentq(lambda z: restitution_of_damping_ratio(z) - e, 0.0, upper, xtol=1e-14,
                   rtol=1e-14)
 

@@ -28,27 +28,23 @@ response_h5.py (response.h5), vtk.py (VTU/PVD arrays), plots.py (PNGs).
     plot_contributions(path, names, level_dba, share_a) -> Path
     write_report_html(path, summary, images={key: png}, notes=None) -> Path   (report.py, jinja2)
     render_surface(path, points, triangles, values, label, ...) -> (Path, renderer)  (render.py)
+
+Each writer's module (and its library: matplotlib, h5py, jinja2, pyvista) is imported on first
+use (:mod:`sarfe.lazy`), so a run that writes no PNG never imports matplotlib.
 """
-from sarfe.io.outputs.plots import (
-    plot_contact_forces,
-    plot_contributions,
-    plot_erp_spectrum,
-    plot_erp_sweep,
-    plot_friction,
-    plot_third_octave,
-)
-from sarfe.io.outputs.report import write_report_html
-from sarfe.io.outputs.response_h5 import read_response_h5, write_response_h5
-from sarfe.io.outputs.summary import console_table, to_jsonable, write_summary_json
-from sarfe.io.outputs.vtk import (
-    contact_markers,
-    erp_point_data,
-    period_samples,
-    write_deflection_animation,
-    write_erp_sweep,
-    write_erp_vtu,
-    write_pvd,
-)
+from sarfe.lazy import lazy_exports
+
+_EXPORTS = {
+    "plot_contact_forces": ".plots", "plot_contributions": ".plots", "plot_erp_spectrum": ".plots",
+    "plot_erp_sweep": ".plots", "plot_friction": ".plots", "plot_third_octave": ".plots",
+    "write_report_html": ".report",
+    "read_response_h5": ".response_h5", "write_response_h5": ".response_h5",
+    "console_table": ".summary", "to_jsonable": ".summary", "write_summary_json": ".summary",
+    "contact_markers": ".vtk", "erp_point_data": ".vtk", "period_samples": ".vtk",
+    "write_deflection_animation": ".vtk", "write_erp_sweep": ".vtk", "write_erp_vtu": ".vtk",
+    "write_pvd": ".vtk",
+}
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
 
 __all__ = [
     "write_summary_json", "console_table", "to_jsonable", "write_response_h5", "read_response_h5",
