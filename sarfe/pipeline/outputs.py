@@ -15,12 +15,12 @@ def write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, d
     """Write the result files asked for in ``output.files`` into ``directory``; returns
     {file kind: file name}. ``config``: the case's :class:`sarfe.io.config.CaseConfig`.
     Everything "at the loudest point" (spectrum, contact plots, animation,
-    report maps) uses ``summary["worst"]["index"]`` (:func:`sarfe.pipeline.postprocess.loudest_point`)."""
+    report maps) uses ``summary["worst"]["index"]`` (:func:`sarfe.pipeline.postprocess.loudest_point`).
+    summary.json itself is written by the caller, last (it lists these files and the timings)."""
     from sarfe.io import outputs
 
     files = config.output.files
     written = {}
-    outputs.write_summary_json(directory / "summary.json", summary)
     written["summary"] = "summary.json"
     if "table" in files:
         types = {name: kind for name, kind, _ in nl.groups}

@@ -40,36 +40,83 @@ NULL_NOTE = ("null stands for a non-finite number (NaN, +inf or -inf), e.g. the 
 def to_jsonable(value, path: str = "$", replaced: list | None = None):
     """Plain-Python copy of ``value``: numpy scalars/arrays → numbers/lists, dataclasses → dicts,
     Paths → str, sets/tuples → lists; NaN/±inf → None, appending ``(json path, repr)`` to ``replaced``.
+
+    numpy arrays are converted whole (``tolist``; only non-finite entries are visited), and a
+    value's JSON path is spelled out only when it is replaced: a run's summary (300 points of
+    spectra and bands, ~4 MB) converts in a few tens of ms.
     """
     if replaced is None:
         replaced = []
-    if is_dataclass(value) and not isinstance(value, type):
-        value = asdict(value)
-    if isinstance(value, dict):
-        return {str(k): to_jsonable(v, f"{path}.{k}", replaced) for k, v in value.items()}
+    return _plain(value, path, replaced)
+
+
+def _path_text(path) -> str:
+    """'$.a.b[3]' of a lazy path: a str, or nested (parent, key) / (parent, index) tuples."""
+    parts = []
+    while isinstance(path, tuple):
+        path, key = path
+        parts.append(f"[{key}]" if isinstance(key, int) else f".{key}")
+    return path + "".join(reversed(parts))
+
+
+def _array(value: np.ndarray, path, replaced: list):
+    """Nested lists of a numeric array; non-finite entries → None (recorded in ``replaced``)."""
+    kind = value.dtype.kind
+    if kind in "biu":
+        return value.tolist()
+    if kind == "f":
+        finite = np.isfinite(value)
+        if finite.all():
+            return value.astype(float, copy=False).tolist()
+        out = value.astype(object)
+        for index in np.argwhere(~finite):
+            where = path
+            for i in index:
+                where = (where, int(i))
+            replaced.append((_path_text(where), repr(float(value[tuple(index)]))))
+        out[~finite] = None
+        return out.tolist()
+    if kind == "c":
+        raise TypeError(f"{_path_text(path)}: complex value {value.flat[0]!r} is not JSON; store "
+                        "real and imaginary parts")
+    return _plain(value.tolist(), path, replaced)
+
+
+def _plain(value, path, replaced: list):
+    kind = type(value)
+    if kind is float:
+        if value - value == 0.0:          # finite (NaN and ±inf give NaN)
+            return value
+        replaced.append((_path_text(path), repr(value)))
+        return None
+    if kind is str or kind is int or kind is bool or value is None:
+        return value
+    if kind is dict:
+        return {str(k): _plain(v, (path, str(k)), replaced) for k, v in value.items()}
+    if kind is list or kind is tuple or kind is set:
+        return [_plain(v, (path, i), replaced) for i, v in enumerate(value)]
     if isinstance(value, np.ndarray):
-        value = value.tolist()
+        return _array(value, path, replaced)
+    if is_dataclass(value) and not isinstance(value, type):
+        return _plain(asdict(value), path, replaced)
+    if isinstance(value, dict):
+        return {str(k): _plain(v, (path, str(k)), replaced) for k, v in value.items()}
     if isinstance(value, (list, tuple, set)):
-        return [to_jsonable(v, f"{path}[{i}]", replaced) for i, v in enumerate(value)]
+        return [_plain(v, (path, i), replaced) for i, v in enumerate(value)]
     if isinstance(value, (np.bool_, bool)):
         return bool(value)
     if isinstance(value, (np.integer, int)):
         return int(value)
     if isinstance(value, (np.floating, float)):
-        value = float(value)
-        if not math.isfinite(value):
-            replaced.append((path, repr(value)))
-            return None
-        return value
+        return _plain(float(value), path, replaced)
     if isinstance(value, (np.str_, str)):
         return str(value)
     if isinstance(value, Path):
         return str(value)
-    if value is None:
-        return None
     if isinstance(value, (np.complexfloating, complex)):
-        raise TypeError(f"{path}: complex value {value!r} is not JSON; store real and imaginary parts")
-    raise TypeError(f"{path}: cannot write {type(value).__name__} to JSON")
+        raise TypeError(f"{_path_text(path)}: complex value {value!r} is not JSON; store real and "
+                        "imaginary parts")
+    raise TypeError(f"{_path_text(path)}: cannot write {type(value).__name__} to JSON")
 
 
 def write_summary_json(path, summary: dict) -> Path:
