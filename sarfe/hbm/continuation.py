@@ -62,8 +62,14 @@ FOLD_DISTANCE = 0.05     # a turn of ω this close (share of the band) to a chec
 COS_CORNER = 0.2         # ω turns with consecutive secants at more than ~80°: a corner, checked
 
 
+DENSE_BELOW = 500        # a sparse J of fewer rows is bordered and factorized dense (sp.bmat and
+                         # SuperLU cost more than the dense LU there: 1-DOF Jenkins, 15 rows)
+
+
 def _bordered(jacobian, d_omega, x_scale, omega_scale, row, row_scale=1.0):
-    """[[J x_s, ∂R/∂ω ω_s], [row · row_scale]] (dense or sparse like J)."""
+    """[[J x_s, ∂R/∂ω ω_s], [row · row_scale]] (sparse like J, dense below DENSE_BELOW rows)."""
+    if sp.issparse(jacobian) and jacobian.shape[0] < DENSE_BELOW:
+        jacobian = jacobian.toarray()
     if sp.issparse(jacobian):
         return sp.bmat([[jacobian * x_scale, sp.csc_matrix(d_omega[:, None] * omega_scale)],
                         [sp.csr_matrix(row[None, :-1] * row_scale),

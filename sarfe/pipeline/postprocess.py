@@ -108,6 +108,27 @@ def baseline_rows(contacts):
     return springs, dashpots
 
 
+_BASELINE = {}     # the matrices of the last model: every point of a run shares them
+
+
+def baseline_matrices(nl: NonlinearModel):
+    """Dense (K + Gᵀ diag(k) G, M, D + Gᵀ diag(c) G) of the linear baseline (:func:`baseline_rows`),
+    built once per model (not per frequency point)."""
+    hit = _BASELINE.get(id(nl))
+    if hit is not None and hit[0] is nl:
+        return hit[1]
+    dense = (lambda A: A.toarray() if sp.issparse(A) else np.asarray(A, dtype=float))
+    K, M, D = dense(nl.model.stiffness), dense(nl.model.mass), dense(nl.model.damping)
+    if nl.contacts.count:
+        G = sp.csr_matrix(nl.contacts.gap_map)
+        k, c = baseline_rows(nl.contacts)
+        K = K + (G.T @ sp.diags(k) @ G).toarray()
+        D = D + (G.T @ sp.diags(c) @ G).toarray()
+    _BASELINE.clear()
+    _BASELINE[id(nl)] = (nl, (K, M, D))
+    return K, M, D
+
+
 def linear_baseline(erp: ErpConfig, stage, nl: NonlinearModel, omega):
     """Linear response at ω of the structure with its contacts at their static state: preloaded
     (closed) pairs as their linearized spring k_n (and dashpot c_n), stuck friction pairs as k_t,
@@ -118,14 +139,8 @@ def linear_baseline(erp: ErpConfig, stage, nl: NonlinearModel, omega):
     its ERP and the linear risk per named contact."""
     from sarfe.risk import linear_risk_from_contacts
 
-    M, D, K = nl.model.mass, nl.model.damping, nl.model.stiffness
-    dense = (lambda A: A.toarray() if sp.issparse(A) else np.asarray(A))
-    springs = dashpots = 0.0
-    if nl.contacts.count:
-        G = sp.csr_matrix(nl.contacts.gap_map)
-        k, c = baseline_rows(nl.contacts)
-        springs, dashpots = (G.T @ sp.diags(k) @ G).toarray(), (G.T @ sp.diags(c) @ G).toarray()
-    S = dense(K) + springs - omega ** 2 * dense(M) + 1j * omega * (dense(D) + dashpots)
+    K, M, D = baseline_matrices(nl)
+    S = K - omega ** 2 * M + 1j * omega * D
     U1 = np.linalg.lstsq(S, nl.excitation_amplitude, rcond=None)[0]
     H = (nl.excitation.shape[0] - 1) // 2
     U = np.zeros((2 * H + 1, stage.dof_count))
