@@ -11,12 +11,15 @@ benchmarks/peer/pyharm_problems.py in its own venv (arc-length steps ds = 0.04 f
 seconds (median), the ratios sarfe/peer against the issue-13 targets (≤ 0.3× with defaults, ≤ 0.1×
 without; Jenkins ≤ 0.3×), and the peak (amplitude of the first harmonic of the forced DOF, and Ω)
 of each curve plus the largest difference of the curves on their common single-valued range.
+Then the breakdown of one more run of each sarfe variant: CPU seconds per stage
+(benchmarks/peer/stage_breakdown.py), and the import floors: an interpreter that imports numpy +
+scipy.sparse/linalg (what any sarfe run needs) and the peer's ``import pyHarm``.
 
 The peer venv: $SARFE_PEER_VENV, else benchmarks/.peer-venv (created on first use:
 `python3 -m venv` + `pip install pyharm-os==1.2.2`; git-ignored). Its first run compiles numba
 kernels into a cache (~40 s): each problem is run once untimed first.
 
-Run: python benchmarks/bench_peer.py [--repeats 2]
+Run: python benchmarks/bench_peer.py [--repeats 3]
 """
 import argparse
 import json
@@ -36,6 +39,10 @@ HERE = pathlib.Path(__file__).resolve().parent
 ROOT = HERE.parent
 PEER = HERE / "peer"
 PEER_VERSION = "pyharm-os==1.2.2"
+STAGE_ROWS = ("start", "imports", "sweep (continuation, all points)", "  of which Hill stability",
+              "error estimates", "point records (ERP, baseline, contributions)",
+              "figures (incl. matplotlib import)", "report.html", "response.h5 (incl. h5py import)",
+              "summary.json", "solve_case (all stages)", "process total")
 TARGETS = {"nlvib03": {"defaults": 0.3, "bare": 0.1}, "jenkins": {"defaults": 0.3, "bare": 0.3}}
 PEER_NAMES = {"nlvib03": "example03", "jenkins": "jenkins"}
 PEER_STEPS = {"nlvib03": 0.04, "jenkins": 0.025}
@@ -106,6 +113,20 @@ def curve_difference(omega_sarfe, amp_sarfe, omega_peer, amp_peer):
                  / amp_peer.max())
 
 
+def stage_breakdown(case, output):
+    """{stage: CPU s} of one more whole ``sarfe solve`` (benchmarks/peer/stage_breakdown.py)."""
+    done = subprocess.run([sys.executable, str(PEER / "stage_breakdown.py"), str(case), "-o",
+                           str(output)], env=ENV, cwd=ROOT, capture_output=True, text=True)
+    if done.returncode not in (0, 3):
+        return {"error": done.stderr[-500:]}
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def import_floor(python, code, runs=3):
+    """Median CPU s of an interpreter that runs ``code`` (imports only)."""
+    return statistics.median(timed([str(python), "-c", code])[1] for _ in range(runs))
+
+
 def run_problem(problem, python, repeats, directory):
     cases = {v: sarfe_case(problem, v, directory) for v in ("defaults", "bare")}
     timed(peer_command(python, problem), cwd=directory)    # warm-up: numba compiles its cache
@@ -130,6 +151,8 @@ def run_problem(problem, python, repeats, directory):
                      "peak_omega": float(omega[peak]),
                      "unstable_points": int(np.sum(stable == 0))},
            "curve_difference": curve_difference(omega, amplitude, peer_omega, peer_amp)}
+    row["breakdown"] = {variant: stage_breakdown(case, pathlib.Path(directory) / f"{problem}_{variant}_b")
+                        for variant, case in cases.items()}
     for key, values in times.items():
         row[f"{key}_wall_s"] = statistics.median(v[0] for v in values)
         row[f"{key}_cpu_s"] = statistics.median(v[1] for v in values)
@@ -167,6 +190,21 @@ def write(results):
         lines.append(f"| {r['problem']} | {p['points']} | {p['peak_amplitude']:.5f} "
                      f"({p['peak_omega']:.5f}) | {s['points']} | {s['peak_amplitude']:.5f} "
                      f"({s['peak_omega']:.5f}) | {diff} |")
+    floors = results.get("import_floor_cpu_s", {})
+    lines += ["", "## Where a sarfe run's time goes (CPU s of one run, stages inclusive)", "",
+              "| stage | " + " | ".join(f"{r['problem']} {v}" for r in results["problems"]
+                                        for v in ("defaults", "bare")) + " |",
+              "|---|" + "---|" * (2 * len(results["problems"]))]
+    for stage in STAGE_ROWS:
+        cells = []
+        for r in results["problems"]:
+            for variant in ("defaults", "bare"):
+                value = r["breakdown"][variant].get(stage.strip())
+                cells.append("-" if value is None else f"{value:.2f}")
+        lines.append(f"| {stage.replace('  ', '&nbsp;&nbsp;')} | " + " | ".join(cells) + " |")
+    lines += ["", f"Import floors (CPU s, median of 3): python + numpy + scipy.sparse/linalg "
+              f"{floors.get('numpy_scipy', float('nan')):.2f}; the peer's `import pyHarm` "
+              f"{floors.get('peer', float('nan')):.2f}."]
     lines += ["", "Peak = largest first-harmonic amplitude among the computed points (a coarse "
               "sweep samples the peak below its true value). Curve difference = max |a_sarfe − "
               "a_peer| / max a_peer at sarfe's points, the peer's denser curve interpolated "
@@ -177,7 +215,7 @@ def write(results):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeats", type=int, default=2)
+    parser.add_argument("--repeats", type=int, default=3)
     args, _ = parser.parse_known_args()   # run_all.py passes its own arguments
     results = {"machine": platform.platform(), "python": platform.python_version(),
                "cpu_count": os.cpu_count(), "load_average": os.getloadavg(),
@@ -193,6 +231,9 @@ def main():
     with tempfile.TemporaryDirectory() as directory:
         results["problems"] = [run_problem(p, python, args.repeats, directory)
                                for p in ("nlvib03", "jenkins")]
+    results["import_floor_cpu_s"] = {
+        "numpy_scipy": import_floor(sys.executable, "import numpy, scipy.sparse, scipy.linalg"),
+        "peer": import_floor(python, "import numpy; from pyHarm.Maestro import Maestro")}
     write(results)
 
 
