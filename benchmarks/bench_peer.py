@@ -122,9 +122,11 @@ def stage_breakdown(case, output):
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 
-def import_floor(python, code, runs=3):
-    """Median CPU s of an interpreter that runs ``code`` (imports only)."""
-    return statistics.median(timed([str(python), "-c", code])[1] for _ in range(runs))
+def import_floor(python, code, directory, runs=3):
+    """Median CPU s of an interpreter that runs ``code`` (imports only) in ``directory`` (pyHarm
+    writes a log folder where it is imported)."""
+    return statistics.median(timed([str(python), "-c", code], cwd=directory)[1]
+                             for _ in range(runs))
 
 
 def run_problem(problem, python, repeats, directory):
@@ -231,9 +233,11 @@ def main():
     with tempfile.TemporaryDirectory() as directory:
         results["problems"] = [run_problem(p, python, args.repeats, directory)
                                for p in ("nlvib03", "jenkins")]
-    results["import_floor_cpu_s"] = {
-        "numpy_scipy": import_floor(sys.executable, "import numpy, scipy.sparse, scipy.linalg"),
-        "peer": import_floor(python, "import numpy; from pyHarm.Maestro import Maestro")}
+        results["import_floor_cpu_s"] = {
+            "numpy_scipy": import_floor(sys.executable, "import numpy, scipy.sparse, scipy.linalg",
+                                        directory),
+            "peer": import_floor(python, "import numpy; from pyHarm.Maestro import Maestro",
+                                 directory)}
     write(results)
 
 
