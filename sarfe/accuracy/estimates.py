@@ -589,10 +589,9 @@ def estimate_errors(solution, model, contacts, excitation, *, erp_map=None, erp_
     if aliasing:
         U_new = newton_step(model, contacts, resize_harmonics(excitation, H), U, omega, H, 2 * N,
                             options, steps)
-        for robust in (False, True):
-            if U_new is None:
-                U_new = newton_correction(model, contacts, excitation, solution, H, 2 * N,
-                                          options, robust)
+        if U_new is None:   # (the cheap climb at the same H would repeat the step above exactly)
+            U_new = newton_correction(model, contacts, excitation, solution, H, 2 * N, options,
+                                      robust=True)
         if U_new is None:   # unknown, not small
             a_rel = a_db = float("inf")
             notes.append("aliasing estimate: no re-solve with 2N converged")
