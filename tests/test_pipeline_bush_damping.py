@@ -7,30 +7,17 @@ import yaml
 
 from sarfe.io.errors import CaseError
 from sarfe.pipeline import build_linear_model, load_case
+from tests.test_pipeline_deck import SHEAR_DECK
 
-# a two-quad plate in mm-t-s held along x = 0, a grounded CBUSH (k3 = 5 N/mm, GE) at GRID 6
-DECK = """BEGIN BULK
-GRID,1,,0.,0.,0.
-GRID,2,,100.,0.,0.
-GRID,3,,100.,100.,0.
-GRID,4,,0.,100.,0.
-GRID,5,,200.,0.,0.
-GRID,6,,200.,100.,0.
-CQUAD4,1,1,1,2,3,4
-CQUAD4,3,1,2,5,6,3
-PSHELL,1,1,2.,1
-MAT1,1,2000.,,0.3,1.e-9
-CBUSH,7,9,6,,,,,0
-PBUSH,9,K,0.,0.,5.,0.,0.,0.
-,,GE,0.1
-SPC1,1,123456,1,4
-{param}ENDDATA
-"""
+# the two-quad mm-t-s plate of test_pipeline_deck (held along x = 0) with a grounded CBUSH
+# (k3 = 5 N/mm, GE = 0.1) at GRID 6 in place of its shear panel
+DECK = SHEAR_DECK.replace("CSHEAR,2,2,2,5,6,3\n", "CBUSH,7,9,6,,,,,0\n").replace(
+    "PSHEAR,2,1,3.\n", "PBUSH,9,K,0.,0.,5.,0.,0.,0.\n,,GE,0.1\n")
 GE, K3_N_M = 0.1, 5.0e3
 
 
 def _case(tmp_path, param=""):
-    (tmp_path / "bush.bdf").write_text(DECK.format(param=param))
+    (tmp_path / "bush.bdf").write_text(DECK.replace("ENDDATA", param + "ENDDATA"))
     data = {"name": "bush", "model": {"fe": {"deck": "bush.bdf", "units": "mm-t-s",
                                              "node_groups": {"tip": [6]}}},
             "excitation": {"forces": [{"group": "tip", "direction": "z", "force_N": 1.0}],
