@@ -106,8 +106,9 @@ def cmd_verify(args) -> int:
     case = load_case(args.case)
     stage = build_linear_model(case, progress=not args.quiet)
     nl = nonlinear_model(case, stage)
-    hbm, tim, check, rows = verify_point(case, stage, nl, 2 * np.pi * args.frequency_hz,
-                                         args.tolerance, args.tolerance_db)
+    hbm, tim, check, rows = verify_point(case.config.solver, case.config.erp, stage, nl,
+                                         2 * np.pi * args.frequency_hz, args.tolerance,
+                                         args.tolerance_db)
     print(f"verify {case.name} at {args.frequency_hz:g} Hz: HBM (H={hbm.harmonics}, "
           f"N={hbm.samples_per_period}, converged={hbm.converged}) vs time integration "
           f"({tim.steps_per_period} steps/period, {tim.periods} periods, steady={tim.steady})"

@@ -13,7 +13,10 @@ Steps (global DOF g = 6·node + c, c = 0..5 = [ux, uy, uz, rx, ry, rz], global a
    listed in ``auto_held``; K_r has no zero pivot left from them.
 
 Spring damping is returned beside K: ``structural_damping`` = Σ GE_e K_e (hysteretic, to be
-multiplied by i) and ``viscous_damping`` = Σ B_e, both on the kept DOFs.
+multiplied by i) and ``viscous_damping`` = Σ B_e, both on the kept DOFs. The HBM model carries
+only the viscous part (its D enters S_k as i kω D, and the time integration as D u̇): a case whose
+deck keeps a hysteretic GE is refused (:mod:`sarfe.pipeline.deck`); with PARAM,W4 the Nastran
+reader has already moved GE into B = GE·K/W4, equal to i·GE·K at ω = W4.
 """
 from __future__ import annotations
 

@@ -18,7 +18,10 @@ cross-references it; this module turns its cards into the reader-neutral `DeckMo
   refused), CROD/PROD, CONROD;
   end offsets (WA/WB) and pin flags refused.
 * CBUSH/PBUSH (K, B, GE), CELAS1/PELAS, CELAS2; CONM2 (offset, inertia, CID);
-  RBE2; RBE3 (UM set refused).
+  RBE2; RBE3 (UM set refused). A spring's GE stays hysteretic (``structural_damping``)
+  unless the deck gives PARAM,W4 > 0: then, as in Nastran's transient solutions, it becomes
+  the viscous damping B += GE·K/W4 (noted), the one form sarfe's damping carries.
+  Material GE and PARAM,G are not applied (the case's ``damping`` damps the structure; noted).
 * SPC/SPC1/SPCADD → ``supports``; FORCE/MOMENT/DAREA/LOAD → ``loads`` (global frame);
   SET1 → ``node_sets['set_<id>']`` (and ``element_sets`` when its ids are elements);
   properties → ``element_sets['pid_<id>']``.
@@ -167,6 +170,22 @@ class _Converter:
         if "WTMASS" in model.params:
             self.wtmass = float(model.params["WTMASS"].values[0])
             self.notes.append(f"PARAM,WTMASS,{self.wtmass:g} applied to every mass")
+        #: PARAM,W4 [rad per deck time unit]: element GE → viscous GE·K/W4 (0: GE kept hysteretic)
+        self.w4 = float(model.params["W4"].values[0]) if "W4" in model.params else 0.0
+        self.note_structural_damping()
+
+    def note_structural_damping(self):
+        """Material GE and PARAM,G are the structure's loss factor in Nastran; sarfe takes the
+        structure's damping from the case (modal ζ or Rayleigh), so they are listed, not applied."""
+        damped = sorted(int(mid) for mid, mat in self.model.materials.items()
+                        if float(getattr(mat, "ge", 0.0) or 0.0) != 0.0)
+        if damped:
+            shown = ", ".join(map(str, damped[:5])) + (" …" if len(damped) > 5 else "")
+            self.notes.append(f"material GE of MAT {shown} not applied (the case's damping "
+                              "section damps the structure)")
+        if "G" in self.model.params and float(self.model.params["G"].values[0] or 0.0) != 0.0:
+            self.notes.append(f"PARAM,G,{float(self.model.params['G'].values[0]):g} not applied "
+                              "(the case's damping section damps the structure)")
 
     def apply_grdset(self):
         """GRDSET CP/CD/PS defaults for GRIDs that leave those fields blank.
@@ -289,8 +308,12 @@ class _Converter:
     # ------------------------------------------------------------------ springs
     def springs(self) -> SpringElements:
         rows = defaultdict(list)
+        converted = []
 
         def add(card, eid, pid, a, b, k6, frame, ge, b6, location=np.nan):
+            if ge != 0.0 and self.w4 > 0.0:   # Nastran transient: B_e = GE_e K_e / W4
+                b6, ge = b6 + ge * k6 / self.w4, 0.0
+                converted.append(eid)
             for key, value in (("card", card), ("element_ids", eid), ("property_ids", pid),
                                ("node_a", a), ("node_b", b), ("stiffness", k6),
                                ("frames", frame), ("structural_damping", ge),
@@ -345,6 +368,10 @@ class _Converter:
                 k6 = np.zeros(6)
                 k6[int(ends[0][1]) - 1] = k
                 add(el.type, eid, pid, a, b, k6, self.frames[a], ge, np.zeros(6))
+        if converted:
+            self.notes.append(f"PARAM,W4,{self.w4:g}: structural damping GE of {len(converted)} "
+                              "spring(s) applied as the viscous damping GE·K/W4 (Nastran's "
+                              "transient rule; equal to the hysteretic i·GE·K at ω = W4)")
         if not rows:
             return SpringElements()
         ints = ("element_ids", "property_ids", "node_a", "node_b")

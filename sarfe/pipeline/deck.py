@@ -325,11 +325,23 @@ def prepare_deck(case: Case) -> PreparedDeck:
              "contact_elements": {k: v.element_ids.tolist() for k, v in element_contacts.items()},
              "deck_notes": list(deck.notes)}
     if len(deck.springs.element_ids) and np.any(deck.springs.structural_damping):
-        notes["spring_damping"] = ("the springs' structural damping GE is not applied (the "
-                                   "viscous B is): hysteretic damping is not a constant D")
-    elif len(deck.springs.element_ids) and np.any(deck.springs.viscous_damping):
+        raise case.error(_hysteretic_spring(deck.springs), DECK_KEY)
+    if len(deck.springs.element_ids) and np.any(deck.springs.viscous_damping):
         notes["spring_damping"] = "the springs' viscous damping B is added to the case's damping"
     return PreparedDeck(deck, mesh, held, element_contacts, contact_case(case, deck), notes)
+
+
+def _hysteretic_spring(springs) -> str:
+    """One line naming the first spring with structural damping GE, which the HBM model (viscous
+    D only, also in time integration) cannot carry; PARAM,W4 makes it viscous at reading."""
+    i = int(np.flatnonzero(springs.structural_damping)[0])
+    card, eid, pid = str(springs.card[i]), int(springs.element_ids[i]), int(springs.property_ids[i])
+    owner = {"CBUSH": f"PBUSH {pid} (CBUSH {eid})", "CELAS1": f"PELAS {pid} (CELAS1 {eid})"}.get(
+        card, f"{card} {eid}")
+    return (f"{owner} has structural damping GE = {float(springs.structural_damping[i]):g}, "
+            "which sarfe cannot apply as hysteretic i·GE·K: add PARAM,W4 (the frequency in rad "
+            "per deck time unit at which GE·K/W4 becomes viscous, as in Nastran transient) or "
+            "remove GE")
 
 
 def check_deck(case: Case) -> dict:

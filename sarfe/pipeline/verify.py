@@ -20,6 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sarfe.io.config import ErpConfig, SolverConfig
+
 
 @dataclass(frozen=True)
 class Comparison:
@@ -39,16 +41,19 @@ def _relative(a, b):
     return abs(a - b) / max(abs(b), 1e-300)
 
 
-def verify_point(case, stage, nl, omega, tolerance=0.05, tolerance_db=0.5):
-    """(hbm solution, time response, perturbation check, [Comparison]) at ω [rad/s]."""
+def verify_point(solver: SolverConfig, erp: ErpConfig, stage, nl, omega, tolerance=0.05,
+                 tolerance_db=0.5):
+    """(hbm solution, time response, perturbation check, [Comparison]) at ω [rad/s].
+
+    solver, erp: the case's sections (``case.config.solver``, ``case.config.erp``): H, N and the
+    Newton options of the HBM point, the air and reference of the ERP rows."""
     from sarfe.hbm.stability_check import perturbation_check
     from sarfe.hbm.time_integration import integrate_time
     from sarfe.pipeline.points import solve_point, solver_options
     from sarfe.pipeline.postprocess import _erp
 
-    solver = case.data["solver"]
-    H, N = solver["harmonics"], solver["samples_per_period"]
-    options, _ = solver_options(case)
+    H, N = solver.harmonics, solver.samples_per_period
+    options, _ = solver_options(solver)
     hbm = solve_point(nl, omega, H, N, options, None)
     steps = max(512, 4 * N)
     tim = integrate_time(nl.model, nl.contacts, nl.excitation, omega, H, steps_per_period=steps)
@@ -75,8 +80,8 @@ def verify_point(case, stage, nl, omega, tolerance=0.05, tolerance_db=0.5):
     diff = _relative(amp_h[j], amp_t[j]) if amp_t[j] > 1e-15 else 0.0
     rows.append(Comparison(f"largest DOF ({j}), 1st harmonic [m]", float(amp_h[j]),
                            float(amp_t[j]), diff, tolerance, "rel.", diff <= tolerance))
-    erp_h, _ = _erp(case, stage, U_h, omega)
-    erp_t, _ = _erp(case, stage, U_t, omega)
+    erp_h, _ = _erp(erp, stage, U_h, omega)
+    erp_t, _ = _erp(erp, stage, U_t, omega)
     p_h, p_t = float(erp_h.power_total), float(erp_t.power_total)
     diff = _relative(p_h, p_t) if p_t > 0 else 0.0
     rows.append(Comparison("ERP total [W]", p_h, p_t, diff, tolerance, "rel.", diff <= tolerance))

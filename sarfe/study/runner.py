@@ -48,9 +48,8 @@ class StudyResult:
 # ------------------------------------------------------------------------------------ variants
 def knob_levels(case, stage, knobs=None) -> dict:
     """{knob: [(label, value), …]} for the applicable knobs (module docstring), finest last."""
-    data = case.data
-    solver = data["solver"]
-    H, N = int(solver["harmonics"]), int(solver["samples_per_period"])
+    config = case.config
+    H, N = config.solver.harmonics, config.solver.samples_per_period
     out = {}
     knobs = KNOBS if knobs is None else tuple(knobs)
     unknown = set(knobs) - set(KNOBS)
@@ -62,23 +61,24 @@ def knob_levels(case, stage, knobs=None) -> dict:
     if "samples" in knobs:
         values = sorted({max(4 * H + 1, N // 2), N, 2 * N, 8 * N})
         out["samples"] = [(f"N={v}", v) for v in values]
-    if "penalty" in knobs and data["contacts"]:
+    if "penalty" in knobs and config.contacts:
         out["penalty"] = [(f"k×{v:g}", v) for v in (0.3, 1.0, 3.0, 10.0)]
     if case.is_fe and "modes" in knobs:
         m = int(stage.info.get("modes", len(stage.mode_frequencies_hz)) or 0)
         if m:
             values = sorted({max(1, m // 2), m, 2 * m, 4 * m})
             out["modes"] = [(f"modes={v}", v) for v in values]
-    fe = data["model"].get("fe", {})
-    if "mesh" in knobs and "generator" in fe:
-        h = float(fe["generator"].get("mesh_size_m", 0) or 0)
+    fe = config.model.fe
+    if "mesh" in knobs and fe is not None and fe.source == "generator":
+        h = float(fe.data["generator"].get("mesh_size_m", 0) or 0)
         if h > 0:
             out["mesh"] = [(f"h={v * 1e3:.3g}mm", v) for v in (2 * h, h, h / math.sqrt(2), h / 2)]
     return out
 
 
 def variant_case(case, knob, value):
-    """A new Case with one knob changed (see module docstring)."""
+    """A new Case with one knob changed (see module docstring): the case's record ``case.data`` is
+    copied, edited and loaded again, so the variant gets its own normalized data and config."""
     from sarfe.io.case import load_case
 
     data = copy.deepcopy(case.data)
@@ -108,10 +108,10 @@ def variant_case(case, knob, value):
 
 def frequency_grid(case, points=16) -> np.ndarray:
     """[Hz]: the listed frequencies, or ``points`` evenly spaced over the sweep."""
-    exc = case.data["excitation"]
-    if "frequency_hz" in exc:
-        return np.atleast_1d(np.asarray(exc["frequency_hz"], dtype=float))
-    return np.linspace(exc["sweep"]["start_hz"], exc["sweep"]["end_hz"], int(points))
+    exc = case.config.excitation
+    if exc.frequency_hz is not None:
+        return np.atleast_1d(np.asarray(exc.frequency_hz, dtype=float))
+    return np.linspace(exc.sweep.start_hz, exc.sweep.end_hz, int(points))
 
 
 # --------------------------------------------------------------------------------------- solve
@@ -126,10 +126,10 @@ def solve_grid(case, stage, frequencies_hz, options=None, guesses=None):
     from sarfe.pipeline import nonlinear_model
 
     nl = nonlinear_model(case, stage)
-    solver = case.data["solver"]
-    H, N = int(solver["harmonics"]), int(solver["samples_per_period"])
-    options = options or SolverOptions(tolerance=solver["tolerance"],
-                                       max_iterations=solver["max_iterations"], stability=False)
+    solver = case.config.solver
+    H, N = solver.harmonics, solver.samples_per_period
+    options = options or SolverOptions(tolerance=solver.tolerance,
+                                       max_iterations=solver.max_iterations, stability=False)
     solutions, iterations, previous = [], 0, None
     clock = time.perf_counter()
     with warnings.catch_warnings():
@@ -162,15 +162,15 @@ def erp_levels(case, stage, displacement, omega):
     """(L_W, L_WA) [dB re reference power] of displacement harmonics (2H+1, n) at ω (−inf if silent)."""
     from sarfe.erp import equivalent_radiated_power
 
-    erp = case.data["erp"]
+    erp = case.config.erp
     W = np.asarray(displacement) @ np.asarray(stage.erp_map).T
     if W.shape[1] == 0:
         return float("-inf"), float("-inf")
     with np.errstate(divide="ignore"):
-        r = equivalent_radiated_power(W, omega, stage.erp_areas, density=erp["rho_kg_m3"],
-                                      sound_speed=erp["c_m_s"],
-                                      radiation_loss_factor=erp["radiation_loss_factor"],
-                                      reference_power=erp["reference_power_W"])
+        r = equivalent_radiated_power(W, omega, stage.erp_areas, density=erp.rho_kg_m3,
+                                      sound_speed=erp.c_m_s,
+                                      radiation_loss_factor=erp.radiation_loss_factor,
+                                      reference_power=erp.reference_power_W)
     return float(r.level_total_db), float(r.level_total_a_db)
 
 
@@ -204,7 +204,7 @@ def branch_guesses(case, stage, baseline_points):
     from sarfe.accuracy import resize_harmonics
 
     nl = nonlinear_model(case, stage)
-    H = int(case.data["solver"]["harmonics"])
+    H = case.config.solver.harmonics
     guesses = []
     for p in baseline_points:
         s = p.get("_solution")
@@ -309,10 +309,10 @@ def run_variant(case, stage, knob, label, value, frequencies_hz, estimate=True,
     if estimate:
         attach_estimates(variant, stage, points)
     converged = [p for p in points if p["converged"]]
-    solver = variant.data["solver"]
+    solver = variant.config.solver
     row = {
         "knob": knob, "level": label, "value": value,
-        "harmonics": int(solver["harmonics"]), "samples_per_period": int(solver["samples_per_period"]),
+        "harmonics": int(solver.harmonics), "samples_per_period": int(solver.samples_per_period),
         "reduced_dofs": int(stage.dof_count),
         "erp_db": _max(p["erp_db"] for p in converged),
         "erp_dba": _max(p["erp_dba"] for p in converged),
@@ -379,24 +379,24 @@ def run_study(case, knobs=None, points=12, frequencies_hz=None, output_dir=None,
     result = StudyResult(case.name, rows, grid, summary)
     if write:
         target = Path(output_dir) if output_dir is not None else (
-            Path(case.data["output"]["directory"]) / "study")
+            Path(case.config.output.directory) / "study")
         result.files = write_study(result, target)
         result.output_dir = target
     return result
 
 
 def _is_baseline(case, stage, knob, value):
-    solver = case.data["solver"]
+    config = case.config
     if knob == "harmonics":
-        return value == solver["harmonics"]
+        return value == config.solver.harmonics
     if knob == "samples":
-        return value == solver["samples_per_period"]
+        return value == config.solver.samples_per_period
     if knob == "penalty":
         return value == 1.0
     if knob == "modes":
         return value == stage.info.get("modes")
     if knob == "mesh":
-        return value == case.data["model"]["fe"]["generator"].get("mesh_size_m")
+        return value == config.model.fe.data["generator"].get("mesh_size_m")
     return False
 
 
