@@ -49,9 +49,12 @@ def sweep_grid_hz(excitation: ExcitationConfig, points=8) -> np.ndarray:
 def resolve_case_accuracy(case, target, points=8, start_harmonics=3, start_samples=64,
                           max_harmonics=64, max_samples=8192, max_points_tuned=3,
                           linear_stage=None) -> dict:
-    """A case's accuracy target → H, N (and mode count): :func:`sarfe.accuracy.resolve_accuracy`
-    over ``points`` frequencies of the case solved at its own H, N. ``linear_stage``: reuse a built
-    stage. Returns the report dict of resolve_accuracy."""
+    """A case's accuracy target → H, N: :func:`sarfe.accuracy.resolve_accuracy` over ``points``
+    frequencies of the case (screened at ``start_harmonics``, then an H ladder at the loudest
+    point), with the case's Newton tolerance and no stability. ``linear_stage``: reuse a built
+    stage. The Craig–Bampton cutoff is the reduction's own rule with the chosen H (set by
+    :func:`sarfe.accuracy.resolve.apply_resolution`). Returns the report dict of
+    resolve_accuracy."""
     from sarfe.hbm import SolverOptions
     from sarfe.io.case import load_case
     from sarfe.pipeline.linear import build_linear_model
@@ -63,18 +66,11 @@ def resolve_case_accuracy(case, target, points=8, start_harmonics=3, start_sampl
     solver, excitation = case.config.solver, case.config.excitation
     options = SolverOptions(tolerance=solver.tolerance, max_iterations=solver.max_iterations,
                             stability=False)
-    modes = None
-    f_max = None
-    if stage.kind == "fe":
-        f_max = excitation.max_frequency_hz
-        modes = getattr(stage.reduced, "mode_frequencies_hz", stage.mode_frequencies_hz)
     return resolve_accuracy(accuracy_problem(stage, nl), target, sweep_grid_hz(excitation, points),
                             solver.harmonics, solver.samples_per_period,
                             start_harmonics=start_harmonics, start_samples=start_samples,
                             max_harmonics=max_harmonics, max_samples=max_samples,
-                            max_points_tuned=max_points_tuned, options=options,
-                            mode_frequencies_hz=modes, max_frequency_hz=f_max,
-                            current_modes=stage.info.get("modes"))
+                            max_points_tuned=max_points_tuned, options=options)
 
 
 RELEVANT_DB = 30.0     # points quieter than the loudest by more than this do not count (dB(A))
