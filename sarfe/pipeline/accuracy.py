@@ -46,31 +46,69 @@ def sweep_grid_hz(excitation: ExcitationConfig, points=8) -> np.ndarray:
     return np.linspace(excitation.sweep.start_hz, excitation.sweep.end_hz, int(points))
 
 
-def resolve_case_accuracy(case, target, points=8, start_harmonics=3, start_samples=64,
-                          max_harmonics=64, max_samples=8192, max_points_tuned=3,
-                          linear_stage=None) -> dict:
-    """A case's accuracy target → H, N: :func:`sarfe.accuracy.resolve_accuracy` over ``points``
-    frequencies of the case (screened at ``start_harmonics``, then an H ladder at the loudest
-    point), with the case's Newton tolerance and no stability. ``linear_stage``: reuse a built
-    stage. The Craig–Bampton cutoff is the reduction's own rule with the chosen H (set by
-    :func:`sarfe.accuracy.resolve.apply_resolution`). Returns the report dict of
-    resolve_accuracy."""
+def case_resolution(case, target, points=8, start_harmonics=3, start_samples=64,
+                    max_harmonics=64, max_samples=8192, max_points_tuned=3, linear_stage=None,
+                    max_rebuilds=2):
+    """A case's accuracy target → (report, linear stage): :func:`sarfe.accuracy.resolve_accuracy`
+    over ``points`` frequencies of the case (screened at ``start_harmonics``, then an H ladder at
+    the loudest point), with the case's Newton tolerance and no stability.
+
+    The Craig–Bampton cutoff is the reduction's own rule with the chosen H (cutoff_margin · H ·
+    f_max). The search runs on the case's stage (its cutoff from the case's H), which may lack the
+    modes of the rungs above it — the A-weighted ERP of those harmonics would come out quasi-static
+    and converge too early. So when the chosen H gives another linear stage (FE models), that stage
+    is built and the search repeated on it from the chosen H at the tuned frequencies (at most
+    ``max_rebuilds`` times); the last stage is returned for the sweep to reuse (its key equals the
+    chosen case's, else the caller builds its own). ``linear_stage``: reuse a built stage."""
     from sarfe.hbm import SolverOptions
     from sarfe.io.case import load_case
-    from sarfe.pipeline.linear import build_linear_model
+    from sarfe.pipeline.linear import build_linear_model, linear_model_key
     from sarfe.pipeline.nonlinear import nonlinear_model
+    from sarfe.accuracy.resolve import apply_resolution
 
     case = load_case(case)
     stage = linear_stage if linear_stage is not None else build_linear_model(case)
-    nl = nonlinear_model(case, stage)
-    solver, excitation = case.config.solver, case.config.excitation
+    solver = case.config.solver
     options = SolverOptions(tolerance=solver.tolerance, max_iterations=solver.max_iterations,
                             stability=False)
-    return resolve_accuracy(accuracy_problem(stage, nl), target, sweep_grid_hz(excitation, points),
-                            solver.harmonics, solver.samples_per_period,
-                            start_harmonics=start_harmonics, start_samples=start_samples,
-                            max_harmonics=max_harmonics, max_samples=max_samples,
-                            max_points_tuned=max_points_tuned, options=options)
+    limits = dict(max_harmonics=max_harmonics, max_samples=max_samples, options=options)
+    report = resolve_accuracy(accuracy_problem(stage, nonlinear_model(case, stage)), target,
+                              sweep_grid_hz(case.config.excitation, points), solver.harmonics,
+                              solver.samples_per_period, start_harmonics=start_harmonics,
+                              start_samples=start_samples, max_points_tuned=max_points_tuned,
+                              **limits)
+    history, seconds, stages = list(report["history"]), report["seconds"], [stage.info.get("modes")]
+    for _ in range(max_rebuilds if stage.kind == "fe" else 0):
+        chosen = load_case(apply_resolution(case.data, report), base_dir=case.base_dir)
+        if linear_model_key(chosen) == stage.key or not report["tuned_hz"]:
+            break
+        stage = build_linear_model(chosen)
+        stages.append(stage.info.get("modes"))
+        again = resolve_accuracy(accuracy_problem(stage, nonlinear_model(chosen, stage)), target,
+                                 np.asarray(report["tuned_hz"]), report["harmonics"],
+                                 report["samples_per_period"],
+                                 start_harmonics=report["harmonics"],
+                                 start_samples=report["samples_per_period"],
+                                 max_points_tuned=len(report["tuned_hz"]), **limits)
+        history += again["history"]
+        seconds += again["seconds"]
+        grew = again["harmonics"] > report["harmonics"]
+        report = again if again["tuned_hz"] else report
+        if not grew:
+            break
+    report.update(history=history, seconds=seconds, search_stage_modes=stages)
+    report["text"] += (f"\n  searched on {len(stages)} linear stage(s) (modes: "
+                       f"{', '.join(str(m) for m in stages)}): the reduction cutoff follows H")
+    return report, stage
+
+
+def resolve_case_accuracy(case, target, points=8, start_harmonics=3, start_samples=64,
+                          max_harmonics=64, max_samples=8192, max_points_tuned=3,
+                          linear_stage=None) -> dict:
+    """The report of :func:`case_resolution` (the report dict of
+    :func:`sarfe.accuracy.resolve_accuracy`)."""
+    return case_resolution(case, target, points, start_harmonics, start_samples, max_harmonics,
+                           max_samples, max_points_tuned, linear_stage)[0]
 
 
 RELEVANT_DB = 30.0     # points quieter than the loudest by more than this do not count (dB(A))
@@ -141,4 +179,4 @@ def accuracy_check(solver: SolverConfig, points) -> dict | None:
 
 
 __all__ = ["accuracy_check", "stage_modal_coordinates", "accuracy_problem", "stage_error_estimate", "sweep_grid_hz",
-           "resolve_case_accuracy"]
+           "resolve_case_accuracy", "case_resolution"]
