@@ -77,13 +77,17 @@ def case_resolution(case, target, points=8, start_harmonics=3, start_samples=64,
                               solver.samples_per_period, start_harmonics=start_harmonics,
                               start_samples=start_samples, max_points_tuned=max_points_tuned,
                               **limits)
-    history, seconds, stages = list(report["history"]), report["seconds"], [stage.info.get("modes")]
+    history, seconds = list(report["history"]), report["seconds"]
+    stages = [stage.info.get("modes")]
+    stage_seconds = [0.0 if linear_stage is not None
+                     else float(stage.timings.get("linear_stage_s", 0.0))]
     for _ in range(max_rebuilds if stage.kind == "fe" else 0):
         chosen = load_case(apply_resolution(case.data, report), base_dir=case.base_dir)
         if linear_model_key(chosen) == stage.key or not report["tuned_hz"]:
             break
         stage = build_linear_model(chosen)
         stages.append(stage.info.get("modes"))
+        stage_seconds.append(float(stage.timings.get("linear_stage_s", 0.0)))
         again = resolve_accuracy(accuracy_problem(stage, nonlinear_model(chosen, stage)), target,
                                  np.asarray(report["tuned_hz"]), report["harmonics"],
                                  report["samples_per_period"],
@@ -96,7 +100,8 @@ def case_resolution(case, target, points=8, start_harmonics=3, start_samples=64,
         report = again if again["tuned_hz"] else report
         if not grew:
             break
-    report.update(history=history, seconds=seconds, search_stage_modes=stages)
+    report.update(history=history, seconds=seconds, search_stage_modes=stages,
+                  search_stage_seconds=stage_seconds)
     report["text"] += (f"\n  searched on {len(stages)} linear stage(s) (modes: "
                        f"{', '.join(str(m) for m in stages)}): the reduction cutoff follows H")
     return report, stage

@@ -79,7 +79,8 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
                                  and linear_stage.key == linear_model_key(case)) else None
         report, searched = case_resolution(case, config.solver.accuracy, linear_stage=given)
         accuracy = {k: report.get(k) for k in ("harmonics", "samples_per_period", "mode_count",
-                                               "estimate", "met", "reason", "tuned_hz")}
+                                               "estimate", "met", "reason", "tuned_hz",
+                                               "search_stage_modes", "search_stage_seconds")}
         accuracy["target"] = config.solver.accuracy
         case = load_case(apply_resolution(case.data, report), base_dir=case.base_dir)
         config = case.config
