@@ -112,9 +112,10 @@ def test_representative_point_is_the_loudest_in_dBA():
 @pytest.mark.timeout(600)
 def test_fe_search_stage_is_the_sweeps(monkeypatch):
     """FE rattle rig (20 mm) at a rattling point, no harmonics given ('balanced'): the linear stage
-    is built only by the search (its last stage has the reduction's cutoff rule 1.5 H f_max with
-    the chosen H and the sweep reuses it), and the point's dB(A) is within 0.5 dB(A) of H = 30 on
-    a stage with twice the cutoff."""
+    is built only by the search — each stage with the reduction's rule 1.5 H f_max, the last at
+    the chosen H or above — and the sweep reuses the last one; the point's dB(A) is within
+    0.5 dB(A) of H = 64, N = 2048 on a stage with twice that cutoff (on this rig the impacts put
+    the dB(A) level into high harmonics: the search climbs far)."""
     import sarfe.pipeline.linear as linear
     import sarfe.pipeline.solve as solve_module
     from sarfe.pipeline import load_case, solve_case
@@ -123,7 +124,7 @@ def test_fe_search_stage_is_the_sweeps(monkeypatch):
     real = linear.build_linear_model
 
     def counting(case, *args, **kwargs):
-        builds.append(case)
+        builds.append(load_case(case))
         return real(case, *args, **kwargs)
 
     monkeypatch.setattr(linear, "build_linear_model", counting)
@@ -139,15 +140,16 @@ def test_fe_search_stage_is_the_sweeps(monkeypatch):
     H = summary["solver"]["harmonics"]
     assert summary["accuracy"]["met"] and summary["points"][0]["converged"]
     assert np.max(np.abs(result.solutions[0].contact_force_time)) > 0      # it rattles
-    assert summary["model"]["cutoff_hz"] == pytest.approx(1.5 * H * 31.0)
-    assert len(builds) >= 1 and all(load_case(c).config.solver.harmonics != H
-                                    for c in builds[:-1])
-    assert load_case(builds[-1]).config.solver.harmonics == H            # the sweep built none
+    cutoffs = [c.config.reduction.cutoff_hz for c in builds]
+    assert cutoffs[0] == pytest.approx(1.5 * 5 * 31.0)                    # the case's H = 5
+    assert cutoffs[-1] >= 1.5 * H * 31.0 - 1e-9
+    assert summary["model"]["cutoff_hz"] == pytest.approx(cutoffs[-1])
+    assert len(builds) == len(summary["accuracy"]["search_stage_modes"])   # the sweep built none
     dba = summary["points"][0]["erp"]["level_dba"]
 
-    data["solver"] = {"harmonics": 30, "samples_per_period": 512, "stability": False,
+    data["solver"] = {"harmonics": 64, "samples_per_period": 2048, "stability": False,
                       "error_estimate": False}
-    data["reduction"] = {"cutoff_hz": 3.0 * H * 31.0}
+    data["reduction"] = {"cutoff_hz": 2.0 * cutoffs[-1]}
     reference = solve_case(data, write=False)
     assert reference.summary["points"][0]["converged"]
     assert abs(dba - reference.summary["points"][0]["erp"]["level_dba"]) <= 0.5

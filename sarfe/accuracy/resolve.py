@@ -310,14 +310,16 @@ def resolve_accuracy(problem: EstimateProblem, target, frequencies_hz, harmonics
 
 def apply_resolution(case_data: dict, report: dict) -> dict:
     """Case data (a copy) with solver.harmonics / samples_per_period set, ``resolution: fixed``
-    (chosen; ``accuracy`` stays the run's error budget) and reduction.mode_count when the report
-    gives one (else the reduction's own rule follows the chosen H)."""
+    (chosen; ``accuracy`` stays the run's error budget) and reduction.cutoff_hz (or mode_count)
+    when the report gives one (the case layer's search: the reduction's rule at the chosen H)."""
     data = copy.deepcopy(case_data)
     data.setdefault("solver", {})
     data["solver"]["harmonics"] = int(report["harmonics"])
     data["solver"]["samples_per_period"] = int(report["samples_per_period"])
     data["solver"]["resolution"] = "fixed"
-    if report.get("mode_count"):
+    if report.get("cutoff_hz"):      # the search's reduction cutoff (FE; none given by the user)
+        data.setdefault("reduction", {})["cutoff_hz"] = float(report["cutoff_hz"])
+    elif report.get("mode_count"):
         red = data.setdefault("reduction", {})
         red.pop("cutoff_hz", None)
         red["mode_count"] = int(report["mode_count"])

@@ -75,17 +75,17 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         from sarfe.pipeline.accuracy import case_resolution
 
         clock = time.perf_counter()
-        given = linear_stage if (linear_stage is not None
-                                 and linear_stage.key == linear_model_key(case)) else None
-        report, searched = case_resolution(case, config.solver.accuracy, linear_stage=given)
+        report, searched = case_resolution(case, config.solver.accuracy)
         accuracy = {k: report.get(k) for k in ("harmonics", "samples_per_period", "mode_count",
                                                "estimate", "met", "reason", "tuned_hz",
-                                               "search_stage_modes", "search_stage_seconds")}
+                                               "search_stage_modes", "search_stage_seconds",
+                                               "cutoff_hz", "history", "seconds")}
         accuracy["target"] = config.solver.accuracy
         case = load_case(apply_resolution(case.data, report), base_dir=case.base_dir)
         config = case.config
-        # the search's last linear stage is the sweep's when its key matches the chosen case
-        linear_stage = searched if searched.key == linear_model_key(case) else None
+        # a given stage, else the search's last one, is the sweep's when its key matches
+        linear_stage = next((s for s in (linear_stage, searched)
+                             if s is not None and s.key == linear_model_key(case)), None)
         timings["accuracy_s"] = time.perf_counter() - clock
     if linear_stage is None:
         linear_stage = build_linear_model(case, progress=progress)
