@@ -18,11 +18,16 @@ r"""Accuracy of a whole sweep as an input: a target (``fast | balanced | fine | 
    budget. H is capped at the audible band: H·f ≤ ``audible_top_hz`` (5 kHz; harmonics above it
    carry little of the A-weighted ERP) and ``max_harmonics``.
 4. N at the chosen H: N → 2N (warm start) until RICHARDSON × the change is within the other half.
-5. Craig–Bampton cutoff: the reduction's own rule with the chosen H (cutoff_margin · H · f_max,
-   default 1.5 H f_max, at least min_mode_count modes, static residual vectors) — the case layer
-   sets H and the linear stage follows. Measured on the door trim (benchmarks/results/audible.md):
-   raising the cutoff above that rule changes the dB(A) level by < 0.01 dB, so no higher cutoff is
+5. Craig–Bampton cutoff (FE; the case layer, :func:`sarfe.pipeline.accuracy.case_resolution`):
+   the reduction's own rule with the chosen H, cutoff_margin · H · f_max (default 1.5 H f_max),
+   set explicitly; the search is repeated on that stage when it needs more modes than the one
+   searched on. Measured on the door trim (benchmarks/results/audible.md): above that rule the
+   dB(A) level moves by ≤ 0.01 dB, so no higher cutoff (and no separate recovery cutoff) is
    chosen; a cutoff or mode count given by the user is kept.
+
+The level change counts dB(A) only when the finer rung reaches AUDIBLE_BOTTOM_HZ (20 Hz): below
+it the A-weighting (−50 dB and falling) turns the weighted level into a measure of the top
+harmonic alone.
 
 Works on plain arrays (:class:`sarfe.accuracy.estimates.EstimateProblem`); the case layer builds
 them (:mod:`sarfe.pipeline.accuracy`) and applies the result with :func:`apply_resolution`.
