@@ -3,6 +3,8 @@ stage and nonlinear model (plain arrays), the per-point error estimate and a cas
 → H, N and mode count (:func:`resolve_case_accuracy`)."""
 from __future__ import annotations
 
+import copy
+
 import numpy as np
 
 from sarfe.accuracy.estimates import (EstimateProblem, highest_natural_frequency_hz,
@@ -46,35 +48,92 @@ def sweep_grid_hz(excitation: ExcitationConfig, points=8) -> np.ndarray:
     return np.linspace(excitation.sweep.start_hz, excitation.sweep.end_hz, int(points))
 
 
-def resolve_case_accuracy(case, target, points=8, start_harmonics=3, start_samples=64,
-                          max_harmonics=64, max_samples=8192, max_points_tuned=3,
-                          linear_stage=None) -> dict:
-    """A case's accuracy target → H, N (and mode count): :func:`sarfe.accuracy.resolve_accuracy`
-    over ``points`` frequencies of the case solved at its own H, N. ``linear_stage``: reuse a built
-    stage. Returns the report dict of resolve_accuracy."""
+def rule_cutoff_hz(case, harmonics) -> float | None:
+    """The reduction's cutoff rule at H: cutoff_margin · H · f_max [Hz] (default margin 1.5), for
+    an FE case whose reduction gives neither cutoff_hz nor mode_count; None otherwise (a matrices
+    model, or the user's reduction, which the accuracy search keeps)."""
+    reduction = case.data.get("reduction") or {}
+    if not case.is_fe or "cutoff_hz" in reduction or "mode_count" in reduction:
+        return None
+    return float(case.config.reduction.cutoff_margin * int(harmonics)
+                 * case.config.excitation.max_frequency_hz)
+
+
+def _with_cutoff(case, cutoff_hz):
+    """The case with reduction.cutoff_hz set (unchanged for None)."""
+    from sarfe.io.case import load_case
+
+    if cutoff_hz is None:
+        return case
+    data = copy.deepcopy(case.data)
+    data.setdefault("reduction", {})["cutoff_hz"] = float(cutoff_hz)
+    return load_case(data, base_dir=case.base_dir)
+
+
+def case_resolution(case, target, points=8, start_harmonics=3, start_samples=64,
+                    max_harmonics=64, max_samples=8192, max_points_tuned=3, max_rebuilds=2):
+    """A case's accuracy target → (report, linear stage): :func:`sarfe.accuracy.resolve_accuracy`
+    over ``points`` frequencies of the case (screened at ``start_harmonics``, then an H ladder at
+    the loudest point), with the case's Newton tolerance and no stability.
+
+    FE cases whose reduction gives neither cutoff_hz nor mode_count: the Craig–Bampton cutoff is
+    the reduction's rule with the chosen H, c(H) = cutoff_margin · H · f_max (:func:`rule_cutoff_hz`,
+    reported as ``cutoff_hz`` and set explicitly by :func:`sarfe.accuracy.resolve.apply_resolution`).
+    The ladder's changes are only trusted on a stage whose modes cover them: a stage with too few
+    modes answers the high harmonics quasi-statically, and its ladder stops too early or climbs
+    too far (door trim: from a 335 Hz stage, H = 27; from 502 Hz, H = 8; benchmarks/results/
+    audible.md). So the search runs first on the stage of the case's H, c(H_case); while the
+    chosen H needs c(H) above the stage's cutoff, the stage of c(H) is built and the search is
+    repeated on it from ``start_harmonics`` at the tuned frequencies (at most ``max_rebuilds``
+    times). The last stage is returned: the sweep reuses it (same key as the chosen case)."""
     from sarfe.hbm import SolverOptions
     from sarfe.io.case import load_case
     from sarfe.pipeline.linear import build_linear_model
     from sarfe.pipeline.nonlinear import nonlinear_model
 
     case = load_case(case)
-    stage = linear_stage if linear_stage is not None else build_linear_model(case)
-    nl = nonlinear_model(case, stage)
-    solver, excitation = case.config.solver, case.config.excitation
+    solver = case.config.solver
     options = SolverOptions(tolerance=solver.tolerance, max_iterations=solver.max_iterations,
                             stability=False)
-    modes = None
-    f_max = None
-    if stage.kind == "fe":
-        f_max = excitation.max_frequency_hz
-        modes = getattr(stage.reduced, "mode_frequencies_hz", stage.mode_frequencies_hz)
-    return resolve_accuracy(accuracy_problem(stage, nl), target, sweep_grid_hz(excitation, points),
-                            solver.harmonics, solver.samples_per_period,
-                            start_harmonics=start_harmonics, start_samples=start_samples,
-                            max_harmonics=max_harmonics, max_samples=max_samples,
-                            max_points_tuned=max_points_tuned, options=options,
-                            mode_frequencies_hz=modes, max_frequency_hz=f_max,
-                            current_modes=stage.info.get("modes"))
+    limits = dict(max_harmonics=max_harmonics, max_samples=max_samples, options=options,
+                  start_harmonics=start_harmonics, start_samples=start_samples)
+    cutoff = rule_cutoff_hz(case, solver.harmonics)
+    grid = sweep_grid_hz(case.config.excitation, points)
+    history, seconds, stages, stage_seconds = [], 0.0, [], []
+    for attempt in range(max_rebuilds + 1):
+        searched = _with_cutoff(case, cutoff)
+        stage = build_linear_model(searched)
+        stages.append(stage.info.get("modes"))
+        stage_seconds.append(float(stage.timings.get("linear_stage_s", 0.0)))
+        report = resolve_accuracy(accuracy_problem(stage, nonlinear_model(searched, stage)),
+                                  target, grid, solver.harmonics, solver.samples_per_period,
+                                  max_points_tuned=max_points_tuned if attempt == 0 else len(grid),
+                                  **limits)
+        history += report["history"]
+        seconds += report["seconds"]
+        if attempt == 0 and report["tuned_hz"]:
+            grid = np.asarray(report["tuned_hz"])
+        need = rule_cutoff_hz(case, report["harmonics"])
+        if cutoff is None or need <= cutoff or not report["tuned_hz"]:
+            break
+        cutoff = need
+    report.update(history=history, seconds=seconds, search_stage_modes=stages,
+                  search_stage_seconds=stage_seconds, cutoff_hz=cutoff)
+    report["text"] += (f"\n  searched on {len(stages)} linear stage(s) (modes: "
+                       f"{', '.join(str(m) for m in stages)})" + (
+                           "" if cutoff is None else
+                           f"; reduction cutoff {cutoff:.0f} Hz (≥ {need:.0f} Hz = "
+                           f"{case.config.reduction.cutoff_margin:g} H f_max at H = "
+                           f"{report['harmonics']})"))
+    return report, stage
+
+
+def resolve_case_accuracy(case, target, points=8, start_harmonics=3, start_samples=64,
+                          max_harmonics=64, max_samples=8192, max_points_tuned=3) -> dict:
+    """The report of :func:`case_resolution` (the report dict of
+    :func:`sarfe.accuracy.resolve_accuracy` with the search's stages and cutoff)."""
+    return case_resolution(case, target, points, start_harmonics, start_samples, max_harmonics,
+                           max_samples, max_points_tuned)[0]
 
 
 RELEVANT_DB = 30.0     # points quieter than the loudest by more than this do not count (dB(A))
@@ -145,4 +204,4 @@ def accuracy_check(solver: SolverConfig, points) -> dict | None:
 
 
 __all__ = ["accuracy_check", "stage_modal_coordinates", "accuracy_problem", "stage_error_estimate", "sweep_grid_hz",
-           "resolve_case_accuracy"]
+           "resolve_case_accuracy", "case_resolution", "rule_cutoff_hz"]

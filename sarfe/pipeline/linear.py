@@ -103,6 +103,14 @@ def default_cutoff_hz(config) -> float:
             * config.excitation.max_frequency_hz)
 
 
+def _reduction_key(reduction: dict, config) -> dict:
+    """The reduction settings a stage depends on: the given ones, plus the default cutoff (which
+    follows H and f_max) only when neither cutoff_hz nor mode_count is given."""
+    if "cutoff_hz" in reduction or "mode_count" in reduction:
+        return dict(reduction)
+    return dict(reduction, effective_cutoff_hz=default_cutoff_hz(config))
+
+
 def linear_model_key(case) -> str:
     """SHA-256 of everything the linear stage depends on (mesh bytes or generator parameters,
     materials, thicknesses, fixed groups, reduction, contact node sets and normals, excitation
@@ -122,8 +130,7 @@ def linear_model_key(case) -> str:
     exc = data["excitation"]
     parts = {
         "model": model,
-        "reduction": dict(data.get("reduction", {}), effective_cutoff_hz=default_cutoff_hz(case.config))
-        if case.is_fe else None,
+        "reduction": _reduction_key(data.get("reduction", {}), case.config) if case.is_fe else None,
         "contacts": [{k: c.get(k) for k in ("name", "between", "pairs", "pairing_tolerance_m",
                                             "normal", "normal_dof", "tangential_dofs",
                                             "from_elements", "element_axis")}

@@ -70,19 +70,22 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     accuracy = None
     config = case.config
     if config.solver.resolution == "auto":
-        # accuracy as an input: choose H, N (and mode count) from cheap error estimates first
+        # accuracy as an input: choose H, N (the reduction cutoff follows H) by a cheap search
         from sarfe.accuracy.resolve import apply_resolution
-        from sarfe.pipeline.accuracy import resolve_case_accuracy
+        from sarfe.pipeline.accuracy import case_resolution
 
         clock = time.perf_counter()
-        report = resolve_case_accuracy(case, config.solver.accuracy)
+        report, searched = case_resolution(case, config.solver.accuracy)
         accuracy = {k: report.get(k) for k in ("harmonics", "samples_per_period", "mode_count",
-                                               "estimate", "met", "reason", "tuned_hz")}
+                                               "estimate", "met", "reason", "tuned_hz",
+                                               "search_stage_modes", "search_stage_seconds",
+                                               "cutoff_hz", "history", "seconds")}
         accuracy["target"] = config.solver.accuracy
         case = load_case(apply_resolution(case.data, report), base_dir=case.base_dir)
         config = case.config
-        linear_stage = None if (linear_stage is not None
-                                and linear_stage.key != linear_model_key(case)) else linear_stage
+        # a given stage, else the search's last one, is the sweep's when its key matches
+        linear_stage = next((s for s in (linear_stage, searched)
+                             if s is not None and s.key == linear_model_key(case)), None)
         timings["accuracy_s"] = time.perf_counter() - clock
     if linear_stage is None:
         linear_stage = build_linear_model(case, progress=progress)
