@@ -15,7 +15,8 @@ from tests.test_pipeline_deck import SHEAR_DECK
 
 # the two-quad mm-t-s plate of test_pipeline_deck (held along x = 0, the ERP surface) beside a
 # 1-DOF oscillator at GRID 10: a CONM2 of 1 kg on grounded CELAS2 springs of 10 N/mm along x, y
-# and z (rotations held; x, y unforced), and the grounded CBUSH 7 (K3 = 5 N/mm, dashpot B3) that becomes the contact
+# and z (rotations held; x, y unforced), and the grounded CBUSH 7 (K3 = 5 N/mm, dashpot B3)
+# that becomes the contact
 OSCILLATOR = ("GRID,10,,400.,0.,0.\nCONM2,20,10,,1.e-3\nCELAS2,21,10.,10,3\n"
               "CELAS2,22,10.,10,1\nCELAS2,23,10.,10,2\nCBUSH,7,9,10,,,,,0\nSPC1,1,456,10\n")
 M_KG, K_N_M = 1.0, 1.0e4

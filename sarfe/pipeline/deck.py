@@ -375,7 +375,8 @@ def _hysteretic_spring(springs) -> str:
     """One line naming the first spring with structural damping GE, which the HBM model (viscous
     D only, also in time integration) cannot carry; PARAM,W4 makes it viscous at reading."""
     i = int(np.flatnonzero(springs.structural_damping)[0])
-    return (f"{_spring_name(springs, i)} has structural damping GE = {float(springs.structural_damping[i]):g}, "
+    return (f"{_spring_name(springs, i)} has structural damping GE = "
+            f"{float(springs.structural_damping[i]):g}, "
             "which sarfe cannot apply as hysteretic i·GE·K: add PARAM,W4 (the frequency in rad "
             "per deck time unit at which GE·K/W4 becomes viscous, as in Nastran transient) or "
             "remove GE")
