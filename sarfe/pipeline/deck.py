@@ -3,7 +3,8 @@ r"""The deck path of the linear stage: an engineer's Nastran / Abaqus deck as it
     deck file ──read (pyNastran / sarfe.mesh.abaqus), to SI──▶ DeckModel
       ├─ unsupported cards: an error unless named in ``ignore_cards`` (then recorded)
       ├─ YAML overrides of a group's material / thickness (the deck's own by default)
-      ├─ CBUSH/CELAS named by a contact's ``from_elements`` leave the linear model
+      ├─ CBUSH/CELAS named by a contact's ``from_elements`` leave the linear model (their
+      │  dashpots B stay as parallel dampers; rotational K and GE refused)
       ├─ quality: duplicate / zero-area elements (errors), coincident unjoined nodes (noted)
       ├─ supports (SPC sets, *BOUNDARY, fixed groups) and the rigid-body check
       └─ K, M (sarfe.fe.deck_assembly, RBE2/RBE3 eliminated: u = C q)   → sarfe.pipeline.deck_stage
@@ -214,6 +215,12 @@ def springs_to_contacts(case: Case, deck):
     The contact normal is the spring axis ``element_axis`` (default: the translational axis of
     largest stiffness; a CELAS has one); the normal stiffness is the spring's along it and the
     tangential stiffness the mean of the other two translational ones (squeak).
+
+    What the contact law has no place for is kept or refused, never dropped: the spring's
+    viscous damping B (all six components, PARAM,W4's GE·K/W4 included) stays in the linear
+    model as a damper between the same nodes (the element kept with its stiffness set to 0), a
+    dashpot parallel to the contact whether it is open or closed; a nonzero rotational stiffness
+    K4–K6 or structural damping GE is a one-line CaseError naming the element.
     """
     from sarfe.pipeline.linear import frame_from_normal
 
@@ -232,6 +239,7 @@ def springs_to_contacts(case: Case, deck):
         rows = np.array([int(r[0]) for r in rows])
         if np.any(remove[rows]):
             raise case.error("an element is already used by another contact", p)
+        _refuse_what_a_contact_cannot_carry(case, springs, rows, p)
         remove[rows] = True
         k = springs.stiffness[rows, :3]
         if "element_axis" in contact:
@@ -254,10 +262,42 @@ def springs_to_contacts(case: Case, deck):
                                                    frame_from_normal(normal), k_n, k_t)
     if not remove.any():
         return deck, contacts
-    keep = ~remove
-    kept = dataclasses.replace(
-        springs, **{f.name: getattr(springs, f.name)[keep] for f in dataclasses.fields(springs)})
+    # a spring's dashpot B stays as a parallel linear damper between its nodes (stiffness 0)
+    damper = remove & np.any(springs.viscous_damping != 0.0, axis=1)
+    keep = ~remove | damper
+    stiffness = np.where(damper[:, None], 0.0, springs.stiffness)
+    fields = {f.name: getattr(springs, f.name) for f in dataclasses.fields(springs)}
+    fields["stiffness"] = stiffness
+    kept = dataclasses.replace(springs, **{name: value[keep] for name, value in fields.items()})
     return dataclasses.replace(deck, springs=kept), contacts
+
+
+def _spring_name(springs, i) -> str:
+    """'PBUSH 9 (CBUSH 7)' / 'PELAS 3 (CELAS1 5)' / 'CELAS2 5' of spring row i."""
+    card, eid, pid = str(springs.card[i]), int(springs.element_ids[i]), int(springs.property_ids[i])
+    return {"CBUSH": f"PBUSH {pid} (CBUSH {eid})", "CELAS1": f"PELAS {pid} (CELAS1 {eid})"}.get(
+        card, f"{card} {eid}")
+
+
+def _refuse_what_a_contact_cannot_carry(case: Case, springs, rows, path):
+    """One-line CaseError for the first spring of a contact whose rotational stiffness K4–K6 or
+    structural damping GE no contact law carries (a contact acts on the translations of its node
+    pair, and the HBM model has no hysteretic i·GE·K); a zero value is nothing lost."""
+    rotational = springs.stiffness[rows, 3:]
+    if np.any(rotational != 0.0):
+        r = int(np.flatnonzero(np.any(rotational != 0.0, axis=1))[0])
+        c = int(np.flatnonzero(rotational[r])[0])
+        raise case.error(f"{_spring_name(springs, rows[r])} has rotational stiffness K{c + 4} = "
+                         f"{float(rotational[r, c]):g} N·m/rad, which a contact cannot carry: set "
+                         "K4–K6 to 0 (or put them on a separate CBUSH between the same GRIDs, "
+                         "kept linear)", path)
+    ge = springs.structural_damping[rows]
+    if np.any(ge != 0.0):
+        r = int(np.flatnonzero(ge)[0])
+        raise case.error(f"{_spring_name(springs, rows[r])} has structural damping GE = "
+                         f"{float(ge[r]):g}, which a contact cannot carry: add PARAM,W4 (GE·K/W4 "
+                         "is then kept as a viscous damper parallel to the contact) or remove GE",
+                         path)
 
 
 def contact_case(case: Case, deck) -> Case:
@@ -335,10 +375,8 @@ def _hysteretic_spring(springs) -> str:
     """One line naming the first spring with structural damping GE, which the HBM model (viscous
     D only, also in time integration) cannot carry; PARAM,W4 makes it viscous at reading."""
     i = int(np.flatnonzero(springs.structural_damping)[0])
-    card, eid, pid = str(springs.card[i]), int(springs.element_ids[i]), int(springs.property_ids[i])
-    owner = {"CBUSH": f"PBUSH {pid} (CBUSH {eid})", "CELAS1": f"PELAS {pid} (CELAS1 {eid})"}.get(
-        card, f"{card} {eid}")
-    return (f"{owner} has structural damping GE = {float(springs.structural_damping[i]):g}, "
+    return (f"{_spring_name(springs, i)} has structural damping GE = "
+            f"{float(springs.structural_damping[i]):g}, "
             "which sarfe cannot apply as hysteretic i·GE·K: add PARAM,W4 (the frequency in rad "
             "per deck time unit at which GE·K/W4 becomes viscous, as in Nastran transient) or "
             "remove GE")
