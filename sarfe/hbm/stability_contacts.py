@@ -30,7 +30,7 @@ import scipy.sparse as sp
 from . import harmonics as hm
 from . import laws
 from .aft import jacobian_matrix, pointwise_jacobian
-from .laws.jenkins import last_reset_index, slider_update_derivatives
+from .laws.jenkins import jenkins_periodic_1d, last_reset_index, slider_update_derivatives
 
 
 def _normal_part(law, p, contacts, idx, R, omega, N):
@@ -83,10 +83,21 @@ def _memory_block(s, omega, P_march, n_rho_march, drho, k_t, H, N):
     return coeff   # (P, n, 2, 3P)
 
 
-def _slider_march(q, rho, start):
+def _slider_march(q, rho, start, one_d=False):
     """The slider states of one period marched from ``start``: ∂w_j/∂w_{j−1} = P_j (N, n, 2, 2)
-    and ∂w_j/∂ρ_j = n_j (N, n, 2). They do not depend on s: computed once per solution."""
+    and ∂w_j/∂ρ_j = n_j (N, n, 2). They do not depend on s: computed once per solution.
+
+    ``one_d`` (every slider has one tangent direction): the states w_j come from the clamp scan of
+    :func:`sarfe.hbm.laws.jenkins.jenkins_periodic_1d` (the march from the periodic state that
+    ``start`` is clamped to, without a sample loop), and P_j, n_j from one vectorized return map."""
     N, n = q.shape[0], q.shape[1]
+    if one_d:
+        periodic = jenkins_periodic_1d(q[:, :, 0], rho, np.asarray(start, dtype=float)[:, 0])
+        previous = np.zeros((N, n, 2))
+        previous[0, :, 0] = periodic["slider_end"]
+        previous[1:, :, 0] = periodic["slider"][:-1]
+        _, _, P, n_rho = slider_update_derivatives(previous, q, rho)
+        return P, n_rho
     P, n_rho = np.empty((N, n, 2, 2)), np.empty((N, n, 2))
     w = np.array(start, dtype=float)
     for j in range(N):    # the 2-D return map is a march (as in the AFT's own 2-D friction)
@@ -161,13 +172,15 @@ class ContactOperator:
             start = np.nan_to_num(forces.slider_end[t_idx])
             normal = np.zeros((sel.size, 3 * (2 * H + 1), 3 * (2 * H + 1)))
             normal[:, 0::3, 0::3] = block[sel]
-            march = _slider_march(q, mu * force_n / k_t, start)
+            one_d = bool(np.all(t_rows[:, 1] < 0))
+            march = _slider_march(q, mu * force_n / k_t, start, one_d)
             self.memory.append(dict(rows=np.column_stack([rows[sel], t_rows]), normal=normal,
                                     march=march, drho=mu * stiff_n / k_t, k_t=k_t, N=N,
-                                    one_d=bool(np.all(t_rows[:, 1] < 0))))
+                                    one_d=one_d))
         self.has_memory = bool(self.memory)
         base = jacobian_matrix(forces.blocks, self.n_rows, H)
         self._fixed = jacobian_matrix(self.static, self.n_rows, H) - base
+        self._dense_parts = None        # (I⊗G, fixed part) as ndarrays, on first dense_correction
 
     def blocks_at(self, s):
         """The tangent-group blocks (rows, 𝒥(s)) — complex — for jacobian_matrix."""
@@ -192,3 +205,16 @@ class ContactOperator:
     def correction(self, s):
         """(I⊗G)ᵀ [𝒥(s) − 𝒥_AFT] (I⊗G) (sparse CSR, complex when s is)."""
         return (self.GG.T @ self.rows_correction(s) @ self.GG).tocsr()
+
+    def dense_correction(self, s):
+        """:meth:`correction` as a dense ndarray (complex), for small models: (I⊗G) and the
+        s-independent part are densified once, the memory blocks scattered densely, so the
+        refinement's many evaluations build no scipy.sparse matrix."""
+        if self._dense_parts is None:
+            self._dense_parts = (self.GG.toarray(), self._fixed.toarray())
+        GG, fixed = self._dense_parts
+        J = fixed.astype(complex)
+        for rows, block in self.blocks_at(s):
+            J += jacobian_matrix([(rows, block.real)], self.n_rows, self.H, dense=True)
+            J += 1j * jacobian_matrix([(rows, block.imag)], self.n_rows, self.H, dense=True)
+        return GG.T @ J @ GG

@@ -41,3 +41,57 @@ def test_vectorized_1d_memory_equals_the_march(s):
     fast = _memory_block_1d(s, omega, P, n_rho, drho, k_t, H, N)
     scale = np.abs(loop[:, :, 0]).max()
     assert np.abs(fast[:, :, 0] - loop[:, :, 0]).max() <= 1e-12 * scale
+
+
+def test_vectorized_1d_slider_march_equals_the_loop():
+    """The clamp-scan march of 1-D sliders (stick, slip and separation) gives the sample loop's
+    return-map derivatives P_j and n_j at every sample."""
+    q, rho, start = one_d_states()
+    P, n_rho = _slider_march(q, rho, start)
+    P_fast, n_rho_fast = _slider_march(q, rho, start, one_d=True)
+    assert np.allclose(P_fast, P, rtol=0, atol=1e-12)
+    assert np.allclose(n_rho_fast, n_rho, rtol=0, atol=1e-12)
+
+
+def test_refined_exponent_is_the_fixed_point_of_successive_linear_problems():
+    """1-DOF Jenkins oscillator in stick-slip (m = k = 1, c = 0.02, k_t = μN = 1, F = 0.5, ω = 1.4,
+    H = 7): the secant refinement lands on the fixed point s = μ(s) of the successive linear
+    problems (iterated here until they converge), and s is a root of Hill's nonlinear problem:
+    T(s) = s²M̃ + sD̃ + ∂R/∂ũ + C(s) is singular there."""
+    import scipy.sparse as sp
+
+    from sarfe.hbm import make_contact_set, make_linear_model, solve_frequency
+    from sarfe.hbm.residual import Problem, full_residual
+    from sarfe.hbm.stability import _dense, _hill, _nearest, floquet_exponents, refine_exponent
+    from sarfe.hbm.stability_contacts import ContactOperator
+
+    model = make_linear_model(np.eye(1), 0.02 * np.eye(1), np.eye(1))
+    contacts = make_contact_set(sp.csr_matrix(np.array([[1.0]])), ["squeak"], [-1], [[0, -1]],
+                                gap=0.0, normal_stiffness=0.0, tangential_stiffness=1.0,
+                                friction_coefficient=1.0, normal_load=1.0)
+    H, N, omega = 7, 256, 1.4
+    F = np.zeros((2 * H + 1, 1))
+    F[1, 0] = 0.5
+    solution = solve_frequency(model, contacts, F, omega, H, N)
+    assert solution.converged
+    problem = Problem(model, contacts, F, H, N)
+    ev = full_residual(problem, solution.displacement.ravel(), omega)
+    operator = ContactOperator(problem, solution.displacement, omega, ev.forces)
+    assert operator.has_memory
+    jacobian = _dense(ev.jacobian) + operator.correction(0.0).real.toarray()
+    Mt, Dt = _hill(model, omega, H, None)
+    frozen = floquet_exponents(model, omega, H, jacobian)
+    s0 = frozen[np.argmax(frozen.real)]
+    s, converged = refine_exponent(Mt, Dt, jacobian, operator, s0, dense=True)
+    assert converged
+    plain = complex(s0)
+    for _ in range(500):                       # the successive linear problems, to convergence
+        new = _nearest(Mt, Dt, jacobian + operator.correction(plain).toarray(), plain, True, 1)[0]
+        if abs(new - plain) <= 1e-12 * max(abs(new), 1.0):
+            break
+        plain = new
+    assert abs(s - new) <= 1e-7 * max(abs(new), 1.0)
+    assert abs(s - s0) > 1e-3 * abs(s0)        # the memory moved the exponent: a real test
+    T = s * s * _dense(Mt) + s * _dense(Dt) + jacobian + operator.dense_correction(s)
+    singular = np.linalg.svd(T, compute_uv=False)
+    assert singular[-1] <= 1e-8 * singular[0]
