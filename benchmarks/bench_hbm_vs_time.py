@@ -9,7 +9,9 @@ reference are compared, the others are listed as excluded):
 - e₁ = ‖R̂₁ − R̂₁,ref‖ / ‖R̂₁,ref‖, R̂₁ = G(u_1c − i u_1s) the complex first harmonic of the contact
   rows (relative displacement across each contact [m]); target max over the points ≤ 1 %;
 - ΔL = |L − L_ref|, L the total ERP level [dB] of the case's radiating surface; second target
-  max ≤ 0.5 dB. The A-weighted level ΔL_A [dB(A)] is reported too: below ~100 Hz the A-weighting
+  max ≤ 0.5 dB, over the points whose reference level is within 40 dB of the sweep's loudest (on
+  the rattle rig the plate is driven only through the contact: at points without impact its ERP
+  is round-off, −220 dB). The A-weighted level ΔL_A [dB(A)] is reported too: below ~100 Hz the A-weighting
   (−40 dB at 30 Hz) lets harmonics far above the fundamental carry it, so it measures the
   higher harmonics, not the first.
 
@@ -19,7 +21,10 @@ that orbit (fine step, no extrapolation): the orbit is confirmed when, after the
 the Poincaré section has settled (spread of the last 5 ≤ 1e-4) and the last period is within ``confirm`` (e₁) of
 the HBM orbit. Otherwise (the HBM orbit is unstable or not converged) the integration goes on to a
 steady state; a steady state is re-solved by HBM (H_ref) from it and taken if it agrees; a point
-with no steady state is excluded (no stable T-periodic response). Points whose reference orbit
+with no steady state is excluded (no stable T-periodic response). Where HBM H_ref does not
+reproduce a steady integrator orbit, the integrator's own step convergence decides: its orbit at
+the fine step with Richardson extrapolation (2 × step) is the reference when the plain fine-step
+orbit is within ``confirm``/2 of it; otherwise the point is excluded. Points whose reference orbit
 never touches a contact are linear: HBM gives the exact solution there and no check is run.
 
 HBM as a user runs it: the pipeline's per-frequency path (``sarfe.pipeline.points.solve_point``,
@@ -49,6 +54,7 @@ import dataclasses
 import json
 import os
 import pathlib
+import pickle
 import platform
 import sys
 import time
@@ -62,6 +68,7 @@ POINTS = int(os.environ.get("BENCH_POINTS", 50))   # smaller only for a smoke ru
 TARGET = 1e-2          # first-harmonic amplitude, relative
 TARGET_DB = 0.5        # ERP dB(A)
 SPREAD_PERIODIC = 1e-6  # Poincaré spread below which a response is T-periodic
+ERP_RANGE_DB = 40.0     # ERP compared where the reference is within this of the sweep's loudest
 SPREAD_CONFIRM = 1e-4   # spread of the last check periods that confirms a reference orbit
 
 CASES = {
@@ -143,14 +150,21 @@ def closed_somewhere(nl, U, N=512):
 # ------------------------------------------------------------------------------ reference
 def reference_sweep(name, case, stage, nl, metrics, freqs):
     from sarfe.hbm import SolverOptions, solve_frequency
-    from sarfe.hbm.time_integration import integrate_time, section_spread
+    from sarfe.hbm.time_integration import (integrate_time, linear_harmonic_response,
+                                            section_spread)
 
     cfg = CASES[name]
     H, N = cfg["reference"]
     nlr = padded(nl, H)
     options = SolverOptions(stability=False)
-    rows, previous = [], None
+    rows, previous, previous_U, impacting_U = [], None, None, None
     t0 = time.perf_counter()
+
+    def settle(omega, initial):
+        return integrate_time(nlr.model, nlr.contacts, nlr.excitation, omega, H,
+                              steps_per_period=cfg["check_steps"], max_periods=400,
+                              steady_tolerance=1e-10, initial=initial)
+
     for f in freqs:
         omega = 2 * np.pi * f
         row = {"f_hz": float(f)}
@@ -158,45 +172,73 @@ def reference_sweep(name, case, stage, nl, metrics, freqs):
                             options=options)
         row["hbm_converged"] = bool(s.converged)
         if s.converged and not closed_somewhere(nl, s.displacement):
-            row.update(status="linear", U=s.displacement)
-            previous = s
-            rows.append(row)
-            continue
-        check = integrate_time(nlr.model, nlr.contacts, nlr.excitation, omega, H,
-                               steps_per_period=cfg["check_steps"],
-                               max_periods=cfg["check_periods"], steady_tolerance=0.0,
-                               initial=s if s.converged else None, accelerate=False)
-        spread = section_spread(check.section, tail=5)
-        distance = metrics.e1(check.displacement_harmonics, s.displacement) if s.converged \
-            else np.inf
-        row.update(check_spread=spread, check_e1=distance)
-        if s.converged and spread <= SPREAD_CONFIRM and distance <= cfg["confirm"]:
-            row.update(status="confirmed", U=s.displacement)
-            previous = s
-            rows.append(row)
-            continue
-        # the HBM orbit is not what the integrator keeps: integrate on to a steady state
-        more = integrate_time(nlr.model, nlr.contacts, nlr.excitation, omega, H,
-                              steps_per_period=cfg["check_steps"], max_periods=400,
-                              steady_tolerance=1e-10, initial=check)
-        row.update(more_periods=int(more.periods), more_steady=bool(more.steady),
-                   spread_last100=section_spread(more.section, tail=100),
-                   spread_last100_2T=section_spread(more.section, tail=100, period=2))
-        if not more.steady:
-            row["status"] = "excluded: no T-periodic steady state (time integration)"
-            rows.append(row)
-            continue
-        s2 = solve_frequency(nlr.model, nlr.contacts, nlr.excitation, omega, H, N,
-                             initial=more.displacement_harmonics, options=options)
-        d2 = metrics.e1(more.displacement_harmonics, s2.displacement) if s2.converged else np.inf
-        row.update(resolved_e1=d2)
-        if s2.converged and d2 <= cfg["confirm"]:
-            row.update(status="confirmed from the integrator's orbit", U=s2.displacement)
-            previous = s2
+            row.update(status="linear", U=s.displacement, solution=s)
         else:
-            row["status"] = "excluded: HBM H_ref does not reproduce the integrator's orbit"
+            row.update(reference_point(cfg, nlr, metrics, omega, s, previous_U, settle, options))
+        if "solution" in row:            # HBM H_ref orbits warm-start the next point
+            previous = row.pop("solution")
+        # a second stable orbit at the same ω (hysteresis): the non-impacting linear orbit where
+        # it clears every gap, or the impacting orbit continued from the previous point
+        if "U" in row and row["status"] != "linear":
+            U_lin = linear_harmonic_response(nlr.model, nlr.excitation, omega)
+            if not closed_somewhere(nl, U_lin):
+                row.update(U_alt=U_lin, alternative="non-impacting linear orbit")
+            impacting_U = row["U"]
+        elif "U" in row and impacting_U is not None:
+            other = settle(omega, impacting_U)
+            if other.steady and closed_somewhere(nl, other.displacement_harmonics):
+                row.update(U_alt=other.displacement_harmonics,
+                           alternative=f"impacting orbit (time integration, "
+                                       f"{cfg['check_steps']} steps/period)")
+                impacting_U = other.displacement_harmonics
+            else:
+                impacting_U = None
+        if "U" in row:
+            previous_U = row["U"]
         rows.append(row)
     return rows, time.perf_counter() - t0
+
+
+def reference_point(cfg, nlr, metrics, omega, s, previous_U, settle, options):
+    """Reference at one ω where HBM H_ref touches a contact (or failed); see the module docstring."""
+    from sarfe.hbm import solve_frequency
+    from sarfe.hbm.time_integration import integrate_time, section_spread
+
+    H, N = cfg["reference"]
+    row = {}
+    start = s if s.converged else previous_U
+    check = integrate_time(nlr.model, nlr.contacts, nlr.excitation, omega, H,
+                           steps_per_period=cfg["check_steps"], max_periods=cfg["check_periods"],
+                           steady_tolerance=0.0, initial=start, accelerate=False)
+    spread = section_spread(check.section, tail=5)
+    distance = metrics.e1(check.displacement_harmonics, s.displacement) if s.converged else np.inf
+    row.update(check_spread=spread, check_e1=distance)
+    if s.converged and spread <= SPREAD_CONFIRM and distance <= cfg["confirm"]:
+        return {**row, "status": "confirmed", "U": s.displacement, "solution": s}
+    # the HBM orbit is not what the integrator keeps: integrate on to a steady state
+    more = settle(omega, check)
+    row.update(more_periods=int(more.periods), more_steady=bool(more.steady),
+               spread_last100=section_spread(more.section, tail=100),
+               spread_last100_2T=section_spread(more.section, tail=100, period=2))
+    if not more.steady:
+        return {**row, "status": "excluded: no T-periodic steady state (time integration)"}
+    s2 = solve_frequency(nlr.model, nlr.contacts, nlr.excitation, omega, H, N,
+                         initial=more.displacement_harmonics, options=options)
+    d2 = metrics.e1(more.displacement_harmonics, s2.displacement) if s2.converged else np.inf
+    row.update(resolved_e1=d2)
+    if s2.converged and d2 <= cfg["confirm"]:
+        return {**row, "status": "confirmed from the integrator's orbit", "U": s2.displacement,
+                "solution": s2}
+    # HBM H_ref is off the integrator's orbit: is the integrator converged in its step?
+    fine = integrate_time(nlr.model, nlr.contacts, nlr.excitation, omega, H,
+                          steps_per_period=cfg["check_steps"], max_periods=400,
+                          steady_tolerance=1e-10, initial=more, richardson=True)
+    d_steps = metrics.e1(more.displacement_harmonics, fine.displacement_harmonics)
+    row.update(richardson_e1=d_steps, fine_steady=bool(fine.steady))
+    if fine.steady and d_steps <= 0.5 * cfg["confirm"]:
+        return {**row, "status": "time-integration reference (HBM H_ref off)",
+                "U": fine.displacement_harmonics}
+    return {**row, "status": "excluded: neither HBM H_ref nor the integrator converged"}
 
 
 # ------------------------------------------------------------------------------ methods
@@ -246,13 +288,20 @@ def ti_sweep(nl, freqs, steps, richardson, H_out):
 
 def score(metrics, freqs, reference, harmonics_list, compared):
     e1, dl, dla = [], [], []
+    audible = max(reference[i]["L"][0] for i in compared) - ERP_RANGE_DB
     for i in compared:
-        U_ref = reference[i]["U"]
         U = harmonics_list[i]
-        e1.append(metrics.e1(U, U_ref))
+        # judged on its own branch where two stable orbits coexist (the nearer reference)
+        options = [("U", "L")] + ([("U_alt", "L_alt")] if "U_alt" in reference[i] else [])
+        errors = [metrics.e1(U, reference[i][u]) for u, _ in options]
+        which = int(np.argmin(errors))
+        e1.append(errors[which])
+        L_ref = reference[i][options[which][1]]
+        if L_ref[0] < audible:    # the surface hardly moves (round-off level)
+            continue
         level, level_a = metrics.level(U, 2 * np.pi * freqs[i])
-        dl.append(abs(level - reference[i]["L"][0]))
-        dla.append(abs(level_a - reference[i]["L"][1]))
+        dl.append(abs(level - L_ref[0]))
+        dla.append(abs(level_a - L_ref[1]))
     worst = int(compared[int(np.argmax(e1))]) if compared else None
     return {"e1_max": max(e1, default=0.0), "dL_max": max(dl, default=0.0),
             "dLA_max": max(dla, default=0.0),
@@ -278,11 +327,23 @@ def run_case(name):
     out = {"case": name, "dofs": int(nl.model.dof_count), "contacts": int(nl.contacts.count),
            "contact_rows": int(nl.contacts.row_count), "band_hz": list(cfg["band_hz"]),
            "reference_setting": list(cfg["reference"])}
-    reference, out["reference_s"] = reference_sweep(name, case, stage, nl, metrics, freqs)
+    cache = pathlib.Path(os.environ.get("BENCH_CACHE", "/tmp")) / f"hbm_vs_time_ref_{name}.pkl"
+    key = (2, cfg["reference"], cfg["confirm"], cfg["check_steps"], cfg["check_periods"],
+           tuple(np.round(freqs, 9)), stage.key)
+    cached = pickle.loads(cache.read_bytes()) if cache.exists() else None
+    if cached and cached[0] == key:      # the reference of an earlier run of the same settings
+        reference, out["reference_s"] = cached[1], cached[2]
+    else:
+        reference, out["reference_s"] = reference_sweep(name, case, stage, nl, metrics, freqs)
+        cache.write_bytes(pickle.dumps((key, reference, out["reference_s"])))
     compared = [i for i, r in enumerate(reference) if "U" in r]
     for i in compared:
         reference[i]["L"] = metrics.level(reference[i]["U"], 2 * np.pi * freqs[i])
-    out["reference"] = [{k: v for k, v in r.items() if k != "U"} for r in reference]
+        if "U_alt" in reference[i]:
+            reference[i]["L_alt"] = metrics.level(reference[i]["U_alt"], 2 * np.pi * freqs[i])
+    out["reference"] = [{k: v for k, v in r.items() if k not in ("U", "U_alt")}
+                        for r in reference]
+    out["coexistence_hz"] = [r["f_hz"] for r in reference if "U_alt" in r]
     out["compared"] = len(compared)
     out["excluded_hz"] = [r["f_hz"] for r in reference if "U" not in r]
     out["nonlinear_compared"] = sum(r["status"] != "linear" for r in reference if "U" in r)
@@ -441,16 +502,19 @@ def markdown(results):
               f"Reference HBM H = {H_ref}, N = {N_ref} ({c['reference_s']:.0f} s incl. the "
               f"time-integration checks): " + "; ".join(f"{k}: {v}" for k, v in statuses.items())
               + f". Compared {c['compared']} points ({c['nonlinear_compared']} nonlinear); "
-              f"excluded: {', '.join(f'{f:.2f}' for f in c['excluded_hz']) or 'none'} Hz.", ""]
-        checks = [r for r in c["reference"] if r["status"] != "linear"]
+              f"excluded: {', '.join(f'{f:.2f}' for f in c['excluded_hz']) or 'none'} Hz. "
+              "Two stable orbits (hysteresis; each method is judged against the nearer one) at: "
+              f"{', '.join(f'{f:.2f}' for f in c.get('coexistence_hz', [])) or 'none'} Hz.", ""]
+        checks = [r for r in c["reference"] if r["status"] != "linear" or "alternative" in r]
         if checks:
             L += ["| f Hz | status | check: e₁ TI vs HBM_ref | Poincaré spread | periods to "
-                  "steady | spread last 100 (T / 2T) |", "|---|---|---|---|---|---|"]
+                  "steady | HBM_ref re-solved: e₁ | TI step check: e₁ | second orbit |",
+                  "|---|---|---|---|---|---|---|---|"]
             for r in checks:
                 L.append(f"| {r['f_hz']:.2f} | {r['status']} | {fmt(r.get('check_e1'), '.1e')} | "
                          f"{fmt(r.get('check_spread'), '.1e')} | {r.get('more_periods', '—')} | "
-                         f"{fmt(r.get('spread_last100'), '.1e')} / "
-                         f"{fmt(r.get('spread_last100_2T'), '.1e')} |")
+                         f"{fmt(r.get('resolved_e1'), '.1e')} | "
+                         f"{fmt(r.get('richardson_e1'), '.1e')} | {r.get('alternative', '—')} |")
             L.append("")
         L += ["| method | setting | sweep s | max e₁ | max ΔL dB | max ΔL_A dB(A) | worst f Hz "
               "| converged/steady | iterations/periods |", "|---|---|---|---|---|---|---|---|---|"]
@@ -473,6 +537,15 @@ def markdown(results):
                      + (f"{t['steps_per_period']} steps/period"
                         f"{' + Richardson' if t['richardson'] else ''}: {t['s']:.2f} s" if t else "—")
                      + f" → **ratio {fmt(q['ratio'], '.1f')}×** (target ≥ 20×)")
+        best = min(c["hbm"], key=lambda r: r["e1_max"])
+        level = max(best["e1_max"], TARGET)
+        t = min((r for r in c["time"] if r["e1_max"] <= level), key=lambda r: r["s"], default=None)
+        h = min((r for r in c["hbm"] if r["e1_max"] <= level), key=lambda r: r["s"])
+        L.append(f"- at the loosest common level e₁ ≤ {level:.1%} (the best scanned HBM "
+                 f"reaches {best['e1_max']:.1%}): HBM H = {h['harmonics']}, N = {h['samples']}: "
+                 f"{h['s']:.2f} s; time integration "
+                 + (f"{t['steps_per_period']} steps/period{' + Richardson' if t['richardson'] else ''}"
+                    f": {t['s']:.2f} s → **ratio {t['s'] / h['s']:.1f}×**" if t else "— (none)"))
         st = c.get("hbm_with_stability")
         if st:
             for method, r in st.items():
