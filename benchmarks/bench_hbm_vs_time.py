@@ -561,6 +561,8 @@ def markdown(results):
                          f"{cont['harmonics']}, N = {cont['samples']}: {cont['s']:.2f} s, "
                          f"{cont['points']} points (N raised up to {cont['largest_N']} at corners)")
         L.append("")
+    if results.get("notes"):             # hand-written notes of a run, kept in the json
+        L += ["## Notes", ""] + [f"- {note}" for note in results["notes"]] + [""]
     study = results.get("study")
     if study:
         L += ["## Reference study: rattle rig 29–34 Hz", "",
