@@ -46,7 +46,7 @@ from . import laws
 from .harmonics import harmonic_coefficients, time_samples
 
 __all__ = ["TimeResponse", "integrate_time", "integrate_transient", "linear_harmonic_response",
-           "period_work"]
+           "period_work", "section_spread"]
 
 DENSE_LIMIT = 3000  # models up to this many DOFs use a dense propagator (reduced models)
 
@@ -72,6 +72,13 @@ class TimeResponse:
     input_work [J], damping_work [J]       ∮ f_eᵀ u̇ dt and ∮ u̇ᵀ D u̇ dt over the last period
     contact_work (n_c,) [J]                ∮ λᵀ dr per contact (friction dissipation ≥ 0)
     max_contact_iterations int             most Newton iterations any step needed
+    section (P, 2 n_out) [m]               Poincaré section of the last run: the period-start state
+                                           (u, u̇/ω at ``output_dofs``) of each of its P periods and
+                                           the end state; a periodic orbit is one point, a 2T
+                                           orbit alternates between two, a non-periodic response
+                                           spreads (see :func:`section_spread`)
+    final_state                            (u, u̇, sliders) at the end: the warm start of the next
+                                           frequency (``initial=`` this response)
     """
 
     omega: float
@@ -93,6 +100,24 @@ class TimeResponse:
     damping_work: float
     contact_work: np.ndarray
     max_contact_iterations: int
+    section: np.ndarray | None = None
+    final_state: tuple | None = None
+
+
+def section_spread(section, tail=None, period=1):
+    """Spread of a Poincaré section, relative to the response amplitude (dimensionless).
+
+    section (P, m) from :class:`TimeResponse`; the last ``tail`` points are used (all by default).
+    Returns max over components of (max − min) of every ``period``-th point, divided by the
+    largest |component| of the tail: ≈ 0 for a T-periodic response (``period`` = 1) or for a
+    k·T-periodic one with ``period`` = k; O(1) for a quasi-periodic or chaotic one.
+    """
+    x = np.asarray(section, dtype=float)
+    if tail is not None:
+        x = x[-int(tail):]
+    scale = max(np.abs(x).max(initial=0.0), 1e-300)
+    spreads = [np.ptp(x[j::period], axis=0).max(initial=0.0) for j in range(min(period, len(x)))]
+    return float(max(spreads, default=0.0) / scale)
 
 
 def linear_harmonic_response(model, excitation, omega, steps_per_period=None):
@@ -305,7 +330,7 @@ def _extrapolation_weights(steps):
 
 
 def _run(model, contacts, forcing, omega, N, u, v, slider, max_periods, steady_tolerance,
-         accelerate, progress, period_offset):
+         accelerate, progress, period_offset, section_dofs=None):
     """Integrate whole periods from (u, v, slider) at t = 0 until periodic; returns a dict.
 
     With ``accelerate``, every few periods the period-start states are extrapolated to the fixed
@@ -370,8 +395,11 @@ def _run(model, contacts, forcing, omega, N, u, v, slider, max_periods, steady_t
     error, steady, periods, worst_iterations = np.inf, False, 0, 0
     window = min(2 * n + slider.size, 12)
     history, jumped, failures, wait = [], None, 0, 0
+    section_dofs = np.arange(n) if section_dofs is None else section_dofs
+    section = []
     while periods < max_periods:
         start = pack(u, v, slider)
+        section.append(np.concatenate((u[section_dofs], v[section_dofs] / omega)))
         r_prev = G @ u
         for j in range(N):
             u_samples[j], v_samples[j] = u, v
@@ -447,6 +475,7 @@ def _run(model, contacts, forcing, omega, N, u, v, slider, max_periods, steady_t
         periods=periods, steady=steady, error=error, input_work=input_work,
         damping_work=damping_work, contact_work=per_contact, iterations=worst_iterations,
         final=(u, v, slider),
+        section=np.array(section + [np.concatenate((u[section_dofs], v[section_dofs] / omega))]),
     )
 
 
@@ -461,8 +490,9 @@ def integrate_time(model, contacts, excitation, omega, harmonics, steps_per_peri
     max_periods: cap on integrated periods (``steady`` is False when it is hit).
     steady_tolerance: relative change of the period-end state (u, u̇/ω, sliders) that ends the run.
     initial: start state — None (the scheme's linear periodic solution, contacts ignored), harmonics
-    (2H'+1, n_dof) [m], or a :class:`HarmonicSolution` (its ``displacement`` and θ = 0 contact force
-    set the slider positions).
+    (2H'+1, n_dof) [m], a :class:`HarmonicSolution` (its ``displacement`` and θ = 0 contact force
+    set the slider positions), or a :class:`TimeResponse` (its end state u, sliders and u̇·ω/ω_prev:
+    a sweep warm-started from the previous frequency's final state).
     output_dofs: DOF indices kept in ``displacement``/``velocity`` samples (default: all DOFs, or
     only the DOFs the contacts touch when n_dof > DENSE_LIMIT). ``displacement_harmonics`` always
     covers all DOFs (the last period is held in memory, N × n_dof).
@@ -490,7 +520,16 @@ def integrate_time(model, contacts, excitation, omega, harmonics, steps_per_peri
 
     law = _ContactLaws(contacts) if contacts is not None and contacts.count else None
     initial_force = None
-    if initial is None:
+    warm = initial.final_state if isinstance(initial, TimeResponse) else None
+    if warm is not None:   # the end state of another run (e.g. the previous frequency of a sweep)
+        u_w, v_w, slider_w = (np.array(x, dtype=float) for x in warm)
+        if u_w.shape != (n,) or slider_w.shape != (law.slider_count if law else 0, 2):
+            raise ValueError(f"initial TimeResponse has a state of {u_w.size} DOFs / "
+                             f"{slider_w.shape[0]} sliders, the model {n} DOFs")
+        # same phase θ = 0 of the excitation; velocity scaled to the new ω (same orbit shape)
+        v_w = v_w * (omega / initial.omega)
+        U_init = None
+    elif initial is None:
         U_init = linear_harmonic_response(model, F, omega, N)
     elif hasattr(initial, "displacement"):
         U_init = np.asarray(initial.displacement, dtype=float)
@@ -498,17 +537,21 @@ def integrate_time(model, contacts, excitation, omega, harmonics, steps_per_peri
         initial_force = None if force_time is None else np.asarray(force_time)[0]
     else:
         U_init = np.asarray(initial, dtype=float)
-    if U_init.ndim != 2 or U_init.shape[1] != n:
+    if U_init is not None and (U_init.ndim != 2 or U_init.shape[1] != n):
         raise ValueError(f"initial harmonics must have shape (2H+1, {n}), got {U_init.shape}")
 
     def one_run(N_run, u, v, slider, offset):
         forcing = time_samples(F, N_run)
         return _run(model, contacts, forcing, omega, N_run, u, v, slider, max_periods,
-                    steady_tolerance, accelerate, progress, offset)
+                    steady_tolerance, accelerate, progress, offset, output_dofs)
 
-    u0, v0 = _state_at_zero(U_init, omega, N)
-    G = contacts.gap_map if contacts is not None else None
-    slider0 = _slider_from_initial(law, G @ u0, initial_force) if law is not None else np.zeros((0, 2))
+    if warm is not None:
+        u0, v0, slider0 = u_w, v_w, slider_w
+    else:
+        u0, v0 = _state_at_zero(U_init, omega, N)
+        G = contacts.gap_map if contacts is not None else None
+        slider0 = _slider_from_initial(law, G @ u0, initial_force) if law is not None \
+            else np.zeros((0, 2))
     run = one_run(N, u0, v0, slider0, 0)
     U = harmonic_coefficients(run["u"], harmonics)
     periods, steady = run["periods"], run["steady"]
@@ -544,6 +587,8 @@ def integrate_time(model, contacts, excitation, omega, harmonics, steps_per_peri
         damping_work=float(run["damping_work"]),
         contact_work=run["contact_work"],
         max_contact_iterations=int(run["iterations"]),
+        section=run["section"],
+        final_state=run["final"],
     )
 
 
