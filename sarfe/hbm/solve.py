@@ -41,6 +41,7 @@ from .solution import HarmonicSolution, SolverOptions
 from .stability import hill_stability
 from .stability_condensed import condensed_stability
 from .stability_contacts import ContactOperator
+from .stability_rows import contact_row_stability
 
 CONDENSED_ABOVE = 3000   # Hill matrix rows 2(2H+1)n above which 'auto' stability is condensed
 
@@ -232,13 +233,27 @@ def contact_damping(problem, forces):
     return (GG.T @ jacobian_matrix(forces.damping_blocks, G.shape[0], H) @ GG).tocsr()
 
 
-def stability(problem, omega, U, ev, options):
-    """Hill stability of a converged orbit by ``options.stability_method`` (StabilityResult)."""
-    operator = ContactOperator(problem, U, omega, ev.forces)
+def stability_method(problem, options) -> str:
+    """'full' | 'condensed' | 'contact_rows' (see :class:`SolverOptions`): 'auto' is the full Hill
+    method up to ``CONDENSED_ABOVE`` Hill rows 2(2H+1)n, else the contact-row count
+    (:mod:`sarfe.hbm.stability_rows`) with the Ritz method where it does not decide."""
     method = options.stability_method
     if method == "auto":
         size = 2 * (2 * problem.harmonics + 1) * problem.model.dof_count
-        method = "condensed" if size > CONDENSED_ABOVE and problem.contacts.count else "full"
+        method = "contact_rows" if size > CONDENSED_ABOVE and problem.contacts.count else "full"
+    return method
+
+
+def stability(problem, omega, U, ev, options):
+    """Hill stability of a converged orbit by ``options.stability_method`` (StabilityResult)."""
+    operator = ContactOperator(problem, U, omega, ev.forces)
+    method = stability_method(problem, options)
+    if method == "contact_rows":
+        result = contact_row_stability(problem.model, problem.contacts, omega, problem.harmonics,
+                                       ev.forces, operator, tolerance=options.stability_tolerance)
+        if result is not None:
+            return result
+        method = "condensed"     # some exponent near or right of the axis: locate them (Ritz)
     if method == "condensed":
         return condensed_stability(problem.model, problem.contacts, omega, problem.harmonics,
                                    ev.forces, operator, tolerance=options.stability_tolerance)
@@ -253,8 +268,9 @@ def finalize(problem, omega, U, converged, reason, iterations, slider, options) 
     residual_norm: the kept rows; dropped_content: η of the dropped rows (for the full set: of the
     rows outside the odd set, what 'auto' would drop)."""
     full = replace(problem, harmonic_orders=None)
-    with np.errstate(all="ignore"):
-        ev = full_residual(full, U.ravel(), omega, slider, jacobian=options.stability)
+    with np.errstate(all="ignore"):     # ∂R/∂ũ on all DOFs only for the full Hill method
+        ev = full_residual(full, U.ravel(), omega, slider, jacobian=options.stability,
+                           assemble=stability_method(full, options) == "full")
     n = problem.model.dof_count
     R = ev.residual.reshape(-1, n)
     rows = kept_rows(problem)
