@@ -90,7 +90,8 @@ class ContactRowDeterminant:
                 valid = np.repeat((rows >= 0)[:, None, :], P, axis=1).reshape(rows.shape[0], P * m)
                 mask = valid[:, :, None] & valid[:, None, :]
                 flat = (local[:, :, None] * size + local[:, None, :])
-                self.scatter.append((mask, flat[mask]))
+                index = flat[mask]
+                self.scatter.append((mask, index, np.unique(index).size == index.size))
         pattern = np.abs(self.contact_terms(np.array([0.37 + 0.21j]) * self.omega)[0])
         loaded = pattern.sum(axis=0) + pattern.sum(axis=1) > 0
         self.loaded = np.flatnonzero(loaded)
@@ -103,9 +104,12 @@ class ContactRowDeterminant:
         if self.memory is not None:
             flat = J.reshape(s.size, -1)
             groups = self.memory.blocks_at_many(s)
-            for (rows, blocks), (mask, index) in zip(groups, self.scatter):
+            for (rows, blocks), (mask, index, unique) in zip(groups, self.scatter):
                 values = blocks[:, mask]                              # (n_s, entries)
-                for i in range(s.size):      # indices may repeat: accumulate
+                if unique:
+                    flat[:, index] += values
+                    continue
+                for i in range(s.size):      # indices repeat: accumulate
                     flat[i] += np.bincount(index, values[i].real, size * size) \
                         + 1j * np.bincount(index, values[i].imag, size * size)
             J = flat.reshape(s.size, size, size)
