@@ -199,6 +199,11 @@ class ContactOperator:
         base = jacobian_matrix(forces.blocks, self.n_rows, H)
         self._fixed = jacobian_matrix(self.static, self.n_rows, H) - base
 
+    @property
+    def pointwise_correction(self):
+        """𝒥 − 𝒥_AFT of the contacts without memory (s-independent; sparse, real)."""
+        return self._fixed
+
     def blocks_at(self, s):
         """The tangent-group blocks (rows, 𝒥(s)) — complex — for jacobian_matrix."""
         return [(rows, J[0]) for rows, J in self.blocks_at_many(np.array([s], dtype=complex))]

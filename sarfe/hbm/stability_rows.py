@@ -79,7 +79,7 @@ class ContactRowDeterminant:
         # 𝒥(s) = 𝒥_AFT + (𝒥(s) − 𝒥_AFT): the pointwise part fixed, the memory blocks at s
         self.fixed = dense(jacobian).astype(complex)
         if operator is not None:
-            self.fixed = self.fixed + dense(operator._fixed)
+            self.fixed = self.fixed + dense(operator.pointwise_correction)
         self.damping = None if damping_jacobian is None else dense(damping_jacobian)
         self.scatter = []
         if self.memory is not None:
@@ -208,8 +208,9 @@ def winding_count(log_det, points, step=PHASE_STEP, budget=MAX_EVALUATIONS):
 
 
 def contact_row_stability(model, contacts, omega, harmonics, forces, operator=None,
-                          tolerance=1e-6, uncertain_band=1e-4):
+                          uncertain_band=1e-4):
     """StabilityResult when the contact-row count decides it (no exponent right of −ε), else None.
+    (No exponent right of −ε is 'stable' for every stability tolerance ≥ 0 of the full method.)
 
     forces: the AFT :class:`ContactForces` of the orbit (all harmonic rows, blocks computed);
     operator: the :class:`ContactOperator` (friction memory) or None. See the module docstring.
