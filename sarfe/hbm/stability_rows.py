@@ -172,8 +172,8 @@ def exponent_bound(basis, gap_modes, omega, harmonics, jacobian_norm, damping_no
 
 def _upper_contour(epsilon, X, top, pole_distance):
     """Samples of the upper half of the boundary of Ω, counter-clockwise: (X, 0) → (X, top) →
-    (−ε, top) → (−ε, 0); geometric spacing along the top edge, steps of at most the distance of
-    twice the distance of the nearest pole along the left edge (the poles lie left of −ε; a pole
+    (−ε, top) → (−ε, 0); geometric spacing along the top edge, steps of at most twice the
+    distance of the nearest pole along the left edge (the poles lie left of −ε; a pole
     at distance d turns arg det F by at most 2 atan(1) = π/2 over such a step, and the refinement
     of :func:`winding_count` halves steps that turn it by more than π/3)."""
     right = X + 1j * top * np.linspace(0.0, 1.0, 3)
@@ -185,8 +185,9 @@ def _upper_contour(epsilon, X, top, pole_distance):
 
 def winding_count(log_det, points, step=PHASE_STEP, budget=MAX_EVALUATIONS):
     """Change of arg f along the polyline ``points`` / π, f = exp(log_det(s)) with log_det
-    vectorized over s; a segment is halved while its change of arg exceeds ``step``. Returns (Δarg/π, evaluations), or
-    (nan, evaluations) when f vanishes on the path or the budget runs out."""
+    vectorized over s; a segment is halved while its change of arg exceeds ``step``. Returns
+    (Δarg/π, evaluations), or (nan, evaluations) when f vanishes on the path or the budget runs
+    out."""
     points = np.asarray(points, dtype=complex)
     values = log_det(points)
     evaluations = points.size
@@ -232,6 +233,8 @@ def contact_row_stability(model, contacts, omega, harmonics, forces, operator=No
     det = ContactRowDeterminant(basis, contacts.gap_map, omega, H, J, Jd, operator)
     if det.loaded.size == 0:
         return StabilityResult(True, least_damped, "", structure)
+    # ‖𝒥(s)‖ for Re s ≥ 0: twice its largest value at s = 0, ω, 10ω (the memory factors e^{−shd}
+    # have modulus ≤ 1 there; the pointwise part does not depend on s)
     probes = det.contact_terms(np.array([0.0, omega, 10.0 * omega]))
     jacobian_norm = 2.0 * max(np.linalg.norm(p, 2) for p in probes)
     damping_norm = 0.0 if Jd is None else float(np.linalg.norm(Jd.toarray(), 2))
