@@ -298,7 +298,9 @@ def write(results):
     if d:
         lines += ["", f"## Door trim sweep at H = {d['harmonics']} ({d['mesh_size_m'] * 1e3:g} mm, "
                   f"{d['reduced_dofs']} reduced DOFs, {d['contact_rows']} contact rows), "
-                  "55 → 70 Hz continuation, in process", "",
+                  "55 → 70 Hz continuation, in process"
+                  + (f"; load average at its end {d['load_average'][0]:.1f}"
+                     if d.get("load_average") else ""), "",
                   "| options | points | Newton its | HBM s | estimate s | post s | s / point all-in |",
                   "|---|---|---|---|---|---|---|"]
         for label, r in d["runs"].items():
