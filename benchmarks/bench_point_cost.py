@@ -16,7 +16,17 @@
    ``condense`` call (factorization per harmonic vs the modal path, and the one-off modal basis)
    at H = 5 and 15, and seconds per point (3 stepped frequencies, stability off) with each path.
 
-Run: python benchmarks/bench_point_cost.py [--quick]
+4. Door trim sweep at H = 15 (15 mm mesh; the reduced model and the per-point cost do not depend
+   on the FE size, section 1), a continuation 55 → 70 Hz (initial step 5 % of the band) capped at
+   ``--sweep-points`` points and completed point by point (steps of 5 % of the band), in process
+   on one linear stage: seconds per point all-in (HBM incl. stability + estimate +
+   postprocess, from ``timings_s``) with the defaults (estimate and stability on) and with both
+   off; and per point of that sweep (every 6th) the stability alone by the Ritz-basis method
+   (the 'auto' method before issue 15's contact-row count) and by the contact-row count
+   ('auto' now), with their verdicts.
+
+Run: python benchmarks/bench_point_cost.py [--quick] [--sweep-only]  (--sweep-only: section 4
+alone, the other sections kept from results/point_cost.json)
 """
 import argparse
 import json
@@ -175,6 +185,63 @@ def condensation_paths(directory, mesh_size=0.010):
     return out
 
 
+def door_sweep_cost(directory, mesh_size=0.015, harmonics=15, points=20):
+    """Section 4 of the module docstring."""
+    from sarfe.hbm.residual import Problem, full_residual
+    from sarfe.hbm.stability_condensed import condensed_stability
+    from sarfe.hbm.stability_contacts import ContactOperator
+    from sarfe.hbm.stability_rows import contact_row_stability
+    from sarfe.io.case import read_yaml
+    from sarfe.pipeline import load_case
+    from sarfe.pipeline.linear import build_linear_model
+    from sarfe.pipeline.nonlinear import nonlinear_model
+    from sarfe.pipeline.solve import solve_case
+
+    data = read_yaml(door_case(mesh_size, directory))[0]
+    data["excitation"].pop("frequency_hz")
+    data["excitation"]["sweep"] = {"start_hz": 55.0, "end_hz": 70.0}
+    runs = {}
+    stage = None
+    for label, on in (("defaults", True), ("stability and estimate off", False)):
+        data["solver"] = {"harmonics": harmonics, "stability": on, "error_estimate": on,
+                          "continuation": {"max_points": points, "initial_step": 0.05}}
+        case = load_case(data, base_dir=ROOT / "cases")
+        if stage is None:
+            start = time.perf_counter()
+            stage = build_linear_model(case)
+            linear_s = time.perf_counter() - start
+        start = time.perf_counter()
+        result = solve_case(case, linear_stage=stage, write=False)
+        wall = time.perf_counter() - start
+        t, pts = result.summary["timings_s"], result.summary["points"]
+        per = (t["hbm_s"] + t.get("error_estimate_s", 0.0) + t["postprocess_s"]) / len(pts)
+        runs[label] = {"points": len(pts), "wall_s": wall, "hbm_s": t["hbm_s"],
+                       "estimate_s": t.get("error_estimate_s", 0.0),
+                       "postprocess_s": t["postprocess_s"], "seconds_per_point": per,
+                       "newton_iterations": int(sum(p["iterations"] for p in pts)),
+                       "stable": [p["stable"] for p in pts]}
+        if not on:
+            solutions = result.solutions
+    nl_model = nonlinear_model(case, stage)
+    compare = []
+    for s in [s for s in solutions if s.converged][::6]:
+        problem = Problem(nl_model.model, nl_model.contacts, nl_model.excitation[:2 * harmonics + 1],
+                          harmonics, s.samples_per_period)
+        ev = full_residual(problem, s.displacement.ravel(), s.omega, assemble=False)
+        operator = ContactOperator(problem, s.displacement, s.omega, ev.forces)
+        row = {"frequency_hz": s.omega / (2 * np.pi)}
+        for name, method in (("ritz", condensed_stability), ("contact_rows", contact_row_stability)):
+            start = time.perf_counter()
+            out = method(nl_model.model, nl_model.contacts, s.omega, harmonics, ev.forces, operator)
+            row[f"{name}_s"] = time.perf_counter() - start
+            row[f"{name}_stable"] = None if out is None else out.stable
+            row[f"{name}_leading"] = None if out is None else float(out.leading)
+        compare.append(row)
+    return {"mesh_size_m": mesh_size, "harmonics": harmonics, "reduced_dofs": stage.dof_count,
+            "contact_rows": nl_model.contacts.row_count, "linear_stage_s": linear_s, "runs": runs,
+            "stability": compare}
+
+
 def exponent(x, t):
     return float(np.polyfit(np.log(np.asarray(x, float)), np.log(np.asarray(t, float)), 1)[0])
 
@@ -227,6 +294,35 @@ def write(results):
             lines += ["", f"Seconds per point (H = 5, N = 64, stability off, in process): "
                       f"factorization {c['factorization_seconds_per_point']:.3f}, "
                       f"modal {c['modal_seconds_per_point']:.3f}."]
+    d = results.get("door_sweep")
+    if d:
+        lines += ["", f"## Door trim sweep at H = {d['harmonics']} ({d['mesh_size_m'] * 1e3:g} mm, "
+                  f"{d['reduced_dofs']} reduced DOFs, {d['contact_rows']} contact rows), "
+                  "55 → 70 Hz continuation, in process"
+                  + (f"; load average at its end {d['load_average'][0]:.1f}"
+                     if d.get("load_average") else ""), "",
+                  "| options | points | Newton its | HBM s | estimate s | post s | s / point all-in |",
+                  "|---|---|---|---|---|---|---|"]
+        for label, r in d["runs"].items():
+            lines.append(f"| {label} | {r['points']} | {r['newton_iterations']} | {r['hbm_s']:.2f} | "
+                         f"{r['estimate_s']:.2f} | {r['postprocess_s']:.2f} | "
+                         f"{r['seconds_per_point']:.3f} |")
+        lines += ["", "Stability alone per point (the same converged points): Ritz basis (the "
+                  "'auto' method before) vs the contact-row count ('auto' now; None = handed over "
+                  "to the Ritz method).", "",
+                  "| f Hz | Ritz s | Ritz verdict (leading 1/s) | contact rows s | contact rows verdict |",
+                  "|---|---|---|---|---|"]
+        for r in d["stability"]:
+            lines.append(f"| {r['frequency_hz']:.2f} | {r['ritz_s']:.2f} | {r['ritz_stable']} "
+                         f"({r['ritz_leading']:.3f}) | {r['contact_rows_s']:.2f} | "
+                         f"{r['contact_rows_stable']} |")
+    profile = results.get("profile")
+    if profile:          # wall-clock sampling profiles of a door-trim sweep (written by hand)
+        lines += ["", "## Where a door-trim point's time goes (H = 15, defaults; sampled wall clock)",
+                  "", profile["setup"], "", "| share of the solve | before | after |",
+                  "|---|---|---|"]
+        lines += [f"| {name} | {before} | {after} |" for name, before, after in profile["rows"]]
+        lines += [""] + profile["notes"]
     (HERE / "results" / "point_cost.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
 
@@ -235,8 +331,18 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="skip the 5 mm door trim")
     parser.add_argument("--repeats", type=int, default=2, help="door-trim runs per size, alternated")
+    parser.add_argument("--sweep-only", action="store_true",
+                        help="section 4 only; the others kept from results/point_cost.json")
+    parser.add_argument("--sweep-points", type=int, default=20)
     args, _ = parser.parse_known_args()   # run_all.py passes its own arguments
     start = time.perf_counter()
+    if args.sweep_only:
+        results = json.loads((HERE / "results" / "point_cost.json").read_text())
+        with tempfile.TemporaryDirectory() as directory:
+            results["door_sweep"] = door_sweep_cost(directory, points=args.sweep_points)
+        results["door_sweep"]["load_average"] = os.getloadavg()
+        write(results)
+        return
     results = {"machine": platform.platform(), "python": platform.python_version(),
                "cpu_count": os.cpu_count(), "load_average": os.getloadavg()}
     sizes = MESH_SIZES_M[:-1] if args.quick else MESH_SIZES_M
@@ -261,6 +367,8 @@ def main():
     results["exponent_harmonics_iteration"] = exponent(
         [r["harmonics"] for r in results["chain_harmonics"]],
         [r["seconds_per_iteration"] for r in results["chain_harmonics"]])
+    with tempfile.TemporaryDirectory() as directory:
+        results["door_sweep"] = door_sweep_cost(directory, points=args.sweep_points)
     results["bench_wall_s"] = time.perf_counter() - start
     write(results)
 

@@ -86,9 +86,11 @@ def nonlinear_force(contacts, U, samples_per_period, slider_start=None, jacobian
     return f, jac, forces
 
 
-def full_residual(problem: Problem, x, omega, slider_start=None, jacobian=True) -> Evaluation:
+def full_residual(problem: Problem, x, omega, slider_start=None, jacobian=True,
+                  assemble=True) -> Evaluation:
     """R(ũ, ω) on all DOFs; x = ũ.ravel() (harmonic-major; kept rows only with a harmonic set).
-    Reference ‖f̃_e‖."""
+    Reference ‖f̃_e‖. ``assemble=False`` (with ``jacobian``): the contact Jacobian blocks in
+    ``forces`` only, ∂R/∂ũ and ∂R/∂ω not assembled (None)."""
     n = problem.model.dof_count
     rows = kept_rows(problem)
     U = expand_rows(x, rows, problem.harmonics, n)
@@ -99,7 +101,7 @@ def full_residual(problem: Problem, x, omega, slider_start=None, jacobian=True) 
     f_nl = np.asarray(G.T @ forces.force.T).T
     R = apply_dynamic_stiffness(problem.model, omega, U) + f_nl - problem.excitation
     J = dR = None
-    if jacobian:
+    if jacobian and assemble:
         P = 2 * problem.harmonics + 1 if rows is None else rows.size
         GG = sp.kron(sp.identity(P), G, format="csr")
         J_nl = GG.T @ jacobian_matrix(forces.blocks, G.shape[0], problem.harmonics,

@@ -28,8 +28,10 @@ class SolverOptions:
         than the full one and at most ``max_condensed_size`` unknowns.
     stability: compute Hill stability of the converged solution.
     stability_method: 'full' (the Hill eigenproblem on all DOFs, :mod:`sarfe.hbm.stability`),
-        'condensed' (its roots on the contact rows, :mod:`sarfe.hbm.stability_condensed`) or
-        'auto': condensed when the full Hill matrix exceeds ``CONDENSED_ABOVE`` (2(2H+1)n rows).
+        'condensed' (Hill on a bounded Ritz basis, :mod:`sarfe.hbm.stability_condensed`),
+        'contact_rows' (the exponents right of the axis counted on the contact rows,
+        :mod:`sarfe.hbm.stability_rows`; the Ritz method where one is found) or 'auto':
+        contact_rows when the full Hill matrix exceeds ``CONDENSED_ABOVE`` (2(2H+1)n rows).
     friction_tolerance, friction_pass_cap: 2-D slider march, stop when the slider state repeats to
         friction_tolerance × (max |q| + max ρ), at most friction_pass_cap periods.
     harmonic_set: None | 'all' | 'odd' | 'auto' | a list of orders: the harmonic orders solved for

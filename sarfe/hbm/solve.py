@@ -41,6 +41,7 @@ from .solution import HarmonicSolution, SolverOptions
 from .stability import hill_stability
 from .stability_condensed import condensed_stability
 from .stability_contacts import ContactOperator
+from .stability_rows import contact_row_stability
 
 CONDENSED_ABOVE = 3000   # Hill matrix rows 2(2H+1)n above which 'auto' stability is condensed
 
@@ -135,6 +136,8 @@ def linearized_guess(problem, omega) -> np.ndarray:
     c, H, n = problem.contacts, problem.harmonics, problem.model.dof_count
     rows_k, rows_c, preload = linearized_rows(c)
     G = c.gap_map
+    if not sp.issparse(problem.model.stiffness):
+        return _linearized_guess_dense(problem, omega, rows_k, rows_c, preload)
     GG = sp.kron(sp.identity(2 * H + 1), G, format="csr")
     A = dynamic_stiffness_matrix(problem.model, omega, H) + GG.T @ sp.diags(
         np.tile(rows_k, 2 * H + 1)) @ GG
@@ -152,6 +155,37 @@ def linearized_guess(problem, omega) -> np.ndarray:
         return expand_rows(solve_linear(A, b), rows, H, n)
     except SingularJacobian:
         return np.zeros((2 * H + 1, n))
+
+
+def _linearized_guess_dense(problem, omega, rows_k, rows_c, preload):
+    """:func:`linearized_guess` of a dense model, harmonic by harmonic (the system is block
+    diagonal over the orders): K_l u₀ = f̃_e,0 − Gᵀp and (K_l − (kω)² M + i kω D_l) Û_k =
+    F_kc − i F_ks, u_kc = Re Û_k, u_ks = −Im Û_k, with K_l = K + Gᵀ diag(k) G, D_l = D +
+    Gᵀ diag(c) G; orders without excitation (or not kept) are zero. Zero where singular."""
+    H, n = problem.harmonics, problem.model.dof_count
+    G = sp.csr_matrix(problem.contacts.gap_map)
+    dense = (lambda a: a.toarray() if sp.issparse(a) else np.asarray(a, dtype=float))  # noqa: E731
+    K = dense(problem.model.stiffness) + dense(G.T @ sp.diags(rows_k) @ G)
+    D = dense(problem.model.damping) + dense(G.T @ sp.diags(rows_c) @ G)
+    M = dense(problem.model.mass)
+    F = problem.excitation.copy()
+    F[0] -= G.T @ preload
+    rows = kept_rows(problem)
+    kept = np.ones(2 * H + 1, bool) if rows is None else np.isin(np.arange(2 * H + 1), rows)
+    U = np.zeros((2 * H + 1, n))
+    try:
+        if kept[0] and np.any(F[0]):
+            U[0] = np.linalg.solve(K, F[0])
+        for k in range(1, H + 1):
+            rhs = F[2 * k - 1] - 1j * F[2 * k]
+            if not (kept[2 * k - 1] and np.any(rhs)):
+                continue
+            w = k * float(omega)
+            Uk = np.linalg.solve(K - w * w * M + 1j * w * D, rhs)
+            U[2 * k - 1], U[2 * k] = Uk.real, -Uk.imag
+    except np.linalg.LinAlgError:
+        return np.zeros((2 * H + 1, n))
+    return U if np.all(np.isfinite(U)) else np.zeros((2 * H + 1, n))
 
 
 def make_evaluator(problem, condensed):
@@ -232,13 +266,27 @@ def contact_damping(problem, forces):
     return (GG.T @ jacobian_matrix(forces.damping_blocks, G.shape[0], H) @ GG).tocsr()
 
 
-def stability(problem, omega, U, ev, options):
-    """Hill stability of a converged orbit by ``options.stability_method`` (StabilityResult)."""
-    operator = ContactOperator(problem, U, omega, ev.forces)
+def stability_method(problem, options) -> str:
+    """'full' | 'condensed' | 'contact_rows' (see :class:`SolverOptions`): 'auto' is the full Hill
+    method up to ``CONDENSED_ABOVE`` Hill rows 2(2H+1)n, else the contact-row count
+    (:mod:`sarfe.hbm.stability_rows`) with the Ritz method where it does not decide."""
     method = options.stability_method
     if method == "auto":
         size = 2 * (2 * problem.harmonics + 1) * problem.model.dof_count
-        method = "condensed" if size > CONDENSED_ABOVE and problem.contacts.count else "full"
+        method = "contact_rows" if size > CONDENSED_ABOVE and problem.contacts.count else "full"
+    return method
+
+
+def stability(problem, omega, U, ev, options):
+    """Hill stability of a converged orbit by ``options.stability_method`` (StabilityResult)."""
+    operator = ContactOperator(problem, U, omega, ev.forces)
+    method = stability_method(problem, options)
+    if method == "contact_rows":
+        result = contact_row_stability(problem.model, problem.contacts, omega, problem.harmonics,
+                                       ev.forces, operator)
+        if result is not None:
+            return result
+        method = "condensed"     # some exponent near or right of the axis: locate them (Ritz)
     if method == "condensed":
         return condensed_stability(problem.model, problem.contacts, omega, problem.harmonics,
                                    ev.forces, operator, tolerance=options.stability_tolerance)
@@ -253,8 +301,9 @@ def finalize(problem, omega, U, converged, reason, iterations, slider, options) 
     residual_norm: the kept rows; dropped_content: η of the dropped rows (for the full set: of the
     rows outside the odd set, what 'auto' would drop)."""
     full = replace(problem, harmonic_orders=None)
-    with np.errstate(all="ignore"):
-        ev = full_residual(full, U.ravel(), omega, slider, jacobian=options.stability)
+    with np.errstate(all="ignore"):     # ∂R/∂ũ on all DOFs only for the full Hill method
+        ev = full_residual(full, U.ravel(), omega, slider, jacobian=options.stability,
+                           assemble=stability_method(full, options) == "full")
     n = problem.model.dof_count
     R = ev.residual.reshape(-1, n)
     rows = kept_rows(problem)

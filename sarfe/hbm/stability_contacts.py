@@ -54,33 +54,52 @@ def _memory_block(s, omega, P_march, n_rho_march, drho, k_t, H, N):
     r"""δλ̃_t/δ(local harmonics) at exponent s (complex), (n, 2, 3P) per sample summed by E:
     returns (P, n, 2, 3P) complex, local layout h·3 + l; P_march, n_rho_march from
     :func:`_slider_march`."""
+    return _memory_blocks(np.array([s], dtype=complex), omega, P_march, n_rho_march, drho, k_t,
+                          H, N)[0]
+
+
+def _memory_blocks(s, omega, P_march, n_rho_march, drho, k_t, H, N):
+    r""":func:`_memory_block` at several exponents s (n_s,) in one march over the samples:
+    (n_s, P, n, 2, 3P) complex. The march is linear in the perturbation and s enters only through
+    the factor e^{−sh} per sample, so all s share the loop; the 2 × 2 return maps are applied
+    component-wise and the harmonic coefficients taken by the DFT matrix E (2H+1, N):
+    δλ̃ = k_t (E δq − E δw − (E ∂w/∂w₀) δw₀)."""
+    s = np.atleast_1d(np.asarray(s, dtype=complex))
     n = P_march.shape[1]
     P = 2 * H + 1
-    Phi = hm.fourier_matrices(H, N)[1]
-    decay = np.exp(-s * 2.0 * np.pi / (omega * N))
+    E, Phi = hm.fourier_matrices(H, N)
+    decay = np.exp(-s * 2.0 * np.pi / (omega * N))[:, None, None]             # (n_s, 1, 1)
     dq = np.zeros((N, 2, 3 * P))
     dq[:, 0, 1::3], dq[:, 1, 2::3] = Phi, Phi
     dn = np.zeros((N, 3 * P))
     dn[:, 0::3] = Phi
-    dw = np.zeros((n, 2, 3 * P), complex)
-    dw_dw0 = np.broadcast_to(np.eye(2, dtype=complex), (n, 2, 2)).copy()
-    dforce = np.empty((N, n, 2, 3 * P), complex)
-    history = np.empty((N, n, 2, 2), complex)
-    for j in range(N):    # 2-D: the linearized march (1-D sliders: _memory_block_1d)
-        Pj, n_rho = P_march[j], n_rho_march[j]
-        dw = Pj @ (decay * dw - dq[j]) + dq[j] + n_rho[:, :, None] * (drho[j][:, None, None]
-                                                                      * dn[j][None, None, :])
-        dw_dw0 = decay * (Pj @ dw_dw0)
-        dforce[j] = k_t[:, None, None] * (dq[j] - dw)
+    # s-independent source of each sample: (I − P_j) δq_j + n_j dρ_j δn_j   (N, n, 2, 3P)
+    source = (dq[:, None] - np.einsum("jcab,jbx->jcax", P_march, dq)
+              + n_rho_march[..., None] * (drho[:, :, None, None] * dn[:, None, None, :]))
+    m = s.size
+    dw_all = np.empty((N, m, n, 2, 3 * P), complex)
+    history = np.empty((N, m, n, 2, 2), complex)
+    dw = np.zeros((m, n, 2, 3 * P), complex)
+    dw_dw0 = np.broadcast_to(np.eye(2, dtype=complex), (m, n, 2, 2)).copy()
+    for j in range(N):    # 2-D: the linearized march (1-D sliders: _memory_blocks_1d)
+        Pj = P_march[j][None, :, :, :, None]                                     # (1, n, 2, 2, 1)
+        x = decay[..., None] * dw                                                 # (m, n, 2, 3P)
+        dw = Pj[:, :, :, 0] * x[:, :, None, 0] + Pj[:, :, :, 1] * x[:, :, None, 1] + source[j]
+        dw_all[j] = dw
+        y = decay[..., None] * dw_dw0
+        dw_dw0 = Pj[:, :, :, 0] * y[:, :, None, 0] + Pj[:, :, :, 1] * y[:, :, None, 1]
         history[j] = dw_dw0
     system = np.eye(2) - dw_dw0
     regular = np.abs(np.linalg.det(system)) > 1e-9
-    dw0 = np.zeros((n, 2, 3 * P), complex)
+    dw0 = np.zeros((m, n, 2, 3 * P), complex)
     if np.any(regular):
         dw0[regular] = np.linalg.solve(system[regular], dw[regular])
-    dforce -= k_t[None, :, None, None] * np.einsum("jcab,cbx->jcax", history, dw0)
-    coeff = hm.harmonic_coefficients(dforce.real, H) + 1j * hm.harmonic_coefficients(dforce.imag, H)
-    return coeff   # (P, n, 2, 3P)
+    Edw = (E @ dw_all.reshape(N, -1)).reshape((P, m, n, 2, 3 * P))
+    Eh = (E @ history.reshape(N, -1)).reshape((P, m, n, 2, 2))
+    Edq = np.einsum("hj,jcx->hcx", E, dq)                                          # (P, 2, 3P)
+    coeff = (Edq[:, None, None] - Edw - Eh[..., 0, None] * dw0[None, :, :, None, 0]
+             - Eh[..., 1, None] * dw0[None, :, :, None, 1])
+    return np.moveaxis(k_t[None, None, :, None, None] * coeff, 1, 0)   # (n_s, P, n, 2, 3P)
 
 
 def _slider_march(q, rho, start, one_d=False):
@@ -113,19 +132,30 @@ def _memory_block_1d(s, omega, P, n_rho, drho, k_t, H, N):
     last reset sample at or before i (cyclic, :func:`last_reset_index`) and d(i) = (i − j(i)) mod N
     — the periodic solution of the march; ŵ = 0 for a contact that never resets (regular where
     e^{−sT} ≠ 1). Only the first tangent row is filled (the second is absent for these contacts)."""
+    return _memory_blocks_1d(np.array([s], dtype=complex), omega, P, n_rho, drho, k_t, H, N)[0]
+
+
+def _memory_blocks_1d(s, omega, P, n_rho, drho, k_t, H, N):
+    """:func:`_memory_block_1d` at several exponents s (n_s,): (n_s, P, n, 2, 3P) complex."""
+    s = np.atleast_1d(np.asarray(s, dtype=complex))
     P_count = 2 * H + 1
     Phi = hm.fourier_matrices(H, N)[1]
     reset = P[:, :, 0, 0] == 0.0
     j, has = last_reset_index(reset)
     distance = (np.arange(N)[:, None] - j) % N
-    weight = np.exp(-s * 2.0 * np.pi / (omega * N) * distance) * has[None, :]      # (N, n)
+    weight = (np.exp(-s[:, None, None] * 2.0 * np.pi / (omega * N) * distance[None])
+              * has[None, None, :])                                                  # (n_s, N, n)
     gathered = Phi[j]                                                                # (N, n, P)
     slope = np.take_along_axis(n_rho[:, :, 0] * drho, j, axis=0)                    # n_j dρ_j
     n = P.shape[1]
-    dforce = np.zeros((N, n, 2, 3 * P_count), complex)
-    dforce[:, :, 0, 1::3] = k_t[None, :, None] * (Phi[:, None, :] - weight[..., None] * gathered)
-    dforce[:, :, 0, 0::3] = -k_t[None, :, None] * (weight * slope)[..., None] * gathered
-    return hm.harmonic_coefficients(dforce.real, H) + 1j * hm.harmonic_coefficients(dforce.imag, H)
+    dforce = np.zeros((N, s.size, n, 2, 3 * P_count), complex)
+    weight = np.moveaxis(weight, 0, 1)                                               # (N, n_s, n)
+    dforce[:, :, :, 0, 1::3] = k_t[None, None, :, None] * (Phi[:, None, None, :]
+                                                           - weight[..., None] * gathered[:, None])
+    dforce[:, :, :, 0, 0::3] = -k_t[None, None, :, None] * (weight * slope[:, None])[..., None] \
+        * gathered[:, None]
+    coeff = hm.harmonic_coefficients(dforce.real, H) + 1j * hm.harmonic_coefficients(dforce.imag, H)
+    return np.moveaxis(coeff, 1, 0)
 
 
 class ContactOperator:
@@ -182,15 +212,25 @@ class ContactOperator:
         self._fixed = jacobian_matrix(self.static, self.n_rows, H) - base
         self._dense_parts = None        # (I⊗G, fixed part) as ndarrays, on first dense_correction
 
+    @property
+    def pointwise_correction(self):
+        """𝒥 − 𝒥_AFT of the contacts without memory (s-independent; sparse, real)."""
+        return self._fixed
+
     def blocks_at(self, s):
         """The tangent-group blocks (rows, 𝒥(s)) — complex — for jacobian_matrix."""
+        return [(rows, J[0]) for rows, J in self.blocks_at_many(np.array([s], dtype=complex))]
+
+    def blocks_at_many(self, s):
+        """:meth:`blocks_at` at several exponents s (n_s,): [(rows, 𝒥 (n_s, n_g, 3P, 3P))]."""
+        s = np.atleast_1d(np.asarray(s, dtype=complex))
         out = []
         for g in self.memory:
-            block = _memory_block_1d if g["one_d"] else _memory_block
-            coeff = block(s, self.omega, *g["march"], g["drho"], g["k_t"], self.H, g["N"])
-            J = g["normal"].astype(complex)
-            J[:, 1::3, :] = np.moveaxis(coeff[:, :, 0, :], 0, 1)
-            J[:, 2::3, :] = np.moveaxis(coeff[:, :, 1, :], 0, 1)
+            blocks = _memory_blocks_1d if g["one_d"] else _memory_blocks
+            coeff = blocks(s, self.omega, *g["march"], g["drho"], g["k_t"], self.H, g["N"])
+            J = np.broadcast_to(g["normal"], (s.size,) + g["normal"].shape).astype(complex)
+            J[:, :, 1::3, :] = np.moveaxis(coeff[:, :, :, 0, :], 1, 2)
+            J[:, :, 2::3, :] = np.moveaxis(coeff[:, :, :, 1, :], 1, 2)
             out.append((g["rows"], J))
         return out
 

@@ -141,7 +141,12 @@ def linear_baseline(erp: ErpConfig, stage, nl: NonlinearModel, omega):
 
     K, M, D = baseline_matrices(nl)
     S = K - omega ** 2 * M + 1j * omega * D
-    U1 = np.linalg.lstsq(S, nl.excitation_amplitude, rcond=None)[0]
+    try:        # one LU; least squares only for a singular S (an undamped free-floating part)
+        U1 = np.linalg.solve(S, nl.excitation_amplitude)
+        if not np.all(np.isfinite(U1)):
+            raise np.linalg.LinAlgError("non-finite")
+    except np.linalg.LinAlgError:
+        U1 = np.linalg.lstsq(S, nl.excitation_amplitude, rcond=None)[0]
     H = (nl.excitation.shape[0] - 1) // 2
     U = np.zeros((2 * H + 1, stage.dof_count))
     U[1], U[2] = U1.real, -U1.imag
