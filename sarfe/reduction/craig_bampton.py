@@ -298,11 +298,16 @@ def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, blo
         done = leading >= wanted and above_cutoff and (wanted == target or cutoff_hz is not None)
         if done or m_new + q.shape[1] > n - 1 or q.shape[1] == 0:
             break
-        if max_columns is not None and m_new + q.shape[1] > max_columns and 0 < leading < len(values):
-            # many modes: hand the converged prefix on to spectrum slicing; the boundary lies
+        if max_columns is not None and m_new + q.shape[1] > max_columns:
+            # many modes: hand the converged prefix on to spectrum slicing — converged relative to
+            # each own ν, as the shifted runs test (ν_1-relative is loose for the higher modes and
+            # would leave them 1e-7 from M-orthogonal to the next slice's); the boundary lies
             # halfway to the next Ritz value
-            return _Partial(omega2[:leading], basis @ vectors[:, :leading],
-                            0.5 * (omega2[leading - 1] + omega2[leading]), m_new)
+            strict = residual <= tol * np.abs(values)
+            prefix = int(np.argmin(strict)) if not strict.all() else len(strict)
+            if 0 < prefix < len(values):
+                return _Partial(omega2[:prefix], basis @ vectors[:, :prefix],
+                                0.5 * (omega2[prefix - 1] + omega2[prefix]), m_new)
         if m_new + q.shape[1] > capacity:
             capacity = min(n, 2 * capacity)
             grown_store, grown_mass = np.empty((n, capacity), order="F"), np.empty((n, capacity), order="F")
@@ -335,17 +340,20 @@ def _slice(k_ii, m_ii, cutoff_hz, partial, progress, timings):
     return omega2, modes
 
 
-def residual_modes(stiffness_ii, mass_ii, operator, loads, modes, relative_tolerance=1e-8):
+def residual_modes(stiffness_ii, mass_ii, operator, loads, modes, relative_tolerance=1e-8,
+                   static=None):
     """Residual modes Φ_r from interior loads (module docstring): ω_r² (ascending), Φ_r.
 
     loads: (n_i, k) interior load columns F_i; operator(F) = K_ii⁻¹ F; modes: Φ (n_i, n_m),
     Φᵀ M_ii Φ = I. Directions whose M-norm after deflation is below relative_tolerance × their norm
-    before (already in span Φ, or dependent) are dropped.
+    before (already in span Φ, or dependent) are dropped. ``static``: K_ii⁻¹ F_i when already
+    computed (then ``operator`` is not called).
     """
     n = mass_ii.shape[0]
     if loads.shape[1] == 0:
         return np.empty(0), np.empty((n, 0))
-    static = operator(np.asarray(loads, dtype=float))
+    if static is None:
+        static = operator(np.asarray(loads, dtype=float))
     norms = np.sqrt(np.einsum("ij,ij->j", static, mass_ii @ static))
     static = static[:, norms > 0] / norms[norms > 0]  # unit M-norm before deflation
     for _ in range(2):  # deflate Φ twice (classical Gram–Schmidt, re-orthogonalized)
@@ -421,10 +429,27 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
     lap("constraint_modes")
 
     applications = [0]
+    held, solver_name = {"factor": factor}, factor.name
+    del factor
 
     def inverse(y):
         applications[0] += 1 if y.ndim == 1 else y.shape[1]
-        return factor.solve(y)
+        if held["factor"] is None:        # freed for spectrum slicing, needed again (fallback)
+            held["factor"] = factorize(k_ii, solver=solver, structure="spd")
+        return held["factor"].solve(y)
+
+    # residual-vector loads and their static responses K_ii⁻¹ F_i, before any mode search (the
+    # factor of K_ii may be freed while slicing the spectrum)
+    m_ii_psi = m_ii @ psi
+    loads = []
+    if residual_vectors and len(boundary):
+        loads.append(m_ib + m_ii_psi)
+    if residual_loads is not None:
+        extra = np.asarray(residual_loads, dtype=float)
+        loads.append((extra[:, None] if extra.ndim == 1 else extra)[interior])
+    loads = np.hstack(loads) if loads else None
+    static = inverse(loads) if loads is not None else None
+    lap("residual_static")
 
     if (mode_count or 0) > 0 or (cutoff_hz is not None and mode_count is None):
         if eigensolver not in ("block", "arpack"):
@@ -437,35 +462,46 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
             found = _block_lanczos_modes(m_ii, inverse, mode_count, cutoff_hz, progress,
                                          max_columns=cap)
             if isinstance(found, _Partial):
+                held["factor"] = None     # K_ii's factor is not used by the shifted runs
                 found = _slice(k_ii, m_ii, cutoff_hz, found, progress, timings)
             if found is None and cap is not None:   # slicing impossible: one uncapped run
                 found = _block_lanczos_modes(m_ii, inverse, mode_count, cutoff_hz, progress)
         if found is None:
             found = _fixed_interface_modes(k_ii, m_ii, inverse, mode_count, cutoff_hz, progress)
             eigensolver = "arpack"
-        omega2, phi = found
+        omega2, blocks = found
         timings["eigensolver"] = eigensolver
     else:
-        omega2, phi = np.empty(0), np.empty((len(interior), 0))
+        omega2, blocks = np.empty(0), np.empty((len(interior), 0))
+    held["factor"] = None
     lap("normal_modes")
 
-    m_ii_psi = m_ii @ psi
-    loads = []
-    if residual_vectors and len(boundary):
-        loads.append(m_ib + m_ii_psi)
-    if residual_loads is not None:
-        extra = np.asarray(residual_loads, dtype=float)
-        loads.append((extra[:, None] if extra.ndim == 1 else extra)[interior])
-    if loads:
-        omega2_r, phi_r = residual_modes(k_ii, m_ii, inverse, np.hstack(loads), phi)
+    # T's interior rows [Ψ, Φ, Φ_r] in one array, filled in place (Φ arrives in column blocks
+    # when sliced; no stacked copies of an n_i × n_m array)
+    n_b = len(boundary)
+    blocks = blocks if isinstance(blocks, list) else [blocks]
+    n_fixed = len(omega2)
+    basis = np.empty((len(interior), n_b + n_fixed + (0 if loads is None else loads.shape[1])))
+    basis[:, :n_b] = psi
+    column = n_b
+    while blocks:
+        block = blocks.pop(0)
+        basis[:, column:column + block.shape[1]] = block
+        column += block.shape[1]
+        del block
+    phi = basis[:, n_b:n_b + n_fixed]
+    if loads is not None:
+        omega2_r, phi_r = residual_modes(k_ii, m_ii, None, loads, phi, static=static)
     else:
         omega2_r, phi_r = np.empty(0), np.empty((len(interior), 0))
+    basis[:, n_b + n_fixed:n_b + n_fixed + phi_r.shape[1]] = phi_r
+    interior_basis = basis[:, :n_b + n_fixed + phi_r.shape[1]]
     lap("residual_modes")
     timings["operator_applications"] = applications[0]
     frequencies = np.sqrt(np.maximum(omega2, 0)) / (2 * np.pi)
     residual_frequencies = np.sqrt(np.maximum(omega2_r, 0)) / (2 * np.pi)
     omega2 = np.concatenate([omega2, omega2_r])
-    phi = np.hstack([phi, phi_r])
+    phi = interior_basis[:, n_b:]
     k_rbb = k_bb + k_ib.T @ psi
     m_rbb = m_bb + m_ib.T @ psi + psi.T @ m_ib + psi.T @ m_ii_psi
     m_rbm = (m_ib + m_ii_psi).T @ phi
@@ -489,7 +525,7 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
 
     return ReducedModel(
         mass=mass_r, stiffness=stiffness_r, boundary_dofs=boundary, interior_dofs=interior,
-        interior_basis=np.hstack([psi, phi]), mode_frequencies_hz=frequencies,
+        interior_basis=interior_basis, mode_frequencies_hz=frequencies,
         residual_frequencies_hz=residual_frequencies,
         full_dof_count=n, free_dofs=None if free_dofs is None else np.asarray(free_dofs, dtype=int),
-        total_dof_count=total_dof_count, solver=factor.name, timings=timings)
+        total_dof_count=total_dof_count, solver=solver_name, timings=timings)

@@ -101,29 +101,64 @@ def shifted_block_lanczos(mass, operator, shift, satisfied, max_columns, block_s
     return lam, converged, eigenvectors
 
 
-def _place_shift(stiffness, mass, right_edge, known, wanted, cutoff_omega2, total, solver, record):
+def _place_shift(stiffness, mass, right_edge, known, wanted, cutoff_omega2, total, rate, solver,
+                 record):
     """The next shift σ > right_edge with about ``wanted`` eigenvalues in (right_edge, σ] and its
     factor of K − σM; the cutoff itself once at most 1.25 ``wanted`` remain below it (``total``
-    eigenvalues ≤ cutoff, ``known`` ≤ right_edge). The guess interpolates N(ω) linearly between
-    (√right_edge, known) and (ω_c, total); a factor whose inertia shows more than 1.5× or fewer
-    than 0.5× ``wanted`` is replaced (twice at most) by the interpolation through that probe."""
+    eigenvalues ≤ cutoff, ``known`` ≤ right_edge). First guess ω = √right_edge + wanted / rate
+    (``rate``: eigenvalues per rad/s the last run saw; None: N(ω) linear up to the cutoff); a
+    factor whose inertia shows more than 1.5× or fewer than 0.5× ``wanted`` is replaced (three
+    times at most) by the interpolation through that probe."""
     omega, top = np.sqrt(right_edge), np.sqrt(cutoff_omega2)
     if total - known <= 1.25 * wanted:
         factor = factorize(stiffness - cutoff_omega2 * mass, solver=solver, structure="symmetric")
         record["factorizations"] += 1
         return cutoff_omega2, factor
-    probe, inside = top, total - known
-    for attempt in range(3):
-        guess = omega + (probe - omega) * wanted / max(inside, 1)
+    guess = omega + wanted / rate if rate else omega + (top - omega) * wanted / (total - known)
+    for attempt in range(4):
         shift = min(guess, top) ** 2
         factor = factorize(stiffness - shift * mass, solver=solver, structure="symmetric")
         record["factorizations"] += 1
         inside = factor.negative_pivots - known
-        if 0.5 * wanted <= inside <= 1.5 * wanted or attempt == 2:
+        if 0.5 * wanted <= inside <= 1.5 * wanted or attempt == 3 or (shift >= cutoff_omega2
+                                                                      and inside <= 1.5 * wanted):
             return shift, factor
-        probe = np.sqrt(shift)
         del factor
+        guess = omega + (np.sqrt(shift) - omega) * wanted / max(inside, 1)
     return shift, factor
+
+
+def _slice_run(mass, factor, shift, lower, counted, right_edge, pending, max_columns, last):
+    """One shifted Lanczos run for the gap (lower, shift] (module docstring). Returns (λ,
+    converged, eigenvectors, take: the run's values kept for the gap, use_pending: whether the
+    previous run's values ≤ shift complete it) or raises SlicingFailed."""
+    gap_count = factor.negative_pivots - counted           # eigenvalues in (lower, shift]
+    need_left = gap_count - sum(1 for v in pending if v <= shift)
+    half_width = shift - right_edge
+    state = {}
+
+    def satisfied(lam, converged):
+        left = converged & (lam > right_edge) & (lam <= shift)
+        alone = converged & (lam > lower) & (lam <= shift)
+        state["alone"] = np.count_nonzero(alone) == gap_count
+        state["left"] = np.count_nonzero(left) == need_left
+        if not (state["left"] or state["alone"]):
+            return False
+        if last:
+            return True
+        # the right side: every Ritz value within the mirrored window has converged
+        open_right = (lam > shift) & ~converged & (lam <= shift + half_width)
+        return not open_right.any()
+
+    lam, converged, eigenvectors = shifted_block_lanczos(mass, factor.solve, shift, satisfied,
+                                                         max_columns)
+    if state.get("left"):
+        return lam, converged, eigenvectors, converged & (lam > right_edge) & (lam <= shift), True
+    if state.get("alone"):
+        return lam, converged, eigenvectors, converged & (lam > lower) & (lam <= shift), False
+    raise SlicingFailed(f"shift {np.sqrt(shift) / (2 * np.pi):.1f} Hz: "
+                        f"{np.count_nonzero(converged & (lam > lower) & (lam <= shift))} of "
+                        f"{gap_count} eigenvalues converged in {len(lam)} columns")
 
 
 def sliced_modes(stiffness, mass, cutoff_omega2, found_omega2, found_modes, boundary,
@@ -131,9 +166,10 @@ def sliced_modes(stiffness, mass, cutoff_omega2, found_omega2, found_modes, boun
     """All eigenpairs of K φ = λ M φ with λ ≤ ``cutoff_omega2`` (module docstring).
 
     found_omega2 (k,), found_modes (n, k): run 0's converged eigenpairs, all λ ≤ ``boundary``
-    (a value between them and run 0's next Ritz value). Returns λ (ascending), Φ (Φᵀ M Φ = I),
-    and a record {"shifts": [...], "columns": [...], "factorizations": s}. Raises SlicingFailed
-    when a gap's count is not reached within ``max_columns``.
+    (a value between them and run 0's next Ritz value). Returns λ (ascending), Φ (Φᵀ M Φ = I) as
+    a list of column blocks in that order (no stacked copy of n × n_m), and a record {"shifts",
+    "columns", "negative_pivots", "factorizations", "modes_below_cutoff"}. Raises SlicingFailed
+    when a gap's count is not reached within ``max_columns`` even at a quarter of the width.
     """
     pending = list(np.asarray(found_omega2, dtype=float))   # found above the last shift,
     pending_modes = np.asarray(found_modes)                  # not yet certified by a count
@@ -147,56 +183,36 @@ def sliced_modes(stiffness, mass, cutoff_omega2, found_omega2, found_modes, boun
     total = factor.negative_pivots                     # eigenvalues below the cutoff
     record["modes_below_cutoff"] = int(total)
     del factor
+    rate = None
     while True:
         known = counted + len(pending)                 # ≈ N(right_edge)
-        shift, factor = _place_shift(stiffness, mass, right_edge, known, slice_modes // 2,
-                                     cutoff_omega2, total, solver, record)
-        last = shift >= cutoff_omega2
-        below = factor.negative_pivots
-        gap_count = below - counted                     # eigenvalues in (lower, shift]
-        carried = np.array([v for v in pending if v <= shift])
-        need_left = gap_count - len(carried)
-        half_width = shift - right_edge
-        state = {}
-
-        def satisfied(lam, converged):
-            left = converged & (lam > right_edge) & (lam <= shift)
-            alone = converged & (lam > lower) & (lam <= shift)
-            state["alone"] = np.count_nonzero(alone) == gap_count
-            state["left"] = np.count_nonzero(left) == need_left
-            if not (state["left"] or state["alone"]):
-                return False
-            if last:
-                return True
-            # the right side: every Ritz value within the mirrored window has converged
-            right = lam > shift
-            open_right = right & ~converged & (lam <= shift + half_width)
-            return not open_right.any()
-
-        def operator(block):
-            return factor.solve(block)
-
-        lam, converged, eigenvectors = shifted_block_lanczos(mass, operator, shift, satisfied,
-                                                             max_columns)
-        record["shifts"].append(float(shift))
+        for retry in range(3):     # a gap the column cap cannot fill: again with half the width
+            shift, factor = _place_shift(stiffness, mass, right_edge, known,
+                                         max(4, slice_modes // 2 >> retry), cutoff_omega2, total,
+                                         rate, solver, record)
+            try:
+                lam, converged, eigenvectors, take, use_pending = _slice_run(
+                    mass, factor, shift, lower, counted, right_edge, pending, max_columns,
+                    shift >= cutoff_omega2)
+                break
+            except SlicingFailed:
+                if retry == 2:
+                    raise
+            finally:
+                record["shifts"].append(float(shift))
+                record["negative_pivots"].append(int(factor.negative_pivots))
+                del factor
         record["columns"].append(int(len(lam)))
-        record["negative_pivots"].append(int(below))
-        del factor
-        if state.get("left"):
-            take = converged & (lam > right_edge) & (lam <= shift)
+        last = shift >= cutoff_omega2
+        if use_pending:
             keep_pending = np.asarray(pending) <= shift
             values.append(np.asarray(pending)[keep_pending])
-            modes.append(pending_modes[:, keep_pending])
-        elif state.get("alone"):
-            take = converged & (lam > lower) & (lam <= shift)
-        else:
-            raise SlicingFailed(f"shift {np.sqrt(shift) / (2 * np.pi):.1f} Hz: "
-                                f"{np.count_nonzero(converged & (lam > lower) & (lam <= shift))} "
-                                f"of {gap_count} eigenvalues converged in {len(lam)} columns")
+            modes.append(pending_modes if keep_pending.all() else pending_modes[:, keep_pending])
         order = np.flatnonzero(take)
+        order = order[np.argsort(lam[order])]
         values.append(lam[order])
         modes.append(eigenvectors(order))
-        counted = below
+        counted = record["negative_pivots"][-1]
         lower = shift
         if progress is not None:
             progress(counted, None)
@@ -214,9 +230,15 @@ def sliced_modes(stiffness, mass, cutoff_omega2, found_omega2, found_modes, boun
             right_edge = float(lam[above[-1]]) if len(above) else shift
         pending = list(lam[chosen])
         pending_modes = eigenvectors(chosen)
+        del eigenvectors             # the run's Krylov store goes before the next one's
+        # eigenvalues per rad/s over this run's coverage: the next shift's first guess
+        start = np.sqrt(max(values[-1][0], 0.0)) if len(values[-1]) else np.sqrt(shift)
+        seen, span = len(values[-1]) + len(pending), np.sqrt(right_edge) - start
+        rate = seen / span if span > 0 and seen else None
         if right_edge >= cutoff_omega2:
             right_edge = cutoff_omega2
     omega2 = np.concatenate(values)
-    order = np.argsort(omega2)
-    phi = np.hstack(modes)[:, order]
-    return omega2[order], phi, record
+    if np.any(np.diff(omega2) < 0):       # blocks are sorted and follow each other; make sure
+        order = np.argsort(omega2)
+        return omega2[order], [np.hstack(modes)[:, order]], record
+    return omega2, modes, record
