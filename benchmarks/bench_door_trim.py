@@ -94,7 +94,8 @@ def run_case(case, timeout):
     path = work / "out" / "summary.json"
     if path.exists():
         summary = json.loads(path.read_text())
-    return {"wall_s": wall, "peak_rss_gb": usage.ru_maxrss / 1024 ** 2, "timed_out": timed_out,
+    return {"wall_s": wall, "cpu_s": usage.ru_utime + usage.ru_stime,
+            "peak_rss_gb": usage.ru_maxrss / 1024 ** 2, "timed_out": timed_out,
             "exit": proc.returncode, "stderr_tail": "\n".join(tail[-4:])[-400:],
             "summary": summary, "stages": stages, "load_average": os.getloadavg()}
 
@@ -138,8 +139,8 @@ def p1_case(mesh_m=None, frequencies=None, harmonics=None, spots=None):
 def run_record(r, **extra):
     """The numbers of one run kept in the results."""
     s = r["summary"]
-    out = dict(extra, **{k: r[k] for k in ("wall_s", "peak_rss_gb", "timed_out", "exit", "stages",
-                                           "load_average")})
+    out = dict(extra, **{k: r[k] for k in ("wall_s", "cpu_s", "peak_rss_gb", "timed_out", "exit",
+                                           "stages", "load_average")})
     if s:
         t = s["timings_s"]
         n = len(s["points"])
@@ -324,10 +325,10 @@ def p1_lines(e, p4):
          "40 → 80 Hz (max_step 0.005: ≥ 200 reported points), default options, mesh → VTU", "",
          "The whole sweep, one `sarfe solve` process (mesh from the cache after the first run; "
          "the cache is what `sarfe solve` uses). Target ≤ 60 s, ≤ 4 GB.", "",
-         "| points | converged | wall s | peak RSS GB | linear stage s | HBM s | estimate s | post s | "
-         "outputs s | reached |", "|---|---|---|---|---|---|---|---|---|---|",
+         "| points | converged | wall s | CPU s | peak RSS GB | linear stage s | HBM s | estimate s | "
+         "post s | outputs s | reached |", "|---|---|---|---|---|---|---|---|---|---|---|",
          f"| {e.get('points_n', '-')} | {e.get('converged', '-')} | {e['wall_s']:.1f}"
-         f"{' (TIMEOUT)' if e['timed_out'] else ''} | {e['peak_rss_gb']:.2f} | "
+         f"{' (TIMEOUT)' if e['timed_out'] else ''} | {e.get('cpu_s', 0):.1f} | {e['peak_rss_gb']:.2f} | "
          f"{fmt(t.get('linear_stage_s'))} | {fmt(t.get('hbm_s'))} | {fmt(t.get('error_estimate_s'))} | "
          f"{fmt(t.get('postprocess_s'))} | {fmt(t.get('outputs_s'))} | "
          f"{'done' if e.get('summary_ok', e.get('points_n')) else stage_of(e)} |", ""]
@@ -351,7 +352,7 @@ def p4_lines(p4):
     L = ["", "## P4: HBM seconds per point (summary.json hbm_s / points: Newton + Hill stability; "
          f"listed frequencies {P4_FREQUENCIES} Hz, default options)", "",
          "| mesh | pairs | H | free DOFs | reduced DOFs | HBM s/point | estimate s | linear stage s | "
-         "wall s | peak RSS GB | converged |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+         "wall s | CPU s | peak RSS GB | converged |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for g in p4.get("sizes", []) + p4.get("grid", []):
         if not g:
             continue
@@ -360,7 +361,8 @@ def p4_lines(p4):
                  f"{m.get('free_dofs', '-')} | {m.get('reduced_dofs', '-')} | "
                  f"{fmt(g.get('hbm_s_per_point'), '.2f')} | {fmt(t.get('error_estimate_s'))} | "
                  f"{fmt(t.get('linear_stage_s'))} | {g['wall_s']:.1f}{' (TIMEOUT)' if g['timed_out'] else ''}"
-                 f" | {g['peak_rss_gb']:.2f} | {g.get('converged', '-')}/{g.get('points_n', '-')} |")
+                 f" | {g.get('cpu_s', 0):.1f} | {g['peak_rss_gb']:.2f} | "
+                 f"{g.get('converged', '-')}/{g.get('points_n', '-')} |")
     fs, fg = p4.get("fit_size"), p4.get("fit_grid")
     L += ["", f"Fitted exponents: HBM s/point ∝ free_DOFs^{fmt(fs[0] if fs else None, '.2f')} "
           "(target: flat within 20 % over 15/10/5 mm); ∝ pairs^"
@@ -376,7 +378,8 @@ def write(results):
          f"Machine: {platform.platform()}, {os.cpu_count()} cores shared with other jobs (other "
          f"helpers ran in parallel: load average at start {results['load_average']}, at the end "
          f"{results.get('load_average_end', '-')}); OPENBLAS/OMP/MKL_NUM_THREADS=1; every "
-         f"`sarfe solve` a whole process, peak RSS = that process's ru_maxrss. Bench wall "
+         f"`sarfe solve` a whole process, peak RSS = that process's ru_maxrss, CPU s = its user + "
+         f"system time (what one core of a quiet machine would take, the stage columns are wall). Bench wall "
          f"{results['wall_s']:.0f} s. Wall seconds under this load are up to ~3× a quiet "
          "machine's.", ""]
     for name, date in (results.get("kept_from") or {}).items():
