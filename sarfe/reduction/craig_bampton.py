@@ -416,8 +416,8 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
 
     k_ii = stiffness[interior][:, interior]
     m_ii = mass[interior][:, interior].tocsr()
-    k_ib = stiffness[interior][:, boundary].toarray()
-    m_ib = mass[interior][:, boundary].toarray()
+    k_ib = stiffness[interior][:, boundary].tocsc()     # sparse: n_i × n_b dense is 0.1 GB
+    m_ib = mass[interior][:, boundary].tocsc()          # per matrix at 206k DOFs
     k_bb = stiffness[boundary][:, boundary].toarray()
     m_bb = mass[boundary][:, boundary].toarray()
     lap("partition")
@@ -425,7 +425,7 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
     factor = factorize(k_ii, solver=solver, structure="spd")
     lap("factorization")
 
-    psi = -factor.solve(k_ib) if len(boundary) else np.empty((len(interior), 0))
+    psi = -factor.solve(k_ib.toarray()) if len(boundary) else np.empty((len(interior), 0))
     lap("constraint_modes")
 
     applications = [0]
@@ -440,14 +440,22 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
 
     # residual-vector loads and their static responses K_ii⁻¹ F_i, before any mode search (the
     # factor of K_ii may be freed while slicing the spectrum)
-    m_ii_psi = m_ii @ psi
-    loads = []
-    if residual_vectors and len(boundary):
-        loads.append(m_ib + m_ii_psi)
-    if residual_loads is not None:
-        extra = np.asarray(residual_loads, dtype=float)
-        loads.append((extra[:, None] if extra.ndim == 1 else extra)[interior])
-    loads = np.hstack(loads) if loads else None
+    # F_b = M_ib + M_ii Ψ: the interior load of unit boundary accelerations (also M_r's coupling
+    # block F_bᵀ Φ); built in place, and shared with the residual-vector loads
+    n_b = len(boundary)
+    extra = None if residual_loads is None else np.asarray(residual_loads, dtype=float)
+    extra = None if extra is None else (extra[:, None] if extra.ndim == 1 else extra)[interior]
+    with_boundary = bool(residual_vectors and n_b)
+    width = (n_b if with_boundary else 0) + (0 if extra is None else extra.shape[1])
+    loads = np.empty((len(interior), width)) if width else None
+    boundary_load = loads[:, :n_b] if with_boundary else np.empty((len(interior), n_b))
+    boundary_load[:] = m_ii @ psi
+    psi_m_psi = psi.T @ boundary_load                               # Ψᵀ M_ii Ψ
+    coo = m_ib.tocoo()
+    np.add.at(boundary_load, (coo.row, coo.col), coo.data)
+    if extra is not None:
+        loads[:, width - extra.shape[1]:] = extra
+        del extra
     static = inverse(loads) if loads is not None else None
     lap("residual_static")
 
@@ -478,7 +486,6 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
 
     # T's interior rows [Ψ, Φ, Φ_r] in one array, filled in place (Φ arrives in column blocks
     # when sliced; no stacked copies of an n_i × n_m array)
-    n_b = len(boundary)
     blocks = blocks if isinstance(blocks, list) else [blocks]
     n_fixed = len(omega2)
     basis = np.empty((len(interior), n_b + n_fixed + (0 if loads is None else loads.shape[1])))
@@ -502,9 +509,10 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
     residual_frequencies = np.sqrt(np.maximum(omega2_r, 0)) / (2 * np.pi)
     omega2 = np.concatenate([omega2, omega2_r])
     phi = interior_basis[:, n_b:]
-    k_rbb = k_bb + k_ib.T @ psi
-    m_rbb = m_bb + m_ib.T @ psi + psi.T @ m_ib + psi.T @ m_ii_psi
-    m_rbm = (m_ib + m_ii_psi).T @ phi
+    k_rbb = k_bb + np.asarray(k_ib.T @ psi)
+    m_ib_psi = np.asarray(m_ib.T @ psi)
+    m_rbb = m_bb + m_ib_psi + m_ib_psi.T + psi_m_psi
+    m_rbm = boundary_load.T @ phi
     n_b, n_m = len(boundary), len(omega2)
     stiffness_r = np.zeros((n_b + n_m, n_b + n_m))
     mass_r = np.zeros_like(stiffness_r)
