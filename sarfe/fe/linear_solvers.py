@@ -177,7 +177,9 @@ class _PardisoHandle:
 
 def _pardiso_release(solver):
     try:
-        solver.free_memory(everything=False)
+        # phase −1: all of this instance's memory; phase 0 (the factor only) left ~0.19 GB per
+        # factorization of the 5 mm door trim behind (measured over 4 factorizations)
+        solver.free_memory(everything=True)
     except Exception:  # noqa: BLE001 - interpreter shutdown
         pass
 
