@@ -336,12 +336,19 @@ def p1_lines(e, p4):
              f"{fmt(e['load_average'][0], '.1f')}.")
     five = next((g for g in (p4 or {}).get("sizes", []) if g["mesh_m"] == 0.005 and g.get("timings_s")),
                 None)
+    sweep_start = next((t for t, line in e.get("stages") or [] if line.startswith("sweep")), None)
+    if sweep_start is not None:
+        L += ["", f"The sweep (HBM) started {sweep_start:.0f} s after launch: checks + mesh + linear "
+              "stage took that long in this run."]
     if e["timed_out"] and five:
         once = five["wall_s"] - five["per_point_s"] * five["points_n"]
+        if sweep_start is not None:    # this run's own linear stage + the P4 run's outputs
+            once = sweep_start + five["timings_s"].get("outputs_s", 0)
         L += ["", f"EXTRAPOLATED (fallback, the real sweep did not finish in {e['timeout_s']:.0f} s): "
-              f"from the P4 5 mm run ({five['points_n']} listed points): once {once:.1f} s (linear "
-              f"stage {five['timings_s']['linear_stage_s']:.1f} s, outputs "
+              f"once {once:.1f} s (until the sweep started in this run, else the P4 5 mm run's linear "
+              f"stage {five['timings_s']['linear_stage_s']:.1f} s; outputs of the P4 5 mm run "
               f"{five['timings_s'].get('outputs_s', 0):.1f} s) + 200 × {five['per_point_s']:.2f} s/point "
+              f"(HBM + estimate + postprocess of the P4 5 mm run, {five['points_n']} listed points) "
               f"= {once + 200 * five['per_point_s']:.0f} s; peak RSS of that run "
               f"{five['peak_rss_gb']:.2f} GB (its points are listed frequencies, each with its own "
               "error estimate; a sweep estimates every 8th point)."]
