@@ -252,6 +252,10 @@ def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, blo
     # doubling below) — never n columns up front, which is two dense n×n arrays
     guess = min(target, n) if mode_count is not None else 64
     capacity = min(n, max(4 * block_size, 5 * guess + 2 * block_size))  # measured: ~4.8 columns per mode
+    if max_columns is not None:
+        # the whole capped store up front: growing it copies, and old + new store at 206k DOFs
+        # were 2.6 GB at once
+        capacity = min(n, max_columns + 2 * block_size)
     # Q, M Q preallocated column-major: a block of columns is then contiguous, which the sparse
     # solvers want (no copy per solve)
     store, mass_store = np.empty((n, capacity), order="F"), np.empty((n, capacity), order="F")
@@ -309,7 +313,7 @@ def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, blo
                 return _Partial(omega2[:prefix], basis @ vectors[:, :prefix],
                                 0.5 * (omega2[prefix - 1] + omega2[prefix]), m_new)
         if m_new + q.shape[1] > capacity:
-            capacity = min(n, 2 * capacity)
+            capacity = min(n, max(2 * capacity, m_new + q.shape[1]))
             grown_store, grown_mass = np.empty((n, capacity), order="F"), np.empty((n, capacity), order="F")
             grown_store[:, :m_new], grown_mass[:, :m_new] = store[:, :m_new], mass_store[:, :m_new]
             store, mass_store = grown_store, grown_mass
