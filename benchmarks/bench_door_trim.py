@@ -391,6 +391,8 @@ def write(results):
          "machine's.", ""]
     for name, date in (results.get("kept_from") or {}).items():
         L.append(f"- `{name}`: kept from the run of {date} (not rerun this time).")
+    for note in results.get("notes") or []:      # added by hand to the .json, kept on rewrite
+        L.append(f"- Note: {note}")
     p4 = {**(results.get("p4sizes") or {}), **(results.get("p4grid") or {})}
     if results.get("p1"):
         L += p1_lines(results["p1"], p4)
@@ -475,6 +477,7 @@ def main():
         old = json.loads(previous.read_text())
         for name in ("p1", "p4sizes", "p4grid", "audible", "hbm_vs_time"):
             if name not in parts and old.get(name) and not (name == "p1" and isinstance(old[name], list)):
+                results.setdefault("notes", old.get("notes", []))
                 results[name] = old[name]
                 results["kept_from"][name] = old.get("date_utc", "an earlier run")
     functions = {"p1": p1, "p4sizes": p4_sizes, "p4grid": p4_grid, "hbm_vs_time": hbm_vs_time,
