@@ -321,7 +321,7 @@ def stage_of(run):
 
 def p1_lines(e, p4):
     t = e.get("timings_s") or {}
-    L = ["## P1: cases/door_trim_p1.yaml — 5 mm, 12 pairs (8 rattle + 4 squeak), H = 15, sweep "
+    L = ["", "## P1: cases/door_trim_p1.yaml — 5 mm, 12 pairs (8 rattle + 4 squeak), H = 15, sweep "
          "40 → 80 Hz (max_step 0.005: ≥ 200 reported points), default options, mesh → VTU", "",
          "The whole sweep, one `sarfe solve` process (mesh from the cache after the first run; "
          "the cache is what `sarfe solve` uses). Target ≤ 60 s, ≤ 4 GB.", "",
@@ -479,7 +479,8 @@ def main():
             if name not in parts and old.get(name) and not (name == "p1" and isinstance(old[name], list)):
                 results.setdefault("notes", old.get("notes", []))
                 results[name] = old[name]
-                results["kept_from"][name] = old.get("date_utc", "an earlier run")
+                results["kept_from"][name] = ((old.get("kept_from") or {}).get(name)
+                                              or old.get("date_utc", "an earlier run"))
     functions = {"p1": p1, "p4sizes": p4_sizes, "p4grid": p4_grid, "hbm_vs_time": hbm_vs_time,
                  "audible": audible}
     for name in parts:
