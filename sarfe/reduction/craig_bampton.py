@@ -513,9 +513,11 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
     residual_frequencies = np.sqrt(np.maximum(omega2_r, 0)) / (2 * np.pi)
     omega2 = np.concatenate([omega2, omega2_r])
     phi = interior_basis[:, n_b:]
-    k_rbb = k_bb + np.asarray(k_ib.T @ psi)
-    m_ib_psi = np.asarray(m_ib.T @ psi)
-    m_rbb = m_bb + m_ib_psi + m_ib_psi.T + psi_m_psi
+    # dense transients for the n_b × n_b blocks: the same BLAS products (and round-off) as before
+    k_rbb = k_bb + k_ib.toarray().T @ psi
+    m_ib = m_ib.toarray()
+    m_rbb = m_bb + m_ib.T @ psi + psi.T @ m_ib + psi_m_psi
+    del m_ib
     m_rbm = boundary_load.T @ phi
     n_b, n_m = len(boundary), len(omega2)
     stiffness_r = np.zeros((n_b + n_m, n_b + n_m))
