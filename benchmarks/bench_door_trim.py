@@ -1,19 +1,20 @@
-"""Issue-15 performance targets not measured elsewhere: P1 (door trim 5 mm, H = 15, defaults),
-the audible study (dB(A) vs H and vs reduction cutoff at a door-trim rattle point, the `balanced`
-preset) and HBM vs the built-in time integrator on the rattle rig's reduced model.
+"""Issue-15 performance targets not measured elsewhere: P1 (cases/door_trim_p1.yaml: door trim
+5 mm, 12 contact pairs — 8 rattle, 4 squeak — H = 15, a continuation sweep 40 → 80 Hz reported at
+≥ 200 points, default options), P4 (HBM seconds per point vs FE size and vs contact pairs × H, with
+fitted exponents), the audible study and HBM vs the built-in time integrator.
 
-P1 and the audible study run whole ``sarfe solve`` processes (OPENBLAS_NUM_THREADS=1), timed for
-wall time and peak RSS (resource.getrusage of the child), each bounded by a timeout; the per-stage
-timings come from the run's summary.json (``timings_s``). The 200-point P1 figure is an
-EXTRAPOLATION: linear stage + outputs once, plus 200 × (HBM + estimate + postprocess s / point).
+Every run is a whole ``sarfe solve`` process (OPENBLAS/OMP/MKL_NUM_THREADS=1) bounded by a timeout,
+timed for wall time and peak RSS (``/usr/bin/time``-free: ru_maxrss of that child, read with
+os.wait4); per-stage timings come from its summary.json (``timings_s``) and, for a run that times
+out, from the time stamps of its stage lines on stderr. P1 runs the whole sweep for real; only
+when it does not finish in its timeout the 200-point figure is an EXTRAPOLATION (labelled so) from
+the P4 5 mm run: linear stage + outputs once, plus 200 × (HBM + estimate + postprocess s / point).
 
-The HBM-vs-time part runs in this process on the rattle rig's reduced model (cases/rattle_rig.yaml):
-10 frequencies of its band; reference = HBM at H = 30, N = 1024; the HBM at the case's H and the
-time integrator (Newmark, cold start, tolerance 1e-6) at increasing steps per period, each timed
-over the 10 points; the ratio is taken at the cheapest time-integration setting whose first-harmonic
-error (max over points of ‖Û₁ − Û₁,ref‖ / ‖Û₁,ref‖) is at most the HBM's or 1 %.
-
-Writes benchmarks/results/door_trim.md and .json. Whole script < 12 min (timeouts).
+Parts: ``python benchmarks/bench_door_trim.py [p4sizes,p1,p4grid,hbm_vs_time,audible]`` (default
+p4sizes,p1,p4grid); parts
+not run keep their previous results from door_trim.json, marked with the date of that run.
+Writes benchmarks/results/door_trim.md and .json. SARFE_BENCH_BUDGET_S bounds the whole script
+(default 3600 s). The machine load (other jobs share the 2 cores) is sampled and written.
 """
 import dataclasses
 import json
@@ -32,7 +33,7 @@ import yaml
 HERE = pathlib.Path(__file__).resolve().parent
 ROOT = HERE.parent
 RESULTS = HERE / "results"
-BUDGET_S = 660.0
+BUDGET_S = float(os.environ.get("SARFE_BENCH_BUDGET_S", 3600))
 T0 = time.perf_counter()
 
 
@@ -51,34 +52,52 @@ def door_case(mesh_m, frequencies, solver, reduction=None):
 
 
 def run_case(case, timeout):
-    """Whole `sarfe solve` process: dict(wall_s, peak_rss_gb, timed_out, exit, summary)."""
+    """Whole `sarfe solve` process: dict(wall_s, peak_rss_gb, timed_out, exit, summary, stages)."""
+    import threading
+
     timeout = max(5.0, min(timeout, left()))
     work = pathlib.Path(tempfile.mkdtemp(prefix="bench_door_"))
     (work / "case.yaml").write_text(yaml.safe_dump(case))
-    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MPLBACKEND="Agg",
-               PYTHONPATH=str(ROOT))
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1",
+               MPLBACKEND="Agg", PYTHONPATH=str(ROOT))
     cmd = [sys.executable, "-m", "sarfe.cli", "solve", str(work / "case.yaml"), "--output",
            str(work / "out")]
     start = time.perf_counter()
     proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                             start_new_session=True)
-    timed_out = False
-    try:
-        _, err = proc.communicate(timeout=timeout)
-    except subprocess.TimeoutExpired:
-        os.killpg(proc.pid, 9)
-        _, err = proc.communicate()
-        timed_out = True
+    stages, tail = [], []
+
+    def read():   # stage lines "sarfe: <stage> …" with their time since start
+        for raw in proc.stderr:
+            line = raw.decode(errors="replace").rstrip()
+            tail.append(line)
+            if line.startswith("sarfe: "):
+                stages.append((round(time.perf_counter() - start, 2), line[7:60]))
+
+    reader = threading.Thread(target=read, daemon=True)
+    reader.start()
+    timed_out, status, usage = False, None, None
+    while True:
+        pid, status, usage = os.wait4(proc.pid, os.WNOHANG)
+        if pid:
+            break
+        if time.perf_counter() - start > timeout:
+            os.killpg(proc.pid, 9)
+            _, status, usage = os.wait4(proc.pid, 0)
+            timed_out = True
+            break
+        time.sleep(0.2)
     wall = time.perf_counter() - start
-    # ru_maxrss of children = the largest child so far (kB on Linux); runs go from small to large
-    peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024 ** 2
+    reader.join(timeout=5)
+    proc.returncode = os.waitstatus_to_exitcode(status)
     summary = None
     path = work / "out" / "summary.json"
     if path.exists():
         summary = json.loads(path.read_text())
-    return {"wall_s": wall, "peak_rss_gb_upper": peak, "timed_out": timed_out,
-            "exit": proc.returncode, "stderr_tail": err.decode(errors="replace")[-300:],
-            "summary": summary}
+    return {"wall_s": wall, "cpu_s": usage.ru_utime + usage.ru_stime,
+            "peak_rss_gb": usage.ru_maxrss / 1024 ** 2, "timed_out": timed_out,
+            "exit": proc.returncode, "stderr_tail": "\n".join(tail[-4:])[-400:],
+            "summary": summary, "stages": stages, "load_average": os.getloadavg()}
 
 
 def point_rows(summary):
@@ -87,30 +106,99 @@ def point_rows(summary):
              "error_estimate": p.get("error_estimate")} for p in summary["points"]]
 
 
-def p1():
-    out = []
-    freqs = [60.0, 64.0, 67.0]
-    solver = {"harmonics": 15}        # defaults otherwise: estimate and stability on
-    for mesh_m in (0.005, 0.010):
-        r = run_case(door_case(mesh_m, freqs, solver), 300.0)
-        entry = {"mesh_m": mesh_m, "harmonics": 15, "frequencies_hz": freqs,
-                 **{k: r[k] for k in ("wall_s", "peak_rss_gb_upper", "timed_out", "exit")}}
-        s = r["summary"]
-        if s:
-            t = s["timings_s"]
-            n = len(s["points"])
-            per_point = (t.get("hbm_s", 0) + t.get("error_estimate_s", 0)
-                         + t.get("postprocess_s", 0)) / n
-            once = r["wall_s"] - per_point * n
-            entry.update(timings_s=t, points=point_rows(s), per_point_s=per_point,
-                         model=s.get("model"), once_s=once,
-                         extrapolated_200_s=once + 200 * per_point)
-        else:
-            entry["stderr_tail"] = r["stderr_tail"]
-        out.append(entry)
-        if s and mesh_m == 0.005:
-            break                       # 5 mm finished: the 10 mm fallback is not needed
+P1_CASE = ROOT / "cases" / "door_trim_p1.yaml"
+P4_FREQUENCIES = [60.0, 67.0, 80.0]   # f_max 80 Hz: the P1 cutoff (1.5 · H · f_max)
+
+
+def p1_case(mesh_m=None, frequencies=None, harmonics=None, spots=None):
+    """cases/door_trim_p1.yaml as data (read as sarfe reads it), optionally changed."""
+    from sarfe.io.case import read_yaml
+
+    case = read_yaml(P1_CASE)[0]
+    gen = case["model"]["fe"]["generator"]
+    if mesh_m is not None:
+        gen["mesh_size_m"] = mesh_m
+    if frequencies is not None:
+        case["excitation"].pop("sweep", None)
+        case["excitation"]["frequency_hz"] = list(frequencies)
+        case["solver"].pop("continuation", None)
+    if harmonics is not None:
+        case["solver"]["harmonics"] = harmonics
+    if spots is not None:               # (rattle, squeak): the first of each kind in the case
+        rattle, squeak = spots
+        gen["params"] = {"rattle_spots": max(rattle, 4), "squeak_spots": max(squeak, 2)}
+        from sarfe.mesh.generators.door_trim import RATTLE_SPOTS, SQUEAK_SPOTS
+        template = {c["type"]: c for c in case["contacts"]}
+        names = [n for n, _ in RATTLE_SPOTS[:rattle]] + [n for n, _ in SQUEAK_SPOTS[:squeak]]
+        case["contacts"] = [dict(template["rattle" if i < rattle else "squeak"], name=n,
+                                 between=[f"contact_{n}_a", f"contact_{n}_b"])
+                            for i, n in enumerate(names)]
+    return case
+
+
+def run_record(r, **extra):
+    """The numbers of one run kept in the results."""
+    s = r["summary"]
+    out = dict(extra, **{k: r[k] for k in ("wall_s", "cpu_s", "peak_rss_gb", "timed_out", "exit",
+                                           "stages", "load_average")})
+    if s:
+        t = s["timings_s"]
+        n = len(s["points"])
+        out.update(timings_s=t, points_n=n, model={k: s["model"].get(k) for k in (
+            "free_dofs", "modes", "reduced_dofs", "boundary_dofs", "cutoff_hz")},
+            contacts=len(s["contacts"]), hbm_s_per_point=t.get("hbm_s", 0) / max(n, 1),
+            per_point_s=(t.get("hbm_s", 0) + t.get("error_estimate_s", 0)
+                         + t.get("postprocess_s", 0)) / max(n, 1),
+            converged=sum(bool(p["converged"]) for p in s["points"]),
+            stable=sum(p["stable"] is True for p in s["points"]),
+            loudest=(s.get("worst") or {}).get("erp_level_dba"),
+            sweep_complete=s.get("sweep_complete"))
+        out["points"] = point_rows(s) if n <= 10 else None
+    else:
+        out["stderr_tail"] = r["stderr_tail"]
     return out
+
+
+def p1(timeout=900.0):
+    """The whole P1 sweep for real, bounded by ``timeout``."""
+    r = run_case(p1_case(), timeout)
+    return run_record(r, case="cases/door_trim_p1.yaml", timeout_s=timeout)
+
+
+def p4_sizes():
+    """HBM s/point vs FE size: 15, 10, 5 mm, 12 pairs, H = 15, listed frequencies."""
+    res = {"frequencies_hz": P4_FREQUENCIES, "sizes": []}
+    for mesh_m in (0.015, 0.010, 0.005):
+        r = run_case(p1_case(mesh_m, P4_FREQUENCIES), 1200.0)
+        res["sizes"].append(run_record(r, mesh_m=mesh_m, pairs=12, harmonics=15))
+    res["fit_size"] = fit([(g["model"]["free_dofs"],), g.get("hbm_s_per_point")]
+                          for g in res["sizes"] if g.get("model"))
+    return res
+
+
+def p4_grid():
+    """HBM s/point vs contact pairs (6, 12, 18) × H (5, 15) on the 15 mm mesh."""
+    res = {"frequencies_hz": P4_FREQUENCIES, "grid": []}
+    for spots in ((4, 2), (8, 4), (12, 6)):
+        for H in (5, 15):
+            if left() < 120:
+                break
+            r = run_case(p1_case(0.015, P4_FREQUENCIES, H, spots), 600.0)
+            res["grid"].append(run_record(r, mesh_m=0.015, pairs=sum(spots), harmonics=H))
+    res["fit_grid"] = fit([(g["pairs"], g["harmonics"]), g.get("hbm_s_per_point")]
+                          for g in res["grid"])
+    return res
+
+
+def fit(rows):
+    """Least-squares exponents of s = c · Π x_i^b_i (log-linear) over rows [(x...), s]."""
+    rows = [(x, y) for x, y in rows if y and y > 0]
+    if len(rows) < 2:
+        return None
+    X = np.array([[1.0, *np.log(np.asarray(x, dtype=float))] for x, _ in rows])
+    y = np.log([y for _, y in rows])
+    coef, *_ = np.linalg.lstsq(X, y, rcond=None)
+    return [float(c) for c in coef[1:]]
 
 
 def audible():
@@ -225,42 +313,98 @@ def fmt(x, spec=".1f"):
     return "-" if x is None else format(x, spec)
 
 
+def stage_of(run):
+    """How far a run got: its last stage line and when it started [s]."""
+    stages = run.get("stages") or []
+    return f"{stages[-1][1]} (from {stages[-1][0]:.0f} s)" if stages else "-"
+
+
+def p1_lines(e, p4):
+    t = e.get("timings_s") or {}
+    L = ["", "## P1: cases/door_trim_p1.yaml — 5 mm, 12 pairs (8 rattle + 4 squeak), H = 15, sweep "
+         "40 → 80 Hz (max_step 0.005: ≥ 200 reported points), default options, mesh → VTU", "",
+         "The whole sweep, one `sarfe solve` process (mesh from the cache after the first run; "
+         "the cache is what `sarfe solve` uses). Target ≤ 60 s, ≤ 4 GB.", "",
+         "| points | converged | wall s | CPU s | peak RSS GB | linear stage s | HBM s | estimate s | "
+         "post s | outputs s | reached |", "|---|---|---|---|---|---|---|---|---|---|---|",
+         f"| {e.get('points_n', '-')} | {e.get('converged', '-')} | {e['wall_s']:.1f}"
+         f"{' (TIMEOUT)' if e['timed_out'] else ''} | {e.get('cpu_s', 0):.1f} | {e['peak_rss_gb']:.2f} | "
+         f"{fmt(t.get('linear_stage_s'))} | {fmt(t.get('hbm_s'))} | {fmt(t.get('error_estimate_s'))} | "
+         f"{fmt(t.get('postprocess_s'))} | {fmt(t.get('outputs_s'))} | "
+         f"{'done' if e.get('summary_ok', e.get('points_n')) else stage_of(e)} |", ""]
+    L.append(f"Stage lines (s since start): {e.get('stages')}; load average during the run "
+             f"{fmt(e['load_average'][0], '.1f')}.")
+    five = next((g for g in (p4 or {}).get("sizes", []) if g["mesh_m"] == 0.005 and g.get("timings_s")),
+                None)
+    sweep_start = next((t for t, line in e.get("stages") or [] if line.startswith("sweep")), None)
+    if sweep_start is not None:
+        L += ["", f"The sweep (HBM) started {sweep_start:.0f} s after launch: checks + mesh + linear "
+              "stage took that long in this run."]
+    if e["timed_out"] and five:
+        once = five["wall_s"] - five["per_point_s"] * five["points_n"]
+        if sweep_start is not None:    # this run's own linear stage + the P4 run's outputs
+            once = sweep_start + five["timings_s"].get("outputs_s", 0)
+        L += ["", f"EXTRAPOLATED (fallback, the real sweep did not finish in {e['timeout_s']:.0f} s): "
+              f"once {once:.1f} s (until the sweep started in this run, else the P4 5 mm run's linear "
+              f"stage {five['timings_s']['linear_stage_s']:.1f} s; outputs of the P4 5 mm run "
+              f"{five['timings_s'].get('outputs_s', 0):.1f} s) + 200 × {five['per_point_s']:.2f} s/point "
+              f"(HBM + estimate + postprocess of the P4 5 mm run, {five['points_n']} listed points) "
+              f"= {once + 200 * five['per_point_s']:.0f} s; peak RSS of that run "
+              f"{five['peak_rss_gb']:.2f} GB (its points are listed frequencies, each with its own "
+              "error estimate; a sweep estimates every 8th point)."]
+    return L
+
+
+def p4_lines(p4):
+    L = ["", "## P4: HBM seconds per point (summary.json hbm_s / points: Newton + Hill stability; "
+         f"listed frequencies {P4_FREQUENCIES} Hz, default options)", "",
+         "| mesh | pairs | H | free DOFs | reduced DOFs | HBM s/point | estimate s | linear stage s | "
+         "wall s | CPU s | peak RSS GB | converged |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for g in p4.get("sizes", []) + p4.get("grid", []):
+        if not g:
+            continue
+        t, m = g.get("timings_s") or {}, g.get("model") or {}
+        L.append(f"| {g['mesh_m'] * 1000:.0f} mm | {g['pairs']} | {g['harmonics']} | "
+                 f"{m.get('free_dofs', '-')} | {m.get('reduced_dofs', '-')} | "
+                 f"{fmt(g.get('hbm_s_per_point'), '.2f')} | {fmt(t.get('error_estimate_s'))} | "
+                 f"{fmt(t.get('linear_stage_s'))} | {g['wall_s']:.1f}{' (TIMEOUT)' if g['timed_out'] else ''}"
+                 f" | {g.get('cpu_s', 0):.1f} | {g['peak_rss_gb']:.2f} | "
+                 f"{g.get('converged', '-')}/{g.get('points_n', '-')} |")
+    fs, fg = p4.get("fit_size"), p4.get("fit_grid")
+    L += ["", f"Fitted exponents: HBM s/point ∝ free_DOFs^{fmt(fs[0] if fs else None, '.2f')} "
+          "(target: flat within 20 % over 15/10/5 mm); ∝ pairs^"
+          f"{fmt(fg[0] if fg else None, '.2f')} · H^{fmt(fg[1] if fg else None, '.2f')} "
+          "(target: roughly linear in pairs × H)."]
+    return L
+
+
 def write(results):
     RESULTS.mkdir(exist_ok=True)
     (RESULTS / "door_trim.json").write_text(json.dumps(results, indent=1, default=str))
-    L = ["# Door trim P1, audible study, HBM vs time integration (issue 15)", "",
-         f"Machine: {platform.platform()}, {os.cpu_count()} cores, load average at start "
-         f"{results['load_average']}; OPENBLAS_NUM_THREADS=1; every `sarfe solve` a whole process. "
-         f"Bench wall {results['wall_s']:.0f} s.", "",
-         "## P1: door trim, H = 15, default options (estimate and stability on), mesh → VTU", "",
-         "Contact pairs: the door_trim generator has 6 spots (4 rattle + 2 squeak) and no parameter "
-         "for more, so 6 pairs (target ≥ 12). Peak RSS = ru_maxrss of the children so far: exact for "
-         "the 5 mm run (the first child).", "",
-         "| mesh | points | wall s | peak RSS GB | linear stage s | HBM s | estimate s | post s | "
-         "outputs s | s / point | EXTRAPOLATED 200 points s |", "|---|---|---|---|---|---|---|---|---|---|---|"]
-    for e in results.get("p1") or []:
-        t = e.get("timings_s", {})
-        L.append(f"| {e['mesh_m'] * 1000:.0f} mm | {len(e['frequencies_hz'])} | {e['wall_s']:.1f}"
-                 f"{' (timeout)' if e['timed_out'] else ''} | {e['peak_rss_gb_upper']:.2f} | "
-                 f"{fmt(t.get('linear_stage_s'))} | {fmt(t.get('hbm_s'))} | "
-                 f"{fmt(t.get('error_estimate_s'))} | {fmt(t.get('postprocess_s'))} | "
-                 f"{fmt(t.get('outputs_s'))} | {fmt(e.get('per_point_s'), '.2f')} | "
-                 f"{fmt(e.get('extrapolated_200_s'), '.0f')} |")
-    L += ["", "Extrapolation = (wall − n × s/point) + 200 × s/point, with s/point = (HBM + estimate + "
-          "postprocess) / n from summary.json; target ≤ 60 s, ≤ 4 GB.", ""]
-    for e in results.get("p1") or []:
-        for p in e.get("points", []):
-            L.append(f"- {e['mesh_m'] * 1000:.0f} mm {p['f_hz']:g} Hz: {fmt(p['dba'], '.2f')} dB(A), "
-                     f"converged {p['converged']}, stable {p['stable']}, {p['iterations']} its")
-    a = results.get("audible")
-    h = results.get("hbm_vs_time")
-    for name in ("p1", "audible", "hbm_vs_time"):
+    L = ["# Door trim P1, P4, audible study, HBM vs time integration (issue 15)", "",
+         f"Machine: {platform.platform()}, {os.cpu_count()} cores shared with other jobs (other "
+         f"helpers ran in parallel: load average at start {results['load_average']}, at the end "
+         f"{results.get('load_average_end', '-')}); OPENBLAS/OMP/MKL_NUM_THREADS=1; every "
+         f"`sarfe solve` a whole process, peak RSS = that process's ru_maxrss, CPU s = its user + "
+         f"system time (what one core of a quiet machine would take, the stage columns are wall). Bench wall "
+         f"{results['wall_s']:.0f} s. Wall seconds under this load are up to ~3× a quiet "
+         "machine's.", ""]
+    for name, date in (results.get("kept_from") or {}).items():
+        L.append(f"- `{name}`: kept from the run of {date} (not rerun this time).")
+    for note in results.get("notes") or []:      # added by hand to the .json, kept on rewrite
+        L.append(f"- Note: {note}")
+    p4 = {**(results.get("p4sizes") or {}), **(results.get("p4grid") or {})}
+    if results.get("p1"):
+        L += p1_lines(results["p1"], p4)
+    if p4:
+        L += p4_lines(p4)
+    for name in ("p1", "p4sizes", "p4grid", "audible", "hbm_vs_time"):
         if results.get(name + "_error"):
             L += ["", f"{name} failed: {results[name + '_error']}"]
-    if a:
-        L += audible_lines(a)
-    if h:
-        L += hbm_lines(h)
+    if results.get("audible"):
+        L += audible_lines(results["audible"])
+    if results.get("hbm_vs_time"):
+        L += hbm_lines(results["hbm_vs_time"])
     (RESULTS / "door_trim.md").write_text("\n".join(L) + "\n")
 
 
@@ -325,14 +469,28 @@ def hbm_lines(h):
 
 
 def main():
-    results = {"load_average": " ".join(f"{x:.1f}" for x in os.getloadavg())}
-    for name, fn in (("p1", p1), ("hbm_vs_time", hbm_vs_time), ("audible", audible)):
+    parts = (sys.argv[1] if len(sys.argv) > 1 else "p4sizes,p1,p4grid").split(",")
+    results = {"load_average": " ".join(f"{x:.1f}" for x in os.getloadavg()),
+               "date_utc": time.strftime("%Y-%m-%d %H:%M", time.gmtime()), "kept_from": {}}
+    previous = RESULTS / "door_trim.json"
+    if previous.exists():       # parts not rerun keep their earlier numbers, marked
+        old = json.loads(previous.read_text())
+        for name in ("p1", "p4sizes", "p4grid", "audible", "hbm_vs_time"):
+            if name not in parts and old.get(name) and not (name == "p1" and isinstance(old[name], list)):
+                results.setdefault("notes", old.get("notes", []))
+                results[name] = old[name]
+                results["kept_from"][name] = ((old.get("kept_from") or {}).get(name)
+                                              or old.get("date_utc", "an earlier run"))
+    functions = {"p1": p1, "p4sizes": p4_sizes, "p4grid": p4_grid, "hbm_vs_time": hbm_vs_time,
+                 "audible": audible}
+    for name in parts:
         try:
-            results[name] = fn()
+            results[name] = functions[name]()
         except Exception as exc:    # a failing part is reported, the others still run
             results[name] = None
             results[name + "_error"] = repr(exc)
         results["wall_s"] = time.perf_counter() - T0
+        results["load_average_end"] = " ".join(f"{x:.1f}" for x in os.getloadavg())
         write(results)
         print(name, "done", f"{results['wall_s']:.0f} s", flush=True)
 

@@ -595,6 +595,7 @@ def _build_fe(case: Case, progress=False) -> dict:
     _step(stages, "reduction")
 
     k_ff, m_ff, free, position = _supports(mesh, fixed_nodes, stiffness, mass)
+    del stiffness, mass                  # the free-DOF copies are all the reduction needs
     boundary = _boundary_positions(paired, load_nodes, position)
     base_load = _base_load(config.excitation, n_nodes, m_ff, free)
     clock = time.perf_counter()

@@ -54,14 +54,21 @@ def write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, d
         mesh = stage.mesh
         markers = outputs.contact_markers(mesh.n_nodes, [g.nodes_a for g in stage.contacts.values()])
         translations = {}
+        every_point = full_field_every_point(stage, solutions)
 
         def nodal_translations(j):
-            # full-field recovery only because a VTU or a map was asked for: (2H+1, n, 3) [m]
-            if j not in translations:
-                u = recover_displacement(stage.reduced, np.asarray(solutions[j].displacement),
-                                         all_dofs=True)
-                translations[j] = u.reshape(u.shape[0], mesh.n_nodes, 6)[:, :, :3]
-            return translations[j]
+            # full-field recovery only because a VTU or a map was asked for: (2H+1, n, 3) [m];
+            # kept for the loudest point only (200 points of a 5 mm door trim would hold 5 GB)
+            if j in translations:
+                return translations[j]
+            if j != loudest and not every_point:
+                return None
+            u = recover_displacement(stage.reduced, np.asarray(solutions[j].displacement),
+                                     all_dofs=True)
+            u = u.reshape(u.shape[0], mesh.n_nodes, 6)[:, :, :3]
+            if j == loudest:
+                translations[j] = u
+            return u
 
         def point_data(j):
             force, motion = contact_pair_fields(stage, nl, solutions[j], mesh.n_nodes)
@@ -107,6 +114,22 @@ def write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, d
         written["report"] = "report.html"
     shutil.rmtree(directory / ".report-figures", ignore_errors=True)
     return written
+
+
+# full-field recovery u = T q of every sweep point for the VTU maps up to this many multiply-adds
+# (Σ_points (2H+1) · n_free · n_r: ~1 s); beyond it only the loudest point's map carries the
+# nodal displacement (docs/outputs.md, displacement_amplitude_m)
+FULL_FIELD_BUDGET = 5e9
+
+
+def full_field_every_point(stage, solutions) -> bool:
+    """True when every point's VTU map gets the recovered nodal displacement (FULL_FIELD_BUDGET)."""
+    reduced = stage.reduced
+    if reduced is None or not solutions:
+        return False
+    cost = sum(np.asarray(s.displacement).shape[0] for s in solutions) \
+        * reduced.full_dof_count * reduced.reduced_dof_count
+    return cost <= FULL_FIELD_BUDGET
 
 
 def results_table(rows, contact_types=None, max_contacts=6) -> str:

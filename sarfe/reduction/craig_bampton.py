@@ -48,6 +48,10 @@ import scipy.sparse.linalg as spla
 from sarfe.fe.linear_solvers import factorize
 
 _MODE_BLOCK = 24  # fixed-interface modes requested per Lanczos run when searching up to a cutoff
+# a σ = 0 block Lanczos run keeps at most max(_SLICE_COLUMNS, _SLICE_ENTRIES / n) Krylov columns;
+# past that the modes up to the cutoff come from spectrum slicing (1.3 GB of Q, MQ at n = 206k)
+_SLICE_COLUMNS = 400
+_SLICE_ENTRIES = 8e7
 
 
 @dataclass(frozen=True, eq=False)  # array fields: compare explicitly, not with ==
@@ -215,8 +219,18 @@ def _m_orthonormal(block, mass):
     return block, mass_block
 
 
+@dataclass(frozen=True, eq=False)
+class _Partial:
+    """A σ = 0 Lanczos run stopped at its column cap: its converged eigenpairs, all ω² ≤ boundary."""
+
+    omega2: np.ndarray
+    modes: np.ndarray
+    boundary: float
+    columns: int
+
+
 def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, block_size=16, tol=1e-8,
-                         seed=0):
+                         seed=0, max_columns=None):
     """Lowest modes of K_ii φ = ω² M_ii φ by block shift-invert Lanczos (σ = 0), full M-reorthogonalization.
 
     Krylov space of A = K_ii⁻¹ M_ii from a block of ``block_size`` columns: every step is ONE
@@ -225,7 +239,8 @@ def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, blo
     Stops when the wanted Ritz pairs have residual < tol·ν (eigenvalue error ~ residual², so 1e-8
     gives frequencies to ~1e-15; 11 % fewer solves than 1e-10 on the door trim). Returns ω²
     (ascending), Φ (Φᵀ M Φ = I), or None when the Krylov space fills the interior before that (tiny
-    models). Door trim at 5 mm (206k DOFs, 60 modes, one thread): 10.8 s CPU, down from 17.8 s with
+    models). With ``max_columns``, a run that would outgrow it stops and returns the converged
+    prefix as ``_Partial`` (for :mod:`sarfe.reduction.spectrum_slicing` to go on from). Door trim at 5 mm (206k DOFs, 60 modes, one thread): 10.8 s CPU, down from 17.8 s with
     two full Gram–Schmidt passes, row-major blocks and a too-small initial store.
     """
     n = mass_ii.shape[0]
@@ -237,6 +252,10 @@ def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, blo
     # doubling below) — never n columns up front, which is two dense n×n arrays
     guess = min(target, n) if mode_count is not None else 64
     capacity = min(n, max(4 * block_size, 5 * guess + 2 * block_size))  # measured: ~4.8 columns per mode
+    if max_columns is not None:
+        # the whole capped store up front: growing it copies, and old + new store at 206k DOFs
+        # were 2.6 GB at once
+        capacity = min(n, max_columns + 2 * block_size)
     # Q, M Q preallocated column-major: a block of columns is then contiguous, which the sparse
     # solvers want (no copy per solve)
     store, mass_store = np.empty((n, capacity), order="F"), np.empty((n, capacity), order="F")
@@ -283,8 +302,18 @@ def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, blo
         done = leading >= wanted and above_cutoff and (wanted == target or cutoff_hz is not None)
         if done or m_new + q.shape[1] > n - 1 or q.shape[1] == 0:
             break
+        if max_columns is not None and m_new + q.shape[1] > max_columns:
+            # many modes: hand the converged prefix on to spectrum slicing — converged relative to
+            # each own ν, as the shifted runs test (ν_1-relative is loose for the higher modes and
+            # would leave them 1e-7 from M-orthogonal to the next slice's); the boundary lies
+            # halfway to the next Ritz value
+            strict = residual <= tol * np.abs(values)
+            prefix = int(np.argmin(strict)) if not strict.all() else len(strict)
+            if 0 < prefix < len(values):
+                return _Partial(omega2[:prefix], basis @ vectors[:, :prefix],
+                                0.5 * (omega2[prefix - 1] + omega2[prefix]), m_new)
         if m_new + q.shape[1] > capacity:
-            capacity = min(n, 2 * capacity)
+            capacity = min(n, max(2 * capacity, m_new + q.shape[1]))
             grown_store, grown_mass = np.empty((n, capacity), order="F"), np.empty((n, capacity), order="F")
             grown_store[:, :m_new], grown_mass[:, :m_new] = store[:, :m_new], mass_store[:, :m_new]
             store, mass_store = grown_store, grown_mass
@@ -296,17 +325,39 @@ def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, blo
     return omega2[:wanted], modes
 
 
-def residual_modes(stiffness_ii, mass_ii, operator, loads, modes, relative_tolerance=1e-8):
+def _slice(k_ii, m_ii, cutoff_hz, partial, progress, timings):
+    """Modes up to the cutoff by spectrum slicing from run 0's converged prefix: (ω², Φ), or None
+    when slicing cannot run (no PARDISO for the inertia) or a gap's count was not reached."""
+    from sarfe.fe.linear_solvers import available_solvers
+    from sarfe.reduction.spectrum_slicing import SlicingFailed, sliced_modes
+
+    if "pardiso" not in available_solvers():
+        return None
+    try:
+        omega2, modes, record = sliced_modes(k_ii, m_ii, (2 * np.pi * cutoff_hz) ** 2,
+                                             partial.omega2, partial.modes, partial.boundary,
+                                             progress=progress, solver="pardiso")
+    except SlicingFailed as exc:
+        timings["slicing"] = {"failed": str(exc)}
+        return None
+    timings["slicing"] = dict(record, run0_columns=partial.columns, run0_modes=len(partial.omega2))
+    return omega2, modes
+
+
+def residual_modes(stiffness_ii, mass_ii, operator, loads, modes, relative_tolerance=1e-8,
+                   static=None):
     """Residual modes Φ_r from interior loads (module docstring): ω_r² (ascending), Φ_r.
 
     loads: (n_i, k) interior load columns F_i; operator(F) = K_ii⁻¹ F; modes: Φ (n_i, n_m),
     Φᵀ M_ii Φ = I. Directions whose M-norm after deflation is below relative_tolerance × their norm
-    before (already in span Φ, or dependent) are dropped.
+    before (already in span Φ, or dependent) are dropped. ``static``: K_ii⁻¹ F_i when already
+    computed (then ``operator`` is not called).
     """
     n = mass_ii.shape[0]
     if loads.shape[1] == 0:
         return np.empty(0), np.empty((n, 0))
-    static = operator(np.asarray(loads, dtype=float))
+    if static is None:
+        static = operator(np.asarray(loads, dtype=float))
     norms = np.sqrt(np.einsum("ij,ij->j", static, mass_ii @ static))
     static = static[:, norms > 0] / norms[norms > 0]  # unit M-norm before deflation
     for _ in range(2):  # deflate Φ twice (classical Gram–Schmidt, re-orthogonalized)
@@ -369,8 +420,8 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
 
     k_ii = stiffness[interior][:, interior]
     m_ii = mass[interior][:, interior].tocsr()
-    k_ib = stiffness[interior][:, boundary].toarray()
-    m_ib = mass[interior][:, boundary].toarray()
+    k_ib = stiffness[interior][:, boundary].tocsc()     # sparse: n_i × n_b dense is 0.1 GB
+    m_ib = mass[interior][:, boundary].tocsc()          # per matrix at 206k DOFs
     k_bb = stiffness[boundary][:, boundary].toarray()
     m_bb = mass[boundary][:, boundary].toarray()
     lap("partition")
@@ -378,50 +429,96 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
     factor = factorize(k_ii, solver=solver, structure="spd")
     lap("factorization")
 
-    psi = -factor.solve(k_ib) if len(boundary) else np.empty((len(interior), 0))
+    psi = -factor.solve(k_ib.toarray()) if len(boundary) else np.empty((len(interior), 0))
     lap("constraint_modes")
 
     applications = [0]
+    held, solver_name = {"factor": factor}, factor.name
+    del factor
 
     def inverse(y):
         applications[0] += 1 if y.ndim == 1 else y.shape[1]
-        return factor.solve(y)
+        if held["factor"] is None:        # freed for spectrum slicing, needed again (fallback)
+            held["factor"] = factorize(k_ii, solver=solver, structure="spd")
+        return held["factor"].solve(y)
+
+    # residual-vector loads and their static responses K_ii⁻¹ F_i, before any mode search (the
+    # factor of K_ii may be freed while slicing the spectrum)
+    # F_b = M_ib + M_ii Ψ: the interior load of unit boundary accelerations (also M_r's coupling
+    # block F_bᵀ Φ); built in place, and shared with the residual-vector loads
+    n_b = len(boundary)
+    extra = None if residual_loads is None else np.asarray(residual_loads, dtype=float)
+    extra = None if extra is None else (extra[:, None] if extra.ndim == 1 else extra)[interior]
+    with_boundary = bool(residual_vectors and n_b)
+    width = (n_b if with_boundary else 0) + (0 if extra is None else extra.shape[1])
+    loads = np.empty((len(interior), width)) if width else None
+    boundary_load = loads[:, :n_b] if with_boundary else np.empty((len(interior), n_b))
+    boundary_load[:] = m_ii @ psi
+    psi_m_psi = psi.T @ boundary_load                               # Ψᵀ M_ii Ψ
+    coo = m_ib.tocoo()
+    np.add.at(boundary_load, (coo.row, coo.col), coo.data)
+    if extra is not None:
+        loads[:, width - extra.shape[1]:] = extra
+        del extra
+    static = inverse(loads) if loads is not None else None
+    lap("residual_static")
 
     if (mode_count or 0) > 0 or (cutoff_hz is not None and mode_count is None):
         if eigensolver not in ("block", "arpack"):
             raise ValueError(f"eigensolver must be 'block' or 'arpack', got {eigensolver!r}")
         found = None
         if eigensolver == "block":
-            found = _block_lanczos_modes(m_ii, inverse, mode_count, cutoff_hz, progress)
+            # many modes up to a cutoff: cap run 0's Krylov space (two n × m arrays), slice the rest
+            cap = max(_SLICE_COLUMNS, int(_SLICE_ENTRIES // max(len(interior), 1))) \
+                if cutoff_hz is not None and mode_count is None else None
+            found = _block_lanczos_modes(m_ii, inverse, mode_count, cutoff_hz, progress,
+                                         max_columns=cap)
+            if isinstance(found, _Partial):
+                held["factor"] = None     # K_ii's factor is not used by the shifted runs
+                found = _slice(k_ii, m_ii, cutoff_hz, found, progress, timings)
+            if found is None and cap is not None:   # slicing impossible: one uncapped run
+                found = _block_lanczos_modes(m_ii, inverse, mode_count, cutoff_hz, progress)
         if found is None:
             found = _fixed_interface_modes(k_ii, m_ii, inverse, mode_count, cutoff_hz, progress)
             eigensolver = "arpack"
-        omega2, phi = found
+        omega2, blocks = found
         timings["eigensolver"] = eigensolver
     else:
-        omega2, phi = np.empty(0), np.empty((len(interior), 0))
+        omega2, blocks = np.empty(0), np.empty((len(interior), 0))
+    held["factor"] = None
     lap("normal_modes")
 
-    m_ii_psi = m_ii @ psi
-    loads = []
-    if residual_vectors and len(boundary):
-        loads.append(m_ib + m_ii_psi)
-    if residual_loads is not None:
-        extra = np.asarray(residual_loads, dtype=float)
-        loads.append((extra[:, None] if extra.ndim == 1 else extra)[interior])
-    if loads:
-        omega2_r, phi_r = residual_modes(k_ii, m_ii, inverse, np.hstack(loads), phi)
+    # T's interior rows [Ψ, Φ, Φ_r] in one array, filled in place (Φ arrives in column blocks
+    # when sliced; no stacked copies of an n_i × n_m array)
+    blocks = blocks if isinstance(blocks, list) else [blocks]
+    n_fixed = len(omega2)
+    basis = np.empty((len(interior), n_b + n_fixed + (0 if loads is None else loads.shape[1])))
+    basis[:, :n_b] = psi
+    column = n_b
+    while blocks:
+        block = blocks.pop(0)
+        basis[:, column:column + block.shape[1]] = block
+        column += block.shape[1]
+        del block
+    phi = basis[:, n_b:n_b + n_fixed]
+    if loads is not None:
+        omega2_r, phi_r = residual_modes(k_ii, m_ii, None, loads, phi, static=static)
     else:
         omega2_r, phi_r = np.empty(0), np.empty((len(interior), 0))
+    basis[:, n_b + n_fixed:n_b + n_fixed + phi_r.shape[1]] = phi_r
+    interior_basis = basis[:, :n_b + n_fixed + phi_r.shape[1]]
     lap("residual_modes")
     timings["operator_applications"] = applications[0]
     frequencies = np.sqrt(np.maximum(omega2, 0)) / (2 * np.pi)
     residual_frequencies = np.sqrt(np.maximum(omega2_r, 0)) / (2 * np.pi)
     omega2 = np.concatenate([omega2, omega2_r])
-    phi = np.hstack([phi, phi_r])
-    k_rbb = k_bb + k_ib.T @ psi
-    m_rbb = m_bb + m_ib.T @ psi + psi.T @ m_ib + psi.T @ m_ii_psi
-    m_rbm = (m_ib + m_ii_psi).T @ phi
+    phi = interior_basis[:, n_b:]
+    # dense transients for the n_b × n_b blocks: the same BLAS products (and round-off) as before
+    k_rbb = k_bb + k_ib.toarray().T @ psi
+    m_ib = m_ib.toarray()
+    m_rbb = m_bb + m_ib.T @ psi + psi.T @ m_ib + psi_m_psi
+    del m_ib
+    m_rbm = boundary_load.T @ phi
     n_b, n_m = len(boundary), len(omega2)
     stiffness_r = np.zeros((n_b + n_m, n_b + n_m))
     mass_r = np.zeros_like(stiffness_r)
@@ -442,7 +539,7 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
 
     return ReducedModel(
         mass=mass_r, stiffness=stiffness_r, boundary_dofs=boundary, interior_dofs=interior,
-        interior_basis=np.hstack([psi, phi]), mode_frequencies_hz=frequencies,
+        interior_basis=interior_basis, mode_frequencies_hz=frequencies,
         residual_frequencies_hz=residual_frequencies,
         full_dof_count=n, free_dofs=None if free_dofs is None else np.asarray(free_dofs, dtype=int),
-        total_dof_count=total_dof_count, solver=factor.name, timings=timings)
+        total_dof_count=total_dof_count, solver=solver_name, timings=timings)

@@ -70,9 +70,14 @@ def normal_velocity_basis(reduced: ReducedModel, node_normals, nodes=None, dofs_
         position[reduced.free_dofs] = np.arange(len(reduced.free_dofs))
         positions = position[dofs]
         free = positions >= 0
-    rows = np.zeros((len(dofs), reduced.reduced_dof_count))
-    rows[free] = dof_rows(reduced, positions[free])
-    return np.einsum("nc,ncr->nr", normals, rows.reshape(len(nodes), 3, -1))
+    # one translation component at a time: (n_nodes, n_r) rows, not (3 n_nodes, n_r) at once
+    positions, free = positions.reshape(len(nodes), 3), free.reshape(len(nodes), 3)
+    out = np.zeros((len(nodes), reduced.reduced_dof_count))
+    for c in range(3):
+        rows = np.zeros_like(out)
+        rows[free[:, c]] = dof_rows(reduced, positions[free[:, c], c])
+        out += normals[:, c:c + 1] * rows
+    return out
 
 
 __all__ = ["recover_displacement", "dof_rows", "normal_velocity_basis", "free_dof_positions"]

@@ -211,3 +211,29 @@ def test_contact_frames():
     assert gap[0] == 0.0 and np.allclose(normal, [[0, 0, -1]])  # from the pad down into the plate
     for pair, (normal, _, gap) in contact_frames(generated("door_trim")).items():
         assert gap == pytest.approx(0.5e-3, rel=1e-9) and normal[0, 2] < -0.9, pair
+
+
+def test_door_trim_contact_spot_counts():
+    """rattle_spots / squeak_spots add named spot pairs on the pocket flange (18 at most), each a
+    node pair 0.5 mm apart along the skin normal; the default counts give the demo's six spots."""
+    from sarfe.mesh import contact_frames
+    from sarfe.mesh.generators import door_trim
+
+    assert list(door_trim.contact_spots()) == ["lower_1", "lower_2", "lower_3", "upper_1",
+                                               "side_left", "side_right"]
+    mesh = door_trim.generate(mesh_size=0.03, rattle_spots=12, squeak_spots=6)
+    frames = contact_frames(mesh)
+    assert len(frames) == 18
+    assert set(frames) == set(door_trim.contact_spots(12, 6))
+    for pair, (normal, _, gap) in frames.items():
+        assert gap == pytest.approx(0.5e-3, rel=1e-9) and normal[0, 2] < -0.9, pair
+    a = np.array([mesh.points[mesh.node_groups[f"contact_{p}_b"][0]] for p in frames])
+    spacing = np.linalg.norm(a[:, None] - a[None], axis=-1) + np.eye(len(a))
+    assert spacing.min() > 0.04                     # distinct spots, ≥ 40 mm apart
+    default = generated("door_trim")
+    assert door_trim.generate(mesh_size=0.03, rattle_spots=4, squeak_spots=2).points.tobytes() \
+        == default.points.tobytes()
+    for bad in ({"rattle_spots": 13}, {"squeak_spots": -1}, {"rattle_spots": 2.0},
+                {"rattle_spots": 0, "squeak_spots": 0}):
+        with pytest.raises(ValueError):
+            door_trim.spec(**bad)
