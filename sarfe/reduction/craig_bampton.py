@@ -219,6 +219,33 @@ def _m_orthonormal(block, mass):
     return block, mass_block
 
 
+def lanczos_extend(basis, mass_products, w, projected, previous_start):
+    """One block-Lanczos step in the M inner product with full re-orthogonalization.
+
+    ``basis`` Q (n, m) holds the Krylov columns so far (the last block new), ``w`` = A q_block the
+    operator applied to the newest block, ``projected`` T_old (m_old, m_old) = Qᵀ M A Q on the older
+    columns, and ``mass_products(cols, y)`` returns Q[:, cols]ᵀ M y. The three-term part (columns
+    from ``previous_start``: the current and previous block carry the large components of A q)
+    comes first, then ONE full M-orthogonalization pass against all of Q removes the rest (as
+    accurate as two full passes at half their cost). Returns (w − Q C, T_new (m, m)) with C the
+    coefficients Qᵀ M w; T_new is symmetrized. Products written as (Cᵀ Qᵀ)ᵀ keep the column-major
+    layout the sparse solvers want.
+    """
+    m_new, m_old = basis.shape[1], projected.shape[0]
+    coefficients = np.zeros((m_new, w.shape[1]))
+    local = slice(previous_start, m_new)
+    coefficients[local] = mass_products(local, w)
+    w = w - (coefficients[local].T @ basis[:, local].T).T
+    correction = mass_products(slice(0, m_new), w)
+    w = w - (correction.T @ basis.T).T
+    coefficients = coefficients + correction
+    grown = np.zeros((m_new, m_new))
+    grown[:m_old, :m_old] = projected
+    grown[:, m_old:] = coefficients
+    grown[m_old:, :] = coefficients.T
+    return w, 0.5 * (grown + grown.T)
+
+
 @dataclass(frozen=True, eq=False)
 class _Partial:
     """A σ = 0 Lanczos run stopped at its column cap: its converged eigenpairs, all ω² ≤ boundary."""
@@ -271,19 +298,9 @@ def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, blo
         # A q), then ONE full M-orthogonalization pass against all of Q removes the rest: as
         # accurate as two full passes at half their cost. (Products written as (Cᵀ Qᵀ)ᵀ keep the
         # column-major layout the solvers want.)
-        coefficients = np.zeros((m_new, w.shape[1]))
-        local = slice(previous_start, m_new)
-        coefficients[local] = mass_basis[:, local].T @ w
-        w = w - (coefficients[local].T @ basis[:, local].T).T
-        correction = mass_basis.T @ w
-        w = w - (correction.T @ basis.T).T
-        coefficients = coefficients + correction
+        w, projected = lanczos_extend(basis, lambda cols, y: mass_basis[:, cols].T @ y, w, projected,
+                                      previous_start)
         previous_start = m_old
-        grown = np.zeros((m_new, m_new))
-        grown[:m_old, :m_old] = projected
-        grown[:, m_old:] = coefficients
-        grown[m_old:, :] = coefficients.T
-        projected = 0.5 * (grown + grown.T)
         q, mq = _m_orthonormal(w, mass_ii)
         coupling = mq.T @ w  # R with w = q R (+ dropped directions)
         values, vectors = np.linalg.eigh(projected)

@@ -28,23 +28,11 @@ from __future__ import annotations
 import numpy as np
 
 from sarfe.fe.linear_solvers import factorize
+from sarfe.reduction.craig_bampton import _m_orthonormal, lanczos_extend
 
 
 class SlicingFailed(RuntimeError):
     """A gap's eigenvalue count was not reached within the column cap (the caller falls back)."""
-
-
-def _m_orthonormalize(block, mass):
-    """Q with Qᵀ M Q = I spanning ``block`` (Gram eigendecomposition twice, dependent columns
-    dropped) and M Q."""
-    mass_block = mass @ block
-    for _ in range(2):
-        gram = block.T @ mass_block
-        values, vectors = np.linalg.eigh(0.5 * (gram + gram.T))
-        keep = values > 1e-12 * max(values.max(initial=0.0), 1e-300)
-        transform = vectors[:, keep] / np.sqrt(values[keep])
-        block, mass_block = (transform.T @ block.T).T, (transform.T @ mass_block.T).T
-    return block, mass_block
 
 
 def shifted_block_lanczos(mass, operator, shift, satisfied, max_columns, block_size=16, tol=1e-8,
@@ -59,7 +47,7 @@ def shifted_block_lanczos(mass, operator, shift, satisfied, max_columns, block_s
     """
     n = mass.shape[0]
     rng = np.random.default_rng(seed)
-    q, mq = _m_orthonormalize(operator(mass @ rng.standard_normal((n, block_size))), mass)
+    q, mq = _m_orthonormal(operator(mass @ rng.standard_normal((n, block_size))), mass)
     store = np.empty((n, max(max_columns, q.shape[1])), order="F")
     m_new = q.shape[1]
     store[:, :m_new] = q
@@ -69,20 +57,10 @@ def shifted_block_lanczos(mass, operator, shift, satisfied, max_columns, block_s
         m_old = projected.shape[0]
         w = operator(mq)                       # A q_block = (K − σM)⁻¹ M q_block
         basis = store[:, :m_new]
-        coefficients = np.zeros((m_new, w.shape[1]))
-        local = slice(previous_start, m_new)
-        coefficients[local] = basis[:, local].T @ (mass @ w)
-        w = w - (coefficients[local].T @ basis[:, local].T).T
-        correction = basis.T @ (mass @ w)      # one full M-orthogonalization pass
-        w = w - (correction.T @ basis.T).T
-        coefficients = coefficients + correction
+        w, projected = lanczos_extend(basis, lambda cols, y: basis[:, cols].T @ (mass @ y), w,
+                                      projected, previous_start)
         previous_start = m_old
-        grown = np.zeros((m_new, m_new))
-        grown[:m_old, :m_old] = projected
-        grown[:, m_old:] = coefficients
-        grown[m_old:, :] = coefficients.T
-        projected = 0.5 * (grown + grown.T)
-        q, mq = _m_orthonormalize(w, mass)
+        q, mq = _m_orthonormal(w, mass)
         coupling = mq.T @ w
         theta, vectors = np.linalg.eigh(projected)
         residual = np.linalg.norm(coupling @ vectors[m_old:], axis=0)
