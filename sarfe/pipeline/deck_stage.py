@@ -14,6 +14,7 @@ import numpy as np
 
 from sarfe.io.case import Case
 from sarfe.pipeline.deck import DECK_KEY, prepare_deck
+from sarfe.pipeline.linear import reduced_coordinates
 
 _LOADED_BOUNDARY_LIMIT = 60   # load-set DOFs kept physically up to this count (else residuals)
 
@@ -229,15 +230,7 @@ def build_deck_stage(case: Case, progress=False) -> dict:
         return out
 
     loads = np.zeros((len(forces), n_r))
-    coord = np.full(6 * deck.n_nodes, -1)
-    coord[boundary_global] = np.arange(n_b)
-
-    def coords_of(nodes_):
-        nodes_ = np.asarray(nodes_)
-        out = np.full((len(nodes_), 3), -1)
-        ok = nodes_ >= 0
-        out[ok] = coord[6 * nodes_[ok, None] + np.arange(3)]
-        return out
+    coords_of = reduced_coordinates(boundary_global, deck.n_nodes)
 
     for i, (load, nodes_i, vector) in enumerate(zip(forces, group_nodes, set_vectors)):
         if vector is not None:

@@ -524,11 +524,12 @@ def _reduce(case: Case, reduction, k_ff, m_ff, boundary, free, n_nodes, base_loa
     return reduced, cutoff
 
 
-def _reduced_coordinates(reduced, free, n_nodes):
+def reduced_coordinates(boundary_global, n_nodes):
     """A function: nodes (m,) → (m, 3) reduced coordinates of their translations (−1 when fixed,
-    not on the boundary, or the node is −1)."""
+    not on the boundary, or the node is −1). ``boundary_global`` (n_b,): the global DOF index
+    6·node + component of each boundary coordinate, in reduced order."""
     coord = np.full(6 * n_nodes, -1)
-    coord[free[reduced.boundary_dofs]] = np.arange(reduced.boundary_count)
+    coord[boundary_global] = np.arange(len(boundary_global))
 
     def coords_of(nodes):
         nodes = np.asarray(nodes)
@@ -605,7 +606,7 @@ def _build_fe(case: Case, progress=False) -> dict:
     _step(stages, "contacts, loads, ERP map")
     n_b, n_r = reduced.boundary_count, reduced.reduced_dof_count
 
-    coords_of = _reduced_coordinates(reduced, free, n_nodes)
+    coords_of = reduced_coordinates(free[reduced.boundary_dofs], n_nodes)
     contacts = _contact_geometry(paired, coords_of)
     loads, base = _load_vectors(config.excitation, load_nodes, coords_of, reduced, base_load)
     erp_nodes, areas, erp_map = _erp_map(mesh, radiating_triangles, reduced)
