@@ -35,6 +35,17 @@ def _project(w0, w1, q0, q1, rho):
     return q0 + t0 * ratio, q1 + t1 * ratio, ratio, slipping, t0 / safe, t1 / safe, r <= 0.0
 
 
+@njit(cache=True, inline="always")
+def _step_derivative(ratio, slipping, u0, u1, separated):
+    """P_j = ∂w_j/∂w_{j−1} of one step → (p00, p01, p10, p11, s0, s1): (ρ/|t|)(I − n nᵀ) in slip,
+    I in stick, 0 separated; (s0, s1) = n in slip, 0 otherwise."""
+    coefficient = 0.0 if separated else ratio
+    s0 = u0 if slipping else 0.0
+    s1 = u1 if slipping else 0.0
+    return ((1.0 - s0 * u0) * coefficient, (0.0 - s0 * u1) * coefficient,
+            (0.0 - s1 * u0) * coefficient, (1.0 - s1 * u1) * coefficient, s0, s1)
+
+
 @njit(cache=True)
 def periodic_start(q, rho, start, tolerance, pass_cap):
     r"""Slider at θ_0 of the periodic state, marched from ``start`` (n, 2) [m].
@@ -57,16 +68,7 @@ def periodic_start(q, rho, start, tolerance, pass_cap):
             for j in range(N):
                 x0, x1, ratio, slipping, u0, u1, separated = _project(
                     x0, x1, q[j, c, 0], q[j, c, 1], rho[j, c])
-                if separated:
-                    coefficient = 0.0
-                else:
-                    coefficient = ratio
-                s0 = u0 if slipping else 0.0
-                s1 = u1 if slipping else 0.0
-                p00 = (1.0 - s0 * u0) * coefficient
-                p01 = (0.0 - s0 * u1) * coefficient
-                p10 = (0.0 - s1 * u0) * coefficient
-                p11 = (1.0 - s1 * u1) * coefficient
+                p00, p01, p10, p11, s0, s1 = _step_derivative(ratio, slipping, u0, u1, separated)
                 a00, a01, a10, a11 = (p00 * a00 + p01 * a10, p00 * a01 + p01 * a11,
                                       p10 * a00 + p11 * a10, p10 * a01 + p11 * a11)
             w[c, 0], w[c, 1] = x0, x1
@@ -120,13 +122,7 @@ def final_pass(q, rho, drho_dw, k_t, start, Phi, jacobian):
             state[j, c] = 0 if separated else (2 if slipping else 1)
             if not jacobian:
                 continue
-            coefficient = 0.0 if separated else ratio
-            s0 = u0 if slipping else 0.0
-            s1 = u1 if slipping else 0.0
-            p00 = (1.0 - s0 * u0) * coefficient
-            p01 = (0.0 - s0 * u1) * coefficient
-            p10 = (0.0 - s1 * u0) * coefficient
-            p11 = (1.0 - s1 * u1) * coefficient
+            p00, p01, p10, p11, s0, s1 = _step_derivative(ratio, slipping, u0, u1, separated)
             weight = drho_dw[j, c]
             for h in range(P):
                 phi = Phi[j, h]
