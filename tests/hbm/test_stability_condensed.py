@@ -10,6 +10,7 @@ from sarfe.hbm.solve import contact_damping
 from sarfe.hbm.stability import hill_stability
 from sarfe.hbm.stability_condensed import condensed_stability, ritz_basis
 from sarfe.hbm.stability_contacts import ContactOperator
+from tests.hbm.shipped_points import shipped_case_points
 
 
 def both(model, contacts, F, s):
@@ -72,22 +73,7 @@ def squeak_rig():
                                   "door_trim", "instrument_panel"])
 def test_shipped_cases_condensed_equals_full(name):
     """Shipped cases at their own settings (H ≤ 5): every solved point, both methods."""
-    from sarfe.pipeline import build_linear_model, load_case, nonlinear_model
-    from sarfe.pipeline.points import solve_point, solver_options
-    case = load_case(f"cases/{name}.yaml")
-    nl = nonlinear_model(case, build_linear_model(case, progress=False))
-    H = min(case.data["solver"]["harmonics"], 5)
-    N = case.data["solver"]["samples_per_period"]
-    options, _ = solver_options(case)
-    excitation = case.data["excitation"]
-    if "sweep" in excitation:
-        a, b = excitation["sweep"]["start_hz"], excitation["sweep"]["end_hz"]
-        freqs = list(np.linspace(a, b, 5))
-    else:
-        freqs = list(excitation["frequency_hz"])
-    for f in freqs[:5]:
-        s = solve_point(nl, 2 * np.pi * f, H, N, options, None)
-        if not s.converged:
-            continue
+    nl, H, points = shipped_case_points(name)
+    for f, s in points:
         full, cond = both(nl.model, nl.contacts, nl.excitation[:2 * H + 1], s)
         assert cond.stable is full.stable, (f, full, cond)

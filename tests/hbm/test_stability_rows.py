@@ -15,6 +15,7 @@ from sarfe.hbm.stability import hill_stability
 from sarfe.hbm.stability_contacts import ContactOperator
 from sarfe.hbm.stability_rows import (ContactRowDeterminant, contact_row_stability,
                                       structural_exponents, winding_count)
+from tests.hbm.shipped_points import shipped_case_points
 
 
 def full_and_rows(model, contacts, F, s):
@@ -127,24 +128,9 @@ def squeak_rig():
 def test_shipped_cases_rows_equal_full(name):
     """Shipped cases at their own settings (H ≤ 5): every solved point, the solver's verdict with
     the count (where it decides) equals the full Hill method's."""
-    from sarfe.pipeline import build_linear_model, load_case, nonlinear_model
-    from sarfe.pipeline.points import solve_point, solver_options
-    case = load_case(f"cases/{name}.yaml")
-    nl = nonlinear_model(case, build_linear_model(case, progress=False))
-    H = min(case.data["solver"]["harmonics"], 5)
-    N = case.data["solver"]["samples_per_period"]
-    options, _ = solver_options(case)
-    excitation = case.data["excitation"]
-    if "sweep" in excitation:
-        a, b = excitation["sweep"]["start_hz"], excitation["sweep"]["end_hz"]
-        freqs = list(np.linspace(a, b, 5))
-    else:
-        freqs = list(excitation["frequency_hz"])
+    nl, H, points = shipped_case_points(name)
     F = nl.excitation[:2 * H + 1]
-    for f in freqs[:5]:
-        s = solve_point(nl, 2 * np.pi * f, H, N, options, None)
-        if not s.converged:
-            continue
+    for f, s in points:
         full, rows, _, _ = full_and_rows(nl.model, nl.contacts, F, s)
         if rows is not None:            # None: handed over to the Ritz method
             assert rows.stable is full.stable, (f, full, rows)

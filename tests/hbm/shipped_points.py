@@ -1,0 +1,28 @@
+"""Converged points of a shipped case, for tests that compare two stability methods on them."""
+import numpy as np
+
+
+def shipped_case_points(name, max_harmonics=5, count=5):
+    """The case ``cases/<name>.yaml`` at its own settings with H ≤ ``max_harmonics``: up to
+    ``count`` of its frequencies (or points spread over its sweep band), each solved cold.
+    Returns (nl, H, [(frequency [Hz], converged HarmonicSolution)])."""
+    from sarfe.pipeline import build_linear_model, load_case, nonlinear_model
+    from sarfe.pipeline.points import solve_point, solver_options
+
+    case = load_case(f"cases/{name}.yaml")
+    nl = nonlinear_model(case, build_linear_model(case, progress=False))
+    H = min(case.data["solver"]["harmonics"], max_harmonics)
+    N = case.data["solver"]["samples_per_period"]
+    options, _ = solver_options(case)
+    excitation = case.data["excitation"]
+    if "sweep" in excitation:
+        a, b = excitation["sweep"]["start_hz"], excitation["sweep"]["end_hz"]
+        freqs = list(np.linspace(a, b, count))
+    else:
+        freqs = list(excitation["frequency_hz"])
+    points = []
+    for f in freqs[:count]:
+        s = solve_point(nl, 2 * np.pi * f, H, N, options, None)
+        if s.converged:
+            points.append((f, s))
+    return nl, H, points
