@@ -61,16 +61,6 @@ def test_frozen_jacobian_is_the_operator_at_s_zero():
     assert abs(op.correction(0.05)).max() > 1e-3 * abs(ev.jacobian).max()
 
 
-@pytest.fixture(scope="module")
-def squeak_rig():
-    from sarfe.pipeline import build_linear_model, load_case, nonlinear_model
-    from sarfe.pipeline.points import solve_point, solver_options
-    case = load_case("cases/squeak_rig.yaml")
-    nl = nonlinear_model(case, build_linear_model(case, progress=False))
-    options, _ = solver_options(case)
-    return nl, [solve_point(nl, 2 * np.pi * f, 3, 128, options, None) for f in (50.0, 150.0)]
-
-
 @pytest.mark.slow
 def test_squeak_rig_150hz_hill_matches_time_integration(squeak_rig):
     nl, sols = squeak_rig

@@ -116,12 +116,6 @@ def test_squeak_rig_rows_equal_full(squeak_rig):
         assert rows is not None and rows.stable is True
 
 
-@pytest.fixture(scope="module")
-def squeak_rig():
-    from tests.hbm.test_stability import squeak_rig as fixture
-    return fixture.__wrapped__()
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize("name", ["lumped_rattle", "rattle_rig", "rattle_rig_deck", "squeak_rig",
                                   "door_trim", "instrument_panel"])
