@@ -98,3 +98,37 @@ def test_w4_makes_ge_a_dashpot_parallel_to_the_contact(tmp_path):
     stage = build_linear_model(_case(tmp_path, bush))
     z = int(np.flatnonzero(stage.load_vectors[0])[0])
     assert stage.added_damping[z, z] == pytest.approx(0.1 * 5.0e3 / 100.0, rel=1e-12)
+
+
+def test_rattle_contact_says_the_cross_axis_stiffness_it_drops(tmp_path, capsys):
+    """A rattle contact acts along the spring axis only: the CBUSH's K1, K2 (mean 2.5 N/mm across
+    the K3 axis) leave the model, and validate and solve say so in one warning line (a squeak
+    contact keeps it as its stick stiffness: no warning)."""
+    from sarfe import cli
+    from sarfe.pipeline.checks import check_case
+
+    case = _case(tmp_path, "PBUSH,9,K,2.,3.,5.,0.,0.,0.\n")
+    (line,) = [w for w in check_case(case, write=False).warnings if "tangential" in w]
+    assert line.startswith("contacts[0] (stop): a rattle contact has no tangential stiffness")
+    assert "2500 N/m" in line and "PBUSH 9 (CBUSH 7)" in line
+    assert cli.main(["validate", str(tmp_path / "case.yaml")]) == 0
+    assert line in capsys.readouterr().err
+    result = solve_case(case, write=False)
+    assert line in result.summary["warnings"]
+
+
+def test_a_mass_hung_on_a_contact_dashpot_alone_is_not_held(tmp_path):
+    """The CBUSH that becomes the contact keeps its dashpot B, but a dashpot holds nothing
+    statically: with the grounded CELAS2 springs removed and the CBUSH run from GRID 10 to the
+    plate, the 1 kg at GRID 10 hangs on the contact alone, so the check names it free (before: the kept damper counted as a joint and
+    the singular stiffness went on to the factorization)."""
+    bush = "PBUSH,9,K,0.,0.,5.,0.,0.,0.\n,,B,0.,0.,0.02,0.,0.,0.\n"
+    case = _case(tmp_path, bush)
+    deck = (tmp_path / "bush.bdf").read_text()
+    (tmp_path / "bush.bdf").write_text("".join(   # CBUSH 7 from GRID 10 to the plate's GRID 5
+        line.replace("CBUSH,7,9,10,", "CBUSH,7,9,10,5") + "\n"
+        for line in deck.splitlines() if not line.startswith("CELAS2")))
+    with pytest.raises(CaseError, match=r"a part of 1 nodes \(GRIDs 10…10\) is free in 3 "
+                                        r"rigid-body motions \(translation x, translation y, "
+                                        r"translation z\)"):
+        build_linear_model(case)

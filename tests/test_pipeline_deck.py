@@ -336,7 +336,8 @@ def test_cbush_squeak_contact_takes_axis_and_stiffness_from_the_element(tmp_path
         with pytest.raises(CaseError, match=r"contacts\[0\]\.from_elements: element 7 is " + expected):
             springs_to_contacts(case, read_case_deck(case))
         return
-    deck, contacts = springs_to_contacts(case, read_case_deck(case))
+    deck, contacts, warnings = springs_to_contacts(case, read_case_deck(case))
+    assert warnings == []                                        # squeak keeps k_t
     assert len(deck.springs.element_ids) == 0                    # left the linear model
     normal, k_n, k_t = expected
     assert np.allclose(contacts["clip"].frames[0, 0], normal)

@@ -217,7 +217,8 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True)
     config = case.config
     if config.model.fe.is_deck:   # a Nastran/Abaqus deck: its own checks, with ids
         from sarfe.pipeline.deck import check_deck
-        return CaseCheck(check_deck(case), tuple(range_warnings(case)), output)
+        info = check_deck(case)
+        return CaseCheck(info, tuple(range_warnings(case)) + tuple(info.pop("warnings")), output)
     mesh = load_case_mesh(case)
     fe = config.model.fe.data
     fixed = np.unique(np.concatenate([

@@ -210,7 +210,9 @@ class ElementContact:
 
 
 def springs_to_contacts(case: Case, deck):
-    """(deck without the springs named by ``from_elements``, {contact name: ElementContact}).
+    """(deck without the springs named by ``from_elements``, {contact name: ElementContact},
+    warnings: one line per contact whose law has no tangent element (rattle) but whose springs
+    are stiff across their axis — that shear stiffness leaves the model, said, never silently).
 
     The contact normal is the spring axis ``element_axis`` (default: the translational axis of
     largest stiffness; a CELAS has one); the normal stiffness is the spring's along it and the
@@ -222,12 +224,13 @@ def springs_to_contacts(case: Case, deck):
     dashpot parallel to the contact whether it is open or closed; a nonzero rotational stiffness
     K4–K6 or structural damping GE is a one-line CaseError naming the element.
     """
+    from sarfe.hbm import laws
     from sarfe.pipeline.linear import frame_from_normal
 
     springs = deck.springs
     remove = np.zeros(len(springs.element_ids), dtype=bool)
-    contacts = {}
-    for i, contact in ((c.index, c.params) for c in case.config.contacts):
+    contacts, warnings = {}, []
+    for i, kind, contact in ((c.index, c.kind, c.params) for c in case.config.contacts):
         if "from_elements" not in contact:
             continue
         p = ("contacts", i, "from_elements")
@@ -258,10 +261,16 @@ def springs_to_contacts(case: Case, deck):
         others = np.ones((len(rows), 3), dtype=bool)
         others[np.arange(len(rows)), axis] = False
         k_t = k[others].reshape(len(rows), 2).mean(axis=1)
+        if np.any(k_t > 0) and not laws.uses_tangent(laws.law(kind), contact):
+            r = int(np.argmax(k_t))
+            warnings.append(f"contacts[{i}] ({contact['name']}): a {kind} contact has no "
+                            f"tangential stiffness: the cross-axis stiffness of its springs "
+                            f"(up to {float(k_t[r]):g} N/m, {_spring_name(springs, rows[r])}) "
+                            "leaves the model; type: squeak keeps it as the stick stiffness")
         contacts[contact["name"]] = ElementContact(ids, springs.node_a[rows], springs.node_b[rows],
                                                    frame_from_normal(normal), k_n, k_t)
     if not remove.any():
-        return deck, contacts
+        return deck, contacts, warnings
     # a spring's dashpot B stays as a parallel linear damper between its nodes (stiffness 0)
     damper = remove & np.any(springs.viscous_damping != 0.0, axis=1)
     keep = ~remove | damper
@@ -269,7 +278,7 @@ def springs_to_contacts(case: Case, deck):
     fields = {f.name: getattr(springs, f.name) for f in dataclasses.fields(springs)}
     fields["stiffness"] = stiffness
     kept = dataclasses.replace(springs, **{name: value[keep] for name, value in fields.items()})
-    return dataclasses.replace(deck, springs=kept), contacts
+    return dataclasses.replace(deck, springs=kept), contacts, warnings
 
 
 def _spring_name(springs, i) -> str:
@@ -319,7 +328,8 @@ class PreparedDeck:
 
     deck: DeckModel (SI, overrides applied, contact springs removed); mesh: its PanelMesh view;
     held: (n, 6) bool supports (CD components); element_contacts: {name: ElementContact};
-    case: the case with GRID-id pairs turned into node indices; notes: {key: value} for info.
+    case: the case with GRID-id pairs turned into node indices; notes: {key: value} for info;
+    warnings: one-line warnings (validate and solve print them; summary.json ``warnings``).
     """
 
     deck: object
@@ -328,6 +338,7 @@ class PreparedDeck:
     element_contacts: dict
     case: Case
     notes: dict
+    warnings: tuple = ()
 
 
 def prepare_deck(case: Case) -> PreparedDeck:
@@ -338,7 +349,7 @@ def prepare_deck(case: Case) -> PreparedDeck:
                          DECK_KEY)
     mesh = deck_panel_mesh(case, deck)
     deck = apply_overrides(case, deck, mesh)
-    deck, element_contacts = springs_to_contacts(case, deck)
+    deck, element_contacts, contact_warnings = springs_to_contacts(case, deck)
     if not has_mass(deck):
         raise case.error("the deck has no mass (" + ("; ".join(deck.notes) or "no density, "
                          "no point masses") + "): give densities (or materials overrides)", DECK_KEY)
@@ -368,7 +379,8 @@ def prepare_deck(case: Case) -> PreparedDeck:
         raise case.error(_hysteretic_spring(deck.springs), DECK_KEY)
     if len(deck.springs.element_ids) and np.any(deck.springs.viscous_damping):
         notes["spring_damping"] = "the springs' viscous damping B is added to the case's damping"
-    return PreparedDeck(deck, mesh, held, element_contacts, contact_case(case, deck), notes)
+    return PreparedDeck(deck, mesh, held, element_contacts, contact_case(case, deck), notes,
+                        tuple(contact_warnings))
 
 
 def _hysteretic_spring(springs) -> str:
@@ -402,4 +414,5 @@ def check_deck(case: Case) -> dict:
     return {"nodes": prepared.deck.n_nodes, "triangles": mesh.n_triangles,
             "contact_pairs": pairs, "ignored_cards": prepared.notes["ignored_cards"],
             "coincident_node_pairs": prepared.notes["coincident_node_pairs"],
-            "coincident_nodes": prepared.notes["coincident_nodes"]}
+            "coincident_nodes": prepared.notes["coincident_nodes"],
+            "warnings": prepared.warnings}

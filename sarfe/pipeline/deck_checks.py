@@ -86,13 +86,18 @@ def support_mask(case: Case, deck, mesh) -> np.ndarray:
 
 def connected_parts(deck) -> tuple[int, np.ndarray, np.ndarray]:
     """(count, part of every node (n,), whether a node is used by any element (n,)): nodes
-    joined by shells, solids, beams, two-node springs and rigid / interpolation elements."""
+    joined by shells, solids, beams, two-node springs with some stiffness and rigid /
+    interpolation elements. A spring without stiffness (a dashpot, e.g. the damping B kept from a
+    spring turned into a contact) uses its nodes but joins nothing: it carries no static load."""
     import scipy.sparse as sp
     from scipy.sparse.csgraph import connected_components
 
     n = deck.n_nodes
+    springs = deck.springs
+    stiff = np.any(springs.stiffness != 0.0, axis=1)
+    spring_edges = np.stack([springs.node_a, springs.node_b], axis=1)
     edges = [deck.shells.triangles[:, [0, 1]], deck.shells.triangles[:, [1, 2]],
-             deck.beams.nodes, np.stack([deck.springs.node_a, deck.springs.node_b], axis=1),
+             deck.beams.nodes, spring_edges[stiff],
              np.stack([deck.rbe2.independent[deck.rbe2.dependent_element], deck.rbe2.dependent], 1),
              np.stack([deck.rbe3.reference[deck.rbe3.independent_element], deck.rbe3.independent], 1)]
     for block in deck.solids.values():
@@ -101,7 +106,7 @@ def connected_parts(deck) -> tuple[int, np.ndarray, np.ndarray]:
     edges = np.concatenate([e.reshape(-1, 2) for e in edges]).astype(np.int64)
     used = np.zeros(n, dtype=bool)
     used[edges[edges >= 0]] = True
-    used[deck.springs.node_a] = True
+    used[spring_edges[spring_edges >= 0]] = True
     edges = edges[(edges >= 0).all(axis=1)]
     graph = sp.coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n, n))
     count, part = connected_components(graph, directed=False)
