@@ -126,9 +126,11 @@ class ContactRowDeterminant:
         self.loaded = (np.arange(P)[:, None] * n_rows + R[None]).ravel()       # L in (P n_rows)
         width = R.size
         self.size = S = P * width
-        self.fixed = fixed[self.loaded][:, self.loaded].toarray().astype(complex)
-        self.damping = None if damping is None else \
-            damping[self.loaded][:, self.loaded].toarray()
+        square = (P, width, P, width)
+        self.fixed = _exponential(fixed[self.loaded][:, self.loaded].toarray().reshape(square),
+                                  0, 2).reshape(S, S)
+        self.damping = None if damping is None else _exponential(
+            damping[self.loaded][:, self.loaded].toarray().reshape(square), 0, 2).reshape(S, S)
         position = np.full(n_rows + 1, -1)
         position[R] = np.arange(width)                     # position[-1] = −1: an absent row
         self.scatter = [_scatter_index(rows, position, width, P) for rows, _ in coefficients]
@@ -142,8 +144,8 @@ class ContactRowDeterminant:
             (rows, coeff[:3]) for rows, coeff in coefficients]) if S else np.zeros((3, 0, 0))
 
     def contact_terms(self, s, coefficients=None):
-        """𝒥_LL(s) (n_s, S, S) complex, for s (n_s,) (``coefficients``: the memory rows at s, when
-        already evaluated)."""
+        """𝒥_LL(s) in the exponential basis, W 𝒥_LL W^H (n_s, S, S) complex, for s (n_s,)
+        (``coefficients``: the memory rows at s, when already evaluated)."""
         s = np.asarray(s, dtype=complex)
         S = self.size
         J = np.empty((s.size, S, S), complex)
@@ -153,7 +155,9 @@ class ContactRowDeterminant:
                 coefficients = self.memory.memory_coefficients(s)
             flat = J.reshape(s.size, S * S)
             for (_, coeff), (mask, index, unique) in zip(coefficients, self.scatter):
-                values = coeff[:, mask]                                       # (n_s, entries)
+                shape = coeff.shape
+                coeff = _exponential(coeff.reshape(shape[:4] + (shape[4] // 3, 3)), 1, 4)
+                values = coeff.reshape(shape)[:, mask]                         # (n_s, entries)
                 if unique:
                     flat[:, index] += values
                 else:                   # contacts sharing a row: accumulate
@@ -163,12 +167,12 @@ class ContactRowDeterminant:
         return J
 
     def compliance_blocks(self, s):
-        """A(λ) = G Z(λ)⁻¹ Gᵀ on the loaded rows at λ = s, s + ikω (k = 1…H), s − ikω:
-        (n_s, 2H+1, |R|, |R|) complex (module docstring)."""
+        """A(λ_b) = G Z(λ_b)⁻¹ Gᵀ on the loaded rows, λ_b = s + i m_b ω for the exponential rows
+        m = 0, 1, −1, 2, −2, …, H, −H: (n_s, 2H+1, |R|, |R|) complex (module docstring)."""
         s = np.asarray(s, dtype=complex)
-        k = np.arange(1, self.H + 1)
-        lam = np.concatenate([s[:, None], s[:, None] + 1j * k * self.omega,
-                              s[:, None] - 1j * k * self.omega], axis=1)       # (n_s, 2H+1)
+        m = np.zeros(2 * self.H + 1)
+        m[1::2], m[2::2] = np.arange(1, self.H + 1), -np.arange(1, self.H + 1)
+        lam = s[:, None] + 1j * self.omega * m                                  # (n_s, 2H+1)
         a = lam[..., None] * self.delta + lam[..., None] ** 2 * self.mu
         q = (-a / (1.0 + a)).reshape(-1, self.mu.size)                         # (n_s (2H+1), n)
         pairs = q.real @ self._pairs.T + 1j * (q.imag @ self._pairs.T)         # (…, n_pairs)
@@ -181,22 +185,15 @@ class ContactRowDeterminant:
         return A.reshape(s.size, 2 * self.H + 1, width, width)
 
     def matrices(self, s):
-        """F(s) = I + C_LL(s) 𝒥_LL(s) (n_s, S, S) complex. C is block diagonal over the harmonics:
-        the mean rows get A(s), the (cos, sin) rows (x, y) of harmonic k the block of A± = A(s ± ikω),
-        applied as cos: ½(A₊ z₋ + A₋ z₊), sin: ½i(A₊ z₋ − A₋ z₊), z∓ = x ∓ i y (two products of
-        |R|² per column instead of the four of the real 2|R| block)."""
+        """W F(s) W^H = I + (W C W^H)(W 𝒥 W^H) (n_s, S, S) complex: F on the loaded rows in the
+        exponential basis W (per harmonic k the rows (cos, sin) → ((cos − i sin)/√2,
+        (cos + i sin)/√2), unitary: same determinant and singular values as F). There C is block
+        diagonal with the blocks A(s + ikω), A(s − ikω) (the real 2|R| block of the module
+        docstring diagonalized), one |R|² product per row block and column."""
         s = np.asarray(s, dtype=complex)
-        H, width, S = self.H, self.rows.size, self.size
-        J = self.contact_terms(s).reshape(s.size, 2 * H + 1, width, S)
-        A = self.compliance_blocks(s)
-        F = np.empty_like(J)
-        F[:, 0] = A[:, 0] @ J[:, 0]
-        x, y = J[:, 1::2], J[:, 2::2]
-        plus = A[:, 1:H + 1] @ (x - 1j * y)
-        minus = A[:, H + 1:] @ (x + 1j * y)
-        F[:, 1::2] = 0.5 * (plus + minus)
-        F[:, 2::2] = 0.5j * (plus - minus)
-        F = F.reshape(s.size, S, S)
+        width, S = self.rows.size, self.size
+        J = self.contact_terms(s).reshape(s.size, 2 * self.H + 1, width, S)
+        F = np.matmul(self.compliance_blocks(s), J).reshape(s.size, S, S)
         F[:, np.arange(S), np.arange(S)] += 1.0
         return F
 
@@ -212,6 +209,22 @@ class ContactRowDeterminant:
             value[bad] = np.nan
             out[first:first + chunk] = value
         return out
+
+
+def _exponential(X, row_axis, column_axis):
+    """W X W^H for harmonic axes ``row_axis``, ``column_axis`` (length 2H+1, mean, cos 1, sin 1,
+    …): W maps the (cos, sin) pair of harmonic k to ((cos − i sin)/√2, (cos + i sin)/√2)
+    (unitary). Complex copy."""
+    X = np.moveaxis(np.asarray(X), (row_axis, column_axis), (0, 1))
+    out = np.empty(X.shape, complex)
+    r = 1.0 / np.sqrt(2.0)
+    out[0] = X[0]
+    out[1::2] = r * (X[1::2] - 1j * X[2::2])
+    out[2::2] = r * (X[1::2] + 1j * X[2::2])
+    Y = out.copy()
+    out[:, 1::2] = r * (Y[:, 1::2] + 1j * Y[:, 2::2])
+    out[:, 2::2] = r * (Y[:, 1::2] - 1j * Y[:, 2::2])
+    return np.moveaxis(out, (0, 1), (row_axis, column_axis))
 
 
 def _nonzero_rows(matrix, n_rows):
