@@ -58,31 +58,23 @@ def _memory_block(s, omega, P_march, n_rho_march, drho, k_t, H, N):
                           H, N)[0]
 
 
-def _memory_blocks(s, omega, P_march, n_rho_march, drho, k_t, H, N, chunk=8):
+def _memory_blocks(s, omega, P_march, n_rho_march, drho, k_t, H, N, chunk=8, setup=None):
     r""":func:`_memory_block` at several exponents s (n_s,): (n_s, P, n, 2, 3P) complex. The march
     is linear in the perturbation and s enters only through the factor e^{−sh} per sample, so the
     compiled march of :func:`sarfe.hbm.stability_march.linear_march` serves all s; its history
     ∂δw_j/∂δw_{−1} = e^{−sh(j+1)} Π_j (Π_j = P_j ⋯ P_0, s-independent), the periodic start
     δw_{−1} = (I − e^{−sT} Π_{N−1})⁻¹ δw_{N−1} where regular, and the harmonic coefficients taken
     by the DFT matrix E (2H+1, N): δλ̃ = k_t (E δq − E δw − (E ∂w/∂w₀) δw₀). ``chunk`` exponents
-    are marched at a time (the samples of a chunk, (N, chunk, n, 2, 3P), stay small)."""
-    from .stability_march import linear_march, step_products
+    are marched at a time (the samples of a chunk, (N, chunk, n, 2, 2, 3P), stay small);
+    ``setup``: the s-independent arrays of :func:`_memory_setup` when already computed."""
+    from .stability_march import linear_march
 
     s = np.atleast_1d(np.asarray(s, dtype=complex))
-    n = P_march.shape[1]
-    P = 2 * H + 1
-    E, Phi = hm.fourier_matrices(H, N)
-    h = 2.0 * np.pi / (omega * N)
-    dq = np.zeros((N, 2, 3 * P))
-    dq[:, 0, 1::3], dq[:, 1, 2::3] = Phi, Phi
-    dn = np.zeros((N, 3 * P))
-    dn[:, 0::3] = Phi
-    # s-independent source of each sample: (I − P_j) δq_j + n_j dρ_j δn_j   (N, n, 2, 3P)
-    source = (dq[:, None] - np.einsum("jcab,jbx->jcax", P_march, dq)
-              + n_rho_march[..., None] * (drho[:, :, None, None] * dn[:, None, None, :]))
-    step = np.ascontiguousarray(P_march, dtype=float)
-    products = step_products(step)                                             # Π_j (N, n, 2, 2)
-    Edq = np.einsum("hj,jcx->hcx", E, dq)                                      # (P, 2, 3P)
+    if setup is None:
+        setup = _memory_setup(omega, P_march, n_rho_march, drho, H, N)
+    step, source, products, E, Edq, h = (setup[k] for k in ("step", "source", "products", "E",
+                                                             "Edq", "h"))
+    n, P = step.shape[1], 2 * H + 1
     out = np.empty((s.size, P, n, 2, 3 * P), complex)
     for first in range(0, s.size, chunk):
         sc = s[first:first + chunk]
@@ -103,6 +95,25 @@ def _memory_blocks(s, omega, P_march, n_rho_march, drho, k_t, H, N, chunk=8):
     return out
 
 
+def _memory_setup(omega, P_march, n_rho_march, drho, H, N):
+    """The s-independent arrays of :func:`_memory_blocks` (once per solution): step P_j
+    (N, n, 2, 2), source b_j = (I − P_j) δq_j + n_j dρ_j δn_j (N, n, 2, 3P), products Π_j
+    (N, n, 2, 2), the DFT matrix E (2H+1, N), E δq (2H+1, 2, 3P), sample spacing h [s]."""
+    from .stability_march import step_products
+
+    P = 2 * H + 1
+    E, Phi = hm.fourier_matrices(H, N)
+    dq = np.zeros((N, 2, 3 * P))
+    dq[:, 0, 1::3], dq[:, 1, 2::3] = Phi, Phi
+    dn = np.zeros((N, 3 * P))
+    dn[:, 0::3] = Phi
+    step = np.ascontiguousarray(P_march, dtype=float)
+    source = (dq[:, None] - np.einsum("jcab,jbx->jcax", step, dq)
+              + n_rho_march[..., None] * (drho[:, :, None, None] * dn[:, None, None, :]))
+    return dict(step=step, source=source, products=step_products(step), E=E,
+                Edq=np.einsum("hj,jcx->hcx", E, dq), h=2.0 * np.pi / (omega * N))
+
+
 def _slider_march(q, rho, start, one_d=False):
     """The slider states of one period marched from ``start``: ∂w_j/∂w_{j−1} = P_j (N, n, 2, 2)
     and ∂w_j/∂ρ_j = n_j (N, n, 2). They do not depend on s: computed once per solution.
@@ -118,11 +129,10 @@ def _slider_march(q, rho, start, one_d=False):
         previous[1:, :, 0] = periodic["slider"][:-1]
         _, _, P, n_rho = slider_update_derivatives(previous, q, rho)
         return P, n_rho
-    P, n_rho = np.empty((N, n, 2, 2)), np.empty((N, n, 2))
-    w = np.array(start, dtype=float)
-    for j in range(N):    # the 2-D return map is a march (as in the AFT's own 2-D friction)
-        w, _, P[j], n_rho[j] = slider_update_derivatives(w, q[j], rho[j])
-    return P, n_rho
+    from .stability_march import slider_steps   # the 2-D return map is a march: compiled
+
+    return slider_steps(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(rho, dtype=float),
+                        np.ascontiguousarray(start, dtype=float))
 
 
 def _memory_block_1d(s, omega, P, n_rho, drho, k_t, H, N):
@@ -230,9 +240,13 @@ class ContactOperator:
         s = np.atleast_1d(np.asarray(s, dtype=complex))
         out = []
         for g in self.memory:
-            blocks = _memory_blocks_1d if g["one_d"] else _memory_blocks
-            out.append((g["rows"], blocks(s, self.omega, *g["march"], g["drho"], g["k_t"],
-                                          self.H, g["N"])))
+            args = (s, self.omega, *g["march"], g["drho"], g["k_t"], self.H, g["N"])
+            if g["one_d"]:
+                out.append((g["rows"], _memory_blocks_1d(*args)))
+                continue
+            if "setup" not in g:         # the s-independent part, once per solution
+                g["setup"] = _memory_setup(self.omega, *g["march"], g["drho"], self.H, g["N"])
+            out.append((g["rows"], _memory_blocks(*args, setup=g["setup"])))
         return out
 
     def blocks_at_many(self, s):

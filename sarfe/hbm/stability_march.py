@@ -20,6 +20,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .laws.jenkins_march import _project, _step_derivative
+
 
 @njit(cache=True)
 def linear_march(decay, step, source):
@@ -72,3 +74,23 @@ def step_products(step):
                                   p10 * h00 + p11 * h10, p10 * h01 + p11 * h11)
             out[j, c, 0, 0], out[j, c, 0, 1], out[j, c, 1, 0], out[j, c, 1, 1] = h00, h01, h10, h11
     return out
+
+
+@njit(cache=True)
+def slider_steps(q, rho, start):
+    r"""The return-map derivatives of one period of 2-D sliders marched from ``start`` (n, 2) [m]:
+    P_j = ∂w_j/∂w_{j−1} (N, n, 2, 2) [-] and n_j = ∂w_j/∂ρ_j (N, n, 2) [-] (the disk projection
+    of :mod:`sarfe.hbm.laws.jenkins_march`: (ρ/|t|)(I − n nᵀ) in slip, I in stick, 0 separated).
+    q (N, n, 2) [m] tangential displacements, rho (N, n) [m] slip radii."""
+    N, n = rho.shape
+    step = np.empty((N, n, 2, 2))
+    slope = np.empty((N, n, 2))
+    for c in range(n):
+        x0, x1 = start[c, 0], start[c, 1]
+        for j in range(N):
+            x0, x1, ratio, slipping, u0, u1, separated = _project(
+                x0, x1, q[j, c, 0], q[j, c, 1], rho[j, c])
+            p00, p01, p10, p11, s0, s1 = _step_derivative(ratio, slipping, u0, u1, separated)
+            step[j, c, 0, 0], step[j, c, 0, 1], step[j, c, 1, 0], step[j, c, 1, 1] = p00, p01, p10, p11
+            slope[j, c, 0], slope[j, c, 1] = s0, s1
+    return step, slope

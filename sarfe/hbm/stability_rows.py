@@ -184,7 +184,7 @@ class ContactRowDeterminant:
         A += self._static
         return A.reshape(s.size, 2 * self.H + 1, width, width)
 
-    def matrices(self, s):
+    def matrices(self, s, coefficients=None):
         """W F(s) W^H = I + (W C W^H)(W 𝒥 W^H) (n_s, S, S) complex: F on the loaded rows in the
         exponential basis W (per harmonic k the rows (cos, sin) → ((cos − i sin)/√2,
         (cos + i sin)/√2), unitary: same determinant and singular values as F). There C is block
@@ -192,18 +192,21 @@ class ContactRowDeterminant:
         docstring diagonalized), one |R|² product per row block and column."""
         s = np.asarray(s, dtype=complex)
         width, S = self.rows.size, self.size
-        J = self.contact_terms(s).reshape(s.size, 2 * self.H + 1, width, S)
+        J = self.contact_terms(s, coefficients).reshape(s.size, 2 * self.H + 1, width, S)
         F = np.matmul(self.compliance_blocks(s), J).reshape(s.size, S, S)
         F[:, np.arange(S), np.arange(S)] += 1.0
         return F
 
     def log_determinants(self, s, chunk=8):
-        """log det F(s) (n_s,) complex: log|det| + i arg det (nan where det F = 0); ``chunk``
-        exponents at a time (F is (chunk, S, S))."""
+        """log det F(s) (n_s,) complex: log|det| + i arg det (nan where det F = 0); the memory
+        rows for all s in one march, F for ``chunk`` exponents at a time (F is (chunk, S, S))."""
         s = np.asarray(s, dtype=complex)
         out = np.empty(s.size, complex)
+        memory = self.memory.memory_coefficients(s) if self.memory is not None else None
         for first in range(0, s.size, chunk):
-            sign, logabs = np.linalg.slogdet(self.matrices(s[first:first + chunk]))
+            part = None if memory is None else [(rows, coeff[first:first + chunk])
+                                                for rows, coeff in memory]
+            sign, logabs = np.linalg.slogdet(self.matrices(s[first:first + chunk], part))
             bad = ~np.isfinite(logabs) | (sign == 0)
             value = logabs + 1j * np.angle(sign)
             value[bad] = np.nan
