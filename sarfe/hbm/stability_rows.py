@@ -199,17 +199,47 @@ class ContactRowDeterminant:
 
     def log_determinants(self, s, chunk=8):
         """log det F(s) (n_s,) complex: log|det| + i arg det (nan where det F = 0); the memory
-        rows for all s in one march, F for ``chunk`` exponents at a time (F is (chunk, S, S))."""
+        rows for all s in one march, ``chunk`` exponents at a time.
+
+        With the compliance blocks A_b(s) regular, det F = det(W C W^H) · det((W C W^H)⁻¹ + W𝒥W^H):
+        the blocks are inverted (|R|² each) and added to the diagonal blocks of 𝒥, so no product
+        C𝒥 is formed, and Π_b det A_b is a product of small determinants. A block that does not
+        invert to 10⁻⁸ (two loaded rows with dependent gap maps, a transmission zero) sends its s
+        to the product form I + C𝒥 (:meth:`matrices`)."""
         s = np.asarray(s, dtype=complex)
         out = np.empty(s.size, complex)
         memory = self.memory.memory_coefficients(s) if self.memory is not None else None
+        P, width, S = 2 * self.H + 1, self.rows.size, self.size
+        diagonal = np.arange(P)
         for first in range(0, s.size, chunk):
+            sc = s[first:first + chunk]
             part = None if memory is None else [(rows, coeff[first:first + chunk])
                                                 for rows, coeff in memory]
-            sign, logabs = np.linalg.slogdet(self.matrices(s[first:first + chunk], part))
-            bad = ~np.isfinite(logabs) | (sign == 0)
-            value = logabs + 1j * np.angle(sign)
-            value[bad] = np.nan
+            J = self.contact_terms(sc, part)
+            A = self.compliance_blocks(sc)                                     # (m, P, |R|, |R|)
+            with np.errstate(all="ignore"):
+                try:
+                    inverse = np.linalg.inv(A)
+                    check = np.abs(A @ inverse - np.eye(width)).max(axis=(1, 2, 3))
+                except np.linalg.LinAlgError:
+                    inverse, check = None, np.full(sc.size, np.inf)
+            regular = np.isfinite(check) & (check <= 1e-8)
+            value = np.empty(sc.size, complex)
+            if np.any(regular):
+                M = J[regular].reshape(-1, P, width, P, width)
+                M[:, diagonal, :, diagonal, :] += np.moveaxis(inverse[regular], 1, 0)
+                sign, logabs = np.linalg.slogdet(M.reshape(-1, S, S))
+                sign_A, logabs_A = np.linalg.slogdet(A[regular])
+                value[regular] = logabs + logabs_A.sum(axis=1) + 1j * np.angle(
+                    sign * np.prod(sign_A, axis=1))
+                value[regular & ~(np.isfinite(logabs) & (sign != 0))] = np.nan
+            if not np.all(regular):
+                F = J[~regular].reshape(-1, P, width, S)
+                F = np.matmul(A[~regular], F).reshape(-1, S, S)
+                F[:, np.arange(S), np.arange(S)] += 1.0
+                sign, logabs = np.linalg.slogdet(F)
+                bad = ~np.isfinite(logabs) | (sign == 0)
+                value[~regular] = np.where(bad, np.nan, logabs + 1j * np.angle(sign))
             out[first:first + chunk] = value
         return out
 
