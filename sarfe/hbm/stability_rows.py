@@ -19,6 +19,18 @@ Vᵀ M V = diag μ, Vᵀ D V = diag δ) gives every G Z(λ)⁻¹ Gᵀ without a 
 
 (C₀(s) = A(s) for the mean), which at s = 0 is the condensed compliance of the Newton solver.
 
+Evaluation (:class:`ContactRowDeterminant`; cost per s independent of the FE size): only the
+loaded rows R enter (𝒥 vanishes elsewhere, so det(I + C𝒥) = det(I + C_LL 𝒥_LL), S = (2H+1)|R|);
+in the exponential basis W (per harmonic the rows (cos ∓ i sin)/√2, unitary) C is block diagonal,
+W C Wᴴ = ⊕_m A(s + imω), m = 0, ±1, …, ±H, so
+
+    det F = Π_m det A(s + imω) · det(⊕_m A(s + imω)⁻¹ + W 𝒥_LL Wᴴ):
+
+one LU of order S per s and 2H+1 small |R|² blocks; GV, G K⁻¹ Gᵀ are per model
+(:func:`row_products`), the pointwise part of 𝒥 and the normal rows of the friction groups per
+point, the Jenkins memory rows per s by one compiled march for all s of a contour
+(:mod:`sarfe.hbm.stability_march`).
+
 The verdict of the full method (:func:`sarfe.hbm.stability.hill_stability`) is decided by the
 exponents in the strip |Im s| ≤ 1.01 ω/2: unstable when one has Re s > tolerance·ω, uncertain
 when the leading one is within ±``uncertain_band``·ω of 0. The number of zeros of det F in the
@@ -226,14 +238,14 @@ class ContactRowDeterminant:
             regular = np.isfinite(check) & (check <= 1e-8)
             value = np.empty(sc.size, complex)
             if np.any(regular):
-                M = J[regular].reshape(-1, P, width, P, width)
+                M = (J if regular.all() else J[regular]).reshape(-1, P, width, P, width)
                 M[:, diagonal, :, diagonal, :] += np.moveaxis(inverse[regular], 1, 0)
                 sign, logabs = np.linalg.slogdet(M.reshape(-1, S, S))
                 sign_A, logabs_A = np.linalg.slogdet(A[regular])
                 value[regular] = logabs + logabs_A.sum(axis=1) + 1j * np.angle(
                     sign * np.prod(sign_A, axis=1))
                 value[regular & ~(np.isfinite(logabs) & (sign != 0))] = np.nan
-            if not np.all(regular):
+            if not np.all(regular):     # (J is intact: M was a copy when some s failed)
                 F = J[~regular].reshape(-1, P, width, S)
                 F = np.matmul(A[~regular], F).reshape(-1, S, S)
                 F[:, np.arange(S), np.arange(S)] += 1.0
