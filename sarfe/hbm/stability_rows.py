@@ -101,8 +101,9 @@ class ContactRowDeterminant:
     every harmonic: L = {(h, r): r ∈ R}, size S = P |R|): 𝒥 vanishes outside L × L, so
     det(I + C 𝒥) = det(I + C_LL 𝒥_LL) and neither 𝒥 nor C is formed on the other rows. 𝒥_LL(s)
     is the s-independent part (pointwise laws, the normal rows of the friction groups) plus the
-    tangent rows of the memory groups scattered at s; C_LL(s) is block diagonal over the harmonics
-    and applied per harmonic (:meth:`matrices`). ``probes`` [0, ω, 10ω, (0.37 + 0.21i)ω]: the
+    tangent rows of the memory groups scattered at s, both held in the exponential basis W, where
+    C_LL(s) is block diagonal with the |R|² blocks A(s + imω) (:meth:`compliance_blocks`;
+    :meth:`log_determinants` inverts them, :meth:`matrices` forms I + C𝒥). ``probes`` [0, ω, 10ω, (0.37 + 0.21i)ω]: the
     exponents at which the memory rows are first evaluated — their union of non-zero rows is R,
     the first three serve the norm of :func:`contact_row_stability`'s exponent bound
     (:attr:`probe_terms`)."""
