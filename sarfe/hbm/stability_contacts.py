@@ -58,48 +58,60 @@ def _memory_block(s, omega, P_march, n_rho_march, drho, k_t, H, N):
                           H, N)[0]
 
 
-def _memory_blocks(s, omega, P_march, n_rho_march, drho, k_t, H, N):
-    r""":func:`_memory_block` at several exponents s (n_s,) in one march over the samples:
-    (n_s, P, n, 2, 3P) complex. The march is linear in the perturbation and s enters only through
-    the factor e^{−sh} per sample, so all s share the loop; the 2 × 2 return maps are applied
-    component-wise and the harmonic coefficients taken by the DFT matrix E (2H+1, N):
-    δλ̃ = k_t (E δq − E δw − (E ∂w/∂w₀) δw₀)."""
+def _memory_blocks(s, omega, P_march, n_rho_march, drho, k_t, H, N, chunk=8, setup=None):
+    r""":func:`_memory_block` at several exponents s (n_s,): (n_s, P, n, 2, 3P) complex. The march
+    is linear in the perturbation and s enters only through the factor e^{−sh} per sample, so the
+    compiled march of :func:`sarfe.hbm.stability_march.linear_march` serves all s; its history
+    ∂δw_j/∂δw_{−1} = e^{−sh(j+1)} Π_j (Π_j = P_j ⋯ P_0, s-independent), the periodic start
+    δw_{−1} = (I − e^{−sT} Π_{N−1})⁻¹ δw_{N−1} where regular, and the harmonic coefficients taken
+    by the DFT matrix E (2H+1, N): δλ̃ = k_t (E δq − E δw − (E ∂w/∂w₀) δw₀). ``chunk`` exponents
+    are marched at a time (the samples of a chunk, (N, chunk, n, 2, 2, 3P), stay small);
+    ``setup``: the s-independent arrays of :func:`_memory_setup` when already computed."""
+    from .stability_march import linear_march
+
     s = np.atleast_1d(np.asarray(s, dtype=complex))
-    n = P_march.shape[1]
+    if setup is None:
+        setup = _memory_setup(omega, P_march, n_rho_march, drho, H, N)
+    step, source, products, E, Edq, h = (setup[k] for k in ("step", "source", "products", "E",
+                                                             "Edq", "h"))
+    n, P = step.shape[1], 2 * H + 1
+    out = np.empty((s.size, P, n, 2, 3 * P), complex)
+    for first in range(0, s.size, chunk):
+        sc = s[first:first + chunk]
+        m = sc.size
+        march = linear_march(np.exp(-sc * h), step, source)                 # (N, m, n, 2, 2, 3P)
+        last = march[-1, :, :, :, 0] + 1j * march[-1, :, :, :, 1]             # δw_{N−1} (m, n, 2, 3P)
+        powers = np.exp(-sc[:, None] * h * np.arange(1, N + 1))                # e^{−sh(j+1)} (m, N)
+        Eh = ((E[None] * powers[:, None, :]) @ products.reshape(N, -1)).reshape(m, P, n, 2, 2)
+        system = np.eye(2) - powers[:, -1, None, None, None] * products[-1]    # (m, n, 2, 2)
+        regular = np.abs(np.linalg.det(system)) > 1e-9
+        dw0 = np.zeros((m, n, 2, 3 * P), complex)
+        if np.any(regular):
+            dw0[regular] = np.linalg.solve(system[regular], last[regular])
+        Edw = (E @ march.reshape(N, -1)).reshape(P, m, n, 2, 2, 3 * P)       # one real GEMM
+        Edw = np.moveaxis(Edw[..., 0, :] + 1j * Edw[..., 1, :], 1, 0)          # (m, P, n, 2, 3P)
+        coeff = Edq[None, :, None] - Edw - Eh @ dw0[:, None]
+        out[first:first + chunk] = k_t[None, None, :, None, None] * coeff
+    return out
+
+
+def _memory_setup(omega, P_march, n_rho_march, drho, H, N):
+    """The s-independent arrays of :func:`_memory_blocks` (once per solution): step P_j
+    (N, n, 2, 2), source b_j = (I − P_j) δq_j + n_j dρ_j δn_j (N, n, 2, 3P), products Π_j
+    (N, n, 2, 2), the DFT matrix E (2H+1, N), E δq (2H+1, 2, 3P), sample spacing h [s]."""
+    from .stability_march import step_products
+
     P = 2 * H + 1
     E, Phi = hm.fourier_matrices(H, N)
-    decay = np.exp(-s * 2.0 * np.pi / (omega * N))[:, None, None]             # (n_s, 1, 1)
     dq = np.zeros((N, 2, 3 * P))
     dq[:, 0, 1::3], dq[:, 1, 2::3] = Phi, Phi
     dn = np.zeros((N, 3 * P))
     dn[:, 0::3] = Phi
-    # s-independent source of each sample: (I − P_j) δq_j + n_j dρ_j δn_j   (N, n, 2, 3P)
-    source = (dq[:, None] - np.einsum("jcab,jbx->jcax", P_march, dq)
+    step = np.ascontiguousarray(P_march, dtype=float)
+    source = (dq[:, None] - np.einsum("jcab,jbx->jcax", step, dq)
               + n_rho_march[..., None] * (drho[:, :, None, None] * dn[:, None, None, :]))
-    m = s.size
-    dw_all = np.empty((N, m, n, 2, 3 * P), complex)
-    history = np.empty((N, m, n, 2, 2), complex)
-    dw = np.zeros((m, n, 2, 3 * P), complex)
-    dw_dw0 = np.broadcast_to(np.eye(2, dtype=complex), (m, n, 2, 2)).copy()
-    for j in range(N):    # 2-D: the linearized march (1-D sliders: _memory_blocks_1d)
-        Pj = P_march[j][None, :, :, :, None]                                     # (1, n, 2, 2, 1)
-        x = decay[..., None] * dw                                                 # (m, n, 2, 3P)
-        dw = Pj[:, :, :, 0] * x[:, :, None, 0] + Pj[:, :, :, 1] * x[:, :, None, 1] + source[j]
-        dw_all[j] = dw
-        y = decay[..., None] * dw_dw0
-        dw_dw0 = Pj[:, :, :, 0] * y[:, :, None, 0] + Pj[:, :, :, 1] * y[:, :, None, 1]
-        history[j] = dw_dw0
-    system = np.eye(2) - dw_dw0
-    regular = np.abs(np.linalg.det(system)) > 1e-9
-    dw0 = np.zeros((m, n, 2, 3 * P), complex)
-    if np.any(regular):
-        dw0[regular] = np.linalg.solve(system[regular], dw[regular])
-    Edw = (E @ dw_all.reshape(N, -1)).reshape((P, m, n, 2, 3 * P))
-    Eh = (E @ history.reshape(N, -1)).reshape((P, m, n, 2, 2))
-    Edq = np.einsum("hj,jcx->hcx", E, dq)                                          # (P, 2, 3P)
-    coeff = (Edq[:, None, None] - Edw - Eh[..., 0, None] * dw0[None, :, :, None, 0]
-             - Eh[..., 1, None] * dw0[None, :, :, None, 1])
-    return np.moveaxis(k_t[None, None, :, None, None] * coeff, 1, 0)   # (n_s, P, n, 2, 3P)
+    return dict(step=step, source=source, products=step_products(step), E=E,
+                Edq=np.einsum("hj,jcx->hcx", E, dq), h=2.0 * np.pi / (omega * N))
 
 
 def _slider_march(q, rho, start, one_d=False):
@@ -117,11 +129,10 @@ def _slider_march(q, rho, start, one_d=False):
         previous[1:, :, 0] = periodic["slider"][:-1]
         _, _, P, n_rho = slider_update_derivatives(previous, q, rho)
         return P, n_rho
-    P, n_rho = np.empty((N, n, 2, 2)), np.empty((N, n, 2))
-    w = np.array(start, dtype=float)
-    for j in range(N):    # the 2-D return map is a march (as in the AFT's own 2-D friction)
-        w, _, P[j], n_rho[j] = slider_update_derivatives(w, q[j], rho[j])
-    return P, n_rho
+    from .stability_march import slider_steps   # the 2-D return map is a march: compiled
+
+    return slider_steps(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(rho, dtype=float),
+                        np.ascontiguousarray(start, dtype=float))
 
 
 def _memory_block_1d(s, omega, P, n_rho, drho, k_t, H, N):
@@ -221,17 +232,32 @@ class ContactOperator:
         """The tangent-group blocks (rows, 𝒥(s)) — complex — for jacobian_matrix."""
         return [(rows, J[0]) for rows, J in self.blocks_at_many(np.array([s], dtype=complex))]
 
+    def memory_coefficients(self, s):
+        """The s-dependent tangent rows of each memory group at exponents s (n_s,):
+        [(rows (n_g, 3), δλ̃_t (n_s, P, n_g, 2, 3P))] — row harmonic, contact, tangent direction,
+        local column h·3 + l (l = 0 normal, 1, 2 tangents); the normal rows of the groups are
+        s-independent (``g["normal"]``)."""
+        s = np.atleast_1d(np.asarray(s, dtype=complex))
+        out = []
+        for g in self.memory:
+            args = (s, self.omega, *g["march"], g["drho"], g["k_t"], self.H, g["N"])
+            if g["one_d"]:
+                out.append((g["rows"], _memory_blocks_1d(*args)))
+                continue
+            if "setup" not in g:         # the s-independent part, once per solution
+                g["setup"] = _memory_setup(self.omega, *g["march"], g["drho"], self.H, g["N"])
+            out.append((g["rows"], _memory_blocks(*args, setup=g["setup"])))
+        return out
+
     def blocks_at_many(self, s):
         """:meth:`blocks_at` at several exponents s (n_s,): [(rows, 𝒥 (n_s, n_g, 3P, 3P))]."""
         s = np.atleast_1d(np.asarray(s, dtype=complex))
         out = []
-        for g in self.memory:
-            blocks = _memory_blocks_1d if g["one_d"] else _memory_blocks
-            coeff = blocks(s, self.omega, *g["march"], g["drho"], g["k_t"], self.H, g["N"])
+        for g, (rows, coeff) in zip(self.memory, self.memory_coefficients(s)):
             J = np.broadcast_to(g["normal"], (s.size,) + g["normal"].shape).astype(complex)
             J[:, :, 1::3, :] = np.moveaxis(coeff[:, :, :, 0, :], 1, 2)
             J[:, :, 2::3, :] = np.moveaxis(coeff[:, :, :, 1, :], 1, 2)
-            out.append((g["rows"], J))
+            out.append((rows, J))
         return out
 
     def rows_correction(self, s):

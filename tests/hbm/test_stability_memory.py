@@ -1,8 +1,13 @@
-"""The friction-memory term of Hill's operator: the vectorized 1-D form equals the sample march."""
+"""The friction-memory term of Hill's operator: the vectorized 1-D form equals the sample march;
+the compiled 2-D march (slider states and the linearized march at many s) equals a plain
+per-sample loop written out here."""
 import numpy as np
 import pytest
 
-from sarfe.hbm.stability_contacts import _memory_block, _memory_block_1d, _slider_march
+from sarfe.hbm import harmonics as hm
+from sarfe.hbm.laws.jenkins import slider_update_derivatives
+from sarfe.hbm.stability_contacts import (_memory_block, _memory_block_1d, _memory_blocks,
+                                          _slider_march)
 
 
 def one_d_states(N=256, n=3, seed=0):
@@ -51,6 +56,74 @@ def test_vectorized_1d_slider_march_equals_the_loop():
     P_fast, n_rho_fast = _slider_march(q, rho, start, one_d=True)
     assert np.allclose(P_fast, P, rtol=0, atol=1e-12)
     assert np.allclose(n_rho_fast, n_rho, rtol=0, atol=1e-12)
+
+
+def two_d_states(N=128, n=3, seed=1):
+    """2-D tangential motion q (N, n, 2) on ellipses and slip radii ρ (N, n) with stick, slip (in
+    changing directions) and a separation; start: the slider after three periods."""
+    theta = 2 * np.pi * np.arange(N) / N
+    rng = np.random.default_rng(seed)
+    amplitude = np.array([0.4, 1.5, 3.0])[:n]
+    q = np.zeros((N, n, 2))
+    q[:, :, 0] = amplitude * np.cos(theta[:, None] + rng.uniform(0, 1, n))
+    q[:, :, 1] = 0.6 * amplitude * np.sin(theta[:, None] + rng.uniform(0, 1, n))
+    rho = np.clip(1.0 + 0.5 * np.sin(2 * theta[:, None] + np.zeros(n)), 0, None)
+    rho[N // 4: N // 4 + 4, 2] = 0.0
+    w = np.zeros((n, 2))
+    for _ in range(3 * N):
+        w = slider_update_derivatives(w, q[_ % N], rho[_ % N])[0]
+    return q, rho, w
+
+
+def test_compiled_2d_slider_march_equals_the_sample_loop():
+    """P_j and n_j of the compiled 2-D march equal the per-sample return map at every sample."""
+    q, rho, start = two_d_states()
+    P, n_rho = _slider_march(q, rho, start)
+    w, states = start.copy(), []
+    for j in range(q.shape[0]):
+        w, state, P_j, n_j = slider_update_derivatives(w, q[j], rho[j])
+        states.append(state)
+        assert np.allclose(P[j], P_j, rtol=0, atol=1e-14)
+        assert np.allclose(n_rho[j], n_j, rtol=0, atol=1e-14)
+    assert set(np.unique(states).tolist()) == {0, 1, 2}        # separated, stick and slip visited
+
+
+@pytest.mark.parametrize("s", [0.0, -0.3 + 0.2j, 0.05 + 1.4j, 40.0 - 3.0j])
+def test_compiled_2d_memory_equals_the_linearized_march(s):
+    """δλ̃_t at s from the compiled march over many s at once (chunked) equals the linearized return
+    map marched sample by sample, δw_j = P_j (e^{−sh} δw_{j−1} − δq_j) + δq_j + n_j dρ_j δn_j, from
+    the periodic start δw_{−1} = δw_{N−1} (where regular), with δλ_t = k_t (δq − δw) transformed by E."""
+    N, H, omega = 128, 4, 2.0
+    q, rho, start = two_d_states(N)
+    n = q.shape[1]
+    P_j, n_j = _slider_march(q, rho, start)
+    drho, k_t = 0.2 * np.ones_like(rho), np.array([1.0, 2.0, 0.5])
+    E, Phi = hm.fourier_matrices(H, N)
+    C = 3 * (2 * H + 1)
+    decay = np.exp(-s * 2 * np.pi / (omega * N))
+    # the march as an affine map of δw_{−1}: δw_j = A_j δw_{−1} + b_j (columns: local harmonics)
+    A = np.broadcast_to(np.eye(2, dtype=complex), (n, 2, 2)).copy()
+    b = np.zeros((n, 2, C), complex)
+    history, forced = [], []
+    for j in range(N):
+        dq = np.zeros((2, C))
+        dq[0, 1::3], dq[1, 2::3] = Phi[j], Phi[j]
+        dn = np.zeros(C)
+        dn[0::3] = Phi[j]
+        A = P_j[j] @ (decay * A)
+        b = P_j[j] @ (decay * b - dq) + dq + n_j[j][:, :, None] * (drho[j][:, None, None] * dn)
+        history.append(A)
+        forced.append(b - dq)
+    w0 = np.zeros_like(b)        # a contact stuck all period at s = 0: no periodic start (δw = 0)
+    regular = np.abs(np.linalg.det(np.eye(2) - A)) > 1e-9
+    w0[regular] = np.linalg.solve((np.eye(2) - A)[regular], b[regular])
+    dw_minus_dq = np.array([hist @ w0 + f for hist, f in zip(history, forced)])   # (N, n, 2, C)
+    reference = -k_t[None, :, None, None] * np.einsum("hj,jcax->hcax", E, dw_minus_dq)
+    many = _memory_blocks(np.array([1.0 + 2.0j, s, 0.3j, s, -1.0]), omega, P_j, n_j, drho, k_t,
+                          H, N, chunk=2)
+    scale = np.abs(reference).max()
+    assert np.abs(many[1] - reference).max() <= 1e-11 * scale
+    assert np.abs(many[3] - reference).max() <= 1e-11 * scale
 
 
 def test_refined_exponent_is_the_fixed_point_of_successive_linear_problems():
