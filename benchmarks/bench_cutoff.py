@@ -20,7 +20,8 @@ Per cutoff c = factor · H · f_max (factors 0.25 … 2.0, f_max = 80 Hz; the de
    the finest basis, ũ_k = Z_k⁻¹ (f̃_k − Gᵀ λ̃_k) (sarfe.hbm.linear.recover_displacement), compared
    with the finest in the same measures — "only the recovery and ERP need the high modes".
 
-Usage: python benchmarks/bench_cutoff.py [mesh_mm ...] (default 10). Writes
+Usage: python benchmarks/bench_cutoff.py [mesh_mm[:factor,factor,...] ...] (default 10 with all
+factors; the largest factor given is the reference). Writes
 benchmarks/results/cutoff.md and .json (one section per mesh; earlier meshes kept from the json).
 """
 import json
@@ -235,10 +236,13 @@ def main(meshes_mm):
     path = RESULTS / "cutoff.json"
     res = json.loads(path.read_text()) if path.exists() else {}
     res.setdefault("meshes", {})
-    for mm in meshes_mm:
+    for spec in meshes_mm:
+        mm, _, factors = str(spec).partition(":")
+        mm = float(mm)
+        factors = tuple(float(x) for x in factors.split(",")) if factors else FACTORS
         clock = time.perf_counter()
         load = " ".join(f"{x:.1f}" for x in os.getloadavg())
-        out = study(mm / 1000.0)
+        out = study(mm / 1000.0, factors)
         out.update(wall_s=time.perf_counter() - clock, load_average=load,
                    machine=f"{platform.platform()}, {os.cpu_count()} cores")
         res["meshes"][f"{mm:g}"] = out
@@ -253,7 +257,7 @@ def write_md(res):
     L = ["# Craig–Bampton cutoff: what Newton needs, what the ERP needs (issue 15)", "",
          "Door trim of cases/door_trim_p1.yaml (12 pairs: 8 rattle, 4 squeak), H = 15, N = 256, "
          "base 10 m/s², modal ζ 3 %; cutoff = factor · H · f_max (f_max = 80 Hz; the rule's default "
-         "factor 1.5). Reference: the finest cutoff (2.0 H f_max = 2400 Hz). Script: "
+         "factor 1.5). Reference: the finest cutoff of each mesh. Script: "
          "benchmarks/bench_cutoff.py (OPENBLAS_NUM_THREADS=1).", "",
          "Columns: max over the points of — a₁: first-harmonic contact amplitude change "
          "(relative to the largest a₁; the estimate's measure); r̃: contact-row displacement "
@@ -267,7 +271,8 @@ def write_md(res):
         L += [f"## {mm} mm (wall {m['wall_s']:.0f} s, load average at start "
               f"{m['load_average']}; {m['machine']})", "",
               f"Points: {', '.join(f'{f:g}' for f in m['frequencies_hz'])} Hz; loudest of the "
-              f"1 Hz screening at H = 15 on the finest stage: {m['loudest_hz']:g} Hz.", "",
+              f"1 Hz screening at H = 15 on the finest stage: {m['loudest_hz']:g} Hz. Reference: "
+              f"factor {max(r['factor'] for r in m['rows']):g}.", "",
               "| factor | cutoff Hz | modes (+res) | stage s | 1st pt s | s/pt | a₁ | r̃ | λ̃ | w̃ "
               "| ΔdB(A) | ΔdB | ΔL_k dB | est a₁ | est dB | brackets a₁ / dB | split w̃ | "
               "split ΔdB(A) | split ΔL_k |",
@@ -316,4 +321,4 @@ if __name__ == "__main__":
     if sys.argv[1:] == ["--md"]:       # rewrite the .md from the .json (notes edited there)
         write_md(json.loads((RESULTS / "cutoff.json").read_text()))
     else:
-        main([float(x) for x in sys.argv[1:]] or [10.0])
+        main(sys.argv[1:] or ["10"])
