@@ -99,10 +99,10 @@ class ReductionConfig:
     """reduction (FE cases): mode_count or cutoff_hz (or neither: cutoff from the excitation),
     cutoff_margin × H × f_max, at least min_mode_count modes, static residual vectors.
 
-    cutoff_margin 1.0 (was 1.5): door trim, 12 contact pairs, H = 15, 40–80 Hz, 15 and 10 mm
+    cutoff_margin 1.0 (was 1.5): door trim, 12 contact pairs, H = 15, 40–80 Hz, 15, 10 and 5 mm
     (benchmarks/results/cutoff.md): the cutoff H f_max changes the contact-row first-harmonic
-    amplitudes by ≤ 1.1e-4, every response harmonic by ≤ 2.3e-4 and the ERP by ≤ 0.012 dB(A)
-    against 2 H f_max, with half the modes of 1.5 H f_max; 0.75 H f_max already moves them by
+    amplitudes by ≤ 1.7e-4, every response harmonic by ≤ 3.1e-4 and the ERP by ≤ 0.012 dB(A)
+    against 2 H f_max (1.5 at 5 mm), with about half the modes of 1.5 H f_max; 0.75 H f_max already moves them by
     1.5e-3 / 0.021 dB(A) (harmonics above the cutoff have no modes to live in)."""
 
     mode_count: int | None = None
