@@ -20,7 +20,7 @@ r"""Accuracy of a whole sweep as an input: a target (``fast | balanced | fine | 
 4. N at the chosen H: N → 2N (warm start) until RICHARDSON × the change is within the other half.
 5. Craig–Bampton cutoff (FE; the case layer, :func:`sarfe.pipeline.accuracy.case_resolution`):
    max(cutoff_margin, LADDER_FACTOR) · H · f_max with the chosen H (1.5 H f_max: modes up to the
-   ladder's next rung, which the search judges H by; the reduction's own default is H f_max),
+   ladder's next rung, which the search judges H by; the reduction's own default is 1.25 H f_max),
    set explicitly; the search is repeated on that stage when it needs more modes than the one
    searched on. Measured on the door trim (benchmarks/results/audible.md, cutoff.md): above
    H f_max the dB(A) level moves by ≤ 0.012 dB, so no higher cutoff is chosen, and contact forces

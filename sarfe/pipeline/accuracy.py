@@ -50,7 +50,7 @@ def sweep_grid_hz(excitation: ExcitationConfig, points=8) -> np.ndarray:
 
 def rule_cutoff_hz(case, harmonics) -> float | None:
     """The accuracy search's cutoff at H: m · H · f_max [Hz] with m = max(cutoff_margin,
-    LADDER_FACTOR) (1.5 by default, above the reduction's own 1.0), for an FE case whose reduction
+    LADDER_FACTOR) (1.5 by default, above the reduction's own 1.25), for an FE case whose reduction
     gives neither cutoff_hz nor mode_count; None otherwise (a matrices model, or the user's
     reduction, which the accuracy search keeps).
 
