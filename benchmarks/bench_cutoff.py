@@ -245,7 +245,7 @@ def main(meshes_mm):
         out = study(mm / 1000.0, factors)
         out.update(wall_s=time.perf_counter() - clock, load_average=load,
                    machine=f"{platform.platform()}, {os.cpu_count()} cores")
-        res["meshes"][f"{mm:g}"] = out
+        res["meshes"][f"{mm:g}" if factors == FACTORS or mm == 5 else str(spec)] = out
         RESULTS.mkdir(exist_ok=True)
         path.write_text(json.dumps(res, indent=1, default=float))
     write_md(res)
@@ -268,7 +268,8 @@ def write_md(res):
          "1e-4 / 0.01 dB ≥ the measured a₁ / max(|ΔdB|, |ΔdB(A)|) at every point); split: "
          "λ̃ from this basis, ũ recovered on the finest basis.", ""]
     for mm, m in res["meshes"].items():
-        L += [f"## {mm} mm (wall {m['wall_s']:.0f} s, load average at start "
+        factors = ", ".join(f"{r['factor']:g}" for r in m["rows"])
+        L += [f"## {m['mesh_m'] * 1e3:g} mm, factors {factors} (wall {m['wall_s']:.0f} s, load average at start "
               f"{m['load_average']}; {m['machine']})", "",
               f"Points: {', '.join(f'{f:g}' for f in m['frequencies_hz'])} Hz; loudest of the "
               f"1 Hz screening at H = 15 on the finest stage: {m['loudest_hz']:g} Hz. Reference: "
