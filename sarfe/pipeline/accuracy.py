@@ -49,14 +49,27 @@ def sweep_grid_hz(excitation: ExcitationConfig, points=8) -> np.ndarray:
 
 
 def rule_cutoff_hz(case, harmonics) -> float | None:
-    """The reduction's cutoff rule at H: cutoff_margin · H · f_max [Hz] (default margin 1.5), for
-    an FE case whose reduction gives neither cutoff_hz nor mode_count; None otherwise (a matrices
-    model, or the user's reduction, which the accuracy search keeps)."""
+    """The accuracy search's cutoff at H: m · H · f_max [Hz] with m = max(cutoff_margin,
+    LADDER_FACTOR) (1.5 by default, above the reduction's own 1.25), for an FE case whose reduction
+    gives neither cutoff_hz nor mode_count; None otherwise (a matrices model, or the user's
+    reduction, which the accuracy search keeps).
+
+    Why more than the reduction's H f_max: the search judges H by the change to the next rung of
+    its ladder, H' ≈ LADDER_FACTOR · H, so its stage keeps modes up to H' f_max; on a stage whose
+    rung harmonics have no modes (answered quasi-statically) the ladder climbs irregularly (door
+    trim, 10 mm, 67 Hz: on a 335 Hz stage to H = 27, then a 610-mode stage, 126 s against 75 s
+    with 1.5; benchmarks/results/audible.md). The sweep reuses the search's last stage."""
     reduction = case.data.get("reduction") or {}
     if not case.is_fe or "cutoff_hz" in reduction or "mode_count" in reduction:
         return None
-    return float(case.config.reduction.cutoff_margin * int(harmonics)
-                 * case.config.excitation.max_frequency_hz)
+    return float(search_margin(case) * int(harmonics) * case.config.excitation.max_frequency_hz)
+
+
+def search_margin(case) -> float:
+    """m of :func:`rule_cutoff_hz`: max(reduction.cutoff_margin, LADDER_FACTOR)."""
+    from sarfe.accuracy.resolve import LADDER_FACTOR
+
+    return float(max(case.config.reduction.cutoff_margin, LADDER_FACTOR))
 
 
 def _with_cutoff(case, cutoff_hz):
@@ -77,8 +90,9 @@ def case_resolution(case, target, points=8, start_harmonics=3, start_samples=64,
     the loudest point), with the case's Newton tolerance and no stability.
 
     FE cases whose reduction gives neither cutoff_hz nor mode_count: the Craig–Bampton cutoff is
-    the reduction's rule with the chosen H, c(H) = cutoff_margin · H · f_max (:func:`rule_cutoff_hz`,
-    reported as ``cutoff_hz`` and set explicitly by :func:`sarfe.accuracy.resolve.apply_resolution`).
+    the search's rule with the chosen H, c(H) = max(cutoff_margin, 1.5) · H · f_max
+    (:func:`rule_cutoff_hz`: modes up to the ladder's next rung; reported as ``cutoff_hz`` and set
+    explicitly by :func:`sarfe.accuracy.resolve.apply_resolution`).
     The ladder's changes are only trusted on a stage whose modes cover them: a stage with too few
     modes answers the high harmonics quasi-statically, and its ladder stops too early or climbs
     too far (door trim: from a 335 Hz stage, H = 27; from 502 Hz, H = 8; benchmarks/results/
@@ -123,8 +137,7 @@ def case_resolution(case, target, points=8, start_harmonics=3, start_samples=64,
                        f"{', '.join(str(m) for m in stages)})" + (
                            "" if cutoff is None else
                            f"; reduction cutoff {cutoff:.0f} Hz (≥ {need:.0f} Hz = "
-                           f"{case.config.reduction.cutoff_margin:g} H f_max at H = "
-                           f"{report['harmonics']})"))
+                           f"{search_margin(case):g} H f_max at H = {report['harmonics']})"))
     return report, stage
 
 
@@ -204,4 +217,4 @@ def accuracy_check(solver: SolverConfig, points) -> dict | None:
 
 
 __all__ = ["accuracy_check", "stage_modal_coordinates", "accuracy_problem", "stage_error_estimate", "sweep_grid_hz",
-           "resolve_case_accuracy", "case_resolution", "rule_cutoff_hz"]
+           "resolve_case_accuracy", "case_resolution", "rule_cutoff_hz", "search_margin"]
