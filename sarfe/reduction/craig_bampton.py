@@ -52,6 +52,11 @@ _MODE_BLOCK = 24  # fixed-interface modes requested per Lanczos run when searchi
 # past that the modes up to the cutoff come from spectrum slicing (1.3 GB of Q, MQ at n = 206k)
 _SLICE_COLUMNS = 400
 _SLICE_ENTRIES = 8e7
+# a second process slices the upper part of the spectrum when the modes below the cutoff
+# outnumber what run 0 finds in its capped space (≈ 0.3 modes per column on the door trim); this
+# process (run 0 and the shifted runs up to the split) takes the modes below _LOWER_SHARE·ω_cutoff
+_PARALLEL_MODES_PER_COLUMN = 0.5
+_LOWER_SHARE = 0.5
 
 
 @dataclass(frozen=True, eq=False)  # array fields: compare explicitly, not with ==
@@ -342,9 +347,29 @@ def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, blo
     return omega2[:wanted], modes
 
 
-def _slice(k_ii, m_ii, cutoff_hz, partial, progress, timings):
-    """Modes up to the cutoff by spectrum slicing from run 0's converged prefix: (ω², Φ), or None
-    when slicing cannot run (no PARDISO for the inertia) or a gap's count was not reached."""
+def _start_upper_slices(k_ii, m_ii, cutoff_hz, cap, workers, held):
+    """With ``workers`` ≥ 2 (None: the usable cores) and PARDISO: before run 0, a forked worker
+    that counts the modes below the cutoff and, when they outnumber what run 0 finds in its capped
+    space, slices the upper part of the spectrum while this process runs run 0 and the lower
+    part (:func:`sarfe.reduction.spectrum_slicing.start_upper_slices`). None otherwise."""
+    from sarfe.fe.linear_solvers import available_solvers
+    from sarfe.reduction.spectrum_slicing import start_upper_slices, usable_cores
+
+    workers = usable_cores() if workers is None else int(workers)
+    if workers < 2 or "pardiso" not in available_solvers():
+        return None
+
+    def drop_inherited_factor():
+        held["factor"] = None     # the worker's copy of K_ii's factor (it has its own shifts)
+
+    return start_upper_slices(k_ii, m_ii, (2 * np.pi * cutoff_hz) ** 2, _LOWER_SHARE,
+                              int(_PARALLEL_MODES_PER_COLUMN * cap), drop_inherited_factor)
+
+
+def _slice(k_ii, m_ii, cutoff_hz, partial, progress, timings, upper):
+    """Modes up to the cutoff by spectrum slicing from run 0's converged prefix (with the upper
+    part from ``upper``'s worker when given): (ω², Φ), or None when slicing cannot run (no
+    PARDISO for the inertia) or a gap's count was not reached."""
     from sarfe.fe.linear_solvers import available_solvers
     from sarfe.reduction.spectrum_slicing import SlicingFailed, sliced_modes
 
@@ -353,7 +378,7 @@ def _slice(k_ii, m_ii, cutoff_hz, partial, progress, timings):
     try:
         omega2, modes, record = sliced_modes(k_ii, m_ii, (2 * np.pi * cutoff_hz) ** 2,
                                              partial.omega2, partial.modes, partial.boundary,
-                                             progress=progress, solver="pardiso")
+                                             progress=progress, solver="pardiso", upper=upper)
     except SlicingFailed as exc:
         timings["slicing"] = {"failed": str(exc)}
         return None
@@ -397,7 +422,7 @@ def residual_modes(stiffness_ii, mass_ii, operator, loads, modes, relative_toler
 
 def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=None, solver="auto",
                   progress=None, free_dofs=None, total_dof_count=None, eigensolver="block",
-                  residual_vectors=False, residual_loads=None) -> ReducedModel:
+                  residual_vectors=False, residual_loads=None, workers=None) -> ReducedModel:
     """Craig–Bampton reduction (see module docstring for the equations).
 
     stiffness, mass: (n, n) sparse K [N/m], M [kg] on the free DOFs (fixed DOFs removed, see
@@ -415,6 +440,9 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
     residual_vectors: add residual modes for the boundary inertia loads M_ib + M_ii Ψ (module
     docstring); residual_loads: (n, k) further load columns on the free DOFs whose interior part
     gets residual modes too (e.g. the base-excitation load −M ι); either needs one extra block solve.
+    workers: processes that slice the spectrum when many modes are wanted (None: the usable
+    cores, 1: this process alone; :mod:`sarfe.reduction.spectrum_slicing`); the modes are the same
+    for any number.
     """
     stiffness, mass = sp.csr_matrix(stiffness), sp.csr_matrix(mass)
     n = stiffness.shape[0]
@@ -488,11 +516,16 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
             # many modes up to a cutoff: cap run 0's Krylov space (two n × m arrays), slice the rest
             cap = max(_SLICE_COLUMNS, int(_SLICE_ENTRIES // max(len(interior), 1))) \
                 if cutoff_hz is not None and mode_count is None else None
+            upper = _start_upper_slices(k_ii, m_ii, cutoff_hz, cap, workers, held) \
+                if cap is not None else None
             found = _block_lanczos_modes(m_ii, inverse, mode_count, cutoff_hz, progress,
                                          max_columns=cap)
             if isinstance(found, _Partial):
                 held["factor"] = None     # K_ii's factor is not used by the shifted runs
-                found = _slice(k_ii, m_ii, cutoff_hz, found, progress, timings)
+                found = _slice(k_ii, m_ii, cutoff_hz, found, progress, timings, upper)
+            elif upper is not None:
+                upper.cancel()            # run 0 found them all after all
+            upper = None
             if found is None and cap is not None:   # slicing impossible: one uncapped run
                 found = _block_lanczos_modes(m_ii, inverse, mode_count, cutoff_hz, progress)
         if found is None:

@@ -1,0 +1,130 @@
+"""Spectrum slicing in one or two processes against a dense reference (scipy.linalg.eigh).
+
+The model: two copies of the clamped plate, the second 1e-3 stiffer, side by side without
+coupling — every eigenvalue comes as a close pair λ, (1 + 1e-3)·λ. The cutoff is placed so that
+the two-process split λ_s = (share·ω_c)² falls inside one pair: the lower process must deliver
+its lower member, the worker its upper one, certified by the inertia counts at λ_s.
+"""
+import importlib
+
+import numpy as np
+import pytest
+import scipy.linalg as sla
+import scipy.sparse as sp
+
+from conftest import plate_model
+from sarfe.fe.linear_solvers import available_solvers, shifted_factorizer
+from sarfe.reduction import craig_bampton, free_dof_positions, node_dofs
+
+STIFFER = 1e-3    # relative spacing of the close pairs
+
+pytestmark = pytest.mark.skipif("pardiso" not in available_solvers(),
+                                reason="spectrum slicing needs PARDISO's inertia")
+
+
+@pytest.fixture(scope="module")
+def twin():
+    """(K, M, boundary, interior, reference ω² of (K_ii, M_ii), cutoff [Hz] with the split inside
+    a close pair)."""
+    plate = plate_model(12, 8)
+    stiffness = sp.block_diag([plate.stiffness, (1 + STIFFER) * plate.stiffness], format="csr")
+    mass = sp.block_diag([plate.mass, plate.mass], format="csr")
+    one = free_dof_positions(node_dofs(plate.boundary_nodes, (0, 1, 2), plate.dofs_per_node),
+                             plate.free_dofs, plate.total_dof_count)
+    boundary = np.concatenate([one, one + plate.stiffness.shape[0]])
+    interior = np.setdiff1d(np.arange(stiffness.shape[0]), boundary)
+    k_ii = stiffness[interior][:, interior].toarray()
+    m_ii = mass[interior][:, interior].toarray()
+    omega2 = sla.eigh(k_ii, m_ii, eigvals_only=True)
+    share = importlib.import_module("sarfe.reduction.craig_bampton")._LOWER_SHARE
+    # the 120th pair: split halfway between its members, cutoff = split / share
+    lower = omega2[(omega2 > 0)][2 * 120]
+    split = lower * (1 + 0.5 * STIFFER)
+    cutoff_hz = np.sqrt(split) / share / (2 * np.pi)
+    return stiffness, mass, boundary, k_ii, m_ii, omega2, cutoff_hz
+
+
+def reduce(twin, monkeypatch, workers):
+    module = importlib.import_module("sarfe.reduction.craig_bampton")
+    monkeypatch.setattr(module, "_SLICE_COLUMNS", 64)    # run 0 capped: slicing from 64 columns
+    monkeypatch.setattr(module, "_SLICE_ENTRIES", 0)
+    stiffness, mass, boundary, *_, cutoff_hz = twin
+    return craig_bampton(stiffness, mass, boundary, cutoff_hz=cutoff_hz, residual_vectors=True,
+                         workers=workers)
+
+
+def check_against_dense(reduced, twin):
+    """Every eigenvalue below the cutoff to 1e-9, modes M-orthonormal, K_ii diagonal."""
+    _, _, _, k_ii, m_ii, omega2, cutoff_hz = twin
+    expected = omega2[omega2 <= (2 * np.pi * cutoff_hz) ** 2]
+    assert reduced.mode_count == len(expected) > 200
+    np.testing.assert_allclose((2 * np.pi * reduced.mode_frequencies_hz) ** 2, expected, rtol=1e-9)
+    phi = reduced.fixed_interface_modes
+    np.testing.assert_allclose(phi.T @ m_ii @ phi, np.eye(len(expected)), atol=1e-7)
+    np.testing.assert_allclose(phi.T @ k_ii @ phi, np.diag(expected), atol=1e-7 * expected.max())
+
+
+def test_two_processes_split_inside_a_close_pair(twin, monkeypatch):
+    """The worker takes (λ_s, cutoff], this process the rest; λ_s lies between the two members of
+    a pair 1e-3 apart, and the result equals the dense reference."""
+    reduced = reduce(twin, monkeypatch, workers=2)
+    record = reduced.timings["slicing"]
+    assert "upper" in record and "upper_failed" not in record
+    omega2 = twin[5]
+    inside = np.count_nonzero(omega2 <= record["split"])
+    assert omega2[inside - 1] < record["split"] < omega2[inside]
+    assert omega2[inside] / omega2[inside - 1] - 1 < 2 * STIFFER      # a close pair
+    assert record["split_count"] == inside
+    check_against_dense(reduced, twin)
+
+
+def test_one_worker_falls_back_to_one_process_with_the_same_modes(twin, monkeypatch):
+    """workers=1, or one usable core, or no fork: the whole chain in this process; the same
+    eigenvalues as two processes (to 1e-12) and as the dense reference, the same reduced model."""
+    two = reduce(twin, monkeypatch, workers=2)
+    one = reduce(twin, monkeypatch, workers=1)
+    assert "upper" not in one.timings["slicing"]
+    check_against_dense(one, twin)
+    np.testing.assert_allclose(one.mode_frequencies_hz, two.mode_frequencies_hz, rtol=1e-12)
+    n_b = one.boundary_count
+    np.testing.assert_allclose(one.stiffness[:n_b, :n_b], two.stiffness[:n_b, :n_b], rtol=1e-12)
+    system = [np.sort(sla.eigh(r.stiffness, r.mass, eigvals_only=True))[:100] for r in (one, two)]
+    np.testing.assert_allclose(system[0], system[1], rtol=1e-9)
+    slicing = importlib.import_module("sarfe.reduction.spectrum_slicing")
+    monkeypatch.setattr(slicing, "usable_cores", lambda: 1)
+    auto = reduce(twin, monkeypatch, workers=None)
+    assert "upper" not in auto.timings["slicing"]
+    np.testing.assert_allclose(auto.mode_frequencies_hz, one.mode_frequencies_hz, rtol=1e-12)
+    monkeypatch.setattr(slicing, "usable_cores", lambda: 2)
+    import multiprocessing
+    monkeypatch.setattr(multiprocessing, "get_all_start_methods", lambda: ["spawn"])
+    no_fork = reduce(twin, monkeypatch, workers=None)
+    assert "upper" not in no_fork.timings["slicing"]
+    np.testing.assert_allclose(no_fork.mode_frequencies_hz, one.mode_frequencies_hz, rtol=1e-12)
+
+
+def test_two_process_runs_give_the_same_modes(twin, monkeypatch):
+    """Deterministic: the worker's shifts follow from its interval and counts, not from timing."""
+    first, second = (reduce(twin, monkeypatch, workers=2) for _ in range(2))
+    assert first.timings["slicing"]["upper"]["shifts"] == second.timings["slicing"]["upper"]["shifts"]
+    np.testing.assert_allclose(first.mode_frequencies_hz, second.mode_frequencies_hz, rtol=1e-13)
+
+
+def test_shifted_factorizer_counts_and_solves():
+    """One analysis for all shifts: each factor of K − σM counts the eigenvalues below σ (dense
+    reference) and solves to round-off; a replaced factor refuses to solve."""
+    plate = plate_model(8, 6)
+    k, m = plate.stiffness, plate.mass
+    omega2 = sla.eigh(k.toarray(), m.toarray(), eigvals_only=True)
+    factor_at = shifted_factorizer(k, m, solver="pardiso")
+    rhs = np.random.default_rng(0).standard_normal((k.shape[0], 3))
+    for shift in (0.5 * omega2[0], 0.5 * (omega2[9] + omega2[10]), 0.5 * (omega2[40] + omega2[41])):
+        factor = factor_at(shift)
+        assert factor.negative_pivots == np.count_nonzero(omega2 < shift)
+        x = factor.solve(rhs)
+        assert np.linalg.norm((k - shift * m) @ x - rhs) < 1e-9 * np.linalg.norm(rhs)
+    factor_at(omega2[5] * 1.01)
+    with pytest.raises(RuntimeError):
+        factor.solve(rhs)
+    factor_at.release()
+    assert factor_at(0.5 * omega2[0]).negative_pivots == 0
