@@ -19,7 +19,19 @@ eigenvalue count so far, N(λ) ≈ a √λ (a plate's modal density), so that a 
 about ``slice_modes`` eigenvalues; each run's Krylov space is bounded by ``max_columns``.
 
 Run 0 is the caller's σ = 0 block Lanczos stopped at its column cap; its converged prefix and the
-next Ritz value enter here as (eigenvalues, modes, boundary). All runs use the M inner product; a Ritz pair is
+next Ritz value enter here as (eigenvalues, modes, boundary).
+
+Every shift's K − σM has the same sparsity pattern: PARDISO's ordering and symbolic analysis run
+once (:func:`sarfe.fe.linear_solvers.shifted_factorizer`), each shift only its numerical LDLᵀ.
+
+Two processes (two usable cores): a chain of runs needs nothing from another chain but a
+certified count at its bottom, so the spectrum is split at λ_s = (share·ω_c)² (N(ω) ≈ a ω
+puts about ``share`` of the modes below it). A worker forked before run 0 counts N(λ_c) and
+N(λ_s) itself and runs the chain over (λ_s, λ_c] from nothing pending, writing its modes to a
+shared-memory file; this process runs run 0 and the chain over (boundary, λ_s], then appends
+the worker's block. Both chains' shifts follow from their intervals and counts alone, so the
+modes do not depend on timing; with one core, no fork, or inside a daemon process (a Dask
+worker) one chain covers it all. All runs use the M inner product; a Ritz pair is
 converged when ‖A φ − θ φ‖_M ≤ tol·|θ| (relative to its own θ: a value next to the shift, with a
 huge θ, must not loosen the test for the others).
 """
@@ -379,12 +391,14 @@ def start_upper_slices(stiffness, mass, cutoff_omega2, lower_share, min_total, o
     process takes (0, λ_s]). K, M are shared copy-on-write; ``on_fork()`` runs first in the
     worker to free what it inherited and does not need (the parent's factor of K_ii). The modes
     go to a file in /dev/shm (memory, not disk, on Linux) that :meth:`UpperSlices.join` reads and
-    removes. Returns an :class:`UpperSlices`, or None where fork is not available. The worker's
+    removes. Returns an :class:`UpperSlices`, or None where fork is not available or this
+    process is a daemon (a Dask or multiprocessing worker may not have children). The worker's
     results do not depend on timing: its shifts follow from its interval and counts alone."""
     import multiprocessing
     import tempfile
 
-    if "fork" not in multiprocessing.get_all_start_methods():
+    if "fork" not in multiprocessing.get_all_start_methods() or \
+            multiprocessing.current_process().daemon:      # e.g. a Dask worker: no children
         return None
     directory = "/dev/shm" if os.path.isdir("/dev/shm") else None
     handle, path = tempfile.mkstemp(prefix="sarfe-slices-", suffix=".f64", dir=directory)
