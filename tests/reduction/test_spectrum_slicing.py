@@ -44,13 +44,30 @@ def twin():
     return stiffness, mass, boundary, k_ii, m_ii, omega2, cutoff_hz
 
 
-def reduce(twin, monkeypatch, workers):
+@pytest.fixture(scope="module")
+def capped():
+    """Run 0 capped at 64 columns: the modes above come from spectrum slicing."""
     module = importlib.import_module("sarfe.reduction.craig_bampton")
-    monkeypatch.setattr(module, "_SLICE_COLUMNS", 64)    # run 0 capped: slicing from 64 columns
-    monkeypatch.setattr(module, "_SLICE_ENTRIES", 0)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(module, "_SLICE_COLUMNS", 64)
+        patch.setattr(module, "_SLICE_ENTRIES", 0)
+        yield
+
+
+def reduce(twin, workers):
     stiffness, mass, boundary, *_, cutoff_hz = twin
     return craig_bampton(stiffness, mass, boundary, cutoff_hz=cutoff_hz, residual_vectors=True,
                          workers=workers)
+
+
+@pytest.fixture(scope="module")
+def two(twin, capped):
+    return reduce(twin, workers=2)
+
+
+@pytest.fixture(scope="module")
+def one(twin, capped):
+    return reduce(twin, workers=1)
 
 
 def check_against_dense(reduced, twin):
@@ -64,25 +81,22 @@ def check_against_dense(reduced, twin):
     np.testing.assert_allclose(phi.T @ k_ii @ phi, np.diag(expected), atol=1e-7 * expected.max())
 
 
-def test_two_processes_split_inside_a_close_pair(twin, monkeypatch):
+def test_two_processes_split_inside_a_close_pair(twin, two):
     """The worker takes (λ_s, cutoff], this process the rest; λ_s lies between the two members of
     a pair 1e-3 apart, and the result equals the dense reference."""
-    reduced = reduce(twin, monkeypatch, workers=2)
-    record = reduced.timings["slicing"]
+    record = two.timings["slicing"]
     assert "upper" in record and "upper_failed" not in record
     omega2 = twin[5]
     inside = np.count_nonzero(omega2 <= record["split"])
     assert omega2[inside - 1] < record["split"] < omega2[inside]
     assert omega2[inside] / omega2[inside - 1] - 1 < 2 * STIFFER      # a close pair
     assert record["split_count"] == inside
-    check_against_dense(reduced, twin)
+    check_against_dense(two, twin)
 
 
-def test_one_worker_falls_back_to_one_process_with_the_same_modes(twin, monkeypatch):
-    """workers=1, or one usable core, or no fork: the whole chain in this process; the same
-    eigenvalues as two processes (to 1e-12) and as the dense reference, the same reduced model."""
-    two = reduce(twin, monkeypatch, workers=2)
-    one = reduce(twin, monkeypatch, workers=1)
+def test_one_worker_gives_the_same_reduced_model(twin, one, two):
+    """workers=1: the whole chain in this process; the same eigenvalues as two processes (to
+    1e-12) and as the dense reference, the same reduced model (statics, system eigenvalues)."""
     assert "upper" not in one.timings["slicing"]
     check_against_dense(one, twin)
     np.testing.assert_allclose(one.mode_frequencies_hz, two.mode_frequencies_hz, rtol=1e-12)
@@ -90,24 +104,27 @@ def test_one_worker_falls_back_to_one_process_with_the_same_modes(twin, monkeypa
     np.testing.assert_allclose(one.stiffness[:n_b, :n_b], two.stiffness[:n_b, :n_b], rtol=1e-12)
     system = [np.sort(sla.eigh(r.stiffness, r.mass, eigvals_only=True))[:100] for r in (one, two)]
     np.testing.assert_allclose(system[0], system[1], rtol=1e-9)
+
+
+def test_falls_back_to_one_process(twin, one, capped, monkeypatch):
+    """workers=None on one usable core, or where fork is not available: one process, same modes."""
     slicing = importlib.import_module("sarfe.reduction.spectrum_slicing")
     monkeypatch.setattr(slicing, "usable_cores", lambda: 1)
-    auto = reduce(twin, monkeypatch, workers=None)
-    assert "upper" not in auto.timings["slicing"]
-    np.testing.assert_allclose(auto.mode_frequencies_hz, one.mode_frequencies_hz, rtol=1e-12)
-    monkeypatch.setattr(slicing, "usable_cores", lambda: 2)
+    single_core = reduce(twin, workers=None)
+    assert "upper" not in single_core.timings["slicing"]
+    np.testing.assert_allclose(single_core.mode_frequencies_hz, one.mode_frequencies_hz, rtol=1e-12)
     import multiprocessing
+
     monkeypatch.setattr(multiprocessing, "get_all_start_methods", lambda: ["spawn"])
-    no_fork = reduce(twin, monkeypatch, workers=None)
-    assert "upper" not in no_fork.timings["slicing"]
-    np.testing.assert_allclose(no_fork.mode_frequencies_hz, one.mode_frequencies_hz, rtol=1e-12)
+    stiffness, mass = twin[0], twin[1]
+    assert slicing.start_upper_slices(stiffness, mass, 1e8, 0.5, 0) is None   # no worker
 
 
-def test_two_process_runs_give_the_same_modes(twin, monkeypatch):
+def test_two_process_runs_give_the_same_modes(twin, two, capped):
     """Deterministic: the worker's shifts follow from its interval and counts, not from timing."""
-    first, second = (reduce(twin, monkeypatch, workers=2) for _ in range(2))
-    assert first.timings["slicing"]["upper"]["shifts"] == second.timings["slicing"]["upper"]["shifts"]
-    np.testing.assert_allclose(first.mode_frequencies_hz, second.mode_frequencies_hz, rtol=1e-13)
+    again = reduce(twin, workers=2)
+    assert again.timings["slicing"]["upper"]["shifts"] == two.timings["slicing"]["upper"]["shifts"]
+    np.testing.assert_allclose(again.mode_frequencies_hz, two.mode_frequencies_hz, rtol=1e-13)
 
 
 def test_shifted_factorizer_counts_and_solves():
