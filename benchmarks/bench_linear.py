@@ -243,6 +243,26 @@ def p1_lines(p1):
     return lines
 
 
+def profile_lines(profile):
+    """linear.md's breakdown of the P1 Craig–Bampton modes by operation: ``profile`` (stored in
+    linear.json under "p1_profile" by an instrumented run — wrappers timing each call of the
+    named functions, one process, cutoff 1.8 kHz) holds {"note", "runs": {label: {item: [calls,
+    CPU s, columns]}}}."""
+    runs = profile["runs"]
+    items = list(dict.fromkeys(k for run in runs.values() for k in run))
+    lines = ["", "### Where the P1 fixed-interface modes' time goes (instrumented, one process)", "",
+             profile["note"], "",
+             "| item | " + " | ".join(f"{label}: calls, CPU [s]" for label in runs) + " |",
+             "|---|" + "---|" * len(runs)]
+    for item in items:
+        cells = []
+        for run in runs.values():
+            calls, cpu, columns = run.get(item, (0, 0.0, 0))
+            cells.append(f"{calls}, {cpu:.1f}" + (f" ({columns} columns)" if columns else "") if calls else "—")
+        lines.append(f"| {item} | " + " | ".join(cells) + " |")
+    return lines
+
+
 def _vm_gb():
     """(current RSS, peak RSS) of this process [GB] from /proc/self/status."""
     fields = dict(line.split(":", 1) for line in open("/proc/self/status") if line.startswith(("VmRSS", "VmHWM")))
@@ -375,13 +395,16 @@ def write_report(cases, quick, p1=None):
                      f"({100 * stages[top] / total:.0f} %); wall time under the shared load was "
                      f"{c['linear_total_s'] / max(c['linear_total_cpu_s'], 1e-9):.1f}× the CPU time.")
     previous = _stored()
+    profile = previous.get("p1_profile") if isinstance(previous, dict) else None
     if p1 is None and isinstance(previous, dict):
         p1 = previous.get("p1")
     if p1:
         lines += p1_lines(p1)
+    if profile:
+        lines += profile_lines(profile)
     (HERE / "results").mkdir(exist_ok=True)
     (HERE / "results" / "linear.md").write_text("\n".join(lines) + "\n")
-    data = {"cases": cases, "p1": p1} if p1 else cases
+    data = {"cases": cases, "p1": p1, "p1_profile": profile} if p1 or profile else cases
     (HERE / "results" / "linear.json").write_text(json.dumps(data, indent=1, default=float) + "\n")
     print("\n".join(lines))
 

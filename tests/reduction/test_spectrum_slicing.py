@@ -103,7 +103,7 @@ def test_one_worker_gives_the_same_reduced_model(twin, one, two):
     n_b = one.boundary_count
     np.testing.assert_allclose(one.stiffness[:n_b, :n_b], two.stiffness[:n_b, :n_b], rtol=1e-12)
     system = [np.sort(sla.eigh(r.stiffness, r.mass, eigvals_only=True))[:100] for r in (one, two)]
-    np.testing.assert_allclose(system[0], system[1], rtol=1e-9)
+    np.testing.assert_allclose(system[0], system[1], rtol=1e-8)   # as one run vs sliced
 
 
 def test_falls_back_to_one_process(twin, one, capped, monkeypatch):
