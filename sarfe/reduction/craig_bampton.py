@@ -390,6 +390,16 @@ def _start_upper_slices(k_ii, m_ii, cutoff_hz, cap, workers, held):
                               int(_PARALLEL_MODES_PER_COLUMN * cap), drop_inherited_factor)
 
 
+def _worker_splits(upper):
+    """Wait for the worker's counts: True when it slices the upper part (else it has exited)."""
+    from sarfe.reduction.spectrum_slicing import SlicingFailed
+
+    try:
+        return upper.plan()[1] is not None
+    except SlicingFailed:
+        return False
+
+
 def _slice(k_ii, m_ii, cutoff_hz, partial, progress, timings, upper):
     """Modes up to the cutoff by spectrum slicing from run 0's converged prefix (with the upper
     part from ``upper``'s worker when given): (ω², Φ), or None when slicing cannot run (no
@@ -541,7 +551,9 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
             cap = max(_SLICE_COLUMNS, int(_SLICE_ENTRIES // max(len(interior), 1))) \
                 if cutoff_hz is not None and mode_count is None else None
             upper = _start_upper_slices(k_ii, m_ii, cutoff_hz, cap, workers, held) \
-                if cap is not None else None
+                if cap is not None and cap < len(interior) else None
+            if upper is not None and not _worker_splits(upper):
+                upper = None              # few modes: run 0 as in one process
             found = _block_lanczos_modes(m_ii, inverse, mode_count, cutoff_hz, progress,
                                          max_columns=cap, store_mass_products=upper is None)
             if isinstance(found, _Partial):

@@ -12,11 +12,22 @@ import pytest
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from conftest import plate_model
 from sarfe.fe.linear_solvers import available_solvers, shifted_factorizer
 from sarfe.reduction import craig_bampton, free_dof_positions, node_dofs
 
 STIFFER = 1e-3    # relative spacing of the close pairs
+
+
+def plate_model(nx, ny):
+    """This folder's conftest plate (loaded by path: every test folder has a ``conftest``)."""
+    import importlib.util
+    from pathlib import Path
+
+    spec = importlib.util.spec_from_file_location("reduction_conftest",
+                                                  Path(__file__).with_name("conftest.py"))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.plate_model(nx, ny)
 
 pytestmark = pytest.mark.skipif("pardiso" not in available_solvers(),
                                 reason="spectrum slicing needs PARDISO's inertia")
