@@ -386,8 +386,11 @@ def _start_upper_slices(k_ii, m_ii, cutoff_hz, cap, workers, held):
     def drop_inherited_factor():
         held["factor"] = None     # the worker's copy of K_ii's factor (it has its own shifts)
 
-    return start_upper_slices(k_ii, m_ii, (2 * np.pi * cutoff_hz) ** 2, _LOWER_SHARE,
-                              int(_PARALLEL_MODES_PER_COLUMN * cap), drop_inherited_factor)
+    try:
+        return start_upper_slices(k_ii, m_ii, (2 * np.pi * cutoff_hz) ** 2, _LOWER_SHARE,
+                                  int(_PARALLEL_MODES_PER_COLUMN * cap), drop_inherited_factor)
+    except OSError:               # no temporary file or no process: one process does it all
+        return None
 
 
 def _worker_splits(upper):
