@@ -240,7 +240,7 @@ def p1_lines(p1):
             f"({run['children_cpu_s']:.1f}) | {run['cb_s']['normal_modes']:.1f} ({run['cb_s']['normal_modes_cpu']:.1f}) "
             f"| {len(slicing.get('shifts', []))} / {len(upper.get('shifts', []))} "
             f"| {run['peak_tree_rss_gb']:.2f} | {run['peak_tree_pss_gb']:.2f} | {run['modes']} | {difference:.1e} |")
-    one, two = p1[0], p1[-1]
+    one, two = p1[0], p1[1]
     critical = two["cpu_s"]            # this process's CPU: the worker runs beside it
     lines += ["", f"What changed (issue 15, eigfast): the spectrum is sliced by two processes when two "
               f"cores are usable. CPU on the critical path (this process) {one['cpu_s']:.0f} s on one core → "
@@ -248,6 +248,10 @@ def p1_lines(p1):
               "run beside it). Wall seconds here are the other jobs' load (see the load column), not the code: "
               "on a quiet machine wall ≈ CPU of the critical path. The earlier tables (60 modes, no slicing) "
               "are unchanged code paths and still hold."]
+    for index, run in enumerate(p1[2:], start=3):
+        lines += ["", f"Row {index}: {run.get('note', 'a rerun')} (load {run['load_average']}): wall "
+                  f"{run['wall_s']:.0f} s, CPU {run['cpu_s']:.0f} s here + {run['children_cpu_s']:.0f} s in the "
+                  f"worker, peak tree PSS {run['peak_tree_pss_gb']:.2f} GB."]
     return lines
 
 
