@@ -19,15 +19,30 @@ eigenvalue count so far, N(λ) ≈ a √λ (a plate's modal density), so that a 
 about ``slice_modes`` eigenvalues; each run's Krylov space is bounded by ``max_columns``.
 
 Run 0 is the caller's σ = 0 block Lanczos stopped at its column cap; its converged prefix and the
-next Ritz value enter here as (eigenvalues, modes, boundary). All runs use the M inner product; a Ritz pair is
+next Ritz value enter here as (eigenvalues, modes, boundary).
+
+Every shift's K − σM has the same sparsity pattern: PARDISO's ordering and symbolic analysis run
+once (:func:`sarfe.fe.linear_solvers.shifted_factorizer`), each shift only its numerical LDLᵀ.
+
+Two processes (two usable cores): a chain of runs needs nothing from another chain but a
+certified count at its bottom, so the spectrum is split at λ_s = (share·ω_c)² (N(ω) ≈ a ω
+puts about ``share`` of the modes below it). A worker forked before run 0 counts N(λ_c) and
+N(λ_s) itself and runs the chain over (λ_s, λ_c] from nothing pending, writing its modes to a
+shared-memory file; this process runs run 0 and the chain over (boundary, λ_s], then appends
+the worker's block. Both chains' shifts follow from their intervals and counts alone, so the
+modes do not depend on timing; with one core, no fork, or inside a daemon process (a Dask
+worker) one chain covers it all. All runs use the M inner product; a Ritz pair is
 converged when ‖A φ − θ φ‖_M ≤ tol·|θ| (relative to its own θ: a value next to the shift, with a
 huge θ, must not loosen the test for the others).
 """
 from __future__ import annotations
 
+import os
+from dataclasses import dataclass
+
 import numpy as np
 
-from sarfe.fe.linear_solvers import factorize
+from sarfe.fe.linear_solvers import shifted_factorizer
 from sarfe.reduction.craig_bampton import _m_orthonormal, lanczos_extend
 
 
@@ -38,7 +53,9 @@ class SlicingFailed(RuntimeError):
 def shifted_block_lanczos(mass, operator, shift, satisfied, max_columns, block_size=16, tol=1e-8,
                           seed=0):
     """Block Lanczos on A = (K − σM)⁻¹ M (``operator(Y)`` = (K − σM)⁻¹ Y, σ = ``shift``) in the
-    M inner product with full re-orthogonalization; only Q (n, m) is stored, M Q is recomputed.
+    M inner product with full re-orthogonalization; Q (n, m) is stored, M Q only for the last two
+    blocks (the three-term part), so a step costs two sparse products M·(n, b): one for the full
+    pass Qᵀ M w, one to M-orthonormalize the new block.
 
     After each block step ``satisfied(lam, converged)`` gets the Ritz eigenvalues λ = σ + 1/θ
     (m,) and their convergence flags (residual ≤ tol·|θ|) and returns True to stop. Returns
@@ -51,14 +68,21 @@ def shifted_block_lanczos(mass, operator, shift, satisfied, max_columns, block_s
     store = np.empty((n, max(max_columns, q.shape[1])), order="F")
     m_new = q.shape[1]
     store[:, :m_new] = q
+    recent = [mq]                # M Q of the previous and the current block
     projected = np.zeros((0, 0))
     previous_start = 0
     while True:
         m_old = projected.shape[0]
         w = operator(mq)                       # A q_block = (K − σM)⁻¹ M q_block
         basis = store[:, :m_new]
-        w, projected = lanczos_extend(basis, lambda cols, y: basis[:, cols].T @ (mass @ y), w,
-                                      projected, previous_start)
+        mass_recent = recent[0] if len(recent) == 1 else np.hstack(recent)
+
+        def mass_products(cols, y, start=previous_start):
+            if cols.start == start:            # the last two blocks: (M Q_l)ᵀ y, no M product
+                return mass_recent.T @ y
+            return basis[:, cols].T @ (mass @ y)
+
+        w, projected = lanczos_extend(basis, mass_products, w, projected, previous_start)
         previous_start = m_old
         q, mq = _m_orthonormal(w, mass)
         coupling = mq.T @ w
@@ -71,6 +95,7 @@ def shifted_block_lanczos(mass, operator, shift, satisfied, max_columns, block_s
         if satisfied(lam, converged) or exhausted:
             break
         store[:, m_new:m_new + q.shape[1]] = q
+        recent = [recent[-1], mq]
         m_new += q.shape[1]
 
     def eigenvectors(selection):
@@ -79,26 +104,25 @@ def shifted_block_lanczos(mass, operator, shift, satisfied, max_columns, block_s
     return lam, converged, eigenvectors
 
 
-def _place_shift(stiffness, mass, right_edge, known, wanted, cutoff_omega2, total, rate, solver,
-                 record):
+def _place_shift(factor_at, right_edge, known, wanted, top_omega2, total, rate, record):
     """The next shift σ > right_edge with about ``wanted`` eigenvalues in (right_edge, σ] and its
-    factor of K − σM; the cutoff itself once at most 1.25 ``wanted`` remain below it (``total``
-    eigenvalues ≤ cutoff, ``known`` ≤ right_edge). First guess ω = √right_edge + wanted / rate
-    (``rate``: eigenvalues per rad/s the last run saw; None: N(ω) linear up to the cutoff); a
-    factor whose inertia shows more than 1.5× or fewer than 0.5× ``wanted`` is replaced (three
-    times at most) by the interpolation through that probe."""
-    omega, top = np.sqrt(right_edge), np.sqrt(cutoff_omega2)
+    factor of K − σM (``factor_at(σ)``); the interval's top itself once at most 1.25 ``wanted``
+    remain below it (``total`` eigenvalues ≤ top, ``known`` ≤ right_edge). First guess
+    ω = √right_edge + wanted / rate (``rate``: eigenvalues per rad/s the last run saw; None: N(ω)
+    linear up to the top); a factor whose inertia shows more than 1.5× or fewer than 0.5×
+    ``wanted`` is replaced (three times at most) by the interpolation through that probe."""
+    omega, top = np.sqrt(right_edge), np.sqrt(top_omega2)
     if total - known <= 1.25 * wanted:
-        factor = factorize(stiffness - cutoff_omega2 * mass, solver=solver, structure="symmetric")
+        factor = factor_at(top_omega2)
         record["factorizations"] += 1
-        return cutoff_omega2, factor
+        return top_omega2, factor
     guess = omega + wanted / rate if rate else omega + (top - omega) * wanted / (total - known)
     for attempt in range(4):
         shift = min(guess, top) ** 2
-        factor = factorize(stiffness - shift * mass, solver=solver, structure="symmetric")
+        factor = factor_at(shift)
         record["factorizations"] += 1
         inside = factor.negative_pivots - known
-        if 0.5 * wanted <= inside <= 1.5 * wanted or attempt == 3 or (shift >= cutoff_omega2
+        if 0.5 * wanted <= inside <= 1.5 * wanted or attempt == 3 or (shift >= top_omega2
                                                                       and inside <= 1.5 * wanted):
             return shift, factor
         del factor
@@ -139,39 +163,43 @@ def _slice_run(mass, factor, shift, lower, counted, right_edge, pending, max_col
                         f"{gap_count} eigenvalues converged in {len(lam)} columns")
 
 
-def sliced_modes(stiffness, mass, cutoff_omega2, found_omega2, found_modes, boundary,
-                 slice_modes=80, max_columns=400, progress=None, solver="auto"):
-    """All eigenpairs of K φ = λ M φ with λ ≤ ``cutoff_omega2`` (module docstring).
+@dataclass(frozen=True, eq=False)
+class ChainStart:
+    """Where a chain of shifted runs begins: every eigenvalue ≤ ``lower`` is someone else's
+    (``counted`` of them, a certified count), and ``pending`` (k,) with ``pending_modes`` (n, k)
+    are converged eigenpairs in (lower, right_edge] not yet certified (run 0's, or none)."""
 
-    found_omega2 (k,), found_modes (n, k): run 0's converged eigenpairs, all λ ≤ ``boundary``
-    (a value between them and run 0's next Ritz value). Returns λ (ascending), Φ (Φᵀ M Φ = I) as
-    a list of column blocks in that order (no stacked copy of n × n_m), and a record {"shifts",
-    "columns", "negative_pivots", "factorizations", "modes_below_cutoff"}. Raises SlicingFailed
-    when a gap's count is not reached within ``max_columns`` even at a quarter of the width.
+    lower: float
+    counted: int
+    right_edge: float
+    pending: np.ndarray
+    pending_modes: np.ndarray
+
+
+def slice_chain(mass, factor_at, start, top_omega2, total, store, slice_modes=80, max_columns=400,
+                progress=None):
+    """Shifted runs that find every eigenpair in (start.lower, top_omega2] (module docstring).
+
+    factor_at(σ): factor of K − σM with its inertia; total: eigenvalues ≤ top_omega2 (its count).
+    ``store(values, modes)`` receives the eigenpairs gap by gap in ascending order (values (k,),
+    modes (n, k) M-normalized), so a caller can write them where they belong. Returns the record
+    {"shifts", "columns", "negative_pivots", "factorizations"}. Raises SlicingFailed when a gap's
+    count is not reached within ``max_columns`` even at a quarter of the width.
     """
-    pending = list(np.asarray(found_omega2, dtype=float))   # found above the last shift,
-    pending_modes = np.asarray(found_modes)                  # not yet certified by a count
-    values, modes = [], []
-    lower, counted = 0.0, 0            # last shift and the eigenvalue count below it
-    right_edge = float(boundary)       # r: the previous run's values cover (lower, r]
-    record = {"shifts": [], "columns": [], "negative_pivots": [], "factorizations": 1}
-    factor = factorize(stiffness - cutoff_omega2 * mass, solver=solver, structure="symmetric")
-    if factor.negative_pivots is None:
-        raise SlicingFailed(f"backend {factor.name} reports no inertia")
-    total = factor.negative_pivots                     # eigenvalues below the cutoff
-    record["modes_below_cutoff"] = int(total)
-    del factor
+    pending, pending_modes = list(np.asarray(start.pending, dtype=float)), start.pending_modes
+    lower, counted, right_edge = float(start.lower), int(start.counted), float(start.right_edge)
+    record = {"shifts": [], "columns": [], "negative_pivots": [], "factorizations": 0}
     rate = None
-    while True:
+    while counted < total:
         known = counted + len(pending)                 # ≈ N(right_edge)
         for retry in range(3):     # a gap the column cap cannot fill: again with half the width
-            shift, factor = _place_shift(stiffness, mass, right_edge, known,
-                                         max(4, slice_modes // 2 >> retry), cutoff_omega2, total,
-                                         rate, solver, record)
+            shift, factor = _place_shift(factor_at, right_edge, known,
+                                         max(4, slice_modes // 2 >> retry), top_omega2, total,
+                                         rate, record)
             try:
                 lam, converged, eigenvectors, take, use_pending = _slice_run(
                     mass, factor, shift, lower, counted, right_edge, pending, max_columns,
-                    shift >= cutoff_omega2)
+                    shift >= top_omega2)
                 break
             except SlicingFailed:
                 if retry == 2:
@@ -181,15 +209,16 @@ def sliced_modes(stiffness, mass, cutoff_omega2, found_omega2, found_modes, boun
                 record["negative_pivots"].append(int(factor.negative_pivots))
                 del factor
         record["columns"].append(int(len(lam)))
-        last = shift >= cutoff_omega2
+        last = shift >= top_omega2
         if use_pending:
             keep_pending = np.asarray(pending) <= shift
-            values.append(np.asarray(pending)[keep_pending])
-            modes.append(pending_modes if keep_pending.all() else pending_modes[:, keep_pending])
+            if keep_pending.any():
+                store(np.asarray(pending)[keep_pending],
+                      pending_modes if keep_pending.all() else pending_modes[:, keep_pending])
         order = np.flatnonzero(take)
         order = order[np.argsort(lam[order])]
-        values.append(lam[order])
-        modes.append(eigenvectors(order))
+        if len(order):
+            store(lam[order], eigenvectors(order))
         counted = record["negative_pivots"][-1]
         lower = shift
         if progress is not None:
@@ -210,13 +239,211 @@ def sliced_modes(stiffness, mass, cutoff_omega2, found_omega2, found_modes, boun
         pending_modes = eigenvectors(chosen)
         del eigenvectors             # the run's Krylov store goes before the next one's
         # eigenvalues per rad/s over this run's coverage: the next shift's first guess
-        start = np.sqrt(max(values[-1][0], 0.0)) if len(values[-1]) else np.sqrt(shift)
-        seen, span = len(values[-1]) + len(pending), np.sqrt(right_edge) - start
+        first = np.sqrt(max(lam[order[0]], 0.0)) if len(order) else np.sqrt(shift)
+        seen, span = len(order) + len(pending), np.sqrt(right_edge) - first
         rate = seen / span if span > 0 and seen else None
-        if right_edge >= cutoff_omega2:
-            right_edge = cutoff_omega2
-    omega2 = np.concatenate(values)
+        if right_edge >= top_omega2:
+            right_edge = top_omega2
+    return record
+
+
+def sliced_modes(stiffness, mass, cutoff_omega2, found_omega2, found_modes, boundary,
+                 slice_modes=80, max_columns=400, progress=None, solver="auto", upper=None,
+                 factor_at=None, total=None):
+    """All eigenpairs of K φ = λ M φ with λ ≤ ``cutoff_omega2`` (module docstring).
+
+    found_omega2 (k,), found_modes (n, k): run 0's converged eigenpairs, all λ ≤ ``boundary``
+    (a value between them and run 0's next Ritz value). ``upper``: an :class:`UpperSlices`
+    already working in a second process; this process then stops at its split λ_s and joins it
+    (or does it all when the worker planned no split). ``factor_at``/``total``: a
+    :func:`shifted_factorizer` and the count below the cutoff when the caller has them. Returns λ (ascending), Φ (Φᵀ M Φ = I) as a list of
+    column blocks in that order (no stacked copy of n × n_m), and a record {"shifts", "columns",
+    "negative_pivots", "factorizations", "modes_below_cutoff"} (with "upper": the other
+    process's record). Raises SlicingFailed when a gap's count is not reached.
+    """
+    record = {"factorizations": 0}
+    if upper is not None:
+        total, split, split_count = upper.plan()
+        upper = upper if split is not None else None
+    if factor_at is None:
+        factor_at = shifted_factorizer(stiffness, mass, solver=solver)
+    if total is None:
+        record["factorizations"] += 1
+        factor = factor_at(cutoff_omega2)
+        if factor.negative_pivots is None:
+            raise SlicingFailed(f"backend {factor.name} reports no inertia")
+        total = int(factor.negative_pivots)                     # eigenvalues below the cutoff
+        del factor
+    values, modes = [], []
+
+    def store(lam, vectors):
+        values.append(lam)
+        modes.append(vectors)
+
+    top, top_count = (cutoff_omega2, total) if upper is None else (split, split_count)
+    start = ChainStart(0.0, 0, float(boundary), np.asarray(found_omega2, dtype=float),
+                       np.asarray(found_modes))
+    try:
+        chain = slice_chain(mass, factor_at, start, top, top_count, store, slice_modes,
+                            max_columns, progress)
+    except BaseException:
+        if upper is not None:
+            upper.cancel()
+        raise
+    record.update(chain, factorizations=record["factorizations"] + chain["factorizations"],
+                  modes_below_cutoff=int(total))
+    if upper is not None:
+        record.update(split=float(split), split_count=int(split_count))
+        try:
+            upper_values, upper_modes, record["upper"] = upper.join()
+            values.append(upper_values)
+            modes.append(upper_modes)
+        except SlicingFailed as exc:      # the worker's part, again in this process
+            record["upper_failed"] = str(exc)
+            start = ChainStart(split, split_count, split, np.zeros(0),
+                               np.zeros((mass.shape[0], 0)))
+            rest = slice_chain(mass, factor_at, start, cutoff_omega2, total, store, slice_modes,
+                               max_columns, progress)
+            record["factorizations"] += rest["factorizations"]
+            for key in ("shifts", "columns", "negative_pivots"):
+                record[key] = record[key] + rest[key]
+    omega2 = np.concatenate(values) if values else np.zeros(0)
     if np.any(np.diff(omega2) < 0):       # blocks are sorted and follow each other; make sure
         order = np.argsort(omega2)
         return omega2[order], [np.hstack(modes)[:, order]], record
     return omega2, modes, record
+
+
+@dataclass(eq=False)
+class UpperSlices:
+    """A forked worker process slicing the upper part of the spectrum (:func:`start_upper_slices`).
+
+    ``plan()`` → (total, lower, counted): the eigenvalue count below the cutoff, and the split
+    λ_s with its count N(λ_s) — or (total, None, None) when the worker found too few modes to
+    be worth a split (it has then exited). ``join()`` → (λ ascending (k,), Φ (n, k) read from
+    the worker's shared file, the worker's record) for (λ_s, cutoff], or raises SlicingFailed."""
+
+    process: object
+    connection: object
+    path: str
+    size: int
+    _plan: tuple | None = None
+
+    def plan(self):
+        if self._plan is None:
+            try:
+                message = self.connection.recv()
+            except EOFError:
+                message = ("error", "the slicing worker died before its counts", None)
+            if message[0] != "plan":
+                self.cancel()
+                raise SlicingFailed(f"upper slices: {message[1]}")
+            self._plan = message[1:]
+            if self._plan[1] is None:
+                self.cancel()
+        return self._plan
+
+    def join(self):
+        try:
+            status, payload, record = self.connection.recv()
+        except EOFError:
+            status, payload, record = "error", "the slicing worker died", None
+        self.process.join()
+        self.connection.close()
+        try:
+            if status != "ok":
+                raise SlicingFailed(f"upper slices: {payload}")
+            count = os.path.getsize(self.path) // (8 * self.size)
+            # mapped, not read: the pages are freed once the caller has copied the block
+            modes = np.memmap(self.path, dtype=float, mode="r", shape=(self.size, count),
+                              order="F") if count else np.zeros((self.size, 0))
+        finally:
+            _remove(self.path)
+        return payload, modes, record
+
+    def cancel(self):
+        if self.process.is_alive():
+            self.process.terminate()
+        self.process.join()
+        self.connection.close()
+        _remove(self.path)
+
+
+def _remove(path):
+    try:
+        os.remove(path)
+    except OSError:
+        pass
+
+
+def usable_cores() -> int:
+    """CPU cores this process may run on (its affinity mask where the OS reports one)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:       # not Linux
+        return os.cpu_count() or 1
+
+
+def start_upper_slices(stiffness, mass, cutoff_omega2, lower_share, min_total, on_fork=None,
+                       slice_modes=80, max_columns=400):
+    """Fork a worker that counts the eigenvalues below the cutoff and, when there are more than
+    ``min_total``, finds every eigenpair in (λ_s, cutoff], λ_s = (lower_share·ω_c)² (this
+    process takes (0, λ_s]). K, M are shared copy-on-write; ``on_fork()`` runs first in the
+    worker to free what it inherited and does not need (the parent's factor of K_ii). The modes
+    go to a file in /dev/shm (memory, not disk, on Linux) that :meth:`UpperSlices.join` reads and
+    removes. Returns an :class:`UpperSlices`, or None where fork is not available or this
+    process is a daemon (a Dask or multiprocessing worker may not have children). The worker's
+    results do not depend on timing: its shifts follow from its interval and counts alone."""
+    import multiprocessing
+    import tempfile
+
+    if "fork" not in multiprocessing.get_all_start_methods() or \
+            multiprocessing.current_process().daemon:      # e.g. a Dask worker: no children
+        return None
+    directory = "/dev/shm" if os.path.isdir("/dev/shm") else None
+    handle, path = tempfile.mkstemp(prefix="sarfe-slices-", suffix=".f64", dir=directory)
+    os.close(handle)
+    context = multiprocessing.get_context("fork")
+    receive, send = context.Pipe(duplex=False)
+    process = context.Process(target=_upper_worker, daemon=True,
+                              args=(send, stiffness, mass, cutoff_omega2, lower_share, min_total,
+                                    on_fork, path, slice_modes, max_columns))
+    process.start()
+    send.close()
+    return UpperSlices(process, receive, path, mass.shape[0])
+
+
+def _upper_worker(connection, stiffness, mass, cutoff_omega2, lower_share, min_total, on_fork,
+                  path, slice_modes, max_columns):
+    """The forked side of :func:`start_upper_slices`: its own PARDISO analysis (the parent's
+    instance is not shared), the two counts, then a chain from (λ_s, N(λ_s)) with nothing
+    pending, each gap's modes appended to ``path`` in ascending order."""
+    values = []
+    try:
+        if on_fork is not None:
+            on_fork()
+        factor_at = shifted_factorizer(stiffness, mass, solver="pardiso")
+        total = int(factor_at(cutoff_omega2).negative_pivots)
+        if total <= min_total:
+            connection.send(("plan", total, None, None))
+            return
+        lower = (lower_share * np.sqrt(cutoff_omega2)) ** 2
+        counted = int(factor_at(lower).negative_pivots)
+        connection.send(("plan", total, lower, counted))
+        with open(path, "wb") as out:
+            def store(lam, vectors):
+                np.asfortranarray(vectors).T.tofile(out)     # column-major: column after column
+                values.append(lam)
+
+            start = ChainStart(lower, counted, lower, np.zeros(0), np.zeros((mass.shape[0], 0)))
+            record = slice_chain(mass, factor_at, start, cutoff_omega2, total, store, slice_modes,
+                                 max_columns)
+        record["factorizations"] += 2                  # the two counts
+        omega2 = np.concatenate(values) if values else np.zeros(0)
+        if len(omega2) != total - counted or np.any(np.diff(omega2) < 0):
+            raise SlicingFailed(f"{len(omega2)} modes for a count of {total - counted}")
+        connection.send(("ok", omega2, record))
+    except Exception as exc:  # noqa: BLE001 - reported to the parent, which falls back
+        connection.send(("error", f"{type(exc).__name__}: {exc}", None))
+    finally:
+        connection.close()

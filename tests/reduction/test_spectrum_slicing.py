@@ -1,0 +1,158 @@
+"""Spectrum slicing in one or two processes against a dense reference (scipy.linalg.eigh).
+
+The model: two copies of the clamped plate, the second 1e-3 stiffer, side by side without
+coupling — every eigenvalue comes as a close pair λ, (1 + 1e-3)·λ. The cutoff is placed so that
+the two-process split λ_s = (share·ω_c)² falls inside one pair: the lower process must deliver
+its lower member, the worker its upper one, certified by the inertia counts at λ_s.
+"""
+import importlib
+
+import numpy as np
+import pytest
+import scipy.linalg as sla
+import scipy.sparse as sp
+
+from sarfe.fe.linear_solvers import available_solvers, shifted_factorizer
+from sarfe.reduction import craig_bampton, free_dof_positions, node_dofs
+
+STIFFER = 1e-3    # relative spacing of the close pairs
+
+
+def plate_model(nx, ny):
+    """This folder's conftest plate (loaded by path: every test folder has a ``conftest``)."""
+    import importlib.util
+    from pathlib import Path
+
+    spec = importlib.util.spec_from_file_location("reduction_conftest",
+                                                  Path(__file__).with_name("conftest.py"))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.plate_model(nx, ny)
+
+pytestmark = pytest.mark.skipif("pardiso" not in available_solvers(),
+                                reason="spectrum slicing needs PARDISO's inertia")
+
+
+@pytest.fixture(scope="module")
+def twin():
+    """(K, M, boundary, interior, reference ω² of (K_ii, M_ii), cutoff [Hz] with the split inside
+    a close pair)."""
+    plate = plate_model(12, 8)
+    stiffness = sp.block_diag([plate.stiffness, (1 + STIFFER) * plate.stiffness], format="csr")
+    mass = sp.block_diag([plate.mass, plate.mass], format="csr")
+    one = free_dof_positions(node_dofs(plate.boundary_nodes, (0, 1, 2), plate.dofs_per_node),
+                             plate.free_dofs, plate.total_dof_count)
+    boundary = np.concatenate([one, one + plate.stiffness.shape[0]])
+    interior = np.setdiff1d(np.arange(stiffness.shape[0]), boundary)
+    k_ii = stiffness[interior][:, interior].toarray()
+    m_ii = mass[interior][:, interior].toarray()
+    omega2 = sla.eigh(k_ii, m_ii, eigvals_only=True)
+    share = importlib.import_module("sarfe.reduction.craig_bampton")._LOWER_SHARE
+    # the 120th pair: split halfway between its members, cutoff = split / share
+    lower = omega2[(omega2 > 0)][2 * 120]
+    split = lower * (1 + 0.5 * STIFFER)
+    cutoff_hz = np.sqrt(split) / share / (2 * np.pi)
+    return stiffness, mass, boundary, k_ii, m_ii, omega2, cutoff_hz
+
+
+@pytest.fixture(scope="module")
+def capped():
+    """Run 0 capped at 64 columns: the modes above come from spectrum slicing."""
+    module = importlib.import_module("sarfe.reduction.craig_bampton")
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(module, "_SLICE_COLUMNS", 64)
+        patch.setattr(module, "_SLICE_ENTRIES", 0)
+        yield
+
+
+def reduce(twin, workers):
+    stiffness, mass, boundary, *_, cutoff_hz = twin
+    return craig_bampton(stiffness, mass, boundary, cutoff_hz=cutoff_hz, residual_vectors=True,
+                         workers=workers)
+
+
+@pytest.fixture(scope="module")
+def two(twin, capped):
+    return reduce(twin, workers=2)
+
+
+@pytest.fixture(scope="module")
+def one(twin, capped):
+    return reduce(twin, workers=1)
+
+
+def check_against_dense(reduced, twin):
+    """Every eigenvalue below the cutoff to 1e-9, modes M-orthonormal, K_ii diagonal."""
+    _, _, _, k_ii, m_ii, omega2, cutoff_hz = twin
+    expected = omega2[omega2 <= (2 * np.pi * cutoff_hz) ** 2]
+    assert reduced.mode_count == len(expected) > 200
+    np.testing.assert_allclose((2 * np.pi * reduced.mode_frequencies_hz) ** 2, expected, rtol=1e-9)
+    phi = reduced.fixed_interface_modes
+    np.testing.assert_allclose(phi.T @ m_ii @ phi, np.eye(len(expected)), atol=1e-7)
+    np.testing.assert_allclose(phi.T @ k_ii @ phi, np.diag(expected), atol=1e-7 * expected.max())
+
+
+def test_two_processes_split_inside_a_close_pair(twin, two):
+    """The worker takes (λ_s, cutoff], this process the rest; λ_s lies between the two members of
+    a pair 1e-3 apart, and the result equals the dense reference."""
+    record = two.timings["slicing"]
+    assert "upper" in record and "upper_failed" not in record
+    omega2 = twin[5]
+    inside = np.count_nonzero(omega2 <= record["split"])
+    assert omega2[inside - 1] < record["split"] < omega2[inside]
+    assert omega2[inside] / omega2[inside - 1] - 1 < 2 * STIFFER      # a close pair
+    assert record["split_count"] == inside
+    check_against_dense(two, twin)
+
+
+def test_one_worker_gives_the_same_reduced_model(twin, one, two):
+    """workers=1: the whole chain in this process; the same eigenvalues as two processes (to
+    1e-12) and as the dense reference, the same reduced model (statics, system eigenvalues)."""
+    assert "upper" not in one.timings["slicing"]
+    check_against_dense(one, twin)
+    np.testing.assert_allclose(one.mode_frequencies_hz, two.mode_frequencies_hz, rtol=1e-12)
+    n_b = one.boundary_count
+    np.testing.assert_allclose(one.stiffness[:n_b, :n_b], two.stiffness[:n_b, :n_b], rtol=1e-12)
+    system = [np.sort(sla.eigh(r.stiffness, r.mass, eigvals_only=True))[:100] for r in (one, two)]
+    np.testing.assert_allclose(system[0], system[1], rtol=1e-8)   # as one run vs sliced
+
+
+def test_falls_back_to_one_process(twin, one, capped, monkeypatch):
+    """workers=None on one usable core, or where fork is not available: one process, same modes."""
+    slicing = importlib.import_module("sarfe.reduction.spectrum_slicing")
+    monkeypatch.setattr(slicing, "usable_cores", lambda: 1)
+    single_core = reduce(twin, workers=None)
+    assert "upper" not in single_core.timings["slicing"]
+    np.testing.assert_allclose(single_core.mode_frequencies_hz, one.mode_frequencies_hz, rtol=1e-12)
+    import multiprocessing
+
+    monkeypatch.setattr(multiprocessing, "get_all_start_methods", lambda: ["spawn"])
+    stiffness, mass = twin[0], twin[1]
+    assert slicing.start_upper_slices(stiffness, mass, 1e8, 0.5, 0) is None   # no worker
+
+
+def test_two_process_runs_give_the_same_modes(twin, two, capped):
+    """Deterministic: the worker's shifts follow from its interval and counts, not from timing."""
+    again = reduce(twin, workers=2)
+    assert again.timings["slicing"]["upper"]["shifts"] == two.timings["slicing"]["upper"]["shifts"]
+    np.testing.assert_allclose(again.mode_frequencies_hz, two.mode_frequencies_hz, rtol=1e-13)
+
+
+def test_shifted_factorizer_counts_and_solves():
+    """One analysis for all shifts: each factor of K − σM counts the eigenvalues below σ (dense
+    reference) and solves to round-off; a replaced factor refuses to solve."""
+    plate = plate_model(8, 6)
+    k, m = plate.stiffness, plate.mass
+    omega2 = sla.eigh(k.toarray(), m.toarray(), eigvals_only=True)
+    factor_at = shifted_factorizer(k, m, solver="pardiso")
+    rhs = np.random.default_rng(0).standard_normal((k.shape[0], 3))
+    for shift in (0.5 * omega2[0], 0.5 * (omega2[9] + omega2[10]), 0.5 * (omega2[40] + omega2[41])):
+        factor = factor_at(shift)
+        assert factor.negative_pivots == np.count_nonzero(omega2 < shift)
+        x = factor.solve(rhs)
+        assert np.linalg.norm((k - shift * m) @ x - rhs) < 1e-9 * np.linalg.norm(rhs)
+    factor_at(omega2[5] * 1.01)
+    with pytest.raises(RuntimeError):
+        factor.solve(rhs)
+    factor_at.release()
+    assert factor_at(0.5 * omega2[0]).negative_pivots == 0
