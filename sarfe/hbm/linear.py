@@ -179,9 +179,10 @@ class Condensation:
             @ m.gap_modes.T
 
     def apply_admittance(self, L: np.ndarray) -> np.ndarray:
-        """Y_k λ_k (m, n) complex for complex λ (m, n_rows) of the kept orders."""
+        """Y_k λ_k (..., m, n) complex for complex λ (..., m, n_rows) of the kept orders (leading
+        axes: several load cases at once)."""
         if self.modal is None:
-            return np.einsum("knm,km->kn", self.solved_admittance, L)
+            return np.einsum("knm,...km->...kn", self.solved_admittance, L)
         m = self.modal
         return L @ m.static_admittance.T + (m.receptance * (L @ m.gap_modes)) @ m.basis.modes.T
 
