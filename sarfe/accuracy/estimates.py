@@ -351,7 +351,7 @@ def newton_step(model, contacts, excitation, U, omega, harmonics, samples_per_pe
         warnings.simplefilter("ignore")
         problem = make_problem(model, contacts, excitation, harmonics, samples_per_period, options)
         try:
-            evaluate, to_x, to_displacement = make_evaluator(problem, contacts.row_count > 0)
+            evaluate, to_x, to_displacement = make_evaluator(problem, contacts.row_count > 0, False)
             state = {"slider": initial_slider(problem, U)}
             result = newton(lambda x, jacobian: evaluate(x, omega, jacobian, state["slider"]),
                             to_x(U), options, accept=slider_acceptor(state))

@@ -178,6 +178,33 @@ class Condensation:
         return m.static_admittance[None] + (m.basis.modes[None] * m.receptance[:, None, :]) \
             @ m.gap_modes.T
 
+    @cached_property
+    def _compliance_blocks(self):
+        """(mean block (n_rows, n_rows) or None, (cos, sin) blocks (m', 2 n_rows, 2 n_rows)) of C."""
+        n_rows = self.linear_response.shape[1]
+        orders = np.arange((self.linear_response.shape[0] + 1) // 2) if self.orders is None \
+            else np.asarray(self.orders)
+        first = n_rows if orders.size and orders[0] == 0 else 0
+        C = self.compliance
+        pairs = (C.shape[0] - first) // (2 * n_rows)
+        blocks = C[first:, first:].reshape(pairs, 2 * n_rows, pairs, 2 * n_rows)
+        index = np.arange(pairs)
+        return (C[:first, :first] if first else None), blocks[index, :, index, :]
+
+    def apply_compliance(self, B: np.ndarray) -> np.ndarray:
+        """C B (P, q) for a dense B (P, q): C is block diagonal over the kept orders (the mean
+        block, then one (cos, sin) block of 2 n_rows per order), applied block by block."""
+        mean, pairs = self._compliance_blocks
+        first = 0 if mean is None else mean.shape[0]
+        out = np.empty(B.shape, dtype=np.result_type(B, float))
+        if first:
+            out[:first] = mean @ B[:first]
+        if pairs.shape[0]:
+            width = pairs.shape[1]
+            out[first:] = (pairs @ B[first:].reshape(pairs.shape[0], width, -1)).reshape(
+                B.shape[0] - first, -1)
+        return out
+
     def apply_admittance(self, L: np.ndarray) -> np.ndarray:
         """Y_k λ_k (..., m, n) complex for complex λ (..., m, n_rows) of the kept orders (leading
         axes: several load cases at once)."""
@@ -330,8 +357,11 @@ def condensed_omega_derivative(model, condensation: Condensation, U: np.ndarray)
     orders = _kept_orders(condensation, H)
     k = orders[:, None]
     z = to_complex(U)[orders]
-    dz = (-2 * k**2 * condensation.omega * np.asarray(model.mass @ z.T).T
-          + 1j * k * np.asarray(model.damping @ z.T).T)
+    Z = np.concatenate([z.real, z.imag])                # real products (M, D real: no complex copy)
+    MZ, DZ = np.asarray(model.mass @ Z.T).T, np.asarray(model.damping @ Z.T).T
+    m = orders.size
+    dz = (-2 * k**2 * condensation.omega * (MZ[:m] + 1j * MZ[m:])
+          + 1j * k * (DZ[:m] + 1j * DZ[m:]))
     out = np.zeros((H + 1, condensation.linear_response.shape[1]), dtype=complex)
     out[orders] = condensation.apply_admittance_transpose(dz)
     return from_complex(out)
