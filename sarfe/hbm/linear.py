@@ -42,7 +42,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .harmonics import derivative_matrix
-from .modal import ModalBasis, cached_modal_basis
+from .modal import ModalBasis, cached_modal_basis, real_product
 
 
 def apply_dynamic_stiffness(model, omega: float, U: np.ndarray) -> np.ndarray:
@@ -301,12 +301,16 @@ def condense(model, gap_map, excitation: np.ndarray, omega: float,
         if basis.singular(k, omega):
             return None
         g = basis.dynamic_receptance(k, omega)              # (m, n_modes)
-        gap_modes = Gd @ basis.modes                        # (n_rows, n_modes)
-        static = basis.static_solve(Gd.T)                   # K⁻¹Gᵀ (n, n_rows)
-        y = basis.static_solve(forces.T).T + (g * (forces @ basis.modes)) @ basis.modes.T
-        # Σ_j (G v_j)_r q_kj (G v_j)_s as one batched product (an optimized 3-operand einsum
-        # re-plans its contraction on every call: a quarter of a sweep's condensation time)
-        Ck = (Gd @ static)[None] + (gap_modes[None] * g[:, None, :]) @ gap_modes.T
+        # GV, K⁻¹Gᵀ, G K⁻¹ Gᵀ, K⁻¹ f_k and Vᵀ f_k do not depend on ω: once per sweep
+        gap_modes, static, static_compliance = basis.gap_projection(Gd)
+        static_forced, modal_forced = basis.load_projection(forces)
+        y = static_forced.copy()
+        loaded = np.flatnonzero(np.any(modal_forced != 0, axis=1))   # (usually order 1 only)
+        y[loaded] += real_product(g[loaded] * modal_forced[loaded], basis.modes.T)
+        # Σ_j (G v_j)_r q_kj (G v_j)_s as one real product over the orders and rows
+        Ck = static_compliance[None] + real_product(
+            (gap_modes[None] * g[:, None, :]).reshape(-1, g.shape[1]),
+            gap_modes.T).reshape(k.size, n_rows, n_rows)
         factors = dict(modal=ModalCompliance(basis, g, gap_modes, static))
     else:
         solved = _solve_factorized(model, Gd, forces, k, omega)
