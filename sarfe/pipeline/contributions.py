@@ -21,7 +21,6 @@ with Q built once per model: a point costs O(S H n²), whatever the size of the 
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sp
 from sarfe.io.config import ErpConfig
 
 EXCITATION = "excitation"
@@ -54,26 +53,13 @@ def source_displacements(condensation, contact_force, member) -> np.ndarray:
     return np.concatenate([y[None], -condensation.apply_admittance(loads)], axis=0)
 
 
-_GRAM = {}     # the radiation Gram matrix of the last stage: every point of a run shares it
-
-
 def radiation_gram(stage) -> np.ndarray:
     """Q = Nᵀ diag(A) N (n, n) [m²], N = ``stage.erp_map`` (n_s, n) the radiating-node normal
     displacement per reduced coordinate, A the nodal areas: Σ_i A_i |w_i|² = uᴴ Q u for any
-    complex reduced displacement u. Built once per stage (not per frequency point)."""
-    hit = _GRAM.get(id(stage))
-    if hit is not None and hit[0] is stage:
-        return hit[1]
-    N, areas = stage.erp_map, np.asarray(stage.erp_areas, dtype=float)
-    if sp.issparse(N):
-        Q = np.asarray((N.T @ sp.diags(areas) @ N).todense())
-    else:
-        N = np.asarray(N, dtype=float)
-        Q = N.T @ (areas[:, None] * N)
-    Q = 0.5 * (Q + Q.T)
-    _GRAM.clear()
-    _GRAM[id(stage)] = (stage, Q)
-    return Q
+    complex reduced displacement u (:func:`sarfe.erp.reduced.radiation_gram`, once per stage)."""
+    from sarfe.erp.reduced import radiation_gram as gram
+
+    return gram(stage.erp_map, stage.erp_areas)
 
 
 def reduced_gram(Q, X, omega) -> np.ndarray:
