@@ -58,13 +58,16 @@ def _kept_indices(rows, width):
 
 @dataclass(frozen=True)
 class Evaluation:
-    """Residual R (P,), Jacobian ∂R/∂x (dense or sparse, or None), ∂R/∂ω (P,), forces, reference."""
+    """Residual R (P,), Jacobian ∂R/∂x (dense or sparse, or None), ∂R/∂ω (P,), forces, reference;
+    unit_columns: indices of the columns of ∂R/∂x equal to unit vectors (condensed rows without
+    contact stiffness, eliminated before the LU: :func:`sarfe.hbm.newton.solve_linear`), or None."""
 
     residual: np.ndarray
     jacobian: object
     omega_derivative: np.ndarray
     forces: ContactForces
     reference: float
+    unit_columns: np.ndarray = None
 
 
 def _gap_blocks(contacts, harmonics):
@@ -140,8 +143,10 @@ def condensed_residual(problem: Problem, condensation, x, slider_start=None,
     R = x - (r_lin if keep is None else r_lin[keep]) + C @ force
     J = dR = None
     if jacobian:
-        J_lam = jacobian_matrix(forces.blocks, n_rows, problem.harmonics, kept_rows=rows)
-        J = condensation.apply_compliance(J_lam.toarray())
+        J_lam = jacobian_matrix(forces.blocks, n_rows, problem.harmonics,
+                                kept_rows=rows).toarray()
+        unit = np.flatnonzero(~J_lam.any(axis=0))       # rows without contact stiffness
+        J = condensation.apply_compliance(J_lam)
         J[np.diag_indices_from(J)] += 1.0
         if omega_derivative:
             U = recover_displacement(condensation, forces.force)
@@ -152,7 +157,7 @@ def condensed_residual(problem: Problem, condensation, x, slider_start=None,
                 rate = forces.omega_derivative.ravel()
                 dR = dR + C @ (rate if keep is None else rate[keep])
     reference = _reference(np.linalg.norm(condensation.linear_response), np.linalg.norm(x))
-    return Evaluation(R, J, dR, forces, reference)
+    return Evaluation(R, J, dR, forces, reference, unit if jacobian else None)
 
 
 def _reference(*values):
