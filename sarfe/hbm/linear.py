@@ -211,14 +211,20 @@ class Condensation:
         if self.modal is None:
             return np.einsum("knm,...km->...kn", self.solved_admittance, L)
         m = self.modal
-        return L @ m.static_admittance.T + (m.receptance * (L @ m.gap_modes)) @ m.basis.modes.T
+        shape = L.shape[:-1]
+        flat = L.reshape(-1, L.shape[-1])
+        modal = (m.receptance * real_product(flat, m.gap_modes).reshape(shape + (-1,)))
+        return (real_product(flat, m.static_admittance.T).reshape(shape + (-1,))
+                + real_product(modal.reshape(flat.shape[0], -1), m.basis.modes.T).reshape(
+                    shape + (-1,)))
 
     def apply_admittance_transpose(self, V: np.ndarray) -> np.ndarray:
         """Y_kᵀ v_k = G Z_k⁻¹ v_k (m, n_rows) complex for complex v (m, n) (Z_k symmetric)."""
         if self.modal is None:
             return np.einsum("knm,kn->km", self.solved_admittance, V)
         m = self.modal
-        return V @ m.static_admittance + (m.receptance * (V @ m.basis.modes)) @ m.gap_modes.T
+        return real_product(V, m.static_admittance) + real_product(
+            m.receptance * real_product(V, m.basis.modes), m.gap_modes.T)
 
 
 @dataclass(frozen=True)
