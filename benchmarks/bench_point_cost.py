@@ -279,10 +279,10 @@ def stage_costs(tree, case_path, directory):
     t = summary["timings_s"]
     points = summary["points"]
     f = [p["frequency_hz"] for p in points]
-    commit = subprocess.run(["git", "-C", str(tree), "rev-parse", "--short", "HEAD"],
-                            capture_output=True, text=True).stdout.strip() or \
-        (pathlib.Path(tree) / "COMMIT").read_text().strip() if (pathlib.Path(tree) / "COMMIT").exists() \
-        else "?"
+    marker = pathlib.Path(tree) / "COMMIT"          # an exported tree (git archive) names it
+    commit = marker.read_text().strip() if marker.exists() else subprocess.run(
+        ["git", "-C", str(tree), "rev-parse", "--short", "HEAD"],
+        capture_output=True, text=True).stdout.strip()
     return {"tree": str(tree), "commit": commit, "process_wall_s": wall, "points": len(points),
             "newton_iterations": int(sum(p["iterations"] for p in points)),
             "points_per_hz": len(points) / max(max(f) - min(f), 1e-9),
