@@ -391,9 +391,11 @@ def write(results):
         lines += [""] + profile["notes"]
     st = results.get("stages")
     if st:
-        lines += ["", "## Stages of a door-trim point, before vs after (issue 15, task pointfast)", "",
+        lines += ["", "## Stages of a door-trim point, before vs after (issue 15, task pointfast)",
+                  "",
                   f"{st['case']}; whole `sarfe solve` processes alternated (before, after, before, "
-                  f"after), fastest of each; load average at the end {st['load_average_end'][0]:.1f} "
+                  f"after), fastest of each; load average at the end "
+                  f"{st['load_average_end'][0]:.1f} "
                   "(2 shared cores: absolute seconds are inflated, compare the columns).", "",
                   "| code | points | points / Hz | Newton its | HBM s | estimate s | post s | "
                   "outputs s | s / point (HBM + estimate + post + outputs) |",

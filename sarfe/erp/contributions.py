@@ -34,8 +34,8 @@ import numpy as np
 from sarfe.erp.erp import AIR_DENSITY, REFERENCE_POWER, SOUND_SPEED, power_level_db
 from sarfe.erp.weighting import a_weighting_db
 
-__all__ = ["ErpContributions", "erp_contributions", "contributions_from_gram", "superposition_stack",
-           "ranking_lines", "normal_velocity", "MOTIONLESS_LEVEL_DB"]
+__all__ = ["ErpContributions", "erp_contributions", "contributions_from_gram",
+           "superposition_stack", "ranking_lines", "normal_velocity", "MOTIONLESS_LEVEL_DB"]
 
 MOTIONLESS_LEVEL_DB = -100.0  # [dB re P_ref] below this total the surface counts as motionless
 
@@ -127,7 +127,7 @@ def contributions_from_gram(names, gram, omega: float, has_total: bool = True,
     of the vectors of :func:`superposition_stack` (S sources, the defect d, the given total):
     P_s,k = κ Γ_k,ss, Q_s,k = κ Re Σ_b≤S Γ_k,sb, P_k = κ Σ_a,b≤S Γ_k,ab, superposition error
     √(Σ_k Γ_k,dd / Σ_k Γ_k,tt) (NaN without a total). The Gram matrices may come from the nodal
-    velocities or from a reduced quadratic form Γ_k = (i kω)² X_kᴴ Q X_k (X reduced coordinates,
+    velocities or from a reduced quadratic form Γ_k = (kω)² X_kᴴ Q X_k (X reduced coordinates,
     Q = Nᵀ diag(A) N, :mod:`sarfe.pipeline.contributions`): the results are the same.
     """
     gram = np.asarray(gram, dtype=complex)
