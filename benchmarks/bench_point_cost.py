@@ -406,7 +406,8 @@ def write(results):
                          f"{r['newton_iterations']} | {r['hbm_s']:.2f} | {r['estimate_s']:.2f} | "
                          f"{r['postprocess_s']:.2f} | {r['outputs_s']:.2f} | "
                          f"{r['per_point_s']:.3f} |")
-        lines += [""] + st.get("notes", [])
+        for note in st.get("notes", []):
+            lines += ["", note]
     (HERE / "results" / "point_cost.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
 
