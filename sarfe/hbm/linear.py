@@ -191,11 +191,21 @@ class Condensation:
         index = np.arange(pairs)
         return (C[:first, :first] if first else None), blocks[index, :, index, :]
 
-    def apply_compliance(self, B: np.ndarray) -> np.ndarray:
-        """C B (P, q) for a dense B (P, q): C is block diagonal over the kept orders (the mean
-        block, then one (cos, sin) block of 2 n_rows per order), applied block by block."""
+    def apply_compliance(self, B) -> np.ndarray:
+        """C B (P, q) dense for a dense or sparse B (P, q): C is block diagonal over the kept orders
+        (the mean block, then one (cos, sin) block of 2 n_rows per order), applied block by block."""
         mean, pairs = self._compliance_blocks
         first = 0 if mean is None else mean.shape[0]
+        if sp.issparse(B):
+            B = sp.csr_matrix(B)
+            out = np.empty(B.shape)
+            if first:
+                out[:first] = (B[:first].T @ mean.T).T
+            width = pairs.shape[1] if pairs.shape[0] else 0
+            for j in range(pairs.shape[0]):
+                block = slice(first + j * width, first + (j + 1) * width)
+                out[block] = (B[block].T @ pairs[j].T).T
+            return out
         out = np.empty(B.shape, dtype=np.result_type(B, float))
         if first:
             out[:first] = mean @ B[:first]

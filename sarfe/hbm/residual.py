@@ -122,6 +122,9 @@ def full_residual(problem: Problem, x, omega, slider_start=None, jacobian=True,
     return Evaluation(R.ravel(), J, dR, forces, _reference(np.linalg.norm(problem.excitation)))
 
 
+DENSE_CONTACT_JACOBIAN = 4000   # ∂λ̃/∂r̃ kept sparse above this many rows (J itself is dense)
+
+
 def condensed_residual(problem: Problem, condensation, x, slider_start=None,
                        jacobian=True, omega_derivative=True) -> Evaluation:
     """R_c(r̃, ω) at the ω of ``condensation``; x = r̃.ravel() (kept rows only with a harmonic set;
@@ -143,9 +146,12 @@ def condensed_residual(problem: Problem, condensation, x, slider_start=None,
     R = x - (r_lin if keep is None else r_lin[keep]) + C @ force
     J = dR = None
     if jacobian:
-        J_lam = jacobian_matrix(forces.blocks, n_rows, problem.harmonics,
-                                kept_rows=rows).toarray()
-        unit = np.flatnonzero(~J_lam.any(axis=0))       # rows without contact stiffness
+        J_lam = jacobian_matrix(forces.blocks, n_rows, problem.harmonics, kept_rows=rows)
+        if J_lam.shape[0] <= DENSE_CONTACT_JACOBIAN:
+            J_lam = J_lam.toarray()
+            unit = np.flatnonzero(~J_lam.any(axis=0))       # rows without contact stiffness
+        else:                                              # (stored entries may be zeros)
+            unit = np.flatnonzero(abs(J_lam).sum(axis=0).A1 == 0)
         J = condensation.apply_compliance(J_lam)
         J[np.diag_indices_from(J)] += 1.0
         if omega_derivative:

@@ -85,6 +85,7 @@ def compare_paths(model, G, omega, orders=None):
     B = np.random.default_rng(2).normal(size=(direct.compliance.shape[0], 7))
     for cond in (modal, direct):
         assert relative(cond.apply_compliance(B), cond.compliance @ B) < 1e-13
+        assert relative(cond.apply_compliance(sp.csr_matrix(B)), cond.compliance @ B) < 1e-13
 
 
 @pytest.mark.parametrize("damping", ["modal", "rayleigh", "none"])
