@@ -25,8 +25,14 @@
    (the 'auto' method before issue 15's contact-row count) and by the contact-row count
    ('auto' now), with their verdicts.
 
-Run: python benchmarks/bench_point_cost.py [--quick] [--sweep-only]  (--sweep-only: section 4
-alone, the other sections kept from results/point_cost.json)
+5. Stages of a door-trim point, before vs after (``--stages BEFORE_TREE``): the 12-pair door trim
+   of cases/door_trim_p1.yaml at 15 mm, H = 15, continuation 60 → 65 Hz at max_step 0.04, error
+   estimate on, Hill stability off (another stage, timed elsewhere), whole `sarfe solve`
+   processes of this tree and of BEFORE_TREE (e.g. a checkout of main) in turn (A B A B …):
+   timings_s per stage (hbm, estimate, postprocess, outputs) and per point, and points per Hz.
+
+Run: python benchmarks/bench_point_cost.py [--quick] [--sweep-only] [--stages TREE]
+(--sweep-only / --stages: that section alone, the others kept from results/point_cost.json)
 """
 import argparse
 import json
@@ -242,6 +248,66 @@ def door_sweep_cost(directory, mesh_size=0.015, harmonics=15, points=20):
             "stability": compare}
 
 
+STAGE_CASE_OVERRIDES = {"mesh_size_m": 0.015, "sweep": {"start_hz": 60.0, "end_hz": 65.0},
+                        "continuation": {"initial_step": 0.04, "max_step": 0.04}}
+
+
+def stage_case(directory):
+    """cases/door_trim_p1.yaml at 15 mm, 60 → 65 Hz, max_step 0.04, stability off (section 5)."""
+    import yaml
+
+    case = yaml.safe_load((ROOT / "cases" / "door_trim_p1.yaml").read_text())
+    case["model"]["fe"]["generator"]["mesh_size_m"] = STAGE_CASE_OVERRIDES["mesh_size_m"]
+    case["excitation"]["sweep"] = dict(STAGE_CASE_OVERRIDES["sweep"])
+    case["solver"]["continuation"] = dict(STAGE_CASE_OVERRIDES["continuation"])
+    case["solver"]["stability"] = False
+    path = pathlib.Path(directory) / "door_trim_stages.yaml"
+    path.write_text(yaml.safe_dump(case, sort_keys=False))
+    return path
+
+
+def stage_costs(tree, case_path, directory):
+    """One `sarfe solve` process of the code in ``tree``: its timings_s, points, Newton
+    iterations, frequency span and the tree's git commit."""
+    out = pathlib.Path(directory) / f"out_{abs(hash((str(tree), time.time())))}"
+    env = dict(ENV, PYTHONPATH=str(tree))
+    start = time.perf_counter()
+    subprocess.run([sys.executable, "-m", "sarfe.cli", "solve", str(case_path), "-o", str(out),
+                    "--force", "--quiet"], env=env, check=False, capture_output=True, cwd=directory)
+    wall = time.perf_counter() - start
+    summary = json.loads((out / "summary.json").read_text())
+    t = summary["timings_s"]
+    points = summary["points"]
+    f = [p["frequency_hz"] for p in points]
+    marker = pathlib.Path(tree) / "COMMIT"          # an exported tree (git archive) names it
+    commit = marker.read_text().strip() if marker.exists() else subprocess.run(
+        ["git", "-C", str(tree), "rev-parse", "--short", "HEAD"],
+        capture_output=True, text=True).stdout.strip()
+    return {"tree": str(tree), "commit": commit, "process_wall_s": wall, "points": len(points),
+            "newton_iterations": int(sum(p["iterations"] for p in points)),
+            "points_per_hz": len(points) / max(max(f) - min(f), 1e-9),
+            "linear_stage_s": t.get("linear_stage_s", float("nan")), "hbm_s": t["hbm_s"],
+            "estimate_s": t.get("error_estimate_s", 0.0),
+            "postprocess_s": t["postprocess_s"] - t.get("error_estimate_s", 0.0),
+            "outputs_s": t.get("outputs_s", float("nan")),
+            "per_point_s": (t["hbm_s"] + t["postprocess_s"] + t.get("outputs_s", 0.0))
+            / max(len(points), 1)}
+
+
+def stages_before_after(before_tree, repeats=2):
+    """Section 5: alternated runs of ``before_tree`` and this tree; the fastest of each kept."""
+    runs = {"before": [], "after": []}
+    with tempfile.TemporaryDirectory() as directory:
+        case = stage_case(directory)
+        for _ in range(repeats):
+            for label, tree in (("before", before_tree), ("after", ROOT)):
+                runs[label].append(stage_costs(tree, case, directory))
+    best = {label: min(r, key=lambda x: x["per_point_s"]) for label, r in runs.items()}
+    return {"case": "cases/door_trim_p1.yaml with " + json.dumps(STAGE_CASE_OVERRIDES)
+            + ", stability off", "load_average_end": os.getloadavg(), "best": best,
+            "all_runs": runs}
+
+
 def exponent(x, t):
     return float(np.polyfit(np.log(np.asarray(x, float)), np.log(np.asarray(t, float)), 1)[0])
 
@@ -323,6 +389,25 @@ def write(results):
                   "|---|---|---|"]
         lines += [f"| {name} | {before} | {after} |" for name, before, after in profile["rows"]]
         lines += [""] + profile["notes"]
+    st = results.get("stages")
+    if st:
+        lines += ["", "## Stages of a door-trim point, before vs after (issue 15, task pointfast)",
+                  "",
+                  f"{st['case']}; whole `sarfe solve` processes alternated (before, after, before, "
+                  f"after), fastest of each; load average at the end "
+                  f"{st['load_average_end'][0]:.1f} "
+                  "(2 shared cores: absolute seconds are inflated, compare the columns).", "",
+                  "| code | points | points / Hz | Newton its | HBM s | estimate s | post s | "
+                  "outputs s | s / point (HBM + estimate + post + outputs) |",
+                  "|---|---|---|---|---|---|---|---|---|"]
+        for label in ("before", "after"):
+            r = st["best"][label]
+            lines.append(f"| {label} ({r['commit']}) | {r['points']} | {r['points_per_hz']:.1f} | "
+                         f"{r['newton_iterations']} | {r['hbm_s']:.2f} | {r['estimate_s']:.2f} | "
+                         f"{r['postprocess_s']:.2f} | {r['outputs_s']:.2f} | "
+                         f"{r['per_point_s']:.3f} |")
+        for note in st.get("notes", []):
+            lines += ["", note]
     (HERE / "results" / "point_cost.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
 
@@ -334,8 +419,15 @@ def main():
     parser.add_argument("--sweep-only", action="store_true",
                         help="section 4 only; the others kept from results/point_cost.json")
     parser.add_argument("--sweep-points", type=int, default=20)
+    parser.add_argument("--stages", metavar="BEFORE_TREE",
+                        help="section 5 alone against the code in BEFORE_TREE (e.g. main)")
     args, _ = parser.parse_known_args()   # run_all.py passes its own arguments
     start = time.perf_counter()
+    if args.stages:
+        results = json.loads((HERE / "results" / "point_cost.json").read_text())
+        results["stages"] = stages_before_after(pathlib.Path(args.stages).resolve())
+        write(results)
+        return
     if args.sweep_only:
         results = json.loads((HERE / "results" / "point_cost.json").read_text())
         with tempfile.TemporaryDirectory() as directory:

@@ -220,21 +220,33 @@ def _first_harmonic_amplitude(contacts, U):
     return np.hypot(G @ U[1], G @ U[2])
 
 
-def _erp_proxy(U, omega, erp_map=None, erp_areas=None, a_weighted=False):
+def _harmonic_powers(U, omega, erp_map=None, erp_areas=None):
+    """p_k = (kω)² Σ_s a_s |w_{s,k}|² (H,) (the ERP of harmonic k up to ½ρc): by the reduced
+    quadratic form Q = Nᵀ diag(a) N (:mod:`sarfe.erp.reduced`, built once per map) when a
+    radiating map N is given, else over all DOFs with unit areas."""
+    from sarfe.erp.reduced import harmonic_power_proxy, radiation_gram
+
+    U = np.asarray(U, dtype=float)
+    if erp_map is None:
+        areas = np.ones(U.shape[1]) if erp_areas is None else np.asarray(erp_areas, dtype=float)
+        rows = (U[1:] ** 2) @ areas
+        return (np.arange(1, rows.size // 2 + 1) * omega) ** 2 * (rows[0::2] + rows[1::2])
+    areas = np.ones(erp_map.shape[0]) if erp_areas is None else erp_areas
+    return harmonic_power_proxy(U, omega, radiation_gram(erp_map, areas))
+
+
+def _erp_proxy(U, omega, erp_map=None, erp_areas=None, a_weighted=False, powers=None):
     """P = Σ_k (kω)² Σ_s a_s |w_{s,k}|² (proportional to the ERP of all harmonics); with
     ``a_weighted`` each harmonic k weighted by 10^{A(k f)/10}, A the A-weighting [dB] at k f,
-    f = ω / 2π (proportional to the A-weighted ERP, which on impacts the high harmonics carry)."""
-    U = np.asarray(U, dtype=float)
-    W = U if erp_map is None else np.asarray(U @ np.asarray(erp_map).T)
-    areas = np.ones(W.shape[1]) if erp_areas is None else np.asarray(erp_areas, dtype=float)
-    H = (W.shape[0] - 1) // 2
-    k = np.repeat(np.arange(1, H + 1), 2)
-    weight = (k * omega) ** 2
+    f = ω / 2π (proportional to the A-weighted ERP, which on impacts the high harmonics carry).
+    ``powers``: :func:`_harmonic_powers` of U when computed already."""
+    p = _harmonic_powers(U, omega, erp_map, erp_areas) if powers is None else powers
     if a_weighted:
         from sarfe.erp.weighting import a_weighting_db
 
-        weight = weight * 10.0 ** (np.asarray(a_weighting_db(k * omega / (2 * np.pi))) / 10.0)
-    return float((weight[:, None] * W[1:] ** 2 * areas).sum())
+        k = np.arange(1, p.size + 1)
+        p = p * 10.0 ** (np.asarray(a_weighting_db(k * omega / (2 * np.pi))) / 10.0)
+    return float(p.sum())
 
 
 def _change(contacts, U, U_new, omega, erp_map, erp_areas, ref_amplitude=None):
@@ -248,8 +260,9 @@ def _change(contacts, U, U_new, omega, erp_map, erp_areas, ref_amplitude=None):
         d0 = np.hypot(U[1], U[2])
         d1 = np.hypot(U_new[1], U_new[2])
         rel = float(np.max(np.abs(d1 - d0)) / max(d0.max(initial=0.0), 1e-300))
-    p0 = _erp_proxy(U, omega, erp_map, erp_areas)
-    p1 = _erp_proxy(U_new, omega, erp_map, erp_areas)
+    q0 = _harmonic_powers(U, omega, erp_map, erp_areas)
+    q1 = _harmonic_powers(U_new, omega, erp_map, erp_areas)
+    p0, p1 = float(q0.sum()), float(q1.sum())
     if erp_map is not None:
         # a radiating surface that is silent compared with the structure (power ratio < 1e-24,
         # amplitude < 1e-12: round-off) has no meaningful level change
@@ -262,8 +275,8 @@ def _change(contacts, U, U_new, omega, erp_map, erp_areas, ref_amplitude=None):
             0.0 if p0 == p1 else float("inf"))
 
     db = level_change(p0, p1)
-    db_a = level_change(_erp_proxy(U, omega, erp_map, erp_areas, True),
-                        _erp_proxy(U_new, omega, erp_map, erp_areas, True))
+    db_a = level_change(_erp_proxy(U, omega, a_weighted=True, powers=q0),
+                        _erp_proxy(U_new, omega, a_weighted=True, powers=q1))
     return rel, (db_a if abs(db_a) > abs(db) else db)      # the larger of dB and dB(A)
 
 
@@ -351,7 +364,7 @@ def newton_step(model, contacts, excitation, U, omega, harmonics, samples_per_pe
         warnings.simplefilter("ignore")
         problem = make_problem(model, contacts, excitation, harmonics, samples_per_period, options)
         try:
-            evaluate, to_x, to_displacement = make_evaluator(problem, contacts.row_count > 0)
+            evaluate, to_x, to_displacement = make_evaluator(problem, contacts.row_count > 0, False)
             state = {"slider": initial_slider(problem, U)}
             result = newton(lambda x, jacobian: evaluate(x, omega, jacobian, state["slider"]),
                             to_x(U), options, accept=slider_acceptor(state))

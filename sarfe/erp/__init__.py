@@ -9,7 +9,10 @@
     normal_displacement(U (2H+1, n, 3), normals (n, 3)), nodal_translations(U (2H+1, n_dof), nodes)
     third_octave_levels(f_k (H,), P_k (H,)) -> ThirdOctaveSpectrum        (bands.py, IEC 61260-1)
     erp_contributions(names, v (S, H, n), areas, omega) -> ErpContributions  (contributions.py:
-        partial ERP and coherent shares per source), ranking_lines(...)
+        partial ERP and coherent shares per source; contributions_from_gram(...) from area-weighted
+        Gram matrices), ranking_lines(...)
+    radiation_gram(erp_map (n_s, n), areas) -> Q = Nᵀ diag(A) N, harmonic_power_proxy(U, omega, Q)
+        (reduced.py: the ERP of reduced coordinates as a quadratic form, once per model)
 """
 from sarfe.erp.erp import (
     AIR_DENSITY,

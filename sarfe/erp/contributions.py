@@ -34,8 +34,8 @@ import numpy as np
 from sarfe.erp.erp import AIR_DENSITY, REFERENCE_POWER, SOUND_SPEED, power_level_db
 from sarfe.erp.weighting import a_weighting_db
 
-__all__ = ["ErpContributions", "erp_contributions", "ranking_lines", "normal_velocity",
-           "MOTIONLESS_LEVEL_DB"]
+__all__ = ["ErpContributions", "erp_contributions", "contributions_from_gram",
+           "superposition_stack", "ranking_lines", "normal_velocity", "MOTIONLESS_LEVEL_DB"]
 
 MOTIONLESS_LEVEL_DB = -100.0  # [dB re P_ref] below this total the surface counts as motionless
 
@@ -84,12 +84,14 @@ def erp_contributions(names, source_velocity, nodal_areas, omega: float, total_v
                       density: float = AIR_DENSITY, sound_speed: float = SOUND_SPEED,
                       radiation_loss_factor: float = 1.0,
                       reference_power: float = REFERENCE_POWER) -> ErpContributions:
-    """Partial ERP and coherent shares (module docstring).
+    """Partial ERP and coherent shares (module docstring) of full-field velocities.
 
     names : S source names; source_velocity : (S, H, n) complex normal velocities v_s,k,i [m/s] of
     harmonics k = 1 … H at n radiating nodes; nodal_areas : (n,) [m²]; omega : [rad/s];
     total_velocity : optional (H, n) complex v_k,i [m/s] of the solved response — the shares are
     taken against Σ_s v_s and ``superposition_error`` says how far that is from the given total.
+    Forms the area-weighted Gram matrices of the sources (:func:`velocity_gram`) and hands them
+    to :func:`contributions_from_gram`.
     """
     V = np.asarray(source_velocity, dtype=complex)
     if V.ndim != 3 or V.shape[0] != len(names):
@@ -97,25 +99,59 @@ def erp_contributions(names, source_velocity, nodal_areas, omega: float, total_v
     areas = np.asarray(nodal_areas, dtype=float)
     if areas.shape != (V.shape[2],):
         raise ValueError(f"nodal_areas must be ({V.shape[2]},), got {areas.shape}")
+    stacked = superposition_stack(V, total_velocity)
+    gram = np.einsum("ahn,n,bhn->hab", stacked.conj(), areas, stacked)
+    return contributions_from_gram(names, gram, omega, total_velocity is not None, density,
+                                   sound_speed, radiation_loss_factor, reference_power)
+
+
+def superposition_stack(sources, total=None):
+    """(S + 2, H, ...) complex: the S sources x_s, their superposition defect d = Σ_s x_s − x and
+    the given total x (zeros when ``total`` is None) — the vectors whose Gram matrix
+    :func:`contributions_from_gram` takes. d is formed here, before any inner product, so a
+    superposition error near round-off is not lost to cancellation."""
+    X = np.asarray(sources, dtype=complex)
+    given = np.zeros(X.shape[1:], dtype=complex) if total is None else \
+        np.asarray(total, dtype=complex)
+    return np.concatenate([X, (X.sum(axis=0) - given)[None], given[None]], axis=0)
+
+
+def contributions_from_gram(names, gram, omega: float, has_total: bool = True,
+                            density: float = AIR_DENSITY, sound_speed: float = SOUND_SPEED,
+                            radiation_loss_factor: float = 1.0,
+                            reference_power: float = REFERENCE_POWER) -> ErpContributions:
+    """Partial ERP and coherent shares from the area-weighted velocity Gram matrices
+
+        Γ_k,ab = Σ_i A_i v̄_a,k,i v_b,k,i      [m⁴/s²],  (H, S + 2, S + 2) complex Hermitian,
+
+    of the vectors of :func:`superposition_stack` (S sources, the defect d, the given total):
+    P_s,k = κ Γ_k,ss, Q_s,k = κ Re Σ_b≤S Γ_k,sb, P_k = κ Σ_a,b≤S Γ_k,ab, superposition error
+    √(Σ_k Γ_k,dd / Σ_k Γ_k,tt) (NaN without a total). The Gram matrices may come from the nodal
+    velocities or from a reduced quadratic form Γ_k = (kω)² X_kᴴ Q X_k (X reduced coordinates,
+    Q = Nᵀ diag(A) N, :mod:`sarfe.pipeline.contributions`): the results are the same.
+    """
+    gram = np.asarray(gram, dtype=complex)
+    S = len(names)
+    if gram.ndim != 3 or gram.shape[1:] != (S + 2, S + 2):
+        raise ValueError(f"gram must be (H, S + 2 = {S + 2}, S + 2), got {gram.shape}")
     kappa = 0.5 * density * sound_speed * radiation_loss_factor
-    total = V.sum(axis=0)                                                  # (H, n)
+    sources = gram[:, :S, :S]                                             # (H, S, S)
     error = float("nan")
-    if total_velocity is not None:
-        given = np.asarray(total_velocity, dtype=complex)
-        norm = np.sqrt(np.sum(areas * np.abs(given) ** 2))
-        diff = np.sqrt(np.sum(areas * np.abs(total - given) ** 2))
+    if has_total:
+        norm = np.sqrt(max(float(gram[:, -1, -1].real.sum()), 0.0))
+        diff = np.sqrt(max(float(gram[:, -2, -2].real.sum()), 0.0))
         error = float(diff / norm) if norm > 0 else float(diff)
-    partial = kappa * np.einsum("shn,n->sh", np.abs(V) ** 2, areas)
-    coherent = kappa * np.einsum("shn,n->sh", (V.conj() * total[None]).real, areas)
-    P = kappa * (np.abs(total) ** 2) @ areas
-    H = V.shape[1]
+    partial = kappa * np.einsum("hss->sh", sources).real.clip(min=0.0)   # (S, H)
+    coherent = kappa * sources.sum(axis=2).real.T                        # (S, H)
+    P = (kappa * sources.sum(axis=(1, 2)).real).clip(min=0.0)            # (H,)
+    H = gram.shape[0]
     f = np.arange(1, H + 1) * float(omega) / (2.0 * np.pi)
     alpha = 10.0 ** (a_weighting_db(f) / 10.0)
     with np.errstate(invalid="ignore", divide="ignore"):
         share = coherent.sum(axis=1) / P.sum()
         share_a = (coherent @ alpha) / (P @ alpha)
     if not P.sum() >= reference_power * 10.0 ** (MOTIONLESS_LEVEL_DB / 10.0):
-        share, share_a = np.full(len(names), np.nan), np.full(len(names), np.nan)
+        share, share_a = np.full(S, np.nan), np.full(S, np.nan)
         error = float("nan")
     return ErpContributions(
         names=tuple(str(n) for n in names), frequencies_hz=f, partial_power_W=partial,

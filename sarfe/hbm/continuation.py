@@ -83,7 +83,7 @@ def tangent(evaluation, x_scale, omega_scale, previous):
     A = _bordered(evaluation.jacobian, evaluation.omega_derivative, x_scale, omega_scale, previous)
     rhs = np.zeros(A.shape[0])
     rhs[-1] = 1.0
-    t = solve_linear(A, rhs)
+    t = solve_linear(A, rhs, evaluation.unit_columns if isinstance(A, np.ndarray) else None)
     t /= np.linalg.norm(t)
     return t if t @ previous >= 0 else -t
 
@@ -316,7 +316,8 @@ def _corrector(evaluate_z, z, predicted, t, step, x_scale, span, options, accept
         residual = np.append(e.residual, e.reference * extra)
         J = (_bordered(e.jacobian, e.omega_derivative, x_scale, span, row, e.reference)
              if jacobian else None)
-        return Evaluation(residual, J, None, e.forces, e.reference)
+        return Evaluation(residual, J, None, e.forces, e.reference,
+                          e.unit_columns if isinstance(J, np.ndarray) else None)
 
     try:
         result = newton(augmented, predicted, options, x_scale=1.0, accept=accept)

@@ -42,7 +42,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .harmonics import derivative_matrix
-from .modal import ModalBasis, cached_modal_basis
+from .modal import ModalBasis, cached_modal_basis, real_product
 
 
 def apply_dynamic_stiffness(model, omega: float, U: np.ndarray) -> np.ndarray:
@@ -178,19 +178,63 @@ class Condensation:
         return m.static_admittance[None] + (m.basis.modes[None] * m.receptance[:, None, :]) \
             @ m.gap_modes.T
 
+    @cached_property
+    def _compliance_blocks(self):
+        """(mean block (n_rows, n_rows) or None, (cos, sin) blocks (m', 2 n_rows, 2 n_rows)) of C."""
+        n_rows = self.linear_response.shape[1]
+        orders = np.arange((self.linear_response.shape[0] + 1) // 2) if self.orders is None \
+            else np.asarray(self.orders)
+        first = n_rows if orders.size and orders[0] == 0 else 0
+        C = self.compliance
+        pairs = (C.shape[0] - first) // (2 * n_rows)
+        blocks = C[first:, first:].reshape(pairs, 2 * n_rows, pairs, 2 * n_rows)
+        index = np.arange(pairs)
+        return (C[:first, :first] if first else None), blocks[index, :, index, :]
+
+    def apply_compliance(self, B) -> np.ndarray:
+        """C B (P, q) dense for a dense or sparse B (P, q): C is block diagonal over the kept orders
+        (the mean block, then one (cos, sin) block of 2 n_rows per order), applied block by block."""
+        mean, pairs = self._compliance_blocks
+        first = 0 if mean is None else mean.shape[0]
+        if sp.issparse(B):
+            B = sp.csr_matrix(B)
+            out = np.empty(B.shape)
+            if first:
+                out[:first] = (B[:first].T @ mean.T).T
+            width = pairs.shape[1] if pairs.shape[0] else 0
+            for j in range(pairs.shape[0]):
+                block = slice(first + j * width, first + (j + 1) * width)
+                out[block] = (B[block].T @ pairs[j].T).T
+            return out
+        out = np.empty(B.shape, dtype=np.result_type(B, float))
+        if first:
+            out[:first] = mean @ B[:first]
+        if pairs.shape[0]:
+            width = pairs.shape[1]
+            out[first:] = (pairs @ B[first:].reshape(pairs.shape[0], width, -1)).reshape(
+                B.shape[0] - first, -1)
+        return out
+
     def apply_admittance(self, L: np.ndarray) -> np.ndarray:
-        """Y_k λ_k (m, n) complex for complex λ (m, n_rows) of the kept orders."""
+        """Y_k λ_k (..., m, n) complex for complex λ (..., m, n_rows) of the kept orders (leading
+        axes: several load cases at once)."""
         if self.modal is None:
-            return np.einsum("knm,km->kn", self.solved_admittance, L)
+            return np.einsum("knm,...km->...kn", self.solved_admittance, L)
         m = self.modal
-        return L @ m.static_admittance.T + (m.receptance * (L @ m.gap_modes)) @ m.basis.modes.T
+        shape = L.shape[:-1]
+        flat = L.reshape(-1, L.shape[-1])
+        modal = (m.receptance * real_product(flat, m.gap_modes).reshape(shape + (-1,)))
+        return (real_product(flat, m.static_admittance.T).reshape(shape + (-1,))
+                + real_product(modal.reshape(flat.shape[0], -1), m.basis.modes.T).reshape(
+                    shape + (-1,)))
 
     def apply_admittance_transpose(self, V: np.ndarray) -> np.ndarray:
         """Y_kᵀ v_k = G Z_k⁻¹ v_k (m, n_rows) complex for complex v (m, n) (Z_k symmetric)."""
         if self.modal is None:
             return np.einsum("knm,kn->km", self.solved_admittance, V)
         m = self.modal
-        return V @ m.static_admittance + (m.receptance * (V @ m.basis.modes)) @ m.gap_modes.T
+        return real_product(V, m.static_admittance) + real_product(
+            m.receptance * real_product(V, m.basis.modes), m.gap_modes.T)
 
 
 @dataclass(frozen=True)
@@ -273,12 +317,16 @@ def condense(model, gap_map, excitation: np.ndarray, omega: float,
         if basis.singular(k, omega):
             return None
         g = basis.dynamic_receptance(k, omega)              # (m, n_modes)
-        gap_modes = Gd @ basis.modes                        # (n_rows, n_modes)
-        static = basis.static_solve(Gd.T)                   # K⁻¹Gᵀ (n, n_rows)
-        y = basis.static_solve(forces.T).T + (g * (forces @ basis.modes)) @ basis.modes.T
-        # Σ_j (G v_j)_r q_kj (G v_j)_s as one batched product (an optimized 3-operand einsum
-        # re-plans its contraction on every call: a quarter of a sweep's condensation time)
-        Ck = (Gd @ static)[None] + (gap_modes[None] * g[:, None, :]) @ gap_modes.T
+        # GV, K⁻¹Gᵀ, G K⁻¹ Gᵀ, K⁻¹ f_k and Vᵀ f_k do not depend on ω: once per sweep
+        gap_modes, static, static_compliance = basis.gap_projection(Gd)
+        static_forced, modal_forced = basis.load_projection(forces)
+        y = static_forced.copy()
+        loaded = np.flatnonzero(np.any(modal_forced != 0, axis=1))   # (usually order 1 only)
+        y[loaded] += real_product(g[loaded] * modal_forced[loaded], basis.modes.T)
+        # Σ_j (G v_j)_r q_kj (G v_j)_s as one real product over the orders and rows
+        Ck = static_compliance[None] + real_product(
+            (gap_modes[None] * g[:, None, :]).reshape(-1, g.shape[1]),
+            gap_modes.T).reshape(k.size, n_rows, n_rows)
         factors = dict(modal=ModalCompliance(basis, g, gap_modes, static))
     else:
         solved = _solve_factorized(model, Gd, forces, k, omega)
@@ -329,8 +377,11 @@ def condensed_omega_derivative(model, condensation: Condensation, U: np.ndarray)
     orders = _kept_orders(condensation, H)
     k = orders[:, None]
     z = to_complex(U)[orders]
-    dz = (-2 * k**2 * condensation.omega * np.asarray(model.mass @ z.T).T
-          + 1j * k * np.asarray(model.damping @ z.T).T)
+    Z = np.concatenate([z.real, z.imag])                # real products (M, D real: no complex copy)
+    MZ, DZ = np.asarray(model.mass @ Z.T).T, np.asarray(model.damping @ Z.T).T
+    m = orders.size
+    dz = (-2 * k**2 * condensation.omega * (MZ[:m] + 1j * MZ[m:])
+          + 1j * k * (DZ[:m] + 1j * DZ[m:]))
     out = np.zeros((H + 1, condensation.linear_response.shape[1]), dtype=complex)
     out[orders] = condensation.apply_admittance_transpose(dz)
     return from_complex(out)

@@ -33,7 +33,7 @@ with n ≤ ``max_dofs`` are decomposed (dense LAPACK).
 from __future__ import annotations
 
 import weakref
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.linalg as sla
@@ -56,6 +56,7 @@ class ModalBasis:
     flexibility: np.ndarray
     damping: np.ndarray
     stiffness_factor: tuple
+    _projections: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     @property
     def natural_frequencies(self) -> np.ndarray:
@@ -78,11 +79,44 @@ class ModalBasis:
             return self.static_solve(B.real) + 1j * self.static_solve(B.imag)
         return sla.cho_solve(self.stiffness_factor, B)
 
+    def _projection(self, kind, operand, build):
+        """build(operand) cached for the last operand of each kind (compared by value: the points
+        of a sweep project the same gap map and the same excitation)."""
+        hit = self._projections.get(kind)
+        if hit is not None and hit[0].shape == operand.shape and np.array_equal(hit[0], operand):
+            return hit[1]
+        value = build(operand)
+        self._projections[kind] = (operand.copy(), value)
+        return value
+
+    def gap_projection(self, gap_map: np.ndarray):
+        """(GV (n_rows, n_modes), K⁻¹Gᵀ (n, n_rows), G K⁻¹ Gᵀ (n_rows, n_rows)) of a dense gap map
+        G (n_rows, n): the frequency-independent factors of G Z_k⁻¹ Gᵀ, computed once per G."""
+        def build(G):
+            static = self.static_solve(G.T)
+            return G @ self.modes, static, G @ static
+        return self._projection("gap", np.asarray(gap_map, dtype=float), build)
+
+    def load_projection(self, loads: np.ndarray):
+        """(K⁻¹ f_k (m, n), Vᵀ f_k (m, n_modes)) complex of load amplitudes f (m, n): the
+        frequency-independent factors of Z_k⁻¹ f_k, computed once per load."""
+        def build(f):
+            return self.static_solve(f.T).T, real_product(f, self.modes)
+        return self._projection("load", np.asarray(loads), build)
+
     def singular(self, orders, omega: float) -> bool:
         """True if some Z_k(ω) is singular to working precision, |1 − a_kj| ≤ 10⁻¹³ max(1, |a_kj|)
         (an undamped resonance (kω)² = ω_j²)."""
         a = self._a(orders, omega)
         return bool(np.any(np.abs(1.0 - a) <= 1e-13 * np.maximum(1.0, np.abs(a))))
+
+
+def real_product(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """A B for a complex (or real) A and a real B, as two real products (no complex copy of B)."""
+    if not np.iscomplexobj(A):
+        return A @ B
+    # contiguous copies of the parts: a strided .real view misses the BLAS path
+    return np.ascontiguousarray(A.real) @ B + 1j * (np.ascontiguousarray(A.imag) @ B)
 
 
 def _dense(matrix):

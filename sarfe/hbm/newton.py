@@ -32,8 +32,20 @@ class SingularJacobian(Exception):
     pass
 
 
-def solve_linear(matrix, rhs):
-    """Solve J Δ = b for a dense ndarray or a scipy sparse J; raises SingularJacobian."""
+UNIT_SHARE = 0.05     # unit columns are eliminated when at least this share of the unknowns
+
+
+def solve_linear(matrix, rhs, unit_columns=None):
+    """Solve J Δ = b for a dense ndarray or a scipy sparse J; raises SingularJacobian.
+
+    ``unit_columns``: indices i whose columns of a dense J are d_i e_i apart from rows outside i
+    (a condensed contact row that carries no contact stiffness: ∂R_c/∂r̃_i = e_i, ×x_s in a
+    bordered system whose extra row may fill them). They are eliminated first (Schur complement
+    on the diagonal block d):
+
+        (J_oo − J_oi d⁻¹ J_io) Δ_o = b_o − J_oi d⁻¹ b_i,     Δ_i = d⁻¹ (b_i − J_io Δ_o),
+
+    so one LU of the |o| rows (the loaded contact rows and the border) replaces the full one."""
     import warnings
 
     with warnings.catch_warnings():
@@ -45,16 +57,52 @@ def solve_linear(matrix, rhs):
                 if diag.min() <= 1e-14 * diag.max():
                     raise SingularJacobian
                 x = lu.solve(rhs)
+            elif unit_columns is not None and len(unit_columns) >= UNIT_SHARE * matrix.shape[0]:
+                x = _solve_eliminating(matrix, rhs, np.asarray(unit_columns, dtype=int))
             else:
-                lu, piv = sla.lu_factor(matrix, check_finite=False)
-                diag = np.abs(np.diag(lu))
-                if not np.all(np.isfinite(diag)) or diag.min() <= 1e-14 * diag.max():
-                    raise SingularJacobian
-                x = sla.lu_solve((lu, piv), rhs, check_finite=False)
+                x = _dense_solve(matrix, rhs)
         except (RuntimeError, ValueError, np.linalg.LinAlgError, Warning) as error:
             raise SingularJacobian from error
     if not np.all(np.isfinite(x)):
         raise SingularJacobian
+    return x
+
+
+def _dense_solve(matrix, rhs, scale=0.0):
+    """LU solve with the singularity test min|U_jj| ≤ 10⁻¹⁴ max(max|U_jj|, scale)."""
+    lu, piv = sla.lu_factor(matrix, check_finite=False)
+    diag = np.abs(np.diag(lu))
+    if not np.all(np.isfinite(diag)) or diag.min() <= 1e-14 * max(diag.max(), scale):
+        raise SingularJacobian
+    return sla.lu_solve((lu, piv), rhs, check_finite=False)
+
+
+def _solve_eliminating(A, b, unit):
+    """:func:`solve_linear` with the ``unit`` columns eliminated (see there)."""
+    n = A.shape[0]
+    mask = np.zeros(n, dtype=bool)
+    mask[unit] = True
+    other = np.flatnonzero(~mask)
+    d = A[unit, unit]
+    A_ii = A[np.ix_(unit, unit)]
+    if np.any(A_ii[~np.eye(unit.size, dtype=bool)]) or np.any(np.abs(d) <= 1e-14 * np.abs(d).max(
+            initial=0.0)) or not np.all(np.isfinite(d)):
+        return _dense_solve(A, b)       # not the structure claimed: the plain LU
+    A_io, A_oi = A[np.ix_(unit, other)], A[np.ix_(other, unit)]
+    S = A[np.ix_(other, other)]
+    b = np.asarray(b)
+    b_i, b_o = b[unit], b[other]
+    filled = np.flatnonzero(A_oi.any(axis=1))          # (the border row; none at fixed ω)
+    if filled.size:
+        S = S.copy()
+        coupling = A_oi[filled] / d
+        S[filled] -= coupling @ A_io
+        b_o = b_o.copy()
+        b_o[filled] -= coupling @ b_i
+    y_o = _dense_solve(S, b_o, np.abs(d).max()) if other.size else np.zeros((0,) + b.shape[1:])
+    x = np.empty(b.shape, dtype=np.result_type(A, b))
+    x[other] = y_o
+    x[unit] = ((b_i - A_io @ y_o).T / d).T
     return x
 
 
@@ -79,7 +127,7 @@ def newton(evaluate, x0, options, x_scale=0.0, accept=None) -> NewtonResult:
         if norm <= tol:
             return NewtonResult(x, ev, True, "converged", iteration - 1, norm)
         try:
-            step = solve_linear(ev.jacobian, -ev.residual)
+            step = solve_linear(ev.jacobian, -ev.residual, ev.unit_columns)
         except SingularJacobian:
             return NewtonResult(x, ev, False, f"singular Jacobian, residual {norm:.3g}",
                                 iteration - 1, norm)

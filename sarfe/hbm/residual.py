@@ -58,13 +58,16 @@ def _kept_indices(rows, width):
 
 @dataclass(frozen=True)
 class Evaluation:
-    """Residual R (P,), Jacobian ∂R/∂x (dense or sparse, or None), ∂R/∂ω (P,), forces, reference."""
+    """Residual R (P,), Jacobian ∂R/∂x (dense or sparse, or None), ∂R/∂ω (P,), forces, reference;
+    unit_columns: indices of the columns of ∂R/∂x equal to unit vectors (condensed rows without
+    contact stiffness, eliminated before the LU: :func:`sarfe.hbm.newton.solve_linear`), or None."""
 
     residual: np.ndarray
     jacobian: object
     omega_derivative: np.ndarray
     forces: ContactForces
     reference: float
+    unit_columns: np.ndarray = None
 
 
 def _gap_blocks(contacts, harmonics):
@@ -119,10 +122,17 @@ def full_residual(problem: Problem, x, omega, slider_start=None, jacobian=True,
     return Evaluation(R.ravel(), J, dR, forces, _reference(np.linalg.norm(problem.excitation)))
 
 
+DENSE_CONTACT_JACOBIAN = 4000   # ∂λ̃/∂r̃ kept sparse above this many rows (J itself is dense)
+
+
 def condensed_residual(problem: Problem, condensation, x, slider_start=None,
-                       jacobian=True) -> Evaluation:
+                       jacobian=True, omega_derivative=True) -> Evaluation:
     """R_c(r̃, ω) at the ω of ``condensation``; x = r̃.ravel() (kept rows only with a harmonic set;
-    the condensation must then hold the same orders). Reference ‖r̃_lin‖."""
+    the condensation must then hold the same orders). Reference ‖r̃_lin‖.
+
+    C is block diagonal over the harmonics, so C ∂λ̃/∂r̃ is formed block row by block row
+    (:meth:`sarfe.hbm.linear.Condensation.apply_compliance`: O(P n_rows · P) instead of O(P³)).
+    ``omega_derivative`` False (Newton at a fixed ω): ∂R_c/∂ω is not formed (None)."""
     n_rows = problem.contacts.row_count
     rows = kept_rows(problem)
     Rr = expand_rows(x, rows, problem.harmonics, n_rows)
@@ -136,20 +146,24 @@ def condensed_residual(problem: Problem, condensation, x, slider_start=None,
     R = x - (r_lin if keep is None else r_lin[keep]) + C @ force
     J = dR = None
     if jacobian:
-        dense = C.shape[0] <= 600
-        J_lam = jacobian_matrix(forces.blocks, n_rows, problem.harmonics, dense=dense,
-                                kept_rows=rows)
-        J = C @ J_lam if dense else np.asarray((J_lam.T @ C.T).T)
+        J_lam = jacobian_matrix(forces.blocks, n_rows, problem.harmonics, kept_rows=rows)
+        if J_lam.shape[0] <= DENSE_CONTACT_JACOBIAN:
+            J_lam = J_lam.toarray()
+            unit = np.flatnonzero(~J_lam.any(axis=0))       # rows without contact stiffness
+        else:                                              # (stored entries may be zeros)
+            unit = np.flatnonzero(abs(J_lam).sum(axis=0).A1 == 0)
+        J = condensation.apply_compliance(J_lam)
         J[np.diag_indices_from(J)] += 1.0
-        U = recover_displacement(condensation, forces.force)
-        dR = condensed_omega_derivative(problem.model, condensation, U).ravel()
-        if keep is not None:
-            dR = dR[keep]
-        if forces.omega_derivative is not None:
-            rate = forces.omega_derivative.ravel()
-            dR = dR + C @ (rate if keep is None else rate[keep])
+        if omega_derivative:
+            U = recover_displacement(condensation, forces.force)
+            dR = condensed_omega_derivative(problem.model, condensation, U).ravel()
+            if keep is not None:
+                dR = dR[keep]
+            if forces.omega_derivative is not None:
+                rate = forces.omega_derivative.ravel()
+                dR = dR + C @ (rate if keep is None else rate[keep])
     reference = _reference(np.linalg.norm(condensation.linear_response), np.linalg.norm(x))
-    return Evaluation(R, J, dR, forces, reference)
+    return Evaluation(R, J, dR, forces, reference, unit if jacobian else None)
 
 
 def _reference(*values):

@@ -188,8 +188,9 @@ def _linearized_guess_dense(problem, omega, rows_k, rows_c, preload):
     return U if np.all(np.isfinite(U)) else np.zeros((2 * H + 1, n))
 
 
-def make_evaluator(problem, condensed):
+def make_evaluator(problem, condensed, omega_derivative=True):
     """evaluate(x, ω, jacobian, slider) for the condensed or full residual; condensation cached per ω.
+    ``omega_derivative`` False: a Newton at fixed ω, the condensed ∂R/∂ω is not formed.
 
     Returns (evaluate, to_x, to_displacement) where to_x maps ũ → x and to_displacement maps an
     evaluation at ω to ũ (2H+1, n). None if condensation was asked but S_k(ω) is singular at ω.
@@ -222,7 +223,8 @@ def make_evaluator(problem, condensed):
         return cache[omega]
 
     def evaluate(x, omega, jacobian, slider):
-        return condensed_residual(problem, condensation(omega), x, slider, jacobian)
+        return condensed_residual(problem, condensation(omega), x, slider, jacobian,
+                                  omega_derivative)
 
     def to_displacement(x, omega, evaluation):
         return recover_displacement(condensation(omega), evaluation.forces.force)
@@ -494,7 +496,7 @@ def _newton(problem, omega, U0, options, slider=None):
     accept = slider_acceptor(state)
     result = None
     for condensed in ((True, False) if wants_condensation(problem, options) else (False,)):
-        evaluate, to_x, to_displacement = make_evaluator(problem, condensed)
+        evaluate, to_x, to_displacement = make_evaluator(problem, condensed, False)
         try:
             result = newton(lambda x, jac: evaluate(x, omega, jac, state["slider"]), to_x(U0),
                             options, x_scale=np.linalg.norm(to_x(U0)), accept=accept)

@@ -129,16 +129,44 @@ def baseline_matrices(nl: NonlinearModel):
     return K, M, D
 
 
-def linear_baseline(erp: ErpConfig, stage, nl: NonlinearModel, omega):
-    """Linear response at ω of the structure with its contacts at their static state: preloaded
-    (closed) pairs as their linearized spring k_n (and dashpot c_n), stuck friction pairs as k_t,
-    open pairs removed (:func:`baseline_rows`):
+def baseline_response(nl: NonlinearModel, omega, condensation=None) -> np.ndarray:
+    """Û (n,) complex [m] of (K + Gᵀ diag(k) G − ω² M + iω (D + Gᵀ diag(c) G)) Û = F̂
+    (:func:`baseline_rows`).
 
-        (K + Gᵀ diag(k) G − ω² M + iω (D + Gᵀ diag(c) G)) Û = F̂   [m],
+    With the point's condensation (:func:`sarfe.pipeline.contributions.point_condensation`, order
+    1 kept) no matrix of model size is factorized: with y = Z₁⁻¹F̂, Y = Z₁⁻¹Gᵀ, C = G Z₁⁻¹ Gᵀ and
+    s = k + iωc on the rows a that carry a spring or dashpot (Woodbury),
 
-    its ERP and the linear risk per named contact."""
-    from sarfe.risk import linear_risk_from_contacts
+        (I + C_aa diag(s_a)) r_a = (G y)_a,      Û = y − Y_a (s_a ⊙ r_a).
 
+    Otherwise (or when that system is singular) one dense LU of the matrix (least squares only for
+    a singular one: an undamped free-floating part)."""
+    if condensation is not None and nl.contacts.count and 1 in np.asarray(condensation.orders):
+        springs, dashpots = baseline_rows(nl.contacts)
+        s = springs + 1j * omega * dashpots
+        active = np.flatnonzero(s != 0)
+        order = int(np.flatnonzero(np.asarray(condensation.orders) == 1)[0])
+        y = np.asarray(condensation.forced)[order]
+        if not active.size:
+            return y
+        n_rows = nl.contacts.row_count
+        first = 2 * order                          # (cos, sin) rows of order 1 (no mean kept)
+        if 0 in np.asarray(condensation.orders):
+            first -= 1
+        C = np.asarray(condensation.compliance)
+        block = slice(first * n_rows, (first + 1) * n_rows)
+        other = slice((first + 1) * n_rows, (first + 2) * n_rows)
+        C1 = C[block, block] + 1j * C[block, other]                      # G Z₁⁻¹ Gᵀ (n_rows²)
+        r_lin = nl.contacts.gap_map @ y
+        A = np.eye(active.size) + C1[np.ix_(active, active)] * s[active][None, :]
+        try:
+            r = np.linalg.solve(A, r_lin[active])
+        except np.linalg.LinAlgError:
+            r = None
+        if r is not None and np.all(np.isfinite(r)):
+            loads = np.zeros((len(condensation.orders), n_rows), dtype=complex)
+            loads[order, active] = s[active] * r
+            return y - condensation.apply_admittance(loads)[order]
     K, M, D = baseline_matrices(nl)
     S = K - omega ** 2 * M + 1j * omega * D
     try:        # one LU; least squares only for a singular S (an undamped free-floating part)
@@ -147,10 +175,25 @@ def linear_baseline(erp: ErpConfig, stage, nl: NonlinearModel, omega):
             raise np.linalg.LinAlgError("non-finite")
     except np.linalg.LinAlgError:
         U1 = np.linalg.lstsq(S, nl.excitation_amplitude, rcond=None)[0]
+    return U1
+
+
+def linear_baseline(erp: ErpConfig, stage, nl: NonlinearModel, omega, condensation=None):
+    """Linear response at ω of the structure with its contacts at their static state: preloaded
+    (closed) pairs as their linearized spring k_n (and dashpot c_n), stuck friction pairs as k_t,
+    open pairs removed (:func:`baseline_rows`):
+
+        (K + Gᵀ diag(k) G − ω² M + iω (D + Gᵀ diag(c) G)) Û = F̂   [m],
+
+    (:func:`baseline_response`; ``condensation``: the point's, when computed), its ERP and the
+    linear risk per named contact."""
+    from sarfe.risk import linear_risk_from_contacts
+
+    U1 = baseline_response(nl, omega, condensation)
     H = (nl.excitation.shape[0] - 1) // 2
     U = np.zeros((2 * H + 1, stage.dof_count))
     U[1], U[2] = U1.real, -U1.imag
-    erp, _ = _erp(erp, stage, U, omega)
+    erp, _ = _erp(erp, stage, U[:3], omega)     # it radiates at ω only
     contacts = []
     if nl.contacts.count:
         R = (nl.contacts.gap_map @ U.T).T
@@ -263,21 +306,25 @@ def point_record(config: CaseConfig, stage, nl, index, solution, error_estimate=
     ``error_estimate``: the point's estimate when computed beforehand (:func:`error_estimates`),
     False to compute it here."""
     from sarfe.pipeline.contact_dynamics import contact_dynamics
-    from sarfe.pipeline.contributions import contributions_record
+    from sarfe.pipeline.contributions import contributions_record, point_condensation
 
     omega = float(solution.omega)
     erp, W = _erp(config.erp, stage, solution.displacement, omega)
     contacts = contact_indicators(solution, nl) if nl.contacts.count else []
     for record, dynamics in zip(contacts, contact_dynamics(solution, nl)):
         record.update({k: v for k, v in dynamics.items() if k != "name"})
-    contributions = contributions_record(config.erp, stage, nl, solution)
+    try:        # shared by the contributions and the linear baseline (None: their own paths)
+        condensation = point_condensation(nl, solution) if nl.contacts.count else None
+    except (ValueError, np.linalg.LinAlgError):
+        condensation = None
+    contributions = contributions_record(config.erp, stage, nl, solution, condensation)
     if contributions.get("available"):
         shares = {c["name"]: c for c in contributions["sources"]}
         for record in contacts:
             source = shares.get(record["name"], {})
             record.update({"erp_level_dba": source.get("level_dba", float("nan")),
                            "erp_share_a": source.get("share_a", float("nan"))})
-    linear = linear_baseline(config.erp, stage, nl, omega)
+    linear = linear_baseline(config.erp, stage, nl, omega, condensation)
     stable = solution.stable
     point = {
         "index": index, "frequency_hz": omega / (2 * np.pi), "omega_rad_s": omega,

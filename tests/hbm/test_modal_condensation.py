@@ -81,6 +81,11 @@ def compare_paths(model, G, omega, orders=None):
     assert relative(recover_displacement(modal, force), U) < 1e-10
     assert relative(condensed_omega_derivative(model, modal, U),
                     condensed_omega_derivative(model, direct, U)) < 1e-10
+    # C applied block by block (block diagonal over the kept orders) = the dense product
+    B = np.random.default_rng(2).normal(size=(direct.compliance.shape[0], 7))
+    for cond in (modal, direct):
+        assert relative(cond.apply_compliance(B), cond.compliance @ B) < 1e-13
+        assert relative(cond.apply_compliance(sp.csr_matrix(B)), cond.compliance @ B) < 1e-13
 
 
 @pytest.mark.parametrize("damping", ["modal", "rayleigh", "none"])
