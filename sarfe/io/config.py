@@ -178,6 +178,7 @@ class SolverConfig:
     error_estimate: bool = True
     harmonic_set: object = "all"
     prune_contacts: object = True
+    workers: object = "auto"         # processes for the per-point work: 'auto' | n (sarfe.workers)
     continuation: ContinuationConfig = field(default_factory=ContinuationConfig)
 
     @property
@@ -272,6 +273,7 @@ def build_config(data: dict) -> CaseConfig:
             stability=solver["stability"], error_estimate=solver["error_estimate"],
             harmonic_set=copy.deepcopy(solver["harmonic_set"]),
             prune_contacts=copy.deepcopy(solver["prune_contacts"]),
+            workers=solver["workers"],
             continuation=ContinuationConfig(initial_step=cont["initial_step"],
                                             min_step=cont["min_step"], max_step=cont["max_step"],
                                             max_points=cont["max_points"])),

@@ -12,6 +12,7 @@ not unstable point of highest A-weighted ERP; every artefact "at the loudest poi
 """
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -19,6 +20,7 @@ import scipy.sparse as sp
 
 from sarfe.io.config import CaseConfig, ErpConfig, SolverConfig
 from sarfe.pipeline.nonlinear import NonlinearModel
+from sarfe.workers import map_points
 
 
 def _erp(erp: ErpConfig, stage, displacement, omega):
@@ -192,8 +194,10 @@ def _error_estimate(solver: SolverConfig, stage, nl, solution):
         return {"failed": f"{type(error).__name__}: {error}"}
 
 
-def error_estimates(config: CaseConfig, stage, nl, solutions, stride=ESTIMATE_STRIDE) -> list:
-    """Per point: the error estimate dict, or None (see :func:`_error_estimate`).
+def error_estimates(config: CaseConfig, stage, nl, solutions, stride=ESTIMATE_STRIDE,
+                    workers=1) -> list:
+    """Per point: the error estimate dict, or None (see :func:`_error_estimate`); the estimates
+    are computed on ``workers`` processes (:func:`sarfe.workers.map_points`).
 
     A sweep's points are estimated on a subset and the others take the larger estimate of their
     two estimated neighbours in continuation order (``interpolated: true``, ``from_points``): every
@@ -206,8 +210,9 @@ def error_estimates(config: CaseConfig, stage, nl, solutions, stride=ESTIMATE_ST
     if not solver.error_estimate or not nl.contacts.count:
         return [None] * n
     eligible = [i for i, s in enumerate(solutions) if s.converged]
+    estimate = functools.partial(_error_estimate, solver, stage, nl)
     if config.excitation.sweep is None or len(eligible) <= 2 * stride:
-        return [_error_estimate(solver, stage, nl, s) for s in solutions]
+        return map_points(estimate, solutions, workers)
     G = nl.contacts.gap_map
 
     def amplitude(i):
@@ -215,7 +220,8 @@ def error_estimates(config: CaseConfig, stage, nl, solutions, stride=ESTIMATE_ST
         return float(np.max(np.hypot(G @ U[1], G @ U[2]), initial=0.0))
 
     chosen = set(eligible[::stride]) | {eligible[0], eligible[-1], max(eligible, key=amplitude)}
-    computed = {i: _error_estimate(solver, stage, nl, solutions[i]) for i in sorted(chosen)}
+    chosen = sorted(chosen)
+    computed = dict(zip(chosen, map_points(estimate, [solutions[i] for i in chosen], workers)))
     usable = [i for i in sorted(computed) if computed[i] is not None and "failed" not in computed[i]
               and np.isfinite(computed[i]["amplitude_rel"])]    # (unknown: that point alone)
     out = []
