@@ -297,7 +297,9 @@ def stability(problem, omega, U, ev, options):
 
 
 def finalize(problem, omega, U, converged, reason, iterations, slider, options) -> HarmonicSolution:
-    """Residual on all DOFs and all harmonic rows, contact fields, Hill stability → HarmonicSolution.
+    """Residual on all DOFs and all harmonic rows, contact fields, Hill stability → HarmonicSolution
+    (inside a :func:`sarfe.hbm.deferred.deferred_stability` block the stability is recorded as a
+    job, ``stability_job``, and computed later).
 
     residual_norm: the kept rows; dropped_content: η of the dropped rows (for the full set: of the
     rows outside the odd set, what 'auto' would drop)."""

@@ -166,7 +166,8 @@ class ContinuationConfig:
 @dataclass(frozen=True)
 class SolverConfig:
     """solver: harmonics H, samples_per_period N, Newton options, continuation, accuracy.
-    ``resolution`` 'auto' (H, N, modes chosen for ``accuracy``) | 'fixed' (harmonics given)."""
+    ``resolution`` 'auto' (H, N, modes chosen for ``accuracy``) | 'fixed' (harmonics given).
+    ``workers`` 'auto' | n: processes for the per-point work after Newton (:mod:`sarfe.workers`)."""
 
     harmonics: int = 5
     samples_per_period: int = 128
