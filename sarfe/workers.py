@@ -10,6 +10,8 @@ process. This module imports nothing from sarfe, so every layer may use it.
 
 - Threads: the pool is forked under ``threadpool_limits(1)`` and every worker keeps one BLAS /
   OpenMP thread (docs/performance.md: oversubscribed BLAS threads on 2 cores cost 75×).
+- Memory: the parent's objects are frozen out of the garbage collector while the workers run
+  (``gc.freeze``), so a worker's collections do not copy the pages they sit on.
 - Errors: an exception raised by ``function`` in a worker is raised again in the parent, as in the
   loop. A worker that dies (killed, out of memory) leaves its items to the parent, which computes
   them itself: the results are the same, only later.
@@ -21,6 +23,7 @@ process. This module imports nothing from sarfe, so every layer may use it.
 """
 from __future__ import annotations
 
+import gc
 import multiprocessing
 import os
 import signal
@@ -105,6 +108,7 @@ def map_points(function, items, workers, progress=None) -> list:
     done = set()
     _TASK = (function, items)
     pool = None
+    gc.freeze()         # the workers' garbage collector leaves the parent's objects (and pages) alone
     try:
         with threadpool_limits(limits=1):     # fork with one BLAS thread (no pool to inherit)
             pool = ProcessPoolExecutor(max_workers=min(int(workers), len(items)),
@@ -127,6 +131,7 @@ def map_points(function, items, workers, progress=None) -> list:
         raise
     finally:
         _TASK = None
+        gc.unfreeze()
     pool.shutdown(wait=True)
     for i in range(len(items)):               # items of a worker that died
         if i not in done:
