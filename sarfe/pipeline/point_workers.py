@@ -40,6 +40,8 @@ def stability_verdicts(solutions, jobs, workers, progress=False):
     of them raised — the serial path ends the continuation there and goes on point by point, so
     the caller solves the points again without deferring."""
     indices = pending(solutions)
+    if not indices:             # (no converged point went through Newton: nothing to compute)
+        return solutions
     bar = _bar(progress, f"Hill stability ({workers} processes)", len(indices), unit="point")
     try:
         results = map_points(stability_of, [jobs[i] for i in indices], workers,
