@@ -173,16 +173,19 @@ def main(argv):
             print(f"workers {workers}: wall {run['wall_s']:.1f} s, CPU {run['cpu_parent_s']:.1f} + "
                   f"{run['cpu_workers_s']:.1f} s, PSS {run['peak_pss_total_mb']:.0f} MB, "
                   f"load {run['load_before']:.1f}", flush=True)
+        write(case_path, band, runs)      # after every pair: a stopped run keeps its results
+
+
+def write(case_path, band, runs):
     diffs = []
     for r in runs[1:]:
         diffs += differences(runs[0]["summary_points"], r["summary_points"])
-    for r in runs:
-        del r["summary_points"]
+    plain = [{k: v for k, v in r.items() if k != "summary_points"} for r in runs]
     RESULTS.mkdir(exist_ok=True)
     (RESULTS / "workers.json").write_text(json.dumps({"case": case_path, "band": band,
-                                                      "runs": runs, "differences": diffs[:50]},
+                                                      "runs": plain, "differences": diffs[:50]},
                                                      indent=1))
-    write_section(case_path, band, runs, diffs)
+    write_section(case_path, band, plain, diffs)
 
 
 if __name__ == "__main__":
