@@ -194,6 +194,21 @@ def _error_estimate(solver: SolverConfig, stage, nl, solution):
         return {"failed": f"{type(error).__name__}: {error}"}
 
 
+def _estimates_in_order(estimate, solutions, first, workers):
+    """[estimate(s) for s in solutions], the ``first`` (a list of at most one index) in this
+    process before the others go to ``workers`` processes: the caches an estimate builds (the
+    coarser Craig–Bampton model; its modal basis, made at a model's second condensation after a
+    factorized first one, sarfe.hbm.linear) are then the same for every later estimate — in the
+    workers as in the serial loop — and so are the round-off of the results."""
+    out = [None] * len(solutions)
+    for i in first:
+        out[i] = estimate(solutions[i])
+    rest = [i for i in range(len(solutions)) if i not in first]
+    for i, value in zip(rest, map_points(estimate, [solutions[i] for i in rest], workers)):
+        out[i] = value
+    return out
+
+
 def error_estimates(config: CaseConfig, stage, nl, solutions, stride=ESTIMATE_STRIDE,
                     workers=1) -> list:
     """Per point: the error estimate dict, or None (see :func:`_error_estimate`); the estimates
@@ -212,7 +227,7 @@ def error_estimates(config: CaseConfig, stage, nl, solutions, stride=ESTIMATE_ST
     eligible = [i for i, s in enumerate(solutions) if s.converged]
     estimate = functools.partial(_error_estimate, solver, stage, nl)
     if config.excitation.sweep is None or len(eligible) <= 2 * stride:
-        return map_points(estimate, solutions, workers)
+        return _estimates_in_order(estimate, solutions, eligible[:1], workers)
     G = nl.contacts.gap_map
 
     def amplitude(i):
@@ -221,7 +236,8 @@ def error_estimates(config: CaseConfig, stage, nl, solutions, stride=ESTIMATE_ST
 
     chosen = set(eligible[::stride]) | {eligible[0], eligible[-1], max(eligible, key=amplitude)}
     chosen = sorted(chosen)
-    computed = dict(zip(chosen, map_points(estimate, [solutions[i] for i in chosen], workers)))
+    computed = dict(zip(chosen, _estimates_in_order(estimate, [solutions[i] for i in chosen],
+                                                    [0], workers)))
     usable = [i for i in sorted(computed) if computed[i] is not None and "failed" not in computed[i]
               and np.isfinite(computed[i]["amplitude_rel"])]    # (unknown: that point alone)
     out = []
