@@ -1,13 +1,13 @@
 """Layers point one way: a lower layer of sarfe never imports a higher one (issue 12).
 
-Order: lazy (package exports on first use) < mesh < fe < reduction < hbm < erp (risk) < io, accuracy < pipeline < study, batch, cli. Every module's
+Order: lazy (package exports on first use), workers (process pool, imports no sarfe) < mesh < fe < reduction < hbm < erp (risk) < io, accuracy < pipeline < study, batch, cli. Every module's
 imports — module level and inside functions — are read with ``ast`` (relative imports resolved).
 """
 import ast
 from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parents[1] / "sarfe"
-LAYERS = {"lazy": 0, "mesh": 0, "fe": 1, "reduction": 2, "hbm": 3, "erp": 4, "risk": 4, "io": 5,
+LAYERS = {"lazy": 0, "workers": 0, "mesh": 0, "fe": 1, "reduction": 2, "hbm": 3, "erp": 4, "risk": 4, "io": 5,
           "accuracy": 5, "pipeline": 6, "study": 7, "batch": 7, "cli": 7, "__main__": 7}
 
 

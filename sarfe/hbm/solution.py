@@ -105,6 +105,8 @@ class HarmonicSolution:
     method: how the point was obtained — 'harmonic balance' (the Newton solve), 'linear' (exact
     solution without nonlinear contacts) or 'time integration' (the stand-in for a point whose
     engine call raised: iterations = periods integrated, residual_norm = periodicity error).
+    stability_job: while the Hill stability is deferred (:mod:`sarfe.hbm.deferred`), the index of
+    its recorded job (``stable`` None until filled in); None otherwise.
     """
 
     omega: float
@@ -127,6 +129,7 @@ class HarmonicSolution:
     dropped_content: float = float("nan")
     stability_note: str = ""
     method: str = "harmonic balance"
+    stability_job: int | None = None
 
     def amplitude(self, dof: int, harmonic: int = 1) -> float:
         """Amplitude √(u_kc² + u_ks²) of harmonic k of one DOF [m] (k = 0: the mean)."""

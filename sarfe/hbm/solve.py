@@ -36,6 +36,7 @@ from .harmonic_set import (AUTO_CANDIDATE, coefficient_rows, dropped_content, ex
 from .harmonics import check_harmonics, derivative_matrix, time_samples
 from .linear import condense, dynamic_stiffness_matrix, recover_displacement
 from .newton import SingularJacobian, newton, solve_linear
+from .deferred import defer
 from .residual import Problem, condensed_residual, full_residual, kept_rows
 from .solution import HarmonicSolution, SolverOptions
 from .stability import hill_stability
@@ -298,7 +299,9 @@ def stability(problem, omega, U, ev, options):
 
 
 def finalize(problem, omega, U, converged, reason, iterations, slider, options) -> HarmonicSolution:
-    """Residual on all DOFs and all harmonic rows, contact fields, Hill stability → HarmonicSolution.
+    """Residual on all DOFs and all harmonic rows, contact fields, Hill stability → HarmonicSolution
+    (inside a :func:`sarfe.hbm.deferred.deferred_stability` block the stability is recorded as a
+    job, ``stability_job``, and computed later).
 
     residual_norm: the kept rows; dropped_content: η of the dropped rows (for the full set: of the
     rows outside the odd set, what 'auto' would drop)."""
@@ -321,10 +324,12 @@ def finalize(problem, omega, U, converged, reason, iterations, slider, options) 
     elif converged and residual > options.full_tolerance:
         converged = False
         reason = f"full residual {residual:.3g} above full_tolerance {options.full_tolerance:g}"
-    stable, exponent, note = None, float("nan"), ""
+    stable, exponent, note, job = None, float("nan"), "", None
     if converged and options.stability:
-        result = stability(full, omega, U, ev, options)
-        stable, exponent, note = result.stable, result.leading, result.note
+        job = defer(full, omega, U, slider, options)    # recorded for later (sarfe.hbm.deferred)
+        if job is None:
+            result = stability(full, omega, U, ev, options)
+            stable, exponent, note = result.stable, result.leading, result.note
     orders = problem.harmonic_orders
     return HarmonicSolution(
         omega=float(omega), harmonics=problem.harmonics,
@@ -335,7 +340,7 @@ def finalize(problem, omega, U, converged, reason, iterations, slider, options) 
         residual_norm=residual, friction_passes=int(ev.forces.friction_passes),
         stable=stable, floquet_exponent=exponent, stability_note=note,
         harmonic_orders=None if orders is None else tuple(int(k) for k in orders),
-        harmonic_set=harmonic_set_label(problem), dropped_content=eta)
+        harmonic_set=harmonic_set_label(problem), dropped_content=eta, stability_job=job)
 
 
 def solve_frequency(model, contacts, excitation, omega, harmonics, samples_per_period,

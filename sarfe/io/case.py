@@ -545,7 +545,7 @@ def _normalize_solver(case, data):
         raise case.error(f"must be >= 2H+1 = {2 * H + 1} for harmonics H = {H}, got {N}",
                          ("solver", "samples_per_period"))
     for key in ("tolerance", "max_iterations", "stability", "error_estimate", "harmonic_set",
-                "prune_contacts"):          # defaults: sarfe.io.config.SolverConfig
+                "prune_contacts", "workers"):          # defaults: sarfe.io.config.SolverConfig
         solver.setdefault(key, getattr(SolverConfig, key))
     cont = solver.setdefault("continuation", {})
     for key in ("initial_step", "min_step", "max_step", "max_points"):

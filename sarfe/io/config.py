@@ -175,7 +175,8 @@ class ContinuationConfig:
 @dataclass(frozen=True)
 class SolverConfig:
     """solver: harmonics H, samples_per_period N, Newton options, continuation, accuracy.
-    ``resolution`` 'auto' (H, N, modes chosen for ``accuracy``) | 'fixed' (harmonics given)."""
+    ``resolution`` 'auto' (H, N, modes chosen for ``accuracy``) | 'fixed' (harmonics given).
+    ``workers`` 'auto' | n: processes for the per-point work after Newton (:mod:`sarfe.workers`)."""
 
     harmonics: int = 5
     samples_per_period: int = 128
@@ -187,6 +188,7 @@ class SolverConfig:
     error_estimate: bool = True
     harmonic_set: object = "all"
     prune_contacts: object = True
+    workers: object = "auto"         # processes for the per-point work: 'auto' | n (sarfe.workers)
     continuation: ContinuationConfig = field(default_factory=ContinuationConfig)
 
     @property
@@ -281,6 +283,7 @@ def build_config(data: dict) -> CaseConfig:
             stability=solver["stability"], error_estimate=solver["error_estimate"],
             harmonic_set=copy.deepcopy(solver["harmonic_set"]),
             prune_contacts=copy.deepcopy(solver["prune_contacts"]),
+            workers=solver["workers"],
             continuation=ContinuationConfig(initial_step=cont["initial_step"],
                                             min_step=cont["min_step"], max_step=cont["max_step"],
                                             max_points=cont["max_points"])),

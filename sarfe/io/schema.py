@@ -186,6 +186,8 @@ SOLVER = _object({
     # contacts that never switch over the frequencies solved linearly (sarfe.pipeline.pruning)
     "prune_contacts": {"oneOf": [{"type": "boolean"}, _object({
         "margin": {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1}})]},
+    # processes for the per-point work after Newton (stability, estimates, records): sarfe.workers
+    "workers": {"oneOf": [{"enum": ["auto"]}, {"type": "integer", "minimum": 1}]},
     "continuation": _object({
         "initial_step": {"type": "number", "exclusiveMinimum": 0, "maximum": 1},
         "min_step": {"type": "number", "exclusiveMinimum": 0, "maximum": 1},

@@ -12,6 +12,7 @@ not unstable point of highest A-weighted ERP; every artefact "at the loudest poi
 """
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -19,6 +20,7 @@ import scipy.sparse as sp
 
 from sarfe.io.config import CaseConfig, ErpConfig, SolverConfig
 from sarfe.pipeline.nonlinear import NonlinearModel
+from sarfe.workers import map_points
 
 
 def _erp(erp: ErpConfig, stage, displacement, omega):
@@ -235,8 +237,25 @@ def _error_estimate(solver: SolverConfig, stage, nl, solution):
         return {"failed": f"{type(error).__name__}: {error}"}
 
 
-def error_estimates(config: CaseConfig, stage, nl, solutions, stride=ESTIMATE_STRIDE) -> list:
-    """Per point: the error estimate dict, or None (see :func:`_error_estimate`).
+def _estimates_in_order(estimate, solutions, first, workers):
+    """[estimate(s) for s in solutions], the ``first`` (a list of at most one index) in this
+    process before the others go to ``workers`` processes: the caches an estimate builds (the
+    coarser Craig–Bampton model; its modal basis, made at a model's second condensation after a
+    factorized first one, sarfe.hbm.linear) are then the same for every later estimate — in the
+    workers as in the serial loop — and so are the round-off of the results."""
+    out = [None] * len(solutions)
+    for i in first:
+        out[i] = estimate(solutions[i])
+    rest = [i for i in range(len(solutions)) if i not in first]
+    for i, value in zip(rest, map_points(estimate, [solutions[i] for i in rest], workers)):
+        out[i] = value
+    return out
+
+
+def error_estimates(config: CaseConfig, stage, nl, solutions, stride=ESTIMATE_STRIDE,
+                    workers=1) -> list:
+    """Per point: the error estimate dict, or None (see :func:`_error_estimate`); the estimates
+    are computed on ``workers`` processes (:func:`sarfe.workers.map_points`).
 
     A sweep's points are estimated on a subset and the others take the larger estimate of their
     two estimated neighbours in continuation order (``interpolated: true``, ``from_points``): every
@@ -249,8 +268,9 @@ def error_estimates(config: CaseConfig, stage, nl, solutions, stride=ESTIMATE_ST
     if not solver.error_estimate or not nl.contacts.count:
         return [None] * n
     eligible = [i for i, s in enumerate(solutions) if s.converged]
+    estimate = functools.partial(_error_estimate, solver, stage, nl)
     if config.excitation.sweep is None or len(eligible) <= 2 * stride:
-        return [_error_estimate(solver, stage, nl, s) for s in solutions]
+        return _estimates_in_order(estimate, solutions, eligible[:1], workers)
     G = nl.contacts.gap_map
 
     def amplitude(i):
@@ -258,7 +278,9 @@ def error_estimates(config: CaseConfig, stage, nl, solutions, stride=ESTIMATE_ST
         return float(np.max(np.hypot(G @ U[1], G @ U[2]), initial=0.0))
 
     chosen = set(eligible[::stride]) | {eligible[0], eligible[-1], max(eligible, key=amplitude)}
-    computed = {i: _error_estimate(solver, stage, nl, solutions[i]) for i in sorted(chosen)}
+    chosen = sorted(chosen)
+    computed = dict(zip(chosen, _estimates_in_order(estimate, [solutions[i] for i in chosen],
+                                                    [0], workers)))
     usable = [i for i in sorted(computed) if computed[i] is not None and "failed" not in computed[i]
               and np.isfinite(computed[i]["amplitude_rel"])]    # (unknown: that point alone)
     out = []

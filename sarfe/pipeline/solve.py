@@ -5,12 +5,14 @@ directory next to the target and moved into place at the end).
 from __future__ import annotations
 
 import datetime as _dt
+import functools
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from sarfe.hbm.deferred import deferred_stability
 from sarfe.io.case import load_case
 from sarfe.io.errors import EXIT_NOT_CONVERGED
 from sarfe.pipeline.accuracy import accuracy_check
@@ -20,8 +22,9 @@ from sarfe.pipeline.nonlinear import NonlinearModel, nonlinear_model
 from sarfe.pipeline.outputs import write_outputs, results_table
 from sarfe.pipeline.points import common_samples, solve_points, sweep_status
 from sarfe.pipeline.progress import bar as _bar
+from sarfe.pipeline.point_workers import point_records, point_workers, stability_verdicts
 from sarfe.pipeline.pruning import solve_points_pruned
-from sarfe.pipeline.postprocess import error_estimates, point_record, worst_of
+from sarfe.pipeline.postprocess import error_estimates, worst_of
 
 
 @dataclass
@@ -102,26 +105,36 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     timings["setup_s"] = time.perf_counter() - clock
 
     clock = time.perf_counter()
-    solutions, pruning = solve_points_pruned(config.solver, config.excitation, nl,
-                                             progress=progress)
-    timings["hbm_s"] = time.perf_counter() - clock
+    workers = point_workers(config.solver)     # processes for the per-point work (1: serial)
+    # with workers, Hill stability is recorded during the sweep and computed on them after it
+    with deferred_stability(enabled=workers > 1 and config.solver.stability) as jobs:
+        solutions, pruning = solve_points_pruned(config.solver, config.excitation, nl,
+                                                 progress=progress)
+    if jobs is not None:
+        clock_stability = time.perf_counter()
+        solutions = stability_verdicts(solutions, jobs, workers, progress)
+        timings["stability_s"] = time.perf_counter() - clock_stability
+    if solutions is None:      # a deferred stability raised: the serial path's sweep
+        solutions, pruning = solve_points_pruned(config.solver, config.excitation, nl,
+                                                 progress=progress)
+    timings["hbm_s"] = time.perf_counter() - clock       # (with the deferred stability)
 
     clock = time.perf_counter()
     points, rows, erps, normal_w = [], [], [], []
     bar = _bar(progress, "ERP and error estimates" if config.solver.error_estimate else "ERP",
                len(solutions), unit="point")
     try:
-        estimates = error_estimates(config, stage, nl, solutions)  # each at the N it was solved with
+        # each at the N it was solved with
+        estimates = error_estimates(config, stage, nl, solutions, workers=workers)
         timings["error_estimate_s"] = time.perf_counter() - clock
         solutions = common_samples(nl, solutions)                # one time grid for the files
-        for index, solution in enumerate(solutions):
-            point, row, erp, W = point_record(config, stage, nl, index, solution, estimates[index])
+        for point, row, erp, W in point_records(
+                config, stage, nl, solutions, estimates, workers,
+                progress=None if bar is None else functools.partial(bar.update, 1)):
             points.append(point)
             rows.append(row)
             erps.append(erp)
             normal_w.append(W)
-            if bar is not None:
-                bar.update(1)
     finally:
         if bar is not None:
             bar.close()

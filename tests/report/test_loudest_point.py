@@ -43,7 +43,8 @@ def test_every_artefact_uses_the_loudest_converged_stable_point(lumped_case, tmp
         order = np.argsort(dba)[::-1]
         solutions[order[0]] = dataclasses.replace(solutions[order[0]], converged=False,
                                                   reason="tampered by the test")
-        solutions[order[1]] = dataclasses.replace(solutions[order[1]], stable=False)
+        solutions[order[1]] = dataclasses.replace(solutions[order[1]], stable=False,
+                                                  stability_job=None)   # (not deferred: final)
         chosen["index"] = int(order[2])
         chosen["frequency_hz"] = float(solutions[order[2]].omega) / (2 * np.pi)
         return solutions, report

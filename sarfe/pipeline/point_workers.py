@@ -1,0 +1,67 @@
+r"""The per-point work that does not feed the sweep, on ``solver.workers`` processes.
+
+Newton and the continuation stay in the solving process: each point starts from the previous
+one. The rest of a point's work reads the converged point only, and runs on worker processes
+forked from the solve (:func:`sarfe.workers.map_points`: the reduced model and the points are
+shared copy-on-write, only the results come back):
+
+1. Hill stability — deferred during the sweep (:mod:`sarfe.hbm.deferred`: ``finalize`` records a
+   job per converged point), then mapped over the reported points (points the sweep dropped are
+   not computed);
+2. the error estimates (:func:`sarfe.pipeline.postprocess.error_estimates`, ``workers``);
+3. the point records: ERP, contact indicators, contributions, linear baseline
+   (:func:`sarfe.pipeline.postprocess.point_record`).
+
+``workers`` = 1 is the serial path (stability in place during the sweep, plain loops). The results
+do not depend on ``workers``: every point is computed by the same function from the same inputs.
+An exception of a deferred stability makes the caller solve the sweep again serially — in the
+serial path that exception ends the continuation and the sweep falls back point by point, so the
+result is that path's.
+"""
+from __future__ import annotations
+
+import functools
+
+from sarfe.hbm.deferred import pending, stability_of, with_stability
+from sarfe.io.config import CaseConfig, SolverConfig
+from sarfe.pipeline.progress import bar as _bar
+from sarfe.workers import map_points, worker_count
+
+
+def point_workers(solver: SolverConfig) -> int:
+    """Processes for the per-point work of a run: ``solver.workers`` (:func:`sarfe.workers.
+    worker_count`; 'auto' = the CPUs this process may use, at most 2, as memory allows)."""
+    return worker_count(solver.workers)
+
+
+def stability_verdicts(solutions, jobs, workers, progress=False):
+    """The solutions with their deferred Hill stability (``jobs`` of a :func:`sarfe.hbm.deferred.
+    deferred_stability` block around the sweep) computed on ``workers`` processes; None when one
+    of them raised — the serial path ends the continuation there and goes on point by point, so
+    the caller solves the points again without deferring."""
+    indices = pending(solutions)
+    if not indices:             # (no converged point went through Newton: nothing to compute)
+        return solutions
+    bar = _bar(progress, f"Hill stability ({workers} processes)", len(indices), unit="point")
+    try:
+        results = map_points(stability_of, [jobs[i] for i in indices], workers,
+                             progress=None if bar is None else functools.partial(bar.update, 1))
+    except Exception:
+        return None
+    finally:
+        if bar is not None:
+            bar.close()
+    return with_stability(solutions, indices, results)
+
+
+def point_records(config: CaseConfig, stage, nl, solutions, estimates, workers,
+                  progress=None) -> list:
+    """[(point dict, table row, ErpResult, radiating displacements W)] per solution
+    (:func:`sarfe.pipeline.postprocess.point_record`), on ``workers`` processes; ``progress()``
+    once per finished point."""
+    from sarfe.pipeline.postprocess import point_record
+
+    def record(index):
+        return point_record(config, stage, nl, index, solutions[index], estimates[index])
+
+    return map_points(record, range(len(solutions)), workers, progress=progress)

@@ -1,0 +1,154 @@
+r"""Worker processes for the per-point work of a run: an ordered map on a fork context.
+
+    map_points(function, items, workers, progress=None) -> [function(item) for item in items]
+
+computed by ``workers`` processes forked from this one. Fork shares the parent's memory
+copy-on-write: ``function`` and ``items`` (a closure over the reduced model, the converged points)
+are never pickled — a worker receives an item's index and pickles back only its result (a
+StabilityResult, a record dict). ``workers`` ≤ 1, or a single item, is the plain loop in this
+process. This module imports nothing from sarfe, so every layer may use it.
+
+- Threads: the pool is forked under ``threadpool_limits(1)`` and every worker keeps one BLAS /
+  OpenMP thread (docs/performance.md: oversubscribed BLAS threads on 2 cores cost 75×).
+- Memory: the parent's objects are frozen out of the garbage collector while the workers run
+  (``gc.freeze``), so a worker's collections do not copy the pages they sit on.
+- Errors: an exception raised by ``function`` in a worker is raised again in the parent, as in the
+  loop. A worker that dies (killed, out of memory) leaves its items to the parent, which computes
+  them itself: the results are the same, only later.
+- Ctrl-C: the workers ignore SIGINT; the parent receives it, stops its workers and re-raises.
+  Nothing is written by the workers (result files are the parent's, written at the end).
+- ``progress()``: called in the parent once per finished item (in finishing order).
+
+:func:`worker_count` turns the case's ``solver.workers`` (``auto`` | n) into a process count.
+"""
+from __future__ import annotations
+
+import gc
+import multiprocessing
+import os
+import signal
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
+
+AUTO_LIMIT = 2          # 'auto' uses at most 2 processes (the P1 machine has 2 cores)
+WORKER_MEMORY_SHARE = 0.5   # 'auto': a worker may add up to half the parent's resident memory
+
+_TASK = None            # (function, items) of the map in progress: inherited by the forked workers
+
+
+def available_cpus() -> int:
+    """The CPUs this process may run on (its affinity mask; the CPU count where there is none)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:       # (not Linux)
+        return os.cpu_count() or 1
+
+
+def _memory_kb(field) -> int | None:
+    """A field of /proc/meminfo or /proc/self/status [kB] (None where unavailable)."""
+    path = "/proc/meminfo" if field == "MemAvailable" else "/proc/self/status"
+    try:
+        with open(path) as stream:
+            for line in stream:
+                if line.startswith(field + ":"):
+                    return int(line.split()[1])
+    except OSError:
+        return None
+    return None
+
+
+def memory_workers() -> int | None:
+    """How many workers the free memory allows: MemAvailable / (WORKER_MEMORY_SHARE × this
+    process's resident set), a worker being assumed to add that much (its own arrays; the model is
+    shared). None where /proc does not say."""
+    available, resident = _memory_kb("MemAvailable"), _memory_kb("VmRSS")
+    if not available or not resident:
+        return None
+    return int(available // (WORKER_MEMORY_SHARE * resident))
+
+
+def worker_count(setting="auto") -> int:
+    """Processes for the per-point work: ``auto`` = min(available CPUs, AUTO_LIMIT, what memory
+    allows), an integer n ≥ 1 = n. 1 in a daemonic process (e.g. a Dask worker of ``sarfe batch``),
+    which may not start processes of its own."""
+    if multiprocessing.current_process().daemon:
+        return 1
+    if setting == "auto":
+        limits = [available_cpus(), AUTO_LIMIT, memory_workers()]
+        return max(1, min(n for n in limits if n is not None))
+    return max(1, int(setting))
+
+
+def _start_worker():
+    """Initializer of a forked worker: SIGINT to the parent only, one BLAS / OpenMP thread."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    from threadpoolctl import threadpool_limits
+
+    threadpool_limits(limits=1)
+
+
+def _run(index):
+    function, items = _TASK
+    return function(items[index])
+
+
+def map_points(function, items, workers, progress=None) -> list:
+    """[function(item) for item in items] on ``workers`` forked processes (module docstring)."""
+    global _TASK
+    items = list(items)
+    results = [None] * len(items)
+    if workers <= 1 or len(items) <= 1 or multiprocessing.current_process().daemon:
+        for i, item in enumerate(items):
+            results[i] = function(item)
+            if progress is not None:
+                progress()
+        return results
+    from threadpoolctl import threadpool_limits
+
+    done = set()
+    _TASK = (function, items)
+    pool = None
+    gc.freeze()         # the workers' garbage collector leaves the parent's objects (and pages) alone
+    try:
+        with threadpool_limits(limits=1):     # fork with one BLAS thread (no pool to inherit)
+            pool = ProcessPoolExecutor(max_workers=min(int(workers), len(items)),
+                                       mp_context=multiprocessing.get_context("fork"),
+                                       initializer=_start_worker)
+            pending = {pool.submit(_run, i): i for i in range(len(items))}
+        while pending:
+            finished, _ = wait(pending, return_when=FIRST_COMPLETED)
+            for future in finished:
+                i = pending.pop(future)
+                try:
+                    results[i] = future.result()
+                except BrokenProcessPool:     # a worker died: the parent computes what is left
+                    continue
+                done.add(i)
+                if progress is not None:
+                    progress()
+    except BaseException:                     # Ctrl-C or an item's exception: stop the workers
+        _stop(pool)
+        raise
+    finally:
+        _TASK = None
+        gc.unfreeze()
+    pool.shutdown(wait=True)
+    for i in range(len(items)):               # items of a worker that died
+        if i not in done:
+            results[i] = function(items[i])
+            if progress is not None:
+                progress()
+    return results
+
+
+def _stop(pool):
+    """Cancel what is queued and end the workers now (running items are abandoned)."""
+    if pool is None:
+        return
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
+        if process.is_alive():
+            process.terminate()
+    for process in processes:
+        process.join(timeout=5)

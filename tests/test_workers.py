@@ -1,0 +1,141 @@
+"""solver.workers: the per-point work after Newton on forked processes gives the serial results.
+
+- sarfe.workers.map_points: the items' results in order, an item's exception raised in the parent,
+  the items of a killed worker computed by the parent, one process when workers = 1.
+- solve_case on the shipped lumped rattle case (a sweep through its contact resonance, rattle and
+  friction, estimates on the stride subset): workers 1 and 2 give the same per-point fields of
+  summary.json within 1e-12 relative and the same stability verdicts; a deferred stability that
+  raises gives the serial path's result.
+"""
+from __future__ import annotations
+
+import math
+import os
+import signal
+from pathlib import Path
+
+import pytest
+
+from sarfe import workers
+from sarfe.io.case import load_case, read_yaml
+from sarfe.io.errors import CaseError
+from sarfe.pipeline import point_workers, solve_case
+
+CASES = Path(__file__).resolve().parents[1] / "cases"
+
+
+def _square(x):
+    return x * x
+
+
+def _pid(_):
+    return os.getpid()
+
+
+def test_map_points_keeps_order_and_uses_other_processes():
+    items = list(range(23))
+    assert workers.map_points(_square, items, 2) == [x * x for x in items]
+    assert os.getpid() not in workers.map_points(_pid, items, 2)
+    assert set(workers.map_points(_pid, items, 1)) == {os.getpid()}     # serial: this process
+
+
+def test_map_points_shares_items_without_pickling_them():
+    """Items and function are inherited by fork: a closure over an unpicklable object works."""
+    lock = __import__("threading").Lock()          # not picklable
+
+    def uses_lock(x):
+        return (x, lock is not None)
+    assert workers.map_points(uses_lock, [1, 2, 3], 2) == [(1, True), (2, True), (3, True)]
+
+
+def _fails_on_three(x):
+    if x == 3:
+        raise ValueError("item 3")
+    return x
+
+
+def test_an_items_exception_is_raised_in_the_parent():
+    with pytest.raises(ValueError, match="item 3"):
+        workers.map_points(_fails_on_three, range(8), 2)
+
+
+def test_items_of_a_killed_worker_are_computed_by_the_parent():
+    parent = os.getpid()
+
+    def dies_in_a_worker(x):
+        if x == 2 and os.getpid() != parent:
+            os.kill(os.getpid(), signal.SIGKILL)
+        return x + 100
+
+    progress = []
+    result = workers.map_points(dies_in_a_worker, range(6), 2, progress=lambda: progress.append(1))
+    assert result == [x + 100 for x in range(6)]
+    assert len(progress) == 6
+
+
+def test_worker_count_setting():
+    assert 1 <= workers.worker_count("auto") <= workers.AUTO_LIMIT
+    assert workers.worker_count("auto") <= workers.available_cpus()
+    assert workers.worker_count(3) == 3
+    assert workers.worker_count(1) == 1
+
+
+def _lumped(workers_setting, band=(45.0, 60.0)):
+    data, _ = read_yaml(CASES / "lumped_rattle.yaml")
+    data["excitation"]["sweep"] = {"start_hz": band[0], "end_hz": band[1]}
+    data["solver"]["workers"] = workers_setting
+    return load_case(data, base_dir=CASES)
+
+
+@pytest.mark.parametrize("value", [0, "two", 1.5])
+def test_workers_setting_is_checked(value):
+    with pytest.raises(CaseError, match="workers"):
+        _lumped(value)
+
+
+def _differences(a, b, path=""):
+    """Paths where summary.json fragments differ beyond 1e-12 relative (timings skipped)."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        if set(a) != set(b):
+            return [f"{path} keys"]
+        return [d for k in a if k != "seconds" for d in _differences(a[k], b[k], f"{path}/{k}")]
+    if isinstance(a, (list, tuple)) and isinstance(b, (list, tuple)):
+        if len(a) != len(b):
+            return [f"{path} length"]
+        return [d for i, (x, y) in enumerate(zip(a, b)) for d in _differences(x, y, f"{path}[{i}]")]
+    if isinstance(a, float) and isinstance(b, float):
+        same = (math.isnan(a) and math.isnan(b)) or a == b or \
+            abs(a - b) <= 1e-12 * max(abs(a), abs(b))
+        return [] if same else [f"{path}: {a!r} vs {b!r}"]
+    if hasattr(a, "tolist") and hasattr(b, "tolist"):
+        return _differences(a.tolist(), b.tolist(), path)
+    return [] if a == b else [f"{path}: {a!r} vs {b!r}"]
+
+
+@pytest.fixture(scope="module")
+def serial():
+    return solve_case(_lumped(1), write=False)
+
+
+def test_two_workers_give_the_serial_points(serial):
+    parallel = solve_case(_lumped(2), write=False)
+    one, two = serial.summary["points"], parallel.summary["points"]
+    assert len(one) > 2 * 8                      # the stride subset of the estimates is used
+    assert any(p["contacts"][0]["max_penetration_m"] > 0 for p in one)     # it rattles
+    assert [p["stable"] for p in one] == [p["stable"] for p in two]
+    assert all(p["stable"] is not None for p in one if p["converged"])
+    assert any(isinstance(p["error_estimate"], dict) and not p["error_estimate"].get(
+        "interpolated") for p in two)
+    assert _differences(one, two) == []
+    assert "stability_s" in parallel.summary["timings_s"]
+    assert all(s.stability_job is None for s in parallel.solutions)
+
+
+def test_a_failing_deferred_stability_gives_the_serial_result(serial, monkeypatch):
+    def broken(job):
+        raise RuntimeError("stability failed in a worker")
+
+    monkeypatch.setattr(point_workers, "stability_of", broken)
+    result = solve_case(_lumped(2), write=False)
+    assert "stability_s" in result.summary["timings_s"]
+    assert _differences(serial.summary["points"], result.summary["points"]) == []
