@@ -377,9 +377,10 @@ def _start_upper_slices(k_ii, m_ii, cutoff_hz, cap, workers, held):
     space, slices the upper part of the spectrum while this process runs run 0 and the lower
     part (:func:`sarfe.reduction.spectrum_slicing.start_upper_slices`). None otherwise."""
     from sarfe.fe.linear_solvers import available_solvers
-    from sarfe.reduction.spectrum_slicing import start_upper_slices, usable_cores
+    from sarfe.reduction.spectrum_slicing import start_upper_slices
+    from sarfe.workers import available_cpus
 
-    workers = usable_cores() if workers is None else int(workers)
+    workers = available_cpus() if workers is None else int(workers)
     if workers < 2 or "pardiso" not in available_solvers():
         return None
 

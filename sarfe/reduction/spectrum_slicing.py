@@ -376,14 +376,6 @@ def _remove(path):
         pass
 
 
-def usable_cores() -> int:
-    """CPU cores this process may run on (its affinity mask where the OS reports one)."""
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:       # not Linux
-        return os.cpu_count() or 1
-
-
 def start_upper_slices(stiffness, mass, cutoff_omega2, lower_share, min_total, on_fork=None,
                        slice_modes=80, max_columns=400):
     """Fork a worker that counts the eigenvalues below the cutoff and, when there are more than
