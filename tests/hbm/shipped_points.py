@@ -26,3 +26,19 @@ def shipped_case_points(name, max_harmonics=5, count=5):
         if s.converged:
             points.append((f, s))
     return nl, H, points
+
+
+def full_hill(model, contacts, F, s):
+    """The full Hill method at a converged point ``s`` (the reference the other stability methods
+    are compared with) → (StabilityResult, the point's Evaluation, its ContactOperator)."""
+    from sarfe.hbm.residual import Problem, full_residual
+    from sarfe.hbm.solve import contact_damping
+    from sarfe.hbm.stability import hill_stability
+    from sarfe.hbm.stability_contacts import ContactOperator
+
+    problem = Problem(model, contacts, F, s.harmonics, s.samples_per_period)
+    ev = full_residual(problem, s.displacement.ravel(), s.omega)
+    op = ContactOperator(problem, s.displacement, s.omega, ev.forces)
+    full = hill_stability(model, s.omega, s.harmonics, ev.jacobian,
+                          contact_damping=contact_damping(problem, ev.forces), operator=op)
+    return full, ev, op

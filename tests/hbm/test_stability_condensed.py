@@ -5,22 +5,13 @@ import numpy as np
 import pytest
 
 from sarfe.hbm import ContinuationOptions, SolverOptions, continuation, solve_frequency
-from sarfe.hbm.residual import Problem, full_residual
-from sarfe.hbm.solve import contact_damping
-from sarfe.hbm.stability import hill_stability
 from sarfe.hbm.stability_condensed import condensed_stability, ritz_basis
-from sarfe.hbm.stability_contacts import ContactOperator
-from tests.hbm.shipped_points import shipped_case_points
+from tests.hbm.shipped_points import full_hill, shipped_case_points
 
 
 def both(model, contacts, F, s):
-    H, N = s.harmonics, s.samples_per_period
-    problem = Problem(model, contacts, F, H, N)
-    ev = full_residual(problem, s.displacement.ravel(), s.omega)
-    op = ContactOperator(problem, s.displacement, s.omega, ev.forces)
-    full = hill_stability(model, s.omega, H, ev.jacobian,
-                          contact_damping=contact_damping(problem, ev.forces), operator=op)
-    cond = condensed_stability(model, contacts, s.omega, H, ev.forces, op)
+    full, ev, op = full_hill(model, contacts, F, s)
+    cond = condensed_stability(model, contacts, s.omega, s.harmonics, ev.forces, op)
     return full, cond
 
 

@@ -10,22 +10,15 @@ from sarfe.hbm import ContinuationOptions, SolverOptions, continuation, solve_fr
 from sarfe.hbm.aft import jacobian_matrix
 from sarfe.hbm.modal import modal_basis
 from sarfe.hbm.residual import Problem, full_residual
-from sarfe.hbm.solve import contact_damping
-from sarfe.hbm.stability import hill_stability
 from sarfe.hbm.stability_contacts import ContactOperator
 from sarfe.hbm.stability_rows import (ContactRowDeterminant, contact_row_stability,
                                       structural_exponents, winding_count)
-from tests.hbm.shipped_points import shipped_case_points
+from tests.hbm.shipped_points import full_hill, shipped_case_points
 
 
 def full_and_rows(model, contacts, F, s):
-    H, N = s.harmonics, s.samples_per_period
-    problem = Problem(model, contacts, F, H, N)
-    ev = full_residual(problem, s.displacement.ravel(), s.omega)
-    op = ContactOperator(problem, s.displacement, s.omega, ev.forces)
-    full = hill_stability(model, s.omega, H, ev.jacobian,
-                          contact_damping=contact_damping(problem, ev.forces), operator=op)
-    rows = contact_row_stability(model, contacts, s.omega, H, ev.forces, op)
+    full, ev, op = full_hill(model, contacts, F, s)
+    rows = contact_row_stability(model, contacts, s.omega, s.harmonics, ev.forces, op)
     return full, rows, ev, op
 
 
