@@ -139,3 +139,25 @@ def test_a_failing_deferred_stability_gives_the_serial_result(serial, monkeypatc
     result = solve_case(_lumped(2), write=False)
     assert "stability_s" in result.summary["timings_s"]
     assert _differences(serial.summary["points"], result.summary["points"]) == []
+
+
+def test_meshing_leaves_sigpipe_ignored():
+    """gmsh's initialize resets SIGPIPE to its default action (kill); sarfe's gmsh start puts
+    Python's ignore back, so a pool whose stopped workers close their pipes cannot kill the
+    process (the suite once ended in `make: *** Broken pipe` right after a mesh was made)."""
+    import ctypes
+
+    from sarfe.mesh.gmsh_model import gmsh_session
+
+    class SigAction(ctypes.Structure):
+        _fields_ = [("handler", ctypes.c_void_p), ("mask", ctypes.c_ulong * 16),
+                    ("flags", ctypes.c_int), ("restorer", ctypes.c_void_p)]
+
+    def handler():
+        action = SigAction()
+        ctypes.CDLL(None).sigaction(signal.SIGPIPE, None, ctypes.byref(action))
+        return action.handler or 0                  # 0 = SIG_DFL, 1 = SIG_IGN
+
+    with gmsh_session():
+        assert handler() == 1
+    assert handler() == 1

@@ -95,9 +95,11 @@ def gmsh_rectangle_triangles(length_x, length_y, size, algorithm=6):
     element size ``size`` [m]; algorithm 6 = Frontal-Delaunay. Returns points, triangles."""
     import gmsh
 
+    from sarfe.mesh.gmsh_model import start_gmsh
+
     started = gmsh.isInitialized()
     if not started:
-        gmsh.initialize(["-noenv"], readConfigFiles=False)
+        start_gmsh(gmsh, ["-noenv"], readConfigFiles=False)
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.model.add("sarfe_fe_rectangle")

@@ -24,6 +24,20 @@ _QUAD_TYPES = {3: 4, 10: 4, 16: 4}         # 4-, 9-, 8-node quadrangles → 2 tr
 _TET_TYPES = {4: 4, 11: 10}
 
 
+def start_gmsh(gmsh, *args, **kwargs):
+    """``gmsh.initialize(*args, **kwargs)``, then SIGPIPE back to ignored (Python's setting).
+
+    gmsh's initialize sets SIGPIPE to its default action, for the whole process and beyond
+    finalize: a later write to a closed pipe (the queue of a stopped worker process, ``sarfe …
+    | head``) then kills the process without a word instead of raising BrokenPipeError (seen as
+    ``make: *** Broken pipe`` at the end of the test suite)."""
+    import signal
+
+    gmsh.initialize(*args, **kwargs)
+    if hasattr(signal, "SIGPIPE"):
+        signal.signal(signal.SIGPIPE, signal.SIG_IGN)
+
+
 @contextmanager
 def gmsh_session(random_seed: int = 1):
     """Context with a fresh, empty gmsh model; yields the `gmsh` module."""
@@ -32,7 +46,7 @@ def gmsh_session(random_seed: int = 1):
     with _LOCK:
         started = not gmsh.isInitialized()
         if started:
-            gmsh.initialize(readConfigFiles=False, interruptible=False)
+            start_gmsh(gmsh, readConfigFiles=False, interruptible=False)
         previous = None if started else gmsh.model.getCurrent()
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.option.setNumber("General.Verbosity", 1)
