@@ -58,23 +58,12 @@ def screen_grid(problem: EstimateProblem, frequencies_hz, harmonics, samples_per
                 options=None):
     """Stepped solve of the grid [Hz] at H, N (warm start from the previous converged point, a
     failed point retried once cold) → list of HarmonicSolution."""
-    from sarfe.hbm import solve_frequency
-
     H, N = int(harmonics), int(samples_per_period)
     solutions, previous = [], None
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        for f in frequencies_hz:
-            omega = 2 * np.pi * float(f)
-            F = resize_harmonics(problem.excitation, H)
-            s = solve_frequency(problem.model, problem.contacts, F, omega, H, N, initial=previous,
-                                options=options)
-            if not s.converged and previous is not None:
-                retry = solve_frequency(problem.model, problem.contacts, F, omega, H, N,
-                                        options=options)
-                s = retry if retry.converged else s
-            solutions.append(s)
-            previous = s if s.converged else None
+    for f in frequencies_hz:
+        s = _solve(problem, 2 * np.pi * float(f), H, N, previous, options)
+        solutions.append(s)
+        previous = s if s.converged else None
     return solutions
 
 
