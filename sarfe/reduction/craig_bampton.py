@@ -53,12 +53,14 @@ _MODE_BLOCK = 24  # fixed-interface modes requested per Lanczos run when searchi
 _SLICE_COLUMNS = 400
 _SLICE_ENTRIES = 8e7
 # a second process slices the upper part of the spectrum when the modes below the cutoff
-# outnumber what run 0 finds in its capped space (≈ 0.3 modes per column on the door trim); this
-# process (run 0 and the shifted runs up to the split) takes the modes below _LOWER_SHARE·ω_cutoff
-# (door trim 5 mm, 1.8 kHz: 245 of 612 modes, run 0's 125 included; measured 86 s CPU here
-# against the worker's 83 s for the other 367 — run 0's columns cost more than the shifted runs')
+# outnumber what run 0 finds in its capped space (≈ 0.3 modes per column on the door trim). The
+# split is by count: this process (run 0 and the shifted runs up to λ_s) takes N(λ_s) ≈ (N(λ_c) +
+# lead)/2 modes, lead = _RUN0_LEAD_PER_COLUMN · run 0's column cap — run 0 finds its modes (125 at
+# a cap of 400 on the door trim at 5 mm) for the CPU time of ≈ 60 shifted-run modes (12 s against
+# 0.2 s per mode), and the worker spends ≈ 3 s on its PARDISO analysis and counts: lead ≈ 125 − 60
+# + 15 ≈ 0.2 per column (benchmarks/results/linear.md, P1 split)
 _PARALLEL_MODES_PER_COLUMN = 0.5
-_LOWER_SHARE = 0.5
+_RUN0_LEAD_PER_COLUMN = 0.2
 
 
 @dataclass(frozen=True, eq=False)  # array fields: compare explicitly, not with ==
@@ -388,18 +390,20 @@ def _start_upper_slices(k_ii, m_ii, cutoff_hz, cap, workers, held):
         held["factor"] = None     # the worker's copy of K_ii's factor (it has its own shifts)
 
     try:
-        return start_upper_slices(k_ii, m_ii, (2 * np.pi * cutoff_hz) ** 2, _LOWER_SHARE,
+        return start_upper_slices(k_ii, m_ii, (2 * np.pi * cutoff_hz) ** 2,
+                                  _RUN0_LEAD_PER_COLUMN * cap,
                                   int(_PARALLEL_MODES_PER_COLUMN * cap), drop_inherited_factor)
     except OSError:               # no temporary file or no process: one process does it all
         return None
 
 
 def _worker_splits(upper):
-    """Wait for the worker's counts: True when it slices the upper part (else it has exited)."""
+    """Wait for the worker's count below the cutoff: True when it slices the upper part (else it
+    has exited); its split comes later (:meth:`UpperSlices.plan`, after run 0)."""
     from sarfe.reduction.spectrum_slicing import SlicingFailed
 
     try:
-        return upper.plan()[1] is not None
+        return upper.splits()
     except SlicingFailed:
         return False
 

@@ -25,15 +25,18 @@ Every shift's K − σM has the same sparsity pattern: PARDISO's ordering and sy
 once (:func:`sarfe.fe.linear_solvers.shifted_factorizer`), each shift only its numerical LDLᵀ.
 
 Two processes (two usable cores): a chain of runs needs nothing from another chain but a
-certified count at its bottom, so the spectrum is split at λ_s = (share·ω_c)² (N(ω) ≈ a ω
-puts about ``share`` of the modes below it). A worker forked before run 0 counts N(λ_c) and
-N(λ_s) itself and runs the chain over (λ_s, λ_c] from nothing pending, writing its modes to a
-shared-memory file; this process runs run 0 and the chain over (boundary, λ_s], then appends
-the worker's block. Both chains' shifts follow from their intervals and counts alone, so the
-modes do not depend on timing; with one core, no fork, or inside a daemon process (a Dask
-worker) one chain covers it all. All runs use the M inner product; a Ritz pair is
-converged when ‖A φ − θ φ‖_M ≤ tol·|θ| (relative to its own θ: a value next to the shift, with a
-huge θ, must not loosen the test for the others).
+certified count at its bottom, so the spectrum is split at a shift λ_s chosen by count. A worker
+forked before run 0 counts N(λ_c) and tells this process whether it splits; it then places λ_s so
+that N(λ_s) ≈ (N(λ_c) + lead)/2 (:func:`split_count`: this process's run 0 finds its modes at a
+lower cost per mode than the shifted runs, ``lead`` modes ahead) from one or two factorizations
+whose inertia gives exact counts (:func:`split_shift`), and runs the chain over (λ_s, λ_c] from
+nothing pending, writing its modes to a shared-memory file; this process runs run 0 and the
+chain over (boundary, λ_s], then appends the worker's block. The split and both chains' shifts
+follow from the model and the counts alone, so the modes do not depend on timing; with one core,
+no fork, or inside a daemon process (a Dask worker) one chain covers it all.
+
+All runs use the M inner product; a Ritz pair is converged when ‖A φ − θ φ‖_M ≤ tol·|θ| (relative
+to its own θ: a value next to the shift, with a huge θ, must not loosen the test for the others).
 """
 from __future__ import annotations
 
@@ -262,8 +265,12 @@ def sliced_modes(stiffness, mass, cutoff_omega2, found_omega2, found_modes, boun
     process's record). Raises SlicingFailed when a gap's count is not reached.
     """
     record = {"factorizations": 0}
+    split = None
     if upper is not None:
-        total, split, split_count = upper.plan()
+        try:
+            total, split, split_count = upper.plan()
+        except SlicingFailed as exc:      # the worker failed placing the split: one chain here
+            record["upper_failed"] = str(exc)
         upper = upper if split is not None else None
     if factor_at is None:
         factor_at = shifted_factorizer(stiffness, mass, solver=solver)
@@ -314,33 +321,77 @@ def sliced_modes(stiffness, mass, cutoff_omega2, found_omega2, found_modes, boun
     return omega2, modes, record
 
 
+def split_count(total, lead):
+    """The eigenvalue count N(λ_s) this process's part (0, λ_s] should hold for the two processes
+    to finish together: parent cost ≈ run 0 + c·(N(λ_s) − r_0), worker cost ≈ c·(total − N(λ_s))
+    with c the cost per mode of a shifted run; run 0 finds r_0 modes for the cost of r_0 − lead
+    shifted-run modes, hence N(λ_s) = (total + lead)/2, kept inside [1, total − 1]."""
+    return int(min(max(round(0.5 * (total + lead)), 1), total - 1))
+
+
+def split_shift(factor_at, cutoff_omega2, total, wanted, tolerance=0.02):
+    """A shift λ_s ≤ cutoff with N(λ_s) ≈ ``wanted`` (within ``tolerance``·total, else the closer
+    of two tries) and its exact count: (λ_s [rad²/s²], N(λ_s)).
+
+    factor_at(σ): factor of K − σM whose ``negative_pivots`` = N(σ) (Sylvester). First try
+    ω = ω_c·wanted/total (N(ω) ≈ a·ω, a plate's modal count in ω); the second interpolates N(ω)
+    linearly through the points counted so far, (0, 0), (ω_1, N_1), (ω_c, total). Depends on the
+    counts only (never on timing). Two factorizations at most."""
+    omega_c = np.sqrt(cutoff_omega2)
+    omegas, counts = [0.0, omega_c], [0, int(total)]
+    omega = omega_c * wanted / total
+    best = None
+    for attempt in range(2):
+        count = int(factor_at(omega ** 2).negative_pivots)
+        if best is None or abs(count - wanted) < abs(best[1] - wanted):
+            best = (float(omega ** 2), count)
+        if abs(count - wanted) <= tolerance * total:
+            break
+        place = np.searchsorted(counts, count)
+        omegas.insert(place, omega)
+        counts.insert(place, count)
+        omega = float(np.interp(wanted, counts, omegas))
+    return best
+
+
 @dataclass(eq=False)
 class UpperSlices:
     """A forked worker process slicing the upper part of the spectrum (:func:`start_upper_slices`).
 
-    ``plan()`` → (total, lower, counted): the eigenvalue count below the cutoff, and the split
-    λ_s with its count N(λ_s) — or (total, None, None) when the worker found too few modes to
-    be worth a split (it has then exited). ``join()`` → (λ ascending (k,), Φ (n, k) read from
-    the worker's shared file, the worker's record) for (λ_s, cutoff], or raises SlicingFailed."""
+    ``splits()`` → whether the worker slices the upper part: it counted the eigenvalues below the
+    cutoff and found enough to be worth a split (else it has exited). ``plan()`` → (total, lower,
+    counted): that count, and the split λ_s with its count N(λ_s) — or (total, None, None)
+    without a split. ``join()`` → (λ ascending (k,), Φ (n, k) read from the worker's shared file,
+    the worker's record) for (λ_s, cutoff], or raises SlicingFailed."""
 
     process: object
     connection: object
     path: str
     size: int
+    _total: tuple | None = None
     _plan: tuple | None = None
 
+    def _receive(self, kind):
+        try:
+            message = self.connection.recv()
+        except EOFError:
+            message = ("error", "the slicing worker died before its counts")
+        if message[0] != kind:
+            self.cancel()
+            raise SlicingFailed(f"upper slices: {message[1]}")
+        return message[1:]
+
+    def splits(self):
+        if self._total is None:
+            self._total = self._receive("count")     # (total, splitting)
+            if not self._total[1]:
+                self.cancel()
+                self._plan = (self._total[0], None, None)
+        return self._total[1]
+
     def plan(self):
-        if self._plan is None:
-            try:
-                message = self.connection.recv()
-            except EOFError:
-                message = ("error", "the slicing worker died before its counts", None)
-            if message[0] != "plan":
-                self.cancel()
-                raise SlicingFailed(f"upper slices: {message[1]}")
-            self._plan = message[1:]
-            if self._plan[1] is None:
-                self.cancel()
+        if self._plan is None and self.splits():
+            self._plan = (self._total[0], *self._receive("plan"))
         return self._plan
 
     def join(self):
@@ -376,16 +427,16 @@ def _remove(path):
         pass
 
 
-def start_upper_slices(stiffness, mass, cutoff_omega2, lower_share, min_total, on_fork=None,
+def start_upper_slices(stiffness, mass, cutoff_omega2, lead, min_total, on_fork=None,
                        slice_modes=80, max_columns=400):
     """Fork a worker that counts the eigenvalues below the cutoff and, when there are more than
-    ``min_total``, finds every eigenpair in (λ_s, cutoff], λ_s = (lower_share·ω_c)² (this
-    process takes (0, λ_s]). K, M are shared copy-on-write; ``on_fork()`` runs first in the
+    ``min_total``, finds every eigenpair in (λ_s, cutoff], N(λ_s) ≈ (total + ``lead``)/2
+    (:func:`split_count`, :func:`split_shift`; this process takes (0, λ_s]). K, M are shared copy-on-write; ``on_fork()`` runs first in the
     worker to free what it inherited and does not need (the parent's factor of K_ii). The modes
     go to a file in /dev/shm (memory, not disk, on Linux) that :meth:`UpperSlices.join` reads and
     removes. Returns an :class:`UpperSlices`, or None where fork is not available or this
     process is a daemon (a Dask or multiprocessing worker may not have children). The worker's
-    results do not depend on timing: its shifts follow from its interval and counts alone."""
+    results do not depend on timing: the split and its shifts follow from counts alone."""
     import multiprocessing
     import tempfile
 
@@ -398,30 +449,37 @@ def start_upper_slices(stiffness, mass, cutoff_omega2, lower_share, min_total, o
     context = multiprocessing.get_context("fork")
     receive, send = context.Pipe(duplex=False)
     process = context.Process(target=_upper_worker, daemon=True,
-                              args=(send, stiffness, mass, cutoff_omega2, lower_share, min_total,
+                              args=(send, stiffness, mass, cutoff_omega2, lead, min_total,
                                     on_fork, path, slice_modes, max_columns))
     process.start()
     send.close()
     return UpperSlices(process, receive, path, mass.shape[0])
 
 
-def _upper_worker(connection, stiffness, mass, cutoff_omega2, lower_share, min_total, on_fork,
+def _upper_worker(connection, stiffness, mass, cutoff_omega2, lead, min_total, on_fork,
                   path, slice_modes, max_columns):
     """The forked side of :func:`start_upper_slices`: its own PARDISO analysis (the parent's
-    instance is not shared), the two counts, then a chain from (λ_s, N(λ_s)) with nothing
-    pending, each gap's modes appended to ``path`` in ascending order."""
+    instance is not shared), the count below the cutoff (sent at once: this process's run 0
+    waits for it), the split by count (sent when placed: this process needs it after run 0),
+    then a chain from (λ_s, N(λ_s)) with nothing pending, each gap's modes appended to ``path``
+    in ascending order."""
     values = []
     try:
         if on_fork is not None:
             on_fork()
         factor_at = shifted_factorizer(stiffness, mass, solver="pardiso")
-        total = int(factor_at(cutoff_omega2).negative_pivots)
+        counting = {"factorizations": 0}
+
+        def count_at(shift):
+            counting["factorizations"] += 1
+            return factor_at(shift)
+
+        total = int(count_at(cutoff_omega2).negative_pivots)
+        connection.send(("count", total, total > min_total))
         if total <= min_total:
-            connection.send(("plan", total, None, None))
             return
-        lower = (lower_share * np.sqrt(cutoff_omega2)) ** 2
-        counted = int(factor_at(lower).negative_pivots)
-        connection.send(("plan", total, lower, counted))
+        lower, counted = split_shift(count_at, cutoff_omega2, total, split_count(total, lead))
+        connection.send(("plan", lower, counted))
         with open(path, "wb") as out:
             def store(lam, vectors):
                 np.asfortranarray(vectors).T.tofile(out)     # column-major: column after column
@@ -430,7 +488,7 @@ def _upper_worker(connection, stiffness, mass, cutoff_omega2, lower_share, min_t
             start = ChainStart(lower, counted, lower, np.zeros(0), np.zeros((mass.shape[0], 0)))
             record = slice_chain(mass, factor_at, start, cutoff_omega2, total, store, slice_modes,
                                  max_columns)
-        record["factorizations"] += 2                  # the two counts
+        record["factorizations"] += counting["factorizations"]    # the counts
         omega2 = np.concatenate(values) if values else np.zeros(0)
         if len(omega2) != total - counted or np.any(np.diff(omega2) < 0):
             raise SlicingFailed(f"{len(omega2)} modes for a count of {total - counted}")

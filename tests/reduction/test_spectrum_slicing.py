@@ -1,10 +1,12 @@
 """Spectrum slicing in one or two processes against a dense reference (scipy.linalg.eigh).
 
 The model: two copies of the clamped plate, the second 1e-3 stiffer, side by side without
-coupling — every eigenvalue comes as a close pair λ, (1 + 1e-3)·λ. The cutoff is placed so that
-the two-process split λ_s = (share·ω_c)² falls inside one pair: the lower process must deliver
-its lower member, the worker its upper one, certified by the inertia counts at λ_s.
+coupling — every eigenvalue comes as a close pair λ, (1 + 1e-3)·λ. One two-process run has its
+split λ_s placed inside one pair: the lower process must deliver its lower member, the worker its
+upper one, certified by the inertia counts at λ_s. Another places λ_s by count, as a user's run
+does (balancing the two processes).
 """
+import contextlib
 import importlib
 
 import numpy as np
@@ -35,8 +37,8 @@ pytestmark = pytest.mark.skipif("pardiso" not in available_solvers(),
 
 @pytest.fixture(scope="module")
 def twin():
-    """(K, M, boundary, interior, reference ω² of (K_ii, M_ii), cutoff [Hz] with the split inside
-    a close pair)."""
+    """(K, M, boundary, k_ii, m_ii, reference ω² of (K_ii, M_ii), cutoff [Hz] at twice the
+    frequency of a split inside the 120th close pair)."""
     plate = plate_model(12, 8)
     stiffness = sp.block_diag([plate.stiffness, (1 + STIFFER) * plate.stiffness], format="csr")
     mass = sp.block_diag([plate.mass, plate.mass], format="csr")
@@ -47,11 +49,10 @@ def twin():
     k_ii = stiffness[interior][:, interior].toarray()
     m_ii = mass[interior][:, interior].toarray()
     omega2 = sla.eigh(k_ii, m_ii, eigvals_only=True)
-    share = importlib.import_module("sarfe.reduction.craig_bampton")._LOWER_SHARE
-    # the 120th pair: split halfway between its members, cutoff = split / share
+    # the 120th pair: split halfway between its members, cutoff at twice its frequency
     lower = omega2[(omega2 > 0)][2 * 120]
     split = lower * (1 + 0.5 * STIFFER)
-    cutoff_hz = np.sqrt(split) / share / (2 * np.pi)
+    cutoff_hz = 2 * np.sqrt(split) / (2 * np.pi)
     return stiffness, mass, boundary, k_ii, m_ii, omega2, cutoff_hz
 
 
@@ -71,9 +72,25 @@ def reduce(twin, workers):
                          workers=workers)
 
 
+@contextlib.contextmanager
+def split_inside_pair(twin):
+    """The worker's split at the twin fixture's λ_s (halfway inside the 120th close pair) instead
+    of by count; the forked worker inherits the patch."""
+    omega2 = twin[5]
+    split = (2 * np.pi * twin[6] / 2) ** 2
+    slicing = importlib.import_module("sarfe.reduction.spectrum_slicing")
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(slicing, "split_shift",
+                      lambda factor_at, cutoff, total, wanted: (split,
+                                                                int(factor_at(split).negative_pivots)))
+        assert np.count_nonzero(omega2 <= split) % 2 == 1     # inside a pair
+        yield
+
+
 @pytest.fixture(scope="module")
 def two(twin, capped):
-    return reduce(twin, workers=2)
+    with split_inside_pair(twin):
+        return reduce(twin, workers=2)
 
 
 @pytest.fixture(scope="module")
@@ -133,9 +150,55 @@ def test_falls_back_to_one_process(twin, one, capped, monkeypatch):
 
 def test_two_process_runs_give_the_same_modes(twin, two, capped):
     """Deterministic: the worker's shifts follow from its interval and counts, not from timing."""
-    again = reduce(twin, workers=2)
+    with split_inside_pair(twin):
+        again = reduce(twin, workers=2)
     assert again.timings["slicing"]["upper"]["shifts"] == two.timings["slicing"]["upper"]["shifts"]
     np.testing.assert_allclose(again.mode_frequencies_hz, two.mode_frequencies_hz, rtol=1e-13)
+
+
+def test_split_by_count_gives_the_same_modes(twin, one, capped):
+    """As a user's run: the worker places λ_s by count — N(λ_s) within 2 % of the total of the
+    balanced count (N(λ_c) + lead)/2 (lead: run 0's head start for its column cap), exact by
+    the dense reference — and the modes equal the dense reference and the one-process run."""
+    module = importlib.import_module("sarfe.reduction.craig_bampton")
+    slicing = importlib.import_module("sarfe.reduction.spectrum_slicing")
+    reduced = reduce(twin, workers=2)
+    record = reduced.timings["slicing"]
+    assert "upper" in record and "upper_failed" not in record
+    total = reduced.mode_count
+    wanted = slicing.split_count(total, module._RUN0_LEAD_PER_COLUMN * module._SLICE_COLUMNS)
+    assert record["split_count"] == np.count_nonzero(twin[5] < record["split"])
+    assert abs(record["split_count"] - wanted) <= 0.02 * total
+    check_against_dense(reduced, twin)
+    np.testing.assert_allclose(reduced.mode_frequencies_hz, one.mode_frequencies_hz, rtol=1e-12)
+
+
+def test_split_shift_hits_the_wanted_count():
+    """split_shift from real inertia counts (PARDISO LDLᵀ of K − σM of the plate): the count it
+    returns is N(λ_s) of the dense spectrum, within 2 % of the total of the wanted count or the
+    closer of its two tries, with at most two factorizations; the balanced count stays inside."""
+    plate = plate_model(12, 8)
+    k, m = plate.stiffness, plate.mass
+    omega2 = sla.eigh(k.toarray(), m.toarray(), eigvals_only=True)
+    slicing = importlib.import_module("sarfe.reduction.spectrum_slicing")
+    factor_at = shifted_factorizer(k, m, solver="pardiso")
+    calls = []
+
+    def counting(shift):
+        calls.append(shift)
+        return factor_at(shift)
+
+    cutoff = 0.5 * (omega2[299] + omega2[300])            # 300 eigenvalues below
+    for wanted in (60, 150, 240):
+        calls.clear()
+        split, count = slicing.split_shift(counting, cutoff, 300, wanted)
+        assert count == np.count_nonzero(omega2 < split)
+        assert len(calls) <= 2 and split in calls and split < cutoff
+        tries = [np.count_nonzero(omega2 < shift) for shift in calls]
+        assert abs(count - wanted) <= 0.02 * 300 or abs(count - wanted) == min(
+            abs(t - wanted) for t in tries)
+    assert slicing.split_count(300, 80) == 190
+    assert slicing.split_count(10, 80) == 9 and slicing.split_count(10, -80) == 1
 
 
 def test_shifted_factorizer_counts_and_solves():
