@@ -41,6 +41,7 @@ to its own θ: a value next to the shift, with a huge θ, must not loosen the te
 from __future__ import annotations
 
 import os
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -262,7 +263,8 @@ def sliced_modes(stiffness, mass, cutoff_omega2, found_omega2, found_modes, boun
     :func:`shifted_factorizer` and the count below the cutoff when the caller has them. Returns λ (ascending), Φ (Φᵀ M Φ = I) as a list of
     column blocks in that order (no stacked copy of n × n_m), and a record {"shifts", "columns",
     "negative_pivots", "factorizations", "modes_below_cutoff"} (with "upper": the other
-    process's record). Raises SlicingFailed when a gap's count is not reached.
+    process's record, "split", "split_count", and "join_wait_s": wall seconds this process
+    waited for the other's block). Raises SlicingFailed when a gap's count is not reached.
     """
     record = {"factorizations": 0}
     split = None
@@ -302,7 +304,9 @@ def sliced_modes(stiffness, mass, cutoff_omega2, found_omega2, found_modes, boun
     if upper is not None:
         record.update(split=float(split), split_count=int(split_count))
         try:
+            waited = time.perf_counter()
             upper_values, upper_modes, record["upper"] = upper.join()
+            record["join_wait_s"] = time.perf_counter() - waited   # idle here (a clock, not a result)
             values.append(upper_values)
             modes.append(upper_modes)
         except SlicingFailed as exc:      # the worker's part, again in this process
