@@ -219,37 +219,40 @@ def run_p1():
 
 
 def p1_lines(p1):
-    """linear.md's section on the P1 linear stage (one core vs two)."""
+    """linear.md's section on the P1 linear stage (one core vs two; rows 3+ carry a ``note``)."""
     lines = ["", f"## P1 linear stage (issue 15): door trim 5 mm, cutoff {p1[0]['cutoff_hz'] / 1e3:.2f} kHz, one core vs two", "",
              "`sarfe.pipeline.linear.build_linear_model(cases/door_trim_p1.yaml)` in a fresh process "
              "(mesh from the cache), pinned to one core with taskset or free on two; MKL/OpenBLAS one "
              "thread per process. CPU = this process + the slicing worker. Peak memory of the process "
              "tree sampled every 0.1 s: RSS summed (counts pages shared by the two processes twice) "
-             "and PSS summed (shared pages split).", "",
-             "| cores | load avg | wall [s] | CPU [s] (worker) | Craig–Bampton modes [s] wall (CPU) | shifts (this / worker) "
-             "| peak tree RSS [GB] | peak tree PSS [GB] | modes | max rel. frequency difference to one core |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+             "and PSS summed (shared pages split). Modes: below the split (this process: run 0 and its "
+             "chain) / above it (the worker); wait: wall seconds this process idled at the join.", "",
+             "| row | cores | load avg | wall [s] | CPU [s] (worker) | Craig–Bampton modes [s] wall (CPU) | shifts (this / worker) "
+             "| modes (this / worker) | wait [s] | peak tree RSS [GB] | peak tree PSS [GB] | modes | max rel. frequency difference to row 1 |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     reference = np.asarray(p1[0]["frequencies_hz"])
-    for run in p1:
+    for index, run in enumerate(p1, start=1):
         slicing = run["slicing"] or {}
         upper = slicing.get("upper") or {}
         frequencies = np.asarray(run["frequencies_hz"])
         difference = np.abs(frequencies / reference - 1).max() if len(frequencies) == len(reference) else float("nan")
+        split = slicing.get("split_count")
+        share = f"{split} / {run['modes'] - split}" if split is not None else f"{run['modes']} / 0"
+        wait = slicing.get("join_wait_s")
         lines.append(
-            f"| {run['cores']} | {run['load_average']} | {run['wall_s']:.1f} | {run['cpu_s'] + run['children_cpu_s']:.1f} "
+            f"| {index} | {run['cores']} | {run['load_average']} | {run['wall_s']:.1f} | {run['cpu_s'] + run['children_cpu_s']:.1f} "
             f"({run['children_cpu_s']:.1f}) | {run['cb_s']['normal_modes']:.1f} ({run['cb_s']['normal_modes_cpu']:.1f}) "
-            f"| {len(slicing.get('shifts', []))} / {len(upper.get('shifts', []))} "
+            f"| {len(slicing.get('shifts', []))} / {len(upper.get('shifts', []))} | {share} "
+            f"| {'—' if wait is None else f'{wait:.1f}'} "
             f"| {run['peak_tree_rss_gb']:.2f} | {run['peak_tree_pss_gb']:.2f} | {run['modes']} | {difference:.1e} |")
     one, two = p1[0], p1[1]
-    critical = two["cpu_s"]            # this process's CPU: the worker runs beside it
-    lines += ["", f"What changed (issue 15, eigfast): the spectrum is sliced by two processes when two "
-              f"cores are usable. Wall {one['wall_s']:.0f} s on one core → {two['wall_s']:.0f} s on two "
-              f"(load {one['load_average']} / {two['load_average']}); CPU of this process {one['cpu_s']:.0f} → "
-              f"{critical:.0f} s, the worker's {two['children_cpu_s']:.0f} s beside it. Wall exceeds this "
-              "process's CPU by the time it waits for the worker's block: the split (half the cutoff "
-              "frequency) leaves the worker the larger share, so the gain in wall is the smaller of the "
-              "two figures. The earlier tables (60 modes, no slicing) are unchanged code paths and "
-              "still hold."]
+    lines += ["", f"Two processes (rows 1, 2): the worker counts N(λ_c) and places the split by count, "
+              f"N(λ_s) ≈ (N(λ_c) + lead)/2 with lead = 0.2 per column of run 0's cap (run 0's head start: it "
+              f"finds its modes cheaper than the shifted runs), from one or two inertia counts. Wall "
+              f"{one['wall_s']:.0f} s on one core → {two['wall_s']:.0f} s on two (load {one['load_average']} / "
+              f"{two['load_average']}); CPU of this process {one['cpu_s']:.0f} → {two['cpu_s']:.0f} s, the "
+              f"worker's {two['children_cpu_s']:.0f} s beside it. The earlier tables (60 modes, no slicing) "
+              "are unchanged code paths and still hold."]
     for index, run in enumerate(p1[2:], start=3):
         lines += ["", f"Row {index}: {run.get('note', 'a rerun')} (load {run['load_average']}): wall "
                   f"{run['wall_s']:.0f} s, CPU {run['cpu_s']:.0f} s here + {run['children_cpu_s']:.0f} s in the "
@@ -257,14 +260,15 @@ def p1_lines(p1):
     return lines
 
 
-def profile_lines(profile):
+def profile_lines(profile, title="Where the P1 fixed-interface modes' time goes (instrumented, one process)"):
     """linear.md's breakdown of the P1 Craig–Bampton modes by operation: ``profile`` (stored in
     linear.json under "p1_profile" by an instrumented run — wrappers timing each call of the
-    named functions, one process, cutoff 1.8 kHz) holds {"note", "runs": {label: {item: [calls,
-    CPU s, columns]}}}."""
+    named functions, one process, cutoff 1.8 kHz — and under "p1_split_profile" for the two
+    processes before and after the split by count) holds {"note", "runs": {label: {item:
+    [calls, CPU s, columns]}}}."""
     runs = profile["runs"]
     items = list(dict.fromkeys(k for run in runs.values() for k in run))
-    lines = ["", "### Where the P1 fixed-interface modes' time goes (instrumented, one process)", "",
+    lines = ["", f"### {title}", "",
              profile["note"], "",
              "| item | " + " | ".join(f"{label}: calls, CPU [s]" for label in runs) + " |",
              "|---|" + "---|" * len(runs)]
@@ -410,15 +414,20 @@ def write_report(cases, quick, p1=None):
                      f"{c['linear_total_s'] / max(c['linear_total_cpu_s'], 1e-9):.1f}× the CPU time.")
     previous = _stored()
     profile = previous.get("p1_profile") if isinstance(previous, dict) else None
+    split_profile = previous.get("p1_split_profile") if isinstance(previous, dict) else None
     if p1 is None and isinstance(previous, dict):
         p1 = previous.get("p1")
     if p1:
         lines += p1_lines(p1)
+    if split_profile:
+        lines += profile_lines(split_profile, "The two-process split, per process (instrumented, "
+                                              "before and after the split by count)")
     if profile:
         lines += profile_lines(profile)
     (HERE / "results").mkdir(exist_ok=True)
     (HERE / "results" / "linear.md").write_text("\n".join(lines) + "\n")
-    data = {"cases": cases, "p1": p1, "p1_profile": profile} if p1 or profile else cases
+    data = {"cases": cases, "p1": p1, "p1_profile": profile, "p1_split_profile": split_profile} \
+        if p1 or profile or split_profile else cases
     (HERE / "results" / "linear.json").write_text(json.dumps(data, indent=1, default=float) + "\n")
     print("\n".join(lines))
 
