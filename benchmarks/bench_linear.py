@@ -251,8 +251,12 @@ def p1_lines(p1):
               f"finds its modes cheaper than the shifted runs), from one or two inertia counts. Wall "
               f"{one['wall_s']:.0f} s on one core → {two['wall_s']:.0f} s on two (load {one['load_average']} / "
               f"{two['load_average']}); CPU of this process {one['cpu_s']:.0f} → {two['cpu_s']:.0f} s, the "
-              f"worker's {two['children_cpu_s']:.0f} s beside it. The earlier tables (60 modes, no slicing) "
-              "are unchanged code paths and still hold."]
+              f"worker's {two['children_cpu_s']:.0f} s beside it; this process idled "
+              f"{(two['slicing'] or {}).get('join_wait_s', float('nan')):.1f} s at the join. Peak tree PSS "
+              f"{two['peak_tree_pss_gb']:.2f} GB (budget 4 GB: both processes hold a full Krylov store and "
+              "a factor of K − σM at once). Rows measured on a shared machine: compare CPU seconds and "
+              "rows run one after the other. The earlier tables (60 modes, no slicing) are unchanged "
+              "code paths and still hold."]
     for index, run in enumerate(p1[2:], start=3):
         lines += ["", f"Row {index}: {run.get('note', 'a rerun')} (load {run['load_average']}): wall "
                   f"{run['wall_s']:.0f} s, CPU {run['cpu_s']:.0f} s here + {run['children_cpu_s']:.0f} s in the "
