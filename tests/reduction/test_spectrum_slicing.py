@@ -173,6 +173,21 @@ def test_split_by_count_gives_the_same_modes(twin, one, capped):
     np.testing.assert_allclose(reduced.mode_frequencies_hz, one.mode_frequencies_hz, rtol=1e-12)
 
 
+def test_worker_failing_at_its_split_leaves_one_chain(twin, one, capped, monkeypatch):
+    """The worker sends its count, then fails placing the split: this process (run 0 already
+    done with the worker's count) slices the whole spectrum itself, with the same modes."""
+    slicing = importlib.import_module("sarfe.reduction.spectrum_slicing")
+
+    def broken(*args):
+        raise RuntimeError("no split")
+
+    monkeypatch.setattr(slicing, "split_shift", broken)          # inherited by the fork
+    reduced = reduce(twin, workers=2)
+    record = reduced.timings["slicing"]
+    assert "upper" not in record and "no split" in record["upper_failed"]
+    np.testing.assert_allclose(reduced.mode_frequencies_hz, one.mode_frequencies_hz, rtol=1e-12)
+
+
 def test_split_shift_hits_the_wanted_count():
     """split_shift from real inertia counts (PARDISO LDLᵀ of K − σM of the plate): the count it
     returns is N(λ_s) of the dense spectrum, within 2 % of the total of the wanted count or the
