@@ -5,7 +5,9 @@ Contact screening (a cheap linear pass). At every ω of a grid over the sweep, t
 linear model with each contact linearized at u = 0 (what :func:`sarfe.hbm.solve.linearized_guess`
 solves: each law's linearization — preloaded contacts as their springs with their preload, open ones
 absent, tangent elements stuck)
-gives the relative normal motion w(θ) of every contact. With the gap g and a margin m ∈ (0, 1):
+gives the relative normal motion w(θ) of every contact — read on the contact rows only
+(:func:`contact_row_responses`: the model's modal compliance G Z_k⁻¹ Gᵀ with the linearized contacts
+as a Woodbury update, no solve of model size per ω). With the gap g and a margin m ∈ (0, 1):
 
 - ``open``   (g > 0):  max_{ω,θ} w ≤ (1 − m) g      — never closes: λ ≡ 0, drop the contact;
 - ``closed`` (g < 0, a law that is ``linear_when_closed``, e.g. rattle): min_{ω,θ} (w − g) ≥
@@ -199,7 +201,7 @@ def _solve_or_nan(A, b):
         return np.full(b.shape, np.nan, dtype=np.result_type(A, b))
 
 
-def contact_row_responses(model, contacts, excitation, omegas) -> np.ndarray:
+def contact_row_responses(model, contacts, excitation, omegas, modal=True) -> np.ndarray:
     r"""r̃ = G ũ (n_ω, 2H+1, n_rows) [m] of the linearized model (:func:`linear_responses`) at each
     ω of ``omegas`` [rad/s], at the rows of G only.
 
@@ -216,7 +218,7 @@ def contact_row_responses(model, contacts, excitation, omegas) -> np.ndarray:
     approximation. Other models (sparse, non-modal damping, singular K) and any ω at which a Z_k is
     singular: :func:`linear_responses` there; so are fewer than MODAL_SCREEN_MIN_SOLVES (ω, order)
     pairs (a few listed frequencies: a handful of solves costs less than the basis, and the model's
-    cache is left as the points find it).
+    cache is left as the points find it), and ``modal`` False (the direct solves: a reference).
     """
     from sarfe.hbm.modal import cached_modal_basis
 
@@ -224,7 +226,7 @@ def contact_row_responses(model, contacts, excitation, omegas) -> np.ndarray:
     omegas = np.atleast_1d(np.asarray(omegas, dtype=float))
     G = contacts.gap_map
     basis = None
-    if omegas.size * ((F.shape[0] - 1) // 2) >= MODAL_SCREEN_MIN_SOLVES:
+    if modal and omegas.size * ((F.shape[0] - 1) // 2) >= MODAL_SCREEN_MIN_SOLVES:
         # from the model's second request on its basis is computed once and cached on the model
         # (:func:`sarfe.hbm.modal.cached_modal_basis`): the sweep that follows reuses it
         basis = cached_modal_basis(model) or cached_modal_basis(model)
@@ -239,12 +241,14 @@ def contact_row_responses(model, contacts, excitation, omegas) -> np.ndarray:
     return R
 
 
-def screen_contacts(model, contacts, excitation, omegas, margin=0.5, samples=64) -> tuple:
+def screen_contacts(model, contacts, excitation, omegas, margin=0.5, samples=64,
+                    modal=True) -> tuple:
     """Decisions (one :class:`ContactDecision` per contact) from the linear pass over ``omegas``.
 
     excitation f̃_e (2H+1, n) [N]; omegas [rad/s] — include the resonances in the band (a grid of a
     few hundred points, or the grid plus the linear natural frequencies); margin m (module docstring).
-    The pass reads the contact rows only (:func:`contact_row_responses`).
+    The pass reads the contact rows only (:func:`contact_row_responses`; ``modal`` False: its
+    direct solves of model size).
     """
     from sarfe.hbm.harmonics import time_samples
     from sarfe.hbm.laws import pruning_rules
@@ -257,7 +261,7 @@ def screen_contacts(model, contacts, excitation, omegas, margin=0.5, samples=64)
     c = contacts
     has = c.normal_row >= 0
     normal = np.where(has, c.normal_row, 0)
-    R = contact_row_responses(model, c, F, omegas)[:, :, normal]     # (n_ω, 2h+1, n_c)
+    R = contact_row_responses(model, c, F, omegas, modal)[:, :, normal]   # (n_ω, 2h+1, n_c)
     w = time_samples(np.moveaxis(R, 0, 1), samples)                  # (samples, n_ω, n_c)
     w_max = np.where(has, w.max(axis=(0, 1)), -np.inf)
     w_min = np.where(has, w.min(axis=(0, 1)), np.inf)
