@@ -125,7 +125,8 @@ def linear_responses(model, contacts, excitation, omegas):
         yield U
 
 
-# bound on the (frequencies × rows × modes) complex intermediate of one block of frequencies
+# bound on the (frequencies × rows × modes) and (frequencies × rows × rows) complex arrays of one
+# block of frequencies
 _BLOCK_ENTRIES = 4_000_000
 # the screen takes the modal path from this many (ω, order) solves on: the modal basis of the door
 # trim's reduced model (613 DOFs) costs as much as ≈ 6 complex solves of it (80 ms vs 13 ms each)
@@ -160,7 +161,7 @@ def _modal_row_responses(basis, contacts, excitation, omegas):
     if h == 0:
         return R, bad
     k = np.arange(1, h + 1)
-    block = max(1, _BLOCK_ENTRIES // max(1, h * n_rows * gap_modes.shape[1]))
+    block = max(1, _BLOCK_ENTRIES // max(1, h * n_rows * max(n_rows, gap_modes.shape[1])))
     for start in range(0, omegas.size, block):
         w = omegas[start:start + block]
         kw = (w[:, None] * k[None, :]).ravel()                      # (b h,): a_kj depends on kω

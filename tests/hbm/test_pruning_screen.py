@@ -108,3 +108,13 @@ def test_few_frequencies_leave_the_model_cache_alone(monkeypatch):
     monkeypatch.setattr(modal, "cached_modal_basis", lambda model: calls.append(model))
     decisions = screen_contacts(p.model, contacts, p.excitation, [60.0, 90.0])
     assert not calls and len(decisions) == contacts.count
+
+
+def test_frequency_blocks_do_not_change_the_rows(monkeypatch):
+    """The frequencies are processed in blocks bounded in memory; one ω per block gives the same."""
+    p, contacts = mixed_contacts()
+    omegas = np.linspace(50.0, 300.0, 30)
+    whole = contact_row_responses(p.model, contacts, p.excitation, omegas)
+    monkeypatch.setattr(pruning, "_BLOCK_ENTRIES", 1)
+    np.testing.assert_allclose(contact_row_responses(p.model, contacts, p.excitation, omegas),
+                               whole, rtol=1e-13, atol=1e-13 * np.abs(whole).max())
