@@ -70,16 +70,25 @@ def write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, d
                 translations[j] = u
             return u
 
+        loudest_data = {}
+
         def point_data(j):
+            if j in loudest_data:     # the loudest point's arrays serve its map and the report's
+                return loudest_data[j]
             force, motion = contact_pair_fields(stage, nl, solutions[j], mesh.n_nodes)
-            return outputs.erp_point_data(mesh.n_nodes, erps[j], normal_w[j],
+            data = outputs.erp_point_data(mesh.n_nodes, erps[j], normal_w[j],
                                           float(solutions[j].omega),
                                           displacement=nodal_translations(j),
                                           radiating_nodes=stage.erp_nodes,
                                           contact_marker=markers, contact_force=force,
                                           contact_displacement=motion,
                                           node_ids=getattr(stage, "node_ids", None))
+            if j == loudest:
+                loudest_data[j] = data
+            return data
 
+        if loudest is not None and ("erp_vtu" in files or "report" in files):
+            point_data(loudest)       # before the VTU workers fork: they inherit it
         if "erp_vtu" in files:
             frequencies = [float(s.omega) / (2 * np.pi) for s in solutions]
             if len(solutions) == 1:
@@ -88,8 +97,8 @@ def write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, d
                 written["erp_vtu"] = "erp.vtu"
             else:
                 outputs.write_erp_sweep(directory / "erp", mesh.points, mesh.triangles,
-                                        (point_data(j) for j in range(len(solutions))),
-                                        frequencies)
+                                        point_data, frequencies,
+                                        workers=map_workers(config, mesh, len(solutions)))
                 written["erp_vtu"] = "erp/erp.pvd"
         if "animation" in files and loudest is not None:
             outputs.write_deflection_animation(directory / "animation", mesh.points,
@@ -114,6 +123,19 @@ def write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, d
         written["report"] = "report.html"
     shutil.rmtree(directory / ".report-figures", ignore_errors=True)
     return written
+
+
+# the ERP maps of a sweep are written on the run's worker processes (solver.workers) when the
+# series holds at least this many point values (points × mesh nodes; ≈ 20 ms per 35k-node map,
+# forking the workers costs ≈ 0.1 s: below this the maps are written in the solving process)
+PARALLEL_MAP_VALUES = 2e6
+
+
+def map_workers(config, mesh, n_maps) -> int:
+    """Processes that write a sweep's ERP maps: the run's point workers for a large series."""
+    from sarfe.pipeline.point_workers import point_workers
+
+    return point_workers(config.solver) if n_maps * mesh.n_nodes >= PARALLEL_MAP_VALUES else 1
 
 
 # full-field recovery u = T q of every sweep point for the VTU maps up to this many multiply-adds

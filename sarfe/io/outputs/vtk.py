@@ -151,9 +151,9 @@ def write_erp_vtu(path, points, triangles, point_data: dict, field_data: dict | 
         if arr.dtype.kind == "b":
             arr = arr.astype(np.int8)
         elif arr.dtype.kind in "iu":
-            arr = arr.astype(np.int32)
+            arr = np.asarray(arr, dtype=np.int32)           # (no copy when already int32)
         else:
-            arr = arr.astype(np.float64)
+            arr = np.asarray(arr, dtype=np.float64)         # (no copy when already float)
             bad = ~np.isfinite(arr)
             if np.any(bad):  # e.g. a point that did not converge: keep the run's files readable
                 warnings.warn(f"point_data[{name!r}]: {int(bad.sum())} non-finite values written as 0",
@@ -264,26 +264,44 @@ def erp_point_data(n_points: int, erp, normal_displacement, omega: float, displa
 
 
 def write_erp_sweep(directory, points, triangles, point_data_per_frequency, frequencies_hz,
-                    basename: str = "erp") -> Path:
+                    basename: str = "erp", workers: int = 1) -> Path:
     """One VTU per frequency point (``<basename>_0000.vtu`` …, in sweep order) plus
     ``<basename>.pvd``. Each VTU carries field data ``frequency_hz`` and ``point_index``.
+
+    ``point_data_per_frequency``: the point data of each frequency — a sequence of dicts, or a
+    function j → dict called when file j is written (so the arrays of all points never coexist).
+    ``workers`` > 1 writes the files on that many processes forked from this one
+    (:func:`sarfe.workers.map_points`; the function's inputs are shared, each worker builds and
+    writes whole files, nothing but None comes back): the same files, each written once.
 
     The PVD "time" is the frequency [Hz] when all frequencies differ; a continuation that turns
     back through a fold visits a frequency more than once, and then the time is the point index
     0, 1, … (ParaView sorts and merges equal times). Returns the PVD path.
     """
+    from sarfe.workers import map_points
+
     directory = Path(directory)
     frequencies = np.asarray(frequencies_hz, dtype=float)
-    data = list(point_data_per_frequency)
-    if len(data) != frequencies.size:
-        raise ValueError(f"{len(data)} point-data sets for {frequencies.size} frequencies")
+    if callable(point_data_per_frequency):
+        data_of = point_data_per_frequency
+    else:
+        data = list(point_data_per_frequency)
+        if len(data) != frequencies.size:
+            raise ValueError(f"{len(data)} point-data sets for {frequencies.size} frequencies")
+        data_of = data.__getitem__
+    names = [f"{basename}_{j:04d}.vtu" for j in range(frequencies.size)]
+
+    def write(j):
+        write_erp_vtu(directory / names[j], points, triangles, data_of(j),
+                      field_data={"frequency_hz": float(frequencies[j]), "point_index": j})
+
+    import pyvista  # noqa: F401  (imported here once, inherited by forked workers)
+    import vtkmodules.vtkIOXML  # noqa: F401
+
+    directory.mkdir(parents=True, exist_ok=True)
+    map_points(write, range(frequencies.size), workers)
     unique = np.unique(frequencies).size == frequencies.size
-    entries = []
-    for j, (f, values) in enumerate(zip(frequencies, data)):
-        name = f"{basename}_{j:04d}.vtu"
-        write_erp_vtu(directory / name, points, triangles, values,
-                      field_data={"frequency_hz": float(f), "point_index": j})
-        entries.append((f if unique else j, name))
+    entries = [(f if unique else j, name) for j, (f, name) in enumerate(zip(frequencies, names))]
     return write_pvd(directory / f"{basename}.pvd", entries)
 
 
