@@ -2,9 +2,12 @@ r"""ParaView files: ERP maps (VTU), collections (PVD) and operating-deflection a
 
 All VTU files are unstructured grids of the surface triangles with undeformed point coordinates
 [m], point data and a little field data (VTK's XML writer: appended raw binary, LZ4-compressed —
-20× faster to write than base64 + zlib at ~10 % more bytes; a 5 mm door-trim map of 34k points
-and 22 arrays takes 0.07 s instead of 1.4 s; ParaView, VTK and pyvista read it). PVD files are plain XML
-collections of VTU files referenced by *relative* file names, so a result directory can be moved.
+20× faster to write than base64 + zlib at ~10 % more bytes; ParaView, VTK and pyvista read it,
+meshio 5 does not know the LZ4 compressor). A 5 mm door-trim map (34k points, 22 arrays, H = 15)
+costs ≈ 10 ms for its arrays and ≈ 10 ms to write (benchmarks/results/outputs.md); a sweep's
+series is built map by map, on worker processes when it is large (:func:`write_erp_sweep`).
+PVD files are plain XML collections of VTU files referenced by *relative* file names, so a result
+directory can be moved.
 
 Standard ERP point arrays (:func:`erp_point_data`), n = number of mesh points:
 
