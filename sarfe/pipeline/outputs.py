@@ -16,7 +16,24 @@ def write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, d
     {file kind: file name}. ``config``: the case's :class:`sarfe.io.config.CaseConfig`.
     Everything "at the loudest point" (spectrum, contact plots, animation,
     report maps) uses ``summary["worst"]["index"]`` (:func:`sarfe.pipeline.postprocess.loudest_point`).
-    summary.json itself is written by the caller, last (it lists these files and the timings)."""
+    summary.json itself is written by the caller, last (it lists these files and the timings).
+    The report's surface renders run in a child process from the moment the loudest point's
+    arrays exist until the report is written (the ERP maps, animation and PNGs are written
+    meanwhile); it is stopped if a writer fails."""
+    renders = []
+    try:
+        return _write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w,
+                              directory, renders)
+    except BaseException:
+        from sarfe.io.outputs.render import cancel_render
+
+        for run in renders:
+            cancel_render(run)
+        raise
+
+
+def _write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, directory,
+                   started_renders):
     from sarfe.io import outputs
 
     files = config.output.files
@@ -39,15 +56,7 @@ def write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, d
             attributes={"case": config.name, "linear_model_key": stage.key})
         written["response"] = "response.h5"
     loudest = (summary.get("worst") or {}).get("index")
-    images = {}
-    if "plots" in files or "report" in files:
-        from sarfe.pipeline.figures import point_figures
-
-        plot_dir = directory if "plots" in files else directory / ".report-figures"
-        images = point_figures(config, stage, nl, summary, solutions, erps, plot_dir, loudest)
-        if "plots" in files:
-            written["plots"] = ", ".join(sorted(Path(v).name for v in images.values()))
-    maps = {}
+    maps, renders = {}, None
     if stage.kind == "fe" and ("erp_vtu" in files or "animation" in files or "report" in files):
         from sarfe.reduction.recovery import recover_displacement
 
@@ -89,6 +98,17 @@ def write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, d
 
         if loudest is not None and ("erp_vtu" in files or "report" in files):
             point_data(loudest)       # before the VTU workers fork: they inherit it
+        if "report" in files and loudest is not None:
+            from sarfe.pipeline.figures import start_surface_maps
+
+            # the report's renders run in their child process while the other files are written
+            renders = start_surface_maps(config, mesh, point_data(loudest),
+                                         nodal_translations(loudest), summary["points"][loudest],
+                                         directory / ".report-figures",
+                                         contact_nodes={name: int(g.nodes_a[0])
+                                                        for name, g in stage.contacts.items()
+                                                        if len(g.nodes_a)})
+            started_renders.append(renders)
         if "erp_vtu" in files:
             frequencies = [float(s.omega) / (2 * np.pi) for s in solutions]
             if len(solutions) == 1:
@@ -109,14 +129,18 @@ def write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, d
                                                    if getattr(stage, "node_ids", None) is not None
                                                    else {}))
             written["animation"] = "animation/deflection.pvd"
-        if "report" in files and loudest is not None:
-            from sarfe.pipeline.figures import surface_maps
+    images = {}
+    if "plots" in files or "report" in files:
+        from sarfe.pipeline.figures import point_figures
 
-            maps = surface_maps(config, mesh, point_data(loudest), nodal_translations(loudest),
-                                summary["points"][loudest], directory / ".report-figures",
-                                contact_nodes={name: int(g.nodes_a[0])
-                                               for name, g in stage.contacts.items()
-                                               if len(g.nodes_a)})
+        plot_dir = directory if "plots" in files else directory / ".report-figures"
+        images = point_figures(config, stage, nl, summary, solutions, erps, plot_dir, loudest)
+        if "plots" in files:
+            written["plots"] = ", ".join(sorted(Path(v).name for v in images.values()))
+    if renders is not None:
+        from sarfe.pipeline.figures import finish_surface_maps
+
+        maps = finish_surface_maps(renders)
     if "report" in files:
         notes = {"renderer": maps.pop("renderer", None)}
         outputs.write_report_html(directory / "report.html", summary, {**images, **maps}, notes)
