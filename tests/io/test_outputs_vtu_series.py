@@ -71,6 +71,7 @@ def test_excursion_equals_dense_sampling_across_blocks():
     W[0], W[3], W[4] = 7.0, [3.0, 0.0, 1.0, 0.0], [4.0, 2.0, 0.0, 0.0]
     np.testing.assert_allclose(excursion_amplitude(W, 4096)[:3], [5.0, 2.0, 1.0], rtol=1e-6)
     assert excursion_amplitude(W, 64)[3] == 0.0
+    np.testing.assert_array_equal(excursion_amplitude(np.ones((1, 4, 3)), 64), np.zeros((4, 3)))
 
 
 def _lumped_power(vtu):

@@ -104,6 +104,8 @@ def excursion_amplitude(harmonics, n_samples: int) -> np.ndarray:
     """
     U = np.asarray(harmonics, dtype=float)
     H = (U.shape[0] - 1) // 2
+    if H == 0:                                            # a constant: no excursion
+        return np.zeros(U.shape[1:])
     theta = 2.0 * np.pi * np.arange(int(n_samples)) / int(n_samples)
     k = np.arange(1, H + 1)
     phi = np.empty((theta.size, 2 * H))
