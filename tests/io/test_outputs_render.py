@@ -59,3 +59,36 @@ def test_cancel_stops_the_child_and_removes_its_data(tmp_path, monkeypatch):
     assert time.monotonic() - clock < 10
     assert run.process.poll() is not None
     assert not list(tmp_path.glob(".render-*"))
+
+
+def test_a_failing_writer_stops_the_report_render(tmp_path, monkeypatch):
+    """write_outputs starts the render before the ERP maps; when a later writer raises, the child
+    is stopped and its data removed, and the error reaches the caller."""
+    from pathlib import Path
+
+    import sarfe.pipeline.outputs as pipeline_outputs
+    from sarfe.pipeline import load_case, solve_case
+
+    started = []
+    start = render.start_render
+
+    def recording_start(jobs, use_pyvista=True):
+        started.append(start(jobs, use_pyvista=use_pyvista))
+        return started[-1]
+
+    def failing_map_workers(*args):
+        raise RuntimeError("disk full (test)")
+
+    monkeypatch.setattr(render, "start_render", recording_start)
+    monkeypatch.setattr(pipeline_outputs, "map_workers", failing_map_workers)
+    data = load_case(Path(__file__).resolve().parents[2] / "cases" / "rattle_rig.yaml").data
+    data["model"]["fe"]["generator"]["mesh_size_m"] = 0.02
+    data["excitation"].pop("sweep")
+    data["excitation"]["frequency_hz"] = [31.0, 26.0]
+    data["solver"].update(error_estimate=False, stability=False, workers=1)
+    data["output"]["files"] = ["summary", "erp_vtu", "report"]
+    with pytest.raises(RuntimeError, match="disk full"):
+        solve_case(data, output_dir=tmp_path / "run")
+    assert len(started) == 1
+    assert started[0].process.poll() is not None
+    assert not any(path.exists() for path in started[0].data)
