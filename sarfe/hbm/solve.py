@@ -286,7 +286,7 @@ def stability(problem, omega, U, ev, options):
     method = stability_method(problem, options)
     if method == "contact_rows":
         result = contact_row_stability(problem.model, problem.contacts, omega, problem.harmonics,
-                                       ev.forces, operator)
+                                       ev.forces, operator, tolerance=options.stability_tolerance)
         if result is not None:
             return result
         method = "condensed"     # some exponent near or right of the axis: locate them (Ritz)
