@@ -379,7 +379,16 @@ def real_zero(log_det, lower, upper, rounds=4, width=16):
 
 def contact_row_stability(model, contacts, omega, harmonics, forces, operator=None,
                           uncertain_band=1e-4, tolerance=1e-6):
-    """StabilityResult when the contact-row count decides it, else None.
+    """StabilityResult when the contact-row count decides it, else None (see
+    :func:`contact_row_count`, which also returns the count)."""
+    return contact_row_count(model, contacts, omega, harmonics, forces, operator, uncertain_band,
+                             tolerance)[0]
+
+
+def contact_row_count(model, contacts, omega, harmonics, forces, operator=None,
+                      uncertain_band=1e-4, tolerance=1e-6):
+    """(StabilityResult or None, zeros): zeros = the number of Floquet exponents right of −ε
+    (None where the count did not close). The result when the count decides it, else None.
 
     No zero of det F right of −ε: stable (for every stability tolerance ≥ 0 of the full method).
     Exactly one: it is real (zeros off the real axis come in conjugate pairs) and it is the leading
@@ -398,19 +407,19 @@ def contact_row_stability(model, contacts, omega, harmonics, forces, operator=No
 
     basis = cached_modal_basis(model) or cached_modal_basis(model)
     if basis is None or model.dof_count == 0:
-        return None
+        return None, None
     omega, H = abs(float(omega)), int(harmonics)
     epsilon = uncertain_band * omega
     structure = structural_exponents(basis.flexibility, basis.damping)
     least_damped = float(structure.real.max())
     if not least_damped < -2.0 * epsilon:       # a pole on or right of the contour
-        return None
+        return None, None
     n_rows = contacts.row_count
     J = jacobian_matrix(forces.blocks, n_rows, H)
     Jd = jacobian_matrix(forces.damping_blocks, n_rows, H) if forces.damping_blocks else None
     det = ContactRowDeterminant(basis, contacts.gap_map, omega, H, J, Jd, operator)
     if det.loaded.size == 0:
-        return StabilityResult(True, least_damped, "", structure)
+        return StabilityResult(True, least_damped, "", structure), 0
     # ‖𝒥(s)‖₂ for Re s ≥ 0: twice its largest value at s = 0, ω, 10ω (the memory factors e^{−shd}
     # have modulus ≤ 1 there; the pointwise part does not depend on s), each bounded above by the
     # Frobenius norm (‖·‖₂ ≤ ‖·‖_F: X only grows, the contour still encloses every exponent)
@@ -419,15 +428,17 @@ def contact_row_stability(model, contacts, omega, harmonics, forces, operator=No
     X = exponent_bound(basis, det.gap_modes, omega, H, jacobian_norm, damping_norm)
     contour = _upper_contour(epsilon, X, 0.505 * omega, -least_damped)
     count, _ = winding_count(det.log_determinants, contour)
-    if not np.isfinite(count) or abs(count - round(count)) > 0.1 or round(count) > 1:
-        return None
-    if round(count) == 0:
-        return StabilityResult(True, least_damped, "", structure)
-    lead = real_zero(det.log_determinants, -epsilon, X)
+    if not np.isfinite(count) or abs(count - round(count)) > 0.1:
+        return None, None
+    zeros = int(round(count))
+    if zeros == 0:
+        return StabilityResult(True, least_damped, "", structure), 0
+    lead = real_zero(det.log_determinants, -epsilon, X) if zeros == 1 else None
     if lead is None:
-        return None
+        return None, zeros
     exponents = np.append(lead, structure)
     if abs(lead) <= epsilon:
         return StabilityResult(None, lead, f"leading Floquet exponent {lead:.3g} 1/s within "
-                               f"±{uncertain_band:g}·ω of 0 (near a fold or bifurcation)", exponents)
-    return StabilityResult(bool(lead <= tolerance * omega), lead, "", exponents)
+                               f"±{uncertain_band:g}·ω of 0 (near a fold or bifurcation)",
+                               exponents), 1
+    return StabilityResult(bool(lead <= tolerance * omega), lead, "", exponents), 1

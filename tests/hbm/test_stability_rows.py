@@ -174,3 +174,28 @@ def test_shipped_cases_rows_equal_full(name):
         full, rows, _, _ = full_and_rows(nl.model, nl.contacts, F, s)
         if rows is not None:            # None: handed over to the Ritz method
             assert rows.stable is full.stable, (f, full, rows)
+
+
+def test_a_ritz_verdict_that_contradicts_the_count_is_reported_uncertain(sweep03, monkeypatch):
+    """Where the count hands over with exponents right of −ε, a Ritz basis that misses them
+    (here: stubbed to say 'stable') cannot turn the point stable: the verdict is None and the note
+    names the count. Points of the NLvib 03 middle branch with two or more such exponents."""
+    import sarfe.hbm.solve as solve_module
+    from sarfe.hbm.stability import StabilityResult
+    from sarfe.hbm.stability_rows import contact_row_count
+
+    model, contacts, F, sols = sweep03
+    stub = StabilityResult(True, -1.0, "", np.array([-1.0 + 0j]))
+    monkeypatch.setattr(solve_module, "condensed_stability", lambda *a, **k: stub)
+    checked = 0
+    for s in sols:
+        full, ev, op = full_hill(model, contacts, F, s)
+        result, zeros = contact_row_count(model, contacts, s.omega, s.harmonics, ev.forces, op)
+        if result is not None or not zeros:
+            continue
+        problem = Problem(model, contacts, F, s.harmonics, s.samples_per_period)
+        verdict = solve_module.stability(problem, s.omega, s.displacement, ev,
+                                         SolverOptions(stability_method="contact_rows"))
+        assert verdict.stable is None and f"finds {zeros} Floquet" in verdict.note
+        checked += 1
+    assert checked >= 1
