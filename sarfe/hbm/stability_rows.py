@@ -403,7 +403,7 @@ def contact_row_count(model, contacts, omega, harmonics, forces, operator=None,
     forces: the AFT :class:`ContactForces` of the orbit (all harmonic rows, blocks computed);
     operator: the :class:`ContactOperator` (friction memory) or None. See the module docstring.
     """
-    from .stability import StabilityResult
+    from .stability import StabilityResult, verdict
 
     basis = cached_modal_basis(model) or cached_modal_basis(model)
     if basis is None or model.dof_count == 0:
@@ -436,9 +436,4 @@ def contact_row_count(model, contacts, omega, harmonics, forces, operator=None,
     lead = real_zero(det.log_determinants, -epsilon, X) if zeros == 1 else None
     if lead is None:
         return None, zeros
-    exponents = np.append(lead, structure)
-    if abs(lead) <= epsilon:
-        return StabilityResult(None, lead, f"leading Floquet exponent {lead:.3g} 1/s within "
-                               f"±{uncertain_band:g}·ω of 0 (near a fold or bifurcation)",
-                               exponents), 1
-    return StabilityResult(bool(lead <= tolerance * omega), lead, "", exponents), 1
+    return verdict(lead, np.append(lead, structure), omega, tolerance, uncertain_band), 1
