@@ -1,6 +1,6 @@
 """Issue-15 performance targets not measured elsewhere: P1 (cases/door_trim_p1.yaml: door trim
 5 mm, 12 contact pairs — 8 rattle, 4 squeak — H = 15, a continuation sweep 40 → 80 Hz reported at
-≥ 200 points, default options), P4 (HBM seconds per point vs FE size and vs contact pairs × H, with
+≈ 200 points, default options), P4 (HBM seconds per point vs FE size and vs contact pairs × H, with
 fitted exponents), the audible study and HBM vs the built-in time integrator.
 
 Every run is a whole ``sarfe solve`` process (OPENBLAS/OMP/MKL_NUM_THREADS=1) bounded by a timeout,
@@ -322,7 +322,7 @@ def stage_of(run):
 def p1_lines(e, p4):
     t = e.get("timings_s") or {}
     L = ["", "## P1: cases/door_trim_p1.yaml — 5 mm, 12 pairs (8 rattle + 4 squeak), H = 15, sweep "
-         "40 → 80 Hz (max_step 0.005: ≥ 200 reported points), default options, mesh → VTU", "",
+         "40 → 80 Hz (max_step 0.05: ≈ 200 reported points), default options, mesh → VTU", "",
          "The whole sweep, one `sarfe solve` process (mesh from the cache after the first run; "
          "the cache is what `sarfe solve` uses). Target ≤ 60 s, ≤ 4 GB.", "",
          "| points | converged | wall s | CPU s | peak RSS GB | linear stage s | HBM s | estimate s | "

@@ -13,9 +13,18 @@ restore) with pruning on and off, same linear stage, and how far the results dif
 Listed frequencies: same ω, so the ERP levels are compared point by point. Sweeps: the pruned
 continuation takes its own adaptive points on the same curve; the peak ERP is compared.
 
-Run: OPENBLAS_NUM_THREADS=1 python benchmarks/bench_pruning.py
+Part ``screen`` (issue 15 P1): the cost of the screening pass alone on the P1 door trim
+(cases/door_trim_p1.yaml: 12 pairs, H = 15, 40 → 80 Hz) at 15, 10 and 5 mm, and on every shipped
+case: the direct solves of model size per ω (``screen_contacts(..., modal=False)``, the code
+before the contact-row pass) against the contact-row pass (modal compliance + Woodbury update of
+the linearized contacts), cold (the modal basis computed, as in ``sarfe solve``) and warm (basis
+cached); the decisions of both and the largest clearance difference.
+
+Run: OPENBLAS_NUM_THREADS=1 python benchmarks/bench_pruning.py [cases,screen]  (default both; a
+part not run keeps its previous results from pruning.json)
 """
 import copy
+import dataclasses
 import json
 import os
 import pathlib
@@ -50,6 +59,7 @@ def lumped_with_extra_contacts():
 def run(case, stage, prune):
     data = copy.deepcopy(case.data)
     data["solver"]["prune_contacts"] = prune
+    data["solver"]["workers"] = 1      # the process time then counts all the work
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         start = time.process_time()
@@ -75,6 +85,7 @@ def hbm_cpu(case, stage, prune, repeats):
 
     data = copy.deepcopy(case.data)
     data["solver"]["prune_contacts"] = prune
+    data["solver"]["workers"] = 1
     case = load_case(data, base_dir=case.base_dir)
     nl = nonlinear_model(case, stage)
     best = float("inf")
@@ -116,19 +127,140 @@ def compare(case, stage=None, repeats=0):
     return row, stage
 
 
-def main():
+def door_trim_p1(mesh_m):
+    from sarfe.io.case import read_yaml
+
+    data = read_yaml(CASES / "door_trim_p1.yaml")[0]
+    data["model"]["fe"]["generator"]["mesh_size_m"] = mesh_m
+    data["name"] = f"door_trim_p1_{mesh_m * 1e3:g}mm"
+    return load_case(data, base_dir=CASES)
+
+
+def best_of(repeats, run):
+    """(result of the last run, best wall time [s] of ``repeats`` runs)."""
+    best = float("inf")
+    for _ in range(repeats):
+        start = time.perf_counter()
+        result = run()
+        best = min(best, time.perf_counter() - start)
+    return result, best
+
+
+def screen_row(case, repeats=3):
+    """The screening pass of ``case`` as ``sarfe solve`` runs it (its frequencies and margin):
+    direct solves vs the contact-row pass (cold: a fresh model object, the modal basis computed;
+    warm: cached)."""
+    import scipy.sparse as sp
+
+    import sarfe.hbm.pruning as pruning
+    from sarfe.pipeline.nonlinear import nonlinear_model
+    from sarfe.pipeline.pruning import pruning_options, screening_frequencies
+
+    start = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        stage = build_linear_model(case)
+    linear_s = time.perf_counter() - start
+    nl = nonlinear_model(case, stage)
+    margin = pruning_options(case.config.solver)[1]
+    (omegas, frequencies_s) = best_of(1, lambda: screening_frequencies(case.config.excitation, nl))
+    F = np.asarray(nl.excitation)
+    screen = (lambda model, modal: pruning.screen_contacts(model, nl.contacts, F, omegas, margin,
+                                                           modal=modal))
+    counted = []
+    solve = pruning._solve
+    pruning._solve = lambda A, b: (counted.append(A.shape[0]), solve(A, b))[1]
+    try:
+        direct, direct_s = best_of(repeats, lambda: screen(nl.model, False))
+        direct_solves = len(counted) // repeats
+        counted.clear()
+        cold, cold_s = best_of(repeats, lambda: screen(dataclasses.replace(nl.model), True))
+        modal_solves = len(counted) // repeats
+        warm_model = dataclasses.replace(nl.model)
+        screen(warm_model, True)
+        warm, warm_s = best_of(repeats, lambda: screen(warm_model, True))
+    finally:
+        pruning._solve = solve
+    finite = [(a.clearance, b.clearance) for a, b in zip(direct, cold)
+              if np.isfinite(a.clearance)]
+    row = {"case": case.name, "linear_stage_s": linear_s, "dofs": int(nl.model.dof_count),
+           "dense": not sp.issparse(nl.model.stiffness), "pairs": int(nl.contacts.count),
+           "contact_rows": int(nl.contacts.row_count), "frequencies": int(len(omegas)),
+           "natural_frequencies_s": frequencies_s,
+           "direct": {"solves": direct_solves, "size": int(nl.model.dof_count), "s": direct_s},
+           "contact_rows_pass": {"model_solves": modal_solves, "cold_s": cold_s, "warm_s": warm_s},
+           "same_decisions": [d.decision for d in direct] == [d.decision for d in cold]
+           == [d.decision for d in warm],
+           "decisions": {k: sum(d.decision == k for d in cold)
+                         for k in ("open", "closed", "nonlinear")},
+           "max_clearance_difference": max((abs(a - b) for a, b in finite), default=0.0)}
+    print(json.dumps(row), flush=True)
+    return row
+
+
+def screen_rows():
+    rows = [screen_row(door_trim_p1(mesh)) for mesh in (0.015, 0.010, 0.005)]
+    for name in ("lumped_rattle", "squeak_rig", "rattle_rig", "rattle_rig_deck", "door_trim",
+                 "instrument_panel"):
+        rows.append(screen_row(load_case(CASES / f"{name}.yaml")))
+    return rows
+
+
+def screen_lines(screen):
+    lines = ["## The screening pass alone (part `screen`, issue 15 P1)", "",
+             f"Machine: {screen['machine']}", "",
+             "The screen as `sarfe solve` runs it (the case's frequencies: a sweep's 201-point "
+             "grid plus the linearized natural frequencies in the band; its margin). Direct: one solve "
+             "of model size per ω and loaded order (plus the static one) — the code before. "
+             "Contact rows: the modal compliance of the model at the contact rows with the "
+             "linearized contacts' springs and dashpots as a Woodbury update, vectorized over ω "
+             "(`sarfe.hbm.pruning.contact_row_responses`); cold: the model's modal basis computed "
+             "(then cached on the model: the sweep's condensations reuse it), warm: cached. Wall "
+             "time, best of 3, one BLAS thread. Clearance difference: largest |Δ| of the screened "
+             "quantity (relative to |g|) between the direct and the contact-row pass.", "",
+             "| case | reduced DOFs (dense) | pairs / rows | ω | direct: solves × size, s "
+             "| contact rows: model solves, cold s, warm s | speed-up (cold) | decisions "
+             "(open/closed/nonlinear) | same | max clearance diff |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    for r in screen["rows"]:
+        d, m = r["direct"], r["contact_rows_pass"]
+        lines.append(
+            f"| {r['case']} | {r['dofs']} ({'dense' if r['dense'] else 'sparse'}) | {r['pairs']} / "
+            f"{r['contact_rows']} | {r['frequencies']} | {d['solves']} × {d['size']}, "
+            f"{d['s']:.3f} | {m['model_solves']}, {m['cold_s']:.3f}, {m['warm_s']:.4f} | "
+            f"{d['s'] / m['cold_s']:.1f}× | {r['decisions']['open']}/{r['decisions']['closed']}/"
+            f"{r['decisions']['nonlinear']} | {r['same_decisions']} | "
+            f"{r['max_clearance_difference']:.1e} |")
+    return lines
+
+
+def machine_line():
     load = os.getloadavg()[0]
-    rows = []
-    for name in ("instrument_panel", "door_trim"):
-        case = load_case(CASES / f"{name}.yaml")
-        row, stage = compare(case)
-        rows += [row, compare(without_stability(case), stage, repeats=3)[0]]
-    rows.append(compare(lumped_with_extra_contacts(), repeats=2)[0])
-    machine = (f"{platform.platform()}, {os.cpu_count()} cores, load average at start {load:.1f} "
-               "(shared machine: timings are upper bounds). One BLAS thread.")
+    return (f"{platform.platform()}, {os.cpu_count()} cores, load average at start {load:.1f} "
+            "(shared machine: timings are upper bounds). One BLAS thread.")
+
+
+def main():
+    parts = (sys.argv[1] if len(sys.argv) > 1 else "cases,screen").split(",")
+    path = HERE / "results" / "pruning.json"
+    previous = json.loads(path.read_text()) if path.exists() else {}
+    machine = previous.get("machine", "")
+    rows = previous.get("rows", [])
+    screen = previous.get("screen")
+    if "cases" in parts:
+        machine = machine_line()
+        rows = []
+        for name in ("instrument_panel", "door_trim"):
+            case = load_case(CASES / f"{name}.yaml")
+            row, stage = compare(case)
+            rows += [row, compare(without_stability(case), stage, repeats=3)[0]]
+        rows.append(compare(lumped_with_extra_contacts(), repeats=2)[0])
+    if "screen" in parts:
+        screen = {"machine": machine_line(), "date": time.strftime("%Y-%m-%d"),
+                  "rows": screen_rows()}
     (HERE / "results").mkdir(exist_ok=True)
-    (HERE / "results" / "pruning.json").write_text(json.dumps({"machine": machine, "rows": rows},
-                                                              indent=2) + "\n")
+    path.write_text(json.dumps({"machine": machine, "rows": rows, "screen": screen},
+                               indent=2) + "\n")
     lines = ["# Contact pruning benchmark (solver.prune_contacts)", "", f"Machine: {machine}", "",
              "Pruned / full contact set, the linear stage shared. HBM wall: `timings_s.hbm_s` of "
              "summary.json (screening + HBM + check + restore). CPU: process time of the whole "
@@ -137,7 +269,9 @@ def main():
              "to the peak. With stability on, Hill stability of every point (the same eigenvalue "
              "problems with or without the dropped contacts) is most of the HBM time. HBM CPU best "
              "of n: the frequency points alone (screening + HBM + check + restore), best of 3 "
-             "(FE, stability off) or 2 (lumped) runs.", "",
+             "(FE, stability off) or 2 (lumped) runs. `solver.workers: 1` (one process: its CPU "
+             "time is all the work). Sweeps: each run's continuation takes its own points, so "
+             "the peak ERP of the two is sampled at different ω.", "",
              "| case | pairs kept / all | screened open or closed | points | HBM wall pruned / "
              "full [s] | solve_case CPU pruned / full [s] | HBM CPU best of n, pruned / full [s] "
              "| peak ERP pruned / full [dB] | max level diff [dB] | max displacement diff |",
@@ -154,6 +288,8 @@ def main():
                         if "hbm_cpu_best_s" in r else "— | ") +
                      f"{r['peak_level_db'][0]:.3f} / {r['peak_level_db'][1]:.3f} | {diff} | "
                      f"{disp} |")
+    if screen:
+        lines += [""] + screen_lines(screen)
     (HERE / "results" / "pruning.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
 

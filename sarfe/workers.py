@@ -16,7 +16,8 @@ process. This module imports nothing from sarfe, so every layer may use it.
   loop. A worker that dies (killed, out of memory) leaves its items to the parent, which computes
   them itself: the results are the same, only later.
 - Ctrl-C: the workers ignore SIGINT; the parent receives it, stops its workers and re-raises.
-  Nothing is written by the workers (result files are the parent's, written at the end).
+  The workers write no result file, except the ERP map series (``sarfe.io.outputs.
+  write_erp_sweep``: each map its own file, in the run's temporary directory, at the end).
 - ``progress()``: called in the parent once per finished item (in finishing order).
 
 :func:`worker_count` turns the case's ``solver.workers`` (``auto`` | n) into a process count.

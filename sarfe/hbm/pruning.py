@@ -5,7 +5,9 @@ Contact screening (a cheap linear pass). At every ω of a grid over the sweep, t
 linear model with each contact linearized at u = 0 (what :func:`sarfe.hbm.solve.linearized_guess`
 solves: each law's linearization — preloaded contacts as their springs with their preload, open ones
 absent, tangent elements stuck)
-gives the relative normal motion w(θ) of every contact. With the gap g and a margin m ∈ (0, 1):
+gives the relative normal motion w(θ) of every contact — read on the contact rows only
+(:func:`contact_row_responses`: the model's modal compliance G Z_k⁻¹ Gᵀ with the linearized contacts
+as a Woodbury update, no solve of model size per ω). With the gap g and a margin m ∈ (0, 1):
 
 - ``open``   (g > 0):  max_{ω,θ} w ≤ (1 − m) g      — never closes: λ ≡ 0, drop the contact;
 - ``closed`` (g < 0, a law that is ``linear_when_closed``, e.g. rattle): min_{ω,θ} (w − g) ≥
@@ -123,11 +125,131 @@ def linear_responses(model, contacts, excitation, omegas):
         yield U
 
 
-def screen_contacts(model, contacts, excitation, omegas, margin=0.5, samples=64) -> tuple:
+# bound on the (frequencies × rows × modes) and (frequencies × rows × rows) complex arrays of one
+# block of frequencies
+_BLOCK_ENTRIES = 4_000_000
+# the screen takes the modal path from this many (ω, order) solves on: the modal basis of the door
+# trim's reduced model (613 DOFs) costs as much as ≈ 6 complex solves of it (80 ms vs 13 ms each)
+MODAL_SCREEN_MIN_SOLVES = 8
+
+
+def _modal_row_responses(basis, contacts, excitation, omegas):
+    r"""(r̃ (n_ω, 2h+1, n_rows) [m], bad (n_ω,) bool): the linearized model's response at the rows
+    of G from the modal basis of the model (no solve of model size per ω; h: the excitation's
+    highest order), ``bad`` where some Z_k(ω) is singular. See :func:`contact_row_responses`."""
+    from sarfe.hbm.linear import from_complex, to_complex
+    from sarfe.hbm.modal import real_product
+    from sarfe.hbm.solve import linearized_rows
+
+    c = contacts
+    springs, dashpots, preload = linearized_rows(c)
+    Gd = sp.csr_matrix(c.gap_map).toarray()
+    n_rows = Gd.shape[0]
+    forces = to_complex(np.asarray(excitation, dtype=float))       # (h+1, n): f_k = f_kc − i f_ks
+    h = forces.shape[0] - 1
+    gap_modes, _, static_compliance = basis.gap_projection(Gd)     # GV, ·, G K⁻¹ Gᵀ
+    static_forced, modal_forced = basis.load_projection(forces)    # K⁻¹ f_k, Vᵀ f_k
+    row_static = static_forced @ Gd.T                               # G K⁻¹ f_k (h+1, n_rows)
+    row_modal = modal_forced[:, None, :] * gap_modes[None]          # (Vᵀf_k)_j (GV)_rj
+    active = np.flatnonzero((springs != 0) | (dashpots != 0))
+    omegas = np.asarray(omegas, dtype=float)
+    R = np.zeros((omegas.size, h + 1, n_rows), dtype=complex)
+    # static order: K r₀ … (I + C₀ diag(k)) r₀ = G K⁻¹ f₀ − C₀ p, λ₀ = k r₀ + p (same at every ω)
+    R[:, 0] = _spring_update(static_compliance[None], (row_static[0] - static_compliance
+                                                       @ preload)[None], springs[None], active)[0]
+    bad = np.zeros(omegas.size, bool)
+    if h == 0:
+        return R, bad
+    k = np.arange(1, h + 1)
+    block = max(1, _BLOCK_ENTRIES // max(1, h * n_rows * max(n_rows, gap_modes.shape[1])))
+    for start in range(0, omegas.size, block):
+        w = omegas[start:start + block]
+        kw = (w[:, None] * k[None, :]).ravel()                      # (b h,): a_kj depends on kω
+        if basis.singular(kw, 1.0):                                 # an undamped resonance
+            bad[start:start + block] = [basis.singular(x, 1.0) for x in kw.reshape(w.size, h)]
+        q = basis.dynamic_receptance(kw, 1.0)                       # (b h, n_modes)
+        # C_k = G K⁻¹ Gᵀ + (GV) diag(q_k) (GV)ᵀ,  G y_k = G K⁻¹ f_k + (GV)(q_k ⊙ Vᵀ f_k)
+        C = static_compliance[None] + real_product(
+            (gap_modes[None] * q[:, None, :]).reshape(-1, q.shape[1]),
+            gap_modes.T).reshape(kw.size, n_rows, n_rows)
+        loaded = (row_static[None, 1:] + np.einsum(
+            "bkj,krj->bkr", q.reshape(w.size, h, -1), row_modal[1:])).reshape(kw.size, n_rows)
+        s = springs[None] + 1j * kw[:, None] * dashpots[None]       # λ_k = (k + i kω c) r_k
+        R[start:start + block, 1:] = _spring_update(C, loaded, s, active).reshape(w.size, h, n_rows)
+    return np.moveaxis(from_complex(np.moveaxis(R, 1, 0)), 0, 1), bad
+
+
+def _spring_update(C, b, s, active):
+    r"""r (p, n_rows) of (I + C diag(s)) r = b for p stacked systems (C (p, n_rows, n_rows), b and
+    s (p, n_rows)): only the rows a with s ≠ 0 couple, (I + C_aa diag(s_a)) r_a = b_a, then
+    r = b − C_:a (s_a ⊙ r_a) (Woodbury: the springs and dashpots of the linearized contacts added
+    to the model's compliance). Non-finite where a system is singular."""
+    if not active.size:
+        return np.array(b, dtype=np.result_type(C, b, s))
+    sa = s[:, active]
+    A = np.eye(active.size) + C[:, active[:, None], active[None, :]] * sa[:, None, :]
+    try:
+        ra = np.linalg.solve(A, b[:, active, None])[..., 0]
+    except np.linalg.LinAlgError:          # one of them is singular: those get nan
+        ra = np.stack([_solve_or_nan(a, x) for a, x in zip(A, b[:, active])])
+    return b - np.einsum("pra,pa->pr", C[:, :, active], sa * ra)
+
+
+def _solve_or_nan(A, b):
+    try:
+        return np.linalg.solve(A, b)
+    except np.linalg.LinAlgError:
+        return np.full(b.shape, np.nan, dtype=np.result_type(A, b))
+
+
+def contact_row_responses(model, contacts, excitation, omegas, modal=True) -> np.ndarray:
+    r"""r̃ = G ũ (n_ω, 2H+1, n_rows) [m] of the linearized model (:func:`linear_responses`) at each
+    ω of ``omegas`` [rad/s], at the rows of G only.
+
+    When the model has a modal basis (:func:`sarfe.hbm.modal.cached_modal_basis`: dense, e.g.
+    Craig–Bampton, K positive definite, D diagonal in the undamped modes) the linearized contacts
+    are a spring/dashpot update of the model's compliance at the contact rows, per order k
+
+        C_k = G Z_k⁻¹ Gᵀ = G K⁻¹ Gᵀ + (GV) diag(q_k) (GV)ᵀ,  ŷ_k = G Z_k⁻¹ f_k,
+        (I + C_k diag(k_s + i kω c)) r̂_k = ŷ_k,   (I + C₀ diag(k_s)) r̂₀ = ŷ₀ − C₀ p,
+
+    (k_s, c, p the laws' springs, dashpots and preloads on the rows: :func:`sarfe.hbm.solve.
+    linearized_rows`), so a frequency costs O(H n_rows² n_modes), vectorized over ω, and no solve of
+    model size — the same equations as :func:`linear_responses` (Woodbury identity), not an
+    approximation. Other models (sparse, non-modal damping, singular K) and any ω at which a Z_k is
+    singular: :func:`linear_responses` there; so are fewer than MODAL_SCREEN_MIN_SOLVES (ω, order)
+    pairs (a few listed frequencies: a handful of solves costs less than the basis, and the model's
+    cache is left as the points find it), and ``modal`` False (the direct solves: a reference).
+    """
+    from sarfe.hbm.modal import cached_modal_basis
+
+    F = np.asarray(excitation, dtype=float)
+    omegas = np.atleast_1d(np.asarray(omegas, dtype=float))
+    G = contacts.gap_map
+    basis = None
+    if modal and omegas.size * ((F.shape[0] - 1) // 2) >= MODAL_SCREEN_MIN_SOLVES:
+        # from the model's second request on its basis is computed once and cached on the model
+        # (:func:`sarfe.hbm.modal.cached_modal_basis`): the sweep that follows reuses it
+        basis = cached_modal_basis(model) or cached_modal_basis(model)
+    if basis is None:
+        return np.stack([np.asarray(G @ U.T).T
+                         for U in linear_responses(model, contacts, F, omegas)])
+    R, bad = _modal_row_responses(basis, contacts, F, omegas)
+    bad |= ~np.all(np.isfinite(R), axis=(1, 2))
+    if np.any(bad):
+        R[bad] = np.stack([np.asarray(G @ U.T).T
+                           for U in linear_responses(model, contacts, F, omegas[bad])])
+    return R
+
+
+def screen_contacts(model, contacts, excitation, omegas, margin=0.5, samples=64,
+                    modal=True) -> tuple:
     """Decisions (one :class:`ContactDecision` per contact) from the linear pass over ``omegas``.
 
     excitation f̃_e (2H+1, n) [N]; omegas [rad/s] — include the resonances in the band (a grid of a
     few hundred points, or the grid plus the linear natural frequencies); margin m (module docstring).
+    The pass reads the contact rows only (:func:`contact_row_responses`; ``modal`` False: its
+    direct solves of model size).
     """
     from sarfe.hbm.harmonics import time_samples
     from sarfe.hbm.laws import pruning_rules
@@ -139,16 +261,12 @@ def screen_contacts(model, contacts, excitation, omegas, margin=0.5, samples=64)
     F = F[:2 * max(highest, 1) + 1]
     c = contacts
     has = c.normal_row >= 0
-    w_max = np.full(c.count, -np.inf)
-    w_min = np.full(c.count, np.inf)
-    w_mean = np.zeros(c.count)
-    for U in linear_responses(model, c, F, omegas):
-        R = np.asarray(c.gap_map @ U.T).T
-        r = time_samples(R, samples)
-        w = r[:, np.where(has, c.normal_row, 0)]
-        w_max = np.maximum(w_max, np.where(has, w.max(axis=0), -np.inf))
-        w_min = np.minimum(w_min, np.where(has, w.min(axis=0), np.inf))
-        w_mean = np.where(has, R[0, np.where(has, c.normal_row, 0)], 0.0)   # static: same at every ω
+    normal = np.where(has, c.normal_row, 0)
+    R = contact_row_responses(model, c, F, omegas, modal)[:, :, normal]   # (n_ω, 2h+1, n_c)
+    w = time_samples(np.moveaxis(R, 0, 1), samples)                  # (samples, n_ω, n_c)
+    w_max = np.where(has, w.max(axis=(0, 1)), -np.inf)
+    w_min = np.where(has, w.min(axis=(0, 1)), np.inf)
+    w_mean = np.where(has, R[-1, 0], 0.0)                            # static: same at every ω
     may_open, may_close = pruning_rules(c)
     decisions = []
     for i in range(c.count):
@@ -366,4 +484,5 @@ def _linear_solution(U, omega, harmonics, samples_per_period):
 __all__ = ["OPEN", "CLOSED", "NONLINEAR", "ContactDecision", "PrunedProblem", "screen_contacts",
            "subset_contacts", "kept_rows", "prune_contacts", "check_pruning", "restore_solution",
            "linearized_stiffness", "linearized_damping", "linear_responses",
+           "contact_row_responses",
            "solve_frequency_pruned"]

@@ -69,12 +69,12 @@ class ContinuationOptions:
     max_points: cap on the number of points returned (the sweep then stops, last point flagged in
     its reason). corrector_iterations: Newton cap of one corrector (a failed corrector halves Δs;
     the corrector also uses at most 3 line-search halvings). solver: SolverOptions of the correctors.
-    Why 6 and 10 (were 4 and 5): with friction contacts the residual is piecewise smooth and a
-    corrector needs 3–5 iterations however small Δs is, so halving on 5 made Δs collapse: the
-    12-pair door trim (15 mm, H = 15, 40 → 80 Hz, default case settings) spent max_points 2000
-    inside 40–45 Hz, raising N to 1024 at "corners", and stopped; with 6 / 10 it completes the
-    band (1627 points, no N raised); the shipped cases and the continuation tests are unchanged
-    (rattle rig 367 → 363 points, complete either way).
+    Why 6 and 10 (were 4 and 5): the 12-pair door trim (15 mm, H = 15, 40 → 80 Hz, default case
+    settings) crawled with 4 / 5 — its squeak correctors needed 3–5 iterations at any Δs — and
+    stopped at max_points 2000 inside 40–45 Hz. The cause was a wrong Jacobian of stuck 2-D
+    sliders (Newton converged linearly; fixed in :mod:`sarfe.hbm.laws.jenkins`); since then the
+    band takes 105 points with 6 / 10 and 116 with 4 / 5, so 6 / 10 stay (the shipped cases and
+    the continuation tests pass with either; rattle rig 367 → 363 points, complete either way).
     The defaults are those of a library call; ``sarfe solve`` always passes the case's
     ``solver.continuation`` (defaults in :class:`sarfe.io.config.ContinuationConfig`, max_step 0.1).
     """

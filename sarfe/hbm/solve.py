@@ -42,7 +42,7 @@ from .solution import HarmonicSolution, SolverOptions
 from .stability import hill_stability
 from .stability_condensed import condensed_stability
 from .stability_contacts import ContactOperator
-from .stability_rows import contact_row_stability
+from .stability_rows import contact_row_count
 
 CONDENSED_ABOVE = 3000   # Hill matrix rows 2(2H+1)n above which 'auto' stability is condensed
 
@@ -285,11 +285,18 @@ def stability(problem, omega, U, ev, options):
     operator = ContactOperator(problem, U, omega, ev.forces)
     method = stability_method(problem, options)
     if method == "contact_rows":
-        result = contact_row_stability(problem.model, problem.contacts, omega, problem.harmonics,
-                                       ev.forces, operator)
+        result, zeros = contact_row_count(problem.model, problem.contacts, omega,
+                                          problem.harmonics, ev.forces, operator,
+                                          tolerance=options.stability_tolerance)
         if result is not None:
             return result
-        method = "condensed"     # some exponent near or right of the axis: locate them (Ritz)
+        ritz = condensed_stability(problem.model, problem.contacts, omega, problem.harmonics,
+                                   ev.forces, operator, tolerance=options.stability_tolerance)
+        if zeros and ritz.stable is True:   # the count is exact, the Ritz basis truncated
+            return replace(ritz, stable=None, note=(
+                f"the contact-row count finds {zeros} Floquet exponent(s) right of "
+                f"−1e-4·ω that the Ritz basis does not locate (it says {ritz.leading:.3g} 1/s)"))
+        return ritz
     if method == "condensed":
         return condensed_stability(problem.model, problem.contacts, omega, problem.harmonics,
                                    ev.forces, operator, tolerance=options.stability_tolerance)

@@ -177,10 +177,16 @@ def hill_stability(model, omega, harmonics, jacobian, tolerance=1e-6, dense_limi
     leading = float(values.real.max())
     if note:
         return StabilityResult(None, leading, note, values)
+    return verdict(leading, values, omega, tolerance, uncertain_band)
+
+
+def verdict(leading, exponents, omega, tolerance, uncertain_band):
+    """The verdict on a located leading exponent [1/s]: uncertain (None, with a note) within
+    ±``uncertain_band``·|ω| of 0, else stable iff leading ≤ ``tolerance``·|ω|."""
     if abs(leading) <= uncertain_band * abs(omega):
         return StabilityResult(None, leading, f"leading Floquet exponent {leading:.3g} 1/s within "
-                               f"±{uncertain_band:g}·ω of 0 (near a fold or bifurcation)", values)
-    return StabilityResult(bool(leading <= tolerance * abs(omega)), leading, "", values)
+                               f"±{uncertain_band:g}·ω of 0 (near a fold or bifurcation)", exponents)
+    return StabilityResult(bool(leading <= tolerance * abs(omega)), leading, "", exponents)
 
 
 def _refine_leading(model, omega, harmonics, jacobian, contact_damping, operator, values,

@@ -43,9 +43,11 @@ arg det F along the upper half of the boundary divided by π. The contour is sam
 
 No zero in Ω: stable, and no exponent is within the uncertain band; the leading exponent reported
 is the least damped exponent of the structure (max Re of μ s² + δ s + 1 = 0; the coupled
-exponents left of −ε are not located). Some zero in Ω, a pole near the contour, a model without
-a modal basis or a contour that does not close on a multiple of π: ``None`` — the caller then
-locates the exponents by the Ritz-basis Hill method (:mod:`sarfe.hbm.stability_condensed`).
+exponents left of −ε are not located). One zero in Ω: it is real (a fold's exponent), located on
+the real axis by the sign of det F, and decides the verdict (:func:`contact_row_stability`). Two
+or more zeros in Ω, a pole near the contour, a model without a modal basis or a contour that does
+not close on a multiple of π: ``None`` — the caller then locates the exponents by the Ritz-basis
+Hill method (:mod:`sarfe.hbm.stability_condensed`).
 Measured against the full Hill method in tests/hbm/test_stability_rows.py and
 benchmarks/bench_stability.py.
 """
@@ -350,31 +352,74 @@ def winding_count(log_det, points, step=PHASE_STEP, budget=MAX_EVALUATIONS):
         evaluations += middle.size
 
 
+def real_zero(log_det, lower, upper, rounds=4, width=16):
+    """The zero of det F on the real segment (lower, upper) [1/s] where det F (real for real s)
+    changes sign exactly once, or None (no single sign change, or det F not finite there).
+
+    One geometric grid (the exponent of a fold lies near 0; ``upper`` is a crude bound), then
+    ``rounds`` subdivisions of the bracket into ``width`` parts: the bracket shrinks by
+    width^rounds (16⁴ ≈ 6.6·10⁴). Returns the bracket's midpoint."""
+    def signs(points):
+        values = log_det(points.astype(complex))
+        return np.sign(np.cos(values.imag)) if np.all(np.isfinite(values)) else None
+
+    small = max(-lower, 1e-12 * upper)
+    grid = np.concatenate([np.linspace(lower, 0.0, 4), np.geomspace(small, upper, 44)])
+    for _ in range(rounds + 1):
+        sign = signs(grid)
+        if sign is None:
+            return None
+        change = np.flatnonzero(sign[1:] != sign[:-1])
+        if change.size != 1:
+            return None
+        a, b = grid[change[0]], grid[change[0] + 1]
+        grid = np.linspace(a, b, width + 1)
+    return 0.5 * (a + b)
+
+
 def contact_row_stability(model, contacts, omega, harmonics, forces, operator=None,
-                          uncertain_band=1e-4):
-    """StabilityResult when the contact-row count decides it (no exponent right of −ε), else None.
-    (No exponent right of −ε is 'stable' for every stability tolerance ≥ 0 of the full method.)
+                          uncertain_band=1e-4, tolerance=1e-6):
+    """StabilityResult when the contact-row count decides it, else None (see
+    :func:`contact_row_count`, which also returns the count)."""
+    return contact_row_count(model, contacts, omega, harmonics, forces, operator, uncertain_band,
+                             tolerance)[0]
+
+
+def contact_row_count(model, contacts, omega, harmonics, forces, operator=None,
+                      uncertain_band=1e-4, tolerance=1e-6):
+    """(StabilityResult or None, zeros): zeros = the number of Floquet exponents right of −ε
+    (None where the count did not close). The result when the count decides it, else None.
+
+    No zero of det F right of −ε: stable (for every stability tolerance ≥ 0 of the full method).
+    Exactly one: it is real (zeros off the real axis come in conjugate pairs) and it is the leading
+    exponent s*; :func:`real_zero` locates it and the verdict is the full method's rule: uncertain
+    (None, with a note) when |s*| ≤ ``uncertain_band``·ω, else stable iff s* ≤ ``tolerance``·ω —
+    the middle branch of a fold is unstable here without an eigen-solve. (The Ritz basis of
+    :mod:`sarfe.hbm.stability_condensed`, which these points went to before, reported 'stable'
+    with a leading exponent near −7 1/s at three points of such a branch of the 12-pair door trim
+    at 46.2 Hz, where det F changes sign at s* ≈ 1.2–3.5 1/s.) Two or more: None (the caller
+    locates them).
 
     forces: the AFT :class:`ContactForces` of the orbit (all harmonic rows, blocks computed);
     operator: the :class:`ContactOperator` (friction memory) or None. See the module docstring.
     """
-    from .stability import StabilityResult
+    from .stability import StabilityResult, verdict
 
     basis = cached_modal_basis(model) or cached_modal_basis(model)
     if basis is None or model.dof_count == 0:
-        return None
+        return None, None
     omega, H = abs(float(omega)), int(harmonics)
     epsilon = uncertain_band * omega
     structure = structural_exponents(basis.flexibility, basis.damping)
     least_damped = float(structure.real.max())
     if not least_damped < -2.0 * epsilon:       # a pole on or right of the contour
-        return None
+        return None, None
     n_rows = contacts.row_count
     J = jacobian_matrix(forces.blocks, n_rows, H)
     Jd = jacobian_matrix(forces.damping_blocks, n_rows, H) if forces.damping_blocks else None
     det = ContactRowDeterminant(basis, contacts.gap_map, omega, H, J, Jd, operator)
     if det.loaded.size == 0:
-        return StabilityResult(True, least_damped, "", structure)
+        return StabilityResult(True, least_damped, "", structure), 0
     # ‖𝒥(s)‖₂ for Re s ≥ 0: twice its largest value at s = 0, ω, 10ω (the memory factors e^{−shd}
     # have modulus ≤ 1 there; the pointwise part does not depend on s), each bounded above by the
     # Frobenius norm (‖·‖₂ ≤ ‖·‖_F: X only grows, the contour still encloses every exponent)
@@ -383,6 +428,12 @@ def contact_row_stability(model, contacts, omega, harmonics, forces, operator=No
     X = exponent_bound(basis, det.gap_modes, omega, H, jacobian_norm, damping_norm)
     contour = _upper_contour(epsilon, X, 0.505 * omega, -least_damped)
     count, _ = winding_count(det.log_determinants, contour)
-    if not np.isfinite(count) or abs(count - round(count)) > 0.1 or round(count) != 0:
-        return None
-    return StabilityResult(True, least_damped, "", structure)
+    if not np.isfinite(count) or abs(count - round(count)) > 0.1:
+        return None, None
+    zeros = int(round(count))
+    if zeros == 0:
+        return StabilityResult(True, least_damped, "", structure), 0
+    lead = real_zero(det.log_determinants, -epsilon, X) if zeros == 1 else None
+    if lead is None:
+        return None, zeros
+    return verdict(lead, np.append(lead, structure), omega, tolerance, uncertain_band), 1

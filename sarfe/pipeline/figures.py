@@ -92,7 +92,26 @@ def surface_maps(config, mesh, point_data, translations, point, directory: Path,
     phase of largest displacement (exaggerated warp, colour |u| [mm]) and, when contacts move,
     their relative displacement [mm], named at ``contact_nodes`` {name: mesh node}. Returns
     {key: PNG path, 'renderer': text}."""
-    from sarfe.io.outputs.render import render_surfaces
+    return finish_surface_maps(start_surface_maps(config, mesh, point_data, translations, point,
+                                                  directory, contact_nodes))
+
+
+def finish_surface_maps(run) -> dict:
+    """{key: PNG path, 'renderer': text} of the renders :func:`start_surface_maps` started."""
+    from sarfe.io.outputs.render import finish_render
+
+    rendered = finish_render(run)
+    maps = {key: path for key, (path, _) in zip(("erp_map", "deflection", "contact_map"),
+                                                rendered)}
+    maps["renderer"] = rendered[0][1]
+    return maps
+
+
+def start_surface_maps(config, mesh, point_data, translations, point, directory: Path,
+                       contact_nodes=None):
+    """Start the renders of :func:`surface_maps` in their child process and return at once
+    (:func:`sarfe.io.outputs.render.start_render`): the run's other files are written meanwhile."""
+    from sarfe.io.outputs.render import start_render
     from sarfe.io.outputs.vtk import period_samples
 
     directory = Path(directory)
@@ -118,8 +137,4 @@ def surface_maps(config, mesh, point_data, translations, point, directory: Path,
                          title=f"contact motion at {at}", cmap="plasma", spots=True,
                          labels=[(mesh.points[node], name)
                                  for name, node in (contact_nodes or {}).items()]))
-    rendered = render_surfaces(jobs)
-    maps = {key: path for key, (path, _) in zip(("erp_map", "deflection", "contact_map"),
-                                                rendered)}
-    maps["renderer"] = rendered[0][1]
-    return maps
+    return start_render(jobs)

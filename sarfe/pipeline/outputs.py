@@ -16,7 +16,24 @@ def write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, d
     {file kind: file name}. ``config``: the case's :class:`sarfe.io.config.CaseConfig`.
     Everything "at the loudest point" (spectrum, contact plots, animation,
     report maps) uses ``summary["worst"]["index"]`` (:func:`sarfe.pipeline.postprocess.loudest_point`).
-    summary.json itself is written by the caller, last (it lists these files and the timings)."""
+    summary.json itself is written by the caller, last (it lists these files and the timings).
+    The report's surface renders run in a child process from the moment the loudest point's
+    arrays exist until the report is written (the ERP maps, animation and PNGs are written
+    meanwhile); it is stopped if a writer fails."""
+    renders = []
+    try:
+        return _write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w,
+                              directory, renders)
+    except BaseException:
+        from sarfe.io.outputs.render import cancel_render
+
+        for run in renders:
+            cancel_render(run)
+        raise
+
+
+def _write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, directory,
+                   started_renders):
     from sarfe.io import outputs
 
     files = config.output.files
@@ -39,15 +56,7 @@ def write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, d
             attributes={"case": config.name, "linear_model_key": stage.key})
         written["response"] = "response.h5"
     loudest = (summary.get("worst") or {}).get("index")
-    images = {}
-    if "plots" in files or "report" in files:
-        from sarfe.pipeline.figures import point_figures
-
-        plot_dir = directory if "plots" in files else directory / ".report-figures"
-        images = point_figures(config, stage, nl, summary, solutions, erps, plot_dir, loudest)
-        if "plots" in files:
-            written["plots"] = ", ".join(sorted(Path(v).name for v in images.values()))
-    maps = {}
+    maps, renders = {}, None
     if stage.kind == "fe" and ("erp_vtu" in files or "animation" in files or "report" in files):
         from sarfe.reduction.recovery import recover_displacement
 
@@ -70,16 +79,36 @@ def write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, d
                 translations[j] = u
             return u
 
+        loudest_data = {}
+
         def point_data(j):
+            if j in loudest_data:     # the loudest point's arrays serve its map and the report's
+                return loudest_data[j]
             force, motion = contact_pair_fields(stage, nl, solutions[j], mesh.n_nodes)
-            return outputs.erp_point_data(mesh.n_nodes, erps[j], normal_w[j],
+            data = outputs.erp_point_data(mesh.n_nodes, erps[j], normal_w[j],
                                           float(solutions[j].omega),
                                           displacement=nodal_translations(j),
                                           radiating_nodes=stage.erp_nodes,
                                           contact_marker=markers, contact_force=force,
                                           contact_displacement=motion,
                                           node_ids=getattr(stage, "node_ids", None))
+            if j == loudest:
+                loudest_data[j] = data
+            return data
 
+        if loudest is not None and ("erp_vtu" in files or "report" in files):
+            point_data(loudest)       # before the VTU workers fork: they inherit it
+        if "report" in files and loudest is not None:
+            from sarfe.pipeline.figures import start_surface_maps
+
+            # the report's renders run in their child process while the other files are written
+            renders = start_surface_maps(config, mesh, point_data(loudest),
+                                         nodal_translations(loudest), summary["points"][loudest],
+                                         directory / ".report-figures",
+                                         contact_nodes={name: int(g.nodes_a[0])
+                                                        for name, g in stage.contacts.items()
+                                                        if len(g.nodes_a)})
+            started_renders.append(renders)
         if "erp_vtu" in files:
             frequencies = [float(s.omega) / (2 * np.pi) for s in solutions]
             if len(solutions) == 1:
@@ -88,8 +117,8 @@ def write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, d
                 written["erp_vtu"] = "erp.vtu"
             else:
                 outputs.write_erp_sweep(directory / "erp", mesh.points, mesh.triangles,
-                                        (point_data(j) for j in range(len(solutions))),
-                                        frequencies)
+                                        point_data, frequencies,
+                                        workers=map_workers(config, mesh, len(solutions)))
                 written["erp_vtu"] = "erp/erp.pvd"
         if "animation" in files and loudest is not None:
             outputs.write_deflection_animation(directory / "animation", mesh.points,
@@ -100,20 +129,37 @@ def write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, d
                                                    if getattr(stage, "node_ids", None) is not None
                                                    else {}))
             written["animation"] = "animation/deflection.pvd"
-        if "report" in files and loudest is not None:
-            from sarfe.pipeline.figures import surface_maps
+    images = {}
+    if "plots" in files or "report" in files:
+        from sarfe.pipeline.figures import point_figures
 
-            maps = surface_maps(config, mesh, point_data(loudest), nodal_translations(loudest),
-                                summary["points"][loudest], directory / ".report-figures",
-                                contact_nodes={name: int(g.nodes_a[0])
-                                               for name, g in stage.contacts.items()
-                                               if len(g.nodes_a)})
+        plot_dir = directory if "plots" in files else directory / ".report-figures"
+        images = point_figures(config, stage, nl, summary, solutions, erps, plot_dir, loudest)
+        if "plots" in files:
+            written["plots"] = ", ".join(sorted(Path(v).name for v in images.values()))
+    if renders is not None:
+        from sarfe.pipeline.figures import finish_surface_maps
+
+        maps = finish_surface_maps(renders)
     if "report" in files:
         notes = {"renderer": maps.pop("renderer", None)}
         outputs.write_report_html(directory / "report.html", summary, {**images, **maps}, notes)
         written["report"] = "report.html"
     shutil.rmtree(directory / ".report-figures", ignore_errors=True)
     return written
+
+
+# the ERP maps of a sweep are written on the run's worker processes (solver.workers) when the
+# series holds at least this many point values (points × mesh nodes; ≈ 20 ms per 35k-node map,
+# forking the workers costs ≈ 0.1 s: below this the maps are written in the solving process)
+PARALLEL_MAP_VALUES = 2e6
+
+
+def map_workers(config, mesh, n_maps) -> int:
+    """Processes that write a sweep's ERP maps: the run's point workers for a large series."""
+    from sarfe.pipeline.point_workers import point_workers
+
+    return point_workers(config.solver) if n_maps * mesh.n_nodes >= PARALLEL_MAP_VALUES else 1
 
 
 # full-field recovery u = T q of every sweep point for the VTU maps up to this many multiply-adds

@@ -125,3 +125,71 @@ def test_one_direction_gauge_and_jacobian(mean_normal, offset):
             column = (hm.harmonic_coefficients(evaluate(*plus)[0][:, 0, 0], H)
                       - hm.harmonic_coefficients(evaluate(*minus)[0][:, 0, 0], H)) / (2 * step)
             assert np.abs(column - J[0, 1::3, 3 * h + l]).max() < 1e-6
+
+
+def stuck_orbits():
+    """Two 2-D contacts that can stick the whole period but not at w = 0 (|q_j| > ρ_j):
+    0: an ellipse around (1, 0) with ρ = 0.5 + 0.1 cos θ (the nearest point of S lies on one disk);
+    1: q = (1, 0.45 sin θ), ρ = 0.5 (S is a lens; its point nearest to 0 is a corner of two disks).
+    Returns harmonics Q (2H+1, 2, 2) [m] and normal-force harmonics L (2H+1, 2) [N] (k_t = μ = 1,
+    so ρ = λ_n)."""
+    Q = np.zeros((2 * H + 1, 2, 2))
+    L = np.zeros((2 * H + 1, 2))
+    Q[0, 0, 0], Q[1, 0, 0], Q[2, 0, 1], Q[3, 0, 0] = 1.0, 0.2, 0.3, 0.05
+    L[0, 0], L[1, 0] = 0.5, 0.1
+    Q[0, 1, 0], Q[2, 1, 1] = 1.0, 0.45
+    L[0, 1] = 0.5
+    return Q, L
+
+
+def stuck_forces(Q, L, jacobian=False):
+    p = {"tangential_stiffness": np.ones(2), "friction_coefficient": np.ones(2)}
+    q = hm.time_samples(Q.reshape(2 * H + 1, -1), N).reshape(N, 2, 2)
+    return periodic_forces(p, q, np.zeros(2, bool), hm.time_samples(L, N), 10.0 * np.ones((N, 2)),
+                           None, H, N, jacobian, 1e-12, 50, np.arange(2 * H + 1))
+
+
+def test_stuck_slider_is_the_point_of_the_stick_set_nearest_to_assembly():
+    """The gauge of a contact that never slips: the constant slider w₀ nearest to w = 0 among those
+    with |w₀ − q_j| ≤ ρ_j at every sample. Reference: scipy's SLSQP on min |w|² under those N
+    constraints; and w₀ is a periodic state of the pointwise return map with no slip."""
+    from scipy.optimize import minimize
+    Q, L = stuck_orbits()
+    force, state, slider, _, _ = stuck_forces(Q, L)
+    q = hm.time_samples(Q.reshape(2 * H + 1, -1), N).reshape(N, 2, 2)
+    rho = hm.time_samples(L, N)
+    assert np.all(state == STICK)
+    for c in range(2):
+        constraints = {"type": "ineq", "fun": lambda w, c=c: rho[:, c] ** 2
+                       - np.sum((w - q[:, c]) ** 2, axis=1)}
+        best = minimize(lambda w: w @ w, q[:, c].mean(axis=0), constraints=constraints,
+                        method="SLSQP", options={"ftol": 1e-15, "maxiter": 500})
+        assert np.linalg.norm(slider[c] - best.x) < 1e-7, (c, slider[c], best.x)
+        w = slider[c].copy()
+        for j in range(N):
+            w, st = slider_update(w, q[j, c], rho[j, c])
+        assert np.linalg.norm(w - slider[c]) < 1e-12
+    assert slider[1] == pytest.approx([1.0 - np.sqrt(0.5**2 - 0.45**2), 0.0], abs=1e-12)
+    assert np.abs(force - (q - slider[None])).max() < 1e-12
+
+
+def test_stuck_slider_jacobian_matches_finite_differences():
+    """The mean rows carry ∂w₀/∂X of the stuck gauge (one active disk; a corner of two): central
+    differences of λ̃_t in every harmonic of q̃ and of λ̃_n (λ_n = λ_n0 + 10 w)."""
+    Q, L = stuck_orbits()
+    _, _, _, _, J = stuck_forces(Q, L, True)
+    step = 1e-7
+    for h in range(2 * H + 1):
+        for l in range(3):
+            plus, minus = (Q.copy(), L.copy()), (Q.copy(), L.copy())
+            if l:
+                plus[0][h, :, l - 1] += step
+                minus[0][h, :, l - 1] -= step
+            else:
+                plus[1][h] += 10 * step
+                minus[1][h] -= 10 * step
+            column = (hm.harmonic_coefficients(stuck_forces(*plus)[0], H)
+                      - hm.harmonic_coefficients(stuck_forces(*minus)[0], H)) / (2 * step)
+            for c in range(2):
+                analytic = J[c, :, 3 * h + l].reshape(2 * H + 1, 3)[:, 1:]
+                assert np.abs(analytic - column[:, c]).max() < 1e-6, (h, l, c)

@@ -19,15 +19,21 @@ its periodic state is fixed by q̃ and λ̃_n. A contact that sticks the whole p
 interval (a convex set in 2-D) of periodic slider positions: its mean tangential force is a
 history constant. Taking it from a warm start (the last evaluation's slider) made the residual
 depend on the path of the iterations, not only on the unknowns — a continuation corrector landed
-on a solution with another mean and rejected it. The periodic state is therefore the one reached
-by marching from the slider position at assembly, w_start = 0 (q is measured from the undeformed
-state): in 1-D w_0 = clip(0, A, B) with [A, B] the interval of periodic starts. A contact that
-never slips keeps the spring it was assembled with (λ_t = k_t q: it carries its share of any static
-load, exactly what a start from rest gives when the contact never slips), and one whose interval
-does not hold 0 rests on the nearest edge — dragged by slip just as far as needed. λ_t is then a
-continuous, piecewise smooth function of q̃ and λ̃_n alone (the ``slider_start`` of a call is not
-used), continuous through stick ↔ slip transitions, and the Jacobian is k_t I in stick (regular
-even where the contact is the only restraint).
+on a solution with another mean and rejected it. The periodic state is therefore fixed by the
+slider position at assembly, w = 0 (q is measured from the undeformed state): where the contact
+can stick the whole period, the slider is the point of the set of stick-periodic sliders
+S = ∩_j {w : |w − q_j| ≤ ρ_j} nearest to 0. In 1-D S is the interval [A, B] of periodic starts and
+w_0 = clip(0, A, B), which is also where a march from 0 ends. In 2-D a march from 0 also ends in S
+(cyclic projections onto convex sets), but at a point that depends on the order in which the disks
+are met, whose motion along the boundary of S no consistent tangent of the march can follow (the
+mean tangential rows of the Jacobian were wrong by up to 37 %, and Newton on the 12-pair door trim
+converged linearly, ×0.15 per iteration); the nearest point of S is a smooth function of q̃ and λ̃_n
+with an exact derivative (:func:`_march_2d`). A contact that never slips with 0 ∈ S keeps the spring
+it was assembled with (λ_t = k_t q: it carries its share of any static load, exactly what a start
+from rest gives when the contact never slips), and one with 0 ∉ S rests on the boundary of S —
+dragged as little as needed. λ_t is then a continuous, piecewise smooth function of q̃ and λ̃_n
+alone (the ``slider_start`` of a call is not used), continuous through stick ↔ slip transitions,
+and the Jacobian is k_t I in stick (regular even where the contact is the only restraint).
 
 The element provides (vectorized over contacts, driven by the law's normal force λ_n(θ)):
 - :func:`periodic_forces`: the periodic steady state over one period and its AFT Jacobian (1-D:
@@ -246,21 +252,33 @@ def _jacobian_1d(res, mu_dlam, k_t, H, N, kept_rows):
 
 
 def _march_2d(q, rho, drho_dw, k_t, start, H, N, jacobian, tolerance, pass_cap, kept_rows):
-    r"""2-D Jenkins elements marched sample by sample (compiled kernels over contacts × samples,
+    r"""2-D Jenkins elements over one period (compiled kernels over contacts × samples,
     :mod:`.jenkins_march`).
 
-    The disk projection of the slider is not composable like the 1-D clamp, so the march over
-    samples is inherent to 2-D hysteresis. Periods are marched from ``start`` until the slider
-    state at θ_0 repeats to ``tolerance`` × (max|q| + max ρ) or ``pass_cap`` periods; between passes
-    the start is updated by Newton on the periodicity, w_0 ← w_0 + (I − A)⁻¹ (w_N − w_0) with
-    A = ∂w_N/∂w_0 (where I − A is regular, i.e. the contact slipped), so a few passes suffice even
-    when slip is rare and the plain iteration contracts slowly; a final period
-    propagates the consistent tangent: with X = local harmonics (h·3 + l),
+    Stuck contacts first (:func:`.jenkins_march.stick_projection`): where the disks
+    D_j = {w : |w − q_j| ≤ ρ_j} have a common point the contact can stick the whole period, and the
+    gauge (module docstring) takes the point of S = ∩_j D_j nearest to w = 0: w₀ = 0 when 0 ∈ S
+    (λ_t = k_t q), else w₀ on the boundary of one disk j (w₀ = q_j (1 − ρ_j/|q_j|)) or of two
+    (a corner of S). λ_t = k_t (q − w₀) with, from those 0–2 active constraints,
+
+        one:  dw₀ = (I − (ρ_j/|q_j|)(I − m mᵀ)) dq_j + m dρ_j,      m = (w₀ − q_j)/ρ_j,
+        two:  (w₀ − q_i)ᵀ dw₀ = (w₀ − q_i)ᵀ dq_i + ρ_i dρ_i,   i ∈ {j, k},
+
+    so the mean rows of the Jacobian are exact there too (the march's periodicity cannot fix a
+    slider that never slips: its I − A is singular or nearly so at a touching sample).
+
+    The others slip (or separate) every period: their periodic state is unique. The disk
+    projection is not composable like the 1-D clamp, so the march over samples is inherent to 2-D
+    hysteresis. Periods are marched from ``start`` until the slider state at θ_0 repeats to
+    ``tolerance`` × (max|q| + max ρ) or ``pass_cap`` periods; between passes the start is updated
+    by Newton on the periodicity, w_0 ← w_0 + (I − A)⁻¹ (w_N − w_0) with A = ∂w_N/∂w_0 (where
+    I − A is regular), so a few passes suffice even when slip is rare and the plain iteration
+    contracts slowly; a final period propagates the consistent tangent: with X = local harmonics
+    (h·3 + l),
         dw_j = (I − P_j) dq_j + n_j dρ_j + P_j dw_{j−1},
     and the periodicity w_N = w_0 gives ∂w_0/∂X = (I − A)⁻¹ B (A = ∂w_N/∂w_0, B = ∂w_N/∂X at
-    fixed w_0) when the contact slipped or separated; 0 when it stuck (``start`` = 0, the gauge of
-    the module docstring).
-    Returns (λ_t (N, n, 2), state (N, n), w_end (n, 2), passes, J (n, 3P, 3P) or None).
+    fixed w_0).
+    Returns (λ_t (N, n, 2), state (N, n), w_start (n, 2), passes, J (n, 3P, 3P) or None).
     """
     from . import jenkins_march as march    # numba is imported (and the kernels loaded) on first use
     n = q.shape[1]
@@ -268,26 +286,85 @@ def _march_2d(q, rho, drho_dw, k_t, start, H, N, jacobian, tolerance, pass_cap, 
     scale = np.abs(q).max() + rho.max() + 1e-300
     q = np.ascontiguousarray(q, dtype=float)
     rho = np.ascontiguousarray(rho, dtype=float)
-    w_start, passes = march.periodic_start(q, rho, np.array(start, dtype=float),
-                                           tolerance * scale, pass_cap)
+    drho_dw = np.ascontiguousarray(drho_dw, dtype=float)
+    k_t = np.asarray(k_t, dtype=float)
     Phi = np.ascontiguousarray(_basis(H, N)[:, kept_rows])
-    force, state, dforce, history, dw = march.final_pass(
-        q, rho, np.ascontiguousarray(drho_dw, dtype=float), np.asarray(k_t, dtype=float),
-        w_start, Phi, jacobian)
-    passes += 1
+    w_start, active, stuck = march.stick_projection(q, rho, STUCK_TOLERANCE * scale,
+                                                    STUCK_ITERATIONS)
+    force = k_t[None, :, None] * (q - w_start[None])
+    state = np.full((N, n), STICK, np.int8)
+    dforce = np.zeros((N, n, 2, 3 * P)) if jacobian else None
+    passes = 0
+    slipping = np.flatnonzero(~stuck)
+    if slipping.size:
+        qs, rs = np.ascontiguousarray(q[:, slipping]), np.ascontiguousarray(rho[:, slipping])
+        w0, passes = march.periodic_start(qs, rs, np.array(start, dtype=float)[slipping],
+                                          tolerance * scale, pass_cap)
+        f, st, df, history, dw = march.final_pass(qs, rs, np.ascontiguousarray(drho_dw[:, slipping]),
+                                                  k_t[slipping], w0, Phi, jacobian)
+        passes += 1
+        force[:, slipping], state[:, slipping], w_start[slipping] = f, st, w0
+        if jacobian:
+            system = np.eye(2) - history[-1]
+            regular = np.abs(np.linalg.det(system)) > 1e-12
+            dw0 = np.zeros_like(dw)             # never slipped (stuck test inconclusive): 0
+            dw0[regular] = np.linalg.solve(system[regular], dw[regular])
+            df -= k_t[None, slipping, None, None] * np.einsum("jcab,cbx->jcax", history, dw0)
+            dforce[:, slipping] = df
     if not jacobian:
         return force, state, w_start, passes, None
-    forgot = np.any(state != STICK, axis=0)
-    dw0 = np.zeros((n, 2, 3 * P))                           # stuck: w_0 = 0, the gauge
-    if np.any(forgot):
-        system = np.eye(2) - history[-1, forgot]
-        dw0[forgot] = np.linalg.solve(system, dw[forgot])
-    dforce -= k_t[None, :, None, None] * np.einsum("jcab,cbx->jcax", history, dw0)
+    held = np.flatnonzero(stuck)
+    if held.size:
+        dq = np.zeros((N, held.size, 2, 3 * P))
+        dq[:, :, 0, 1::3] = Phi[:, None, :]
+        dq[:, :, 1, 2::3] = Phi[:, None, :]
+        dw0 = _stuck_slider_derivative(q[:, held], rho[:, held], drho_dw[:, held], Phi,
+                                       w_start[held], active[held])
+        dforce[:, held] = k_t[None, held, None, None] * (dq - dw0[None])
     coeff = hm.harmonic_coefficients(dforce, H)[kept_rows]  # (P, n, 2, 3P)
     J = np.zeros((n, 3 * P, 3 * P))
     J[:, 1::3, :] = np.moveaxis(coeff[:, :, 0, :], 0, 1)
     J[:, 2::3, :] = np.moveaxis(coeff[:, :, 1, :], 0, 1)
     return force, state, w_start, passes, J
+
+
+STUCK_TOLERANCE = 1e-10      # a stuck slider may lie outside a disk by this × (max|q| + max ρ)
+STUCK_ITERATIONS = 64        # cutting-plane steps of the stuck test (more: treated as slipping)
+
+
+def _stuck_slider_derivative(q, rho, drho_dw, Phi, w, active):
+    r"""∂w₀/∂X (m, 2, 3P) of stuck sliders w₀ (m, 2) with active disks ``active`` (m, 2) (sample
+    indices, −1 none): the formulas of :func:`_march_2d`. q (N, m, 2), ρ, ∂ρ/∂w_n (N, m)."""
+    m, C = w.shape[0], 3 * Phi.shape[1]
+    contacts = np.arange(m)
+
+    def rows(j):              # dq_j (m, 2, C) and dρ_j (m, C) of the samples j (m,)
+        dq = np.zeros((m, 2, C))
+        dq[:, 0, 1::3] = Phi[j]
+        dq[:, 1, 2::3] = Phi[j]
+        drho = np.zeros((m, C))
+        drho[:, 0::3] = drho_dw[j, contacts][:, None] * Phi[j]
+        return dq, drho
+
+    j, k = np.maximum(active[:, 0], 0), np.maximum(active[:, 1], 0)
+    dq_j, drho_j = rows(j)
+    q_j, rho_j = q[j, contacts], rho[j, contacts]
+    unit = (w - q_j) / rho_j[:, None]
+    ratio = rho_j / np.maximum(np.linalg.norm(q_j, axis=1), 1e-300)
+    M = np.eye(2) - ratio[:, None, None] * (np.eye(2) - unit[:, :, None] * unit[:, None, :])
+    one = M @ dq_j + unit[:, :, None] * drho_j[:, None, :]
+    dq_k, drho_k = rows(k)
+    n_j, n_k = w - q_j, w - q[k, contacts]
+    normals = np.stack([n_j, n_k], axis=1)                              # (m, 2, 2)
+    rhs = np.stack([np.einsum("ma,mac->mc", n_j, dq_j) + rho_j[:, None] * drho_j,
+                    np.einsum("ma,mac->mc", n_k, dq_k) + rho[k, contacts][:, None] * drho_k], axis=1)
+    two = active[:, 1] >= 0
+    det = np.linalg.det(normals)
+    corner = two & (np.abs(det) > 1e-12 * np.einsum("mab,mab->m", normals, normals))
+    result = np.where((active[:, 0] >= 0)[:, None, None], one, 0.0)
+    if np.any(corner):
+        result[corner] = np.linalg.solve(normals[corner], rhs[corner])
+    return result
 
 
 def step(p, q, normal_force, slider_previous):

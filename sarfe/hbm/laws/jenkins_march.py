@@ -144,3 +144,115 @@ def final_pass(q, rho, drho_dw, k_t, start, Phi, jacobian):
         if jacobian:
             dw_end[c] = dw
     return force, state, dforce, history, dw_end
+
+
+@njit(cache=True, inline="always")
+def _disk_projection(q0, q1, rho):
+    """Point of the disk |w − q| ≤ ρ nearest to the origin → (w0, w1, active)."""
+    d = np.sqrt(q0 * q0 + q1 * q1)
+    if d <= rho:
+        return 0.0, 0.0, False
+    s = 1.0 - rho / d
+    return q0 * s, q1 * s, True
+
+
+@njit(cache=True)
+def _nearest_in_disks(q, rho, c, members, tolerance):
+    r"""min |w| over the intersection of the disks ``members`` (indices of samples, ≤ 3, −1 unused)
+    of contact c, by enumeration: the minimizer is the origin, the projection of the origin onto
+    one disk, or an intersection point of two circles. Returns (w0, w1, a0, a1, found)."""
+    best, b0, b1, ba0, ba1, found = np.inf, 0.0, 0.0, -1, -1, False
+    m = members.size
+    for x in range(m):
+        s = members[x]
+        if s < 0:
+            continue
+        for y in range(x, m):
+            t = members[y]
+            if t < 0:
+                continue
+            points = np.empty((2, 2))
+            count = 0
+            if y == x:
+                p0, p1, active = _disk_projection(q[s, c, 0], q[s, c, 1], rho[s, c])
+                points[0, 0], points[0, 1] = p0, p1
+                count = 1
+                a0, a1 = (s if active else -1), -1
+            else:
+                d0, d1 = q[t, c, 0] - q[s, c, 0], q[t, c, 1] - q[s, c, 1]
+                d = np.sqrt(d0 * d0 + d1 * d1)
+                r1, r2 = rho[s, c], rho[t, c]
+                if d <= 0.0 or d > r1 + r2 or d < abs(r1 - r2):
+                    continue
+                a = (r1 * r1 - r2 * r2 + d * d) / (2.0 * d)
+                h = np.sqrt(max(r1 * r1 - a * a, 0.0))
+                for sign in range(2):
+                    g = h if sign == 0 else -h
+                    points[sign, 0] = q[s, c, 0] + (a * d0 - g * d1) / d
+                    points[sign, 1] = q[s, c, 1] + (a * d1 + g * d0) / d
+                count = 2
+                a0, a1 = s, t
+            for i in range(count):
+                w0, w1 = points[i, 0], points[i, 1]
+                norm = np.sqrt(w0 * w0 + w1 * w1)
+                if norm >= best:
+                    continue
+                inside = True
+                for z in range(m):
+                    u = members[z]
+                    if u < 0 or u == a0 or u == a1:
+                        continue
+                    e0, e1 = w0 - q[u, c, 0], w1 - q[u, c, 1]
+                    if np.sqrt(e0 * e0 + e1 * e1) - rho[u, c] > tolerance:
+                        inside = False
+                        break
+                if inside:
+                    best, b0, b1, ba0, ba1, found = norm, w0, w1, a0, a1, True
+    return b0, b1, ba0, ba1, found
+
+
+@njit(cache=True)
+def stick_projection(q, rho, tolerance, max_iterations):
+    r"""Gauge slider of contacts that can stick the whole period: the point nearest to the
+    assembly position w = 0 of S = ∩_j {w : |w − q_j| ≤ ρ_j} (the constant sliders that never slip).
+
+    Cutting planes on the disks: from the working set (the active disks and the most violated
+    one, ≤ 3) the exact minimizer of |w| over their intersection (:func:`_nearest_in_disks`); |w|
+    grows at every step, so the active set never repeats. Stops when no disk is violated by more
+    than ``tolerance`` [m] (stuck), when the working set has an empty intersection (S = ∅: the
+    contact slips every period) or after ``max_iterations`` (treated as slipping). A contact that
+    separates anywhere (ρ_j ≤ 0) forgets its slider: not stuck.
+    q (N, n, 2) [m], ρ (N, n) [m]. Returns (w (n, 2) [m], active (n, 2) sample indices of the disks
+    whose boundary holds w (−1: none), stuck (n,) bool).
+    """
+    N, n = rho.shape
+    w = np.zeros((n, 2))
+    active = np.full((n, 2), -1, np.int64)
+    stuck = np.zeros(n, np.bool_)
+    members = np.full(3, -1, np.int64)
+    for c in range(n):
+        separates = False
+        for j in range(N):
+            if rho[j, c] <= 0.0:
+                separates = True
+                break
+        if separates:
+            continue
+        w0, w1, a0, a1 = 0.0, 0.0, -1, -1
+        for _ in range(max_iterations):
+            worst, k = tolerance, -1
+            for j in range(N):
+                e0, e1 = w0 - q[j, c, 0], w1 - q[j, c, 1]
+                violation = np.sqrt(e0 * e0 + e1 * e1) - rho[j, c]
+                if violation > worst:
+                    worst, k = violation, j
+            if k < 0:
+                stuck[c] = True
+                w[c, 0], w[c, 1] = w0, w1
+                active[c, 0], active[c, 1] = a0, a1
+                break
+            members[0], members[1], members[2] = a0, a1, k
+            w0, w1, a0, a1, found = _nearest_in_disks(q, rho, c, members, tolerance)
+            if not found:
+                break
+    return w, active, stuck

@@ -15,8 +15,8 @@ response_h5.py (response.h5), vtk.py (VTU/PVD arrays), plots.py (PNGs).
                    radiating_nodes=None, contact_marker=None) -> dict
     contact_markers(n_points, contact_nodes) -> (n_points,) int32
     write_pvd(path, [(time_or_frequency, vtu_filename), ...]) -> Path
-    write_erp_sweep(directory, points, triangles, point_data_per_frequency, frequencies_hz,
-                    basename="erp") -> Path (.pvd)
+    write_erp_sweep(directory, points, triangles, point_data_per_frequency (list | j → dict),
+                    frequencies_hz, basename="erp", workers=1) -> Path (.pvd)
     write_deflection_animation(directory, points, triangles, displacement_harmonics (2H+1, n, 3),
                                n_frames=24, omega=None, basename="deflection", point_data=None) -> Path (.pvd)
     plot_erp_sweep(path, frequencies_hz, level_db, stable=None, level_a_db=None, title=None,
@@ -27,7 +27,8 @@ response_h5.py (response.h5), vtk.py (VTU/PVD arrays), plots.py (PNGs).
     plot_third_octave(path, nominal_hz, level_dba, linear_level_dba=None, ...) -> Path
     plot_contributions(path, names, level_dba, share_a) -> Path
     write_report_html(path, summary, images={key: png}, notes=None) -> Path   (report.py, jinja2)
-    render_surface(path, points, triangles, values, label, ...) -> (Path, renderer)  (render.py)
+    render_surface(path, points, triangles, values, label, ...) -> (Path, renderer)  (render.py;
+    start_render(jobs) / finish_render(run) render in a child while the caller goes on)
 
 Each writer's module (and its library: matplotlib, h5py, jinja2, pyvista) is imported on first
 use (:mod:`sarfe.lazy`), so a run that writes no PNG never imports matplotlib.
