@@ -39,6 +39,7 @@ q_r (n_r, residual modes)]. Units: K [N/m], M [kg], frequencies [Hz].
 from __future__ import annotations
 
 import time
+import weakref
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -266,7 +267,8 @@ class _Partial:
 
 
 def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, block_size=16, tol=1e-8,
-                         seed=0, max_columns=None, store_mass_products=True):
+                         seed=0, max_columns=None, store_mass_products=True, release_operator=None,
+                         keep_prefix=None):
     """Lowest modes of K_ii φ = ω² M_ii φ by block shift-invert Lanczos (σ = 0), full M-reorthogonalization.
 
     Krylov space of A = K_ii⁻¹ M_ii from a block of ``block_size`` columns: every step is ONE
@@ -280,7 +282,11 @@ def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, blo
     two full Gram–Schmidt passes, row-major blocks and a too-small initial store.
     ``store_mass_products=False`` keeps M Q only for the last two blocks (half the memory, one
     more sparse product M·(n, b) per step: the full pass's Qᵀ (M w)); the spectrum-slicing worker
-    runs beside this process then.
+    runs beside this process then. ``release_operator()``, when given, is called after the last
+    operator application, before the Ritz vectors are formed (the caller frees its factor there:
+    the factor, the Krylov store and the modes are not alive at once). ``keep_prefix(modes)``,
+    when given, receives a capped run's converged prefix (n, k) and returns what ``_Partial``
+    holds instead (the spectrum-slicing sink's handle: the vectors wait on disk).
     """
     n = mass_ii.shape[0]
     rng = np.random.default_rng(seed)
@@ -352,8 +358,12 @@ def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, blo
             strict = residual <= tol * np.abs(values)
             prefix = int(np.argmin(strict)) if not strict.all() else len(strict)
             if 0 < prefix < len(values):
-                return _Partial(omega2[:prefix], basis @ vectors[:, :prefix],
-                                0.5 * (omega2[prefix - 1] + omega2[prefix]), m_new)
+                if release_operator is not None:
+                    release_operator()
+                modes = basis @ vectors[:, :prefix]
+                return _Partial(omega2[:prefix], modes if keep_prefix is None else
+                                keep_prefix(modes), 0.5 * (omega2[prefix - 1] + omega2[prefix]),
+                                m_new)
         if m_new + q.shape[1] > capacity:
             capacity = min(n, max(2 * capacity, m_new + q.shape[1]))
             grown_store = np.empty((n, capacity), order="F")
@@ -369,22 +379,28 @@ def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, blo
         m_new += q.shape[1]
     if not done:
         return None  # Krylov space exhausted before convergence (tiny interior): caller uses ARPACK
+    if release_operator is not None:
+        release_operator()
     modes = basis @ vectors[:, :wanted]
     return omega2[:wanted], modes
 
 
-def _start_upper_slices(k_ii, m_ii, cutoff_hz, cap, workers, held):
-    """With ``workers`` ≥ 2 (None: the usable cores) and PARDISO: before run 0, a forked worker
-    that counts the modes below the cutoff and, when they outnumber what run 0 finds in its capped
-    space, slices the upper part of the spectrum while this process runs run 0 and the lower
-    part (:func:`sarfe.reduction.spectrum_slicing.start_upper_slices`). None otherwise."""
+def _two_processes(workers):
+    """Whether spectrum slicing may run in two processes: ``workers`` ≥ 2 (None: the usable
+    cores) and PARDISO (the worker's inertia counts)."""
     from sarfe.fe.linear_solvers import available_solvers
-    from sarfe.reduction.spectrum_slicing import start_upper_slices
     from sarfe.workers import available_cpus
 
     workers = available_cpus() if workers is None else int(workers)
-    if workers < 2 or "pardiso" not in available_solvers():
-        return None
+    return workers >= 2 and "pardiso" in available_solvers()
+
+
+def _start_upper_slices(k_ii, m_ii, cutoff_hz, cap, held):
+    """Before run 0, a forked worker that counts the modes below the cutoff and, when they
+    outnumber what run 0 finds in its capped space, slices the upper part of the spectrum while
+    this process runs run 0 and the lower part
+    (:func:`sarfe.reduction.spectrum_slicing.start_upper_slices`). None where it cannot start."""
+    from sarfe.reduction.spectrum_slicing import start_upper_slices
 
     def drop_inherited_factor():
         held["factor"] = None     # the worker's copy of K_ii's factor (it has its own shifts)
@@ -395,6 +411,37 @@ def _start_upper_slices(k_ii, m_ii, cutoff_hz, cap, workers, held):
                                   int(_PARALLEL_MODES_PER_COLUMN * cap), drop_inherited_factor)
     except OSError:               # no temporary file or no process: one process does it all
         return None
+
+
+def _park(*arrays):
+    """Write (n, k) arrays (or None) to a temporary file on disk and return a function that reads
+    them back, in their memory order, and removes the file (:mod:`sarfe.reduction.mode_sinks`)."""
+    from sarfe.reduction.mode_sinks import FileSink
+
+    sink = FileSink(next(a.shape[0] for a in arrays if a is not None))
+    try:
+        parked = [None if a is None else (sink.put(a), "F" if np.isfortran(a) else "C")
+                  for a in arrays]
+    except BaseException:
+        sink.remove()
+        raise
+
+    def restore():
+        try:
+            return [None if p is None else np.array(sink.read(p[0]), order=p[1])
+                    for p in parked]
+        finally:
+            sink.remove()
+
+    weakref.finalize(restore, sink.remove)      # an error on the way: the file goes too
+    return restore
+
+
+def _file_sink(rows):
+    """A :class:`sarfe.reduction.mode_sinks.FileSink` for this process's found vectors."""
+    from sarfe.reduction.mode_sinks import FileSink
+
+    return FileSink(rows)
 
 
 def _worker_splits(upper):
@@ -408,19 +455,23 @@ def _worker_splits(upper):
         return False
 
 
-def _slice(k_ii, m_ii, cutoff_hz, partial, progress, timings, upper):
+def _slice(k_ii, m_ii, cutoff_hz, partial, progress, timings, upper, sink):
     """Modes up to the cutoff by spectrum slicing from run 0's converged prefix (with the upper
-    part from ``upper``'s worker when given): (ω², Φ), or None when slicing cannot run (no
-    PARDISO for the inertia) or a gap's count was not reached."""
+    part from ``upper``'s worker when given; ``sink``: where the found vectors wait, None: in
+    memory): (ω², Φ as column blocks), or None when slicing cannot run (no PARDISO for the
+    inertia) or a gap's count was not reached."""
     from sarfe.fe.linear_solvers import available_solvers
     from sarfe.reduction.spectrum_slicing import SlicingFailed, sliced_modes
 
     if "pardiso" not in available_solvers():
+        if sink is not None:
+            sink.remove()
         return None
     try:
         omega2, modes, record = sliced_modes(k_ii, m_ii, (2 * np.pi * cutoff_hz) ** 2,
                                              partial.omega2, partial.modes, partial.boundary,
-                                             progress=progress, solver="pardiso", upper=upper)
+                                             progress=progress, solver="pardiso", upper=upper,
+                                             sink=sink)
     except SlicingFailed as exc:
         timings["slicing"] = {"failed": str(exc)}
         return None
@@ -549,6 +600,7 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
         del extra
     static = inverse(loads) if loads is not None else None
     lap("residual_static")
+    restore = None                  # set when the statics wait on disk (two slicing processes)
 
     if (mode_count or 0) > 0 or (cutoff_hz is not None and mode_count is None):
         if eigensolver not in ("block", "arpack"):
@@ -558,18 +610,32 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
             # many modes up to a cutoff: cap run 0's Krylov space (two n × m arrays), slice the rest
             cap = max(_SLICE_COLUMNS, int(_SLICE_ENTRIES // max(len(interior), 1))) \
                 if cutoff_hz is not None and mode_count is None else None
-            upper = _start_upper_slices(k_ii, m_ii, cutoff_hz, cap, workers, held) \
-                if cap is not None and cap < len(interior) else None
+            two = cap is not None and cap < len(interior) and _two_processes(workers)
+            if two:
+                # two processes will each hold a Krylov store and a factor: Ψ, the residual loads
+                # and their statics wait on disk, dropped before the fork so neither keeps them
+                restore = _park(psi, None if with_boundary else boundary_load, loads, static)
+                psi = boundary_load = loads = static = None
+            upper = _start_upper_slices(k_ii, m_ii, cutoff_hz, cap, held) if two else None
             if upper is not None and not _worker_splits(upper):
                 upper = None              # few modes: run 0 as in one process
+            # two processes: the found vectors wait on disk while both slice (mode_sinks)
+            sink = _file_sink(len(interior)) if upper is not None else None
+
+            def release_factor():         # run 0 is over: K_ii's factor goes before its modes
+                held["factor"] = None     # (inverse() factorizes again if a fallback needs it)
+
             found = _block_lanczos_modes(m_ii, inverse, mode_count, cutoff_hz, progress,
-                                         max_columns=cap, store_mass_products=upper is None)
+                                         max_columns=cap, store_mass_products=upper is None,
+                                         release_operator=release_factor if cap else None,
+                                         keep_prefix=None if sink is None else sink.put)
             if isinstance(found, _Partial):
                 held["factor"] = None     # K_ii's factor is not used by the shifted runs
-                found = _slice(k_ii, m_ii, cutoff_hz, found, progress, timings, upper)
+                found = _slice(k_ii, m_ii, cutoff_hz, found, progress, timings, upper, sink)
             elif upper is not None:
                 upper.cancel()            # run 0 found them all after all
-            upper = None
+                sink.remove()
+            upper = sink = None
             if found is None and cap is not None:   # slicing impossible: one uncapped run
                 found = _block_lanczos_modes(m_ii, inverse, mode_count, cutoff_hz, progress)
         if found is None:
@@ -580,6 +646,9 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
     else:
         omega2, blocks = np.empty(0), np.empty((len(interior), 0))
     held["factor"] = None
+    if restore is not None:
+        psi, boundary_load, loads, static = restore()
+        boundary_load = loads[:, :n_b] if with_boundary else boundary_load
     lap("normal_modes")
 
     # T's interior rows [Ψ, Φ, Φ_r] in one array, filled in place (Φ arrives in column blocks

@@ -30,10 +30,18 @@ forked before run 0 counts N(λ_c) and tells this process whether it splits; it 
 that N(λ_s) ≈ (N(λ_c) + lead)/2 (:func:`split_count`: this process's run 0 finds its modes at a
 lower cost per mode than the shifted runs, ``lead`` modes ahead) from one or two factorizations
 whose inertia gives exact counts (:func:`split_shift`), and runs the chain over (λ_s, λ_c] from
-nothing pending, writing its modes to a shared-memory file; this process runs run 0 and the
-chain over (boundary, λ_s], then appends the worker's block. The split and both chains' shifts
-follow from the model and the counts alone, so the modes do not depend on timing; with one core,
-no fork, or inside a daemon process (a Dask worker) one chain covers it all.
+nothing pending; this process runs run 0 and the chain over (boundary, λ_s], then appends the
+worker's block. The split and both chains' shifts follow from the model and the counts alone, so
+the modes do not depend on timing; with one core, no fork, or inside a daemon process (a Dask
+worker) one chain covers it all.
+
+Memory with two processes: each holds a Krylov store (up to ``max_columns`` = 400 columns, 0.66
+GB at 206k DOFs) and a factor of K − σM (0.32 GB) at once, so the vectors both have found wait
+on disk until Craig–Bampton copies them (:class:`~sarfe.reduction.mode_sinks.FileSink`, run 0's
+prefix included), and run 0's factor of K_ii goes before its Ritz vectors are formed. A smaller
+column cap would save memory too but costs CPU steeply: each run spends ≈ 150 columns before its
+window converges (door trim at 5 mm, cap 240 with windows of 48: 262 s CPU instead of 100 s;
+benchmarks/results/linear.md, P1 memory).
 
 All runs use the M inner product; a Ritz pair is converged when ‖A φ − θ φ‖_M ≤ tol·|θ| (relative
 to its own θ: a value next to the shift, with a huge θ, must not loosen the test for the others).
@@ -47,6 +55,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sarfe.fe.linear_solvers import shifted_factorizer
+from sarfe.reduction.mode_sinks import FileSink, MemorySink
 from sarfe.reduction.craig_bampton import _m_orthonormal, lanczos_extend
 
 
@@ -170,23 +179,25 @@ def _slice_run(mass, factor, shift, lower, counted, right_edge, pending, max_col
 @dataclass(frozen=True, eq=False)
 class ChainStart:
     """Where a chain of shifted runs begins: every eigenvalue ≤ ``lower`` is someone else's
-    (``counted`` of them, a certified count), and ``pending`` (k,) with ``pending_modes`` (n, k)
-    are converged eigenpairs in (lower, right_edge] not yet certified (run 0's, or none)."""
+    (``counted`` of them, a certified count), and ``pending`` (k,) ascending with
+    ``pending_modes`` (the chain's sink's handle of (n, k) vectors) are converged eigenpairs in
+    (lower, right_edge] not yet certified (run 0's, or none)."""
 
     lower: float
     counted: int
     right_edge: float
     pending: np.ndarray
-    pending_modes: np.ndarray
+    pending_modes: object
 
 
-def slice_chain(mass, factor_at, start, top_omega2, total, store, slice_modes=80, max_columns=400,
+def slice_chain(mass, factor_at, start, top_omega2, total, sink, slice_modes=80, max_columns=400,
                 progress=None):
     """Shifted runs that find every eigenpair in (start.lower, top_omega2] (module docstring).
 
     factor_at(σ): factor of K − σM with its inertia; total: eigenvalues ≤ top_omega2 (its count).
-    ``store(values, modes)`` receives the eigenpairs gap by gap in ascending order (values (k,),
-    modes (n, k) M-normalized), so a caller can write them where they belong. Returns the record
+    ``sink`` (:mod:`sarfe.reduction.mode_sinks`) takes each run's vectors as they are formed and
+    keeps the certified eigenpairs gap by gap in ascending order (values (k,), modes (n, k)
+    M-normalized); a run's pending vectors go in at once too. Returns the record
     {"shifts", "columns", "negative_pivots", "factorizations"}. Raises SlicingFailed when a gap's
     count is not reached within ``max_columns`` even at a quarter of the width.
     """
@@ -219,14 +230,14 @@ def slice_chain(mass, factor_at, start, top_omega2, total, store, slice_modes=80
         record["columns"].append(int(len(lam)))
         last = shift >= top_omega2
         if use_pending:
-            keep_pending = np.asarray(pending) <= shift
-            if keep_pending.any():
-                store(np.asarray(pending)[keep_pending],
-                      pending_modes if keep_pending.all() else pending_modes[:, keep_pending])
+            keep_pending = np.count_nonzero(np.asarray(pending) <= shift)   # pending ascend
+            if keep_pending:
+                sink.keep(np.asarray(pending)[:keep_pending],
+                          sink.prefix(pending_modes, keep_pending))
         order = np.flatnonzero(take)
         order = order[np.argsort(lam[order])]
         if len(order):
-            store(lam[order], eigenvectors(order))
+            sink.keep(lam[order], sink.put(eigenvectors(order)))
         counted = record["negative_pivots"][-1]
         lower = shift
         if progress is not None:
@@ -244,7 +255,7 @@ def slice_chain(mass, factor_at, start, top_omega2, total, store, slice_modes=80
         else:
             right_edge = float(lam[above[-1]]) if len(above) else shift
         pending = list(lam[chosen])
-        pending_modes = eigenvectors(chosen)
+        pending_modes = sink.put(eigenvectors(chosen))
         del eigenvectors             # the run's Krylov store goes before the next one's
         # eigenvalues per rad/s over this run's coverage: the next shift's first guess
         first = np.sqrt(max(lam[order[0]], 0.0)) if len(order) else np.sqrt(shift)
@@ -257,19 +268,36 @@ def slice_chain(mass, factor_at, start, top_omega2, total, store, slice_modes=80
 
 def sliced_modes(stiffness, mass, cutoff_omega2, found_omega2, found_modes, boundary,
                  slice_modes=80, max_columns=400, progress=None, solver="auto", upper=None,
-                 factor_at=None, total=None):
+                 factor_at=None, total=None, sink=None):
     """All eigenpairs of K φ = λ M φ with λ ≤ ``cutoff_omega2`` (module docstring).
 
-    found_omega2 (k,), found_modes (n, k): run 0's converged eigenpairs, all λ ≤ ``boundary``
-    (a value between them and run 0's next Ritz value). ``upper``: an :class:`UpperSlices`
-    already working in a second process; this process then stops at its split λ_s and joins it
-    (or does it all when the worker planned no split). ``factor_at``/``total``: a
-    :func:`shifted_factorizer` and the count below the cutoff when the caller has them. Returns λ (ascending), Φ (Φᵀ M Φ = I) as a list of
-    column blocks in that order (no stacked copy of n × n_m), and a record {"shifts", "columns",
-    "negative_pivots", "factorizations", "modes_below_cutoff"} (with "upper": the other
-    process's record, "split", "split_count", and "join_wait_s": wall seconds this process
-    waited for the other's block). Raises SlicingFailed when a gap's count is not reached.
+    found_omega2 (k,), found_modes: run 0's converged eigenpairs, all λ ≤ ``boundary`` (a value
+    between them and run 0's next Ritz value); found_modes is (n, k), or ``sink``'s handle of it
+    when a sink is given (:mod:`sarfe.reduction.mode_sinks`; default: in memory). ``upper``: an
+    :class:`UpperSlices` already working in a second process; this process then stops at its
+    split λ_s and joins it (or does it all when the worker planned no split).
+    ``factor_at``/``total``: a :func:`shifted_factorizer` and the count below the cutoff when the
+    caller has them. Returns λ (ascending), Φ (Φᵀ M Φ = I) as a list of column blocks in that
+    order (no stacked copy of n × n_m; maps of the sinks' files when on disk), and a record
+    {"shifts", "columns", "negative_pivots", "factorizations", "modes_below_cutoff"} (with
+    "upper": the other process's record, "split", "split_count", and "join_wait_s": wall
+    seconds this process waited for the other's block). Raises SlicingFailed when a gap's count
+    is not reached (the sink's file is removed).
     """
+    sink = MemorySink() if sink is None else sink
+    try:
+        return _sliced_modes(stiffness, mass, cutoff_omega2, found_omega2, found_modes, boundary,
+                             slice_modes, max_columns, progress, solver, upper, factor_at, total,
+                             sink)
+    except BaseException:
+        sink.remove()
+        if upper is not None:
+            upper.cancel()
+        raise
+
+
+def _sliced_modes(stiffness, mass, cutoff_omega2, found_omega2, found_modes, boundary,
+                  slice_modes, max_columns, progress, solver, upper, factor_at, total, sink):
     record = {"factorizations": 0}
     split = None
     if upper is not None:
@@ -287,42 +315,31 @@ def sliced_modes(stiffness, mass, cutoff_omega2, found_omega2, found_modes, boun
             raise SlicingFailed(f"backend {factor.name} reports no inertia")
         total = int(factor.negative_pivots)                     # eigenvalues below the cutoff
         del factor
-    values, modes = [], []
-
-    def store(lam, vectors):
-        values.append(lam)
-        modes.append(vectors)
-
     top, top_count = (cutoff_omega2, total) if upper is None else (split, split_count)
     start = ChainStart(0.0, 0, float(boundary), np.asarray(found_omega2, dtype=float),
-                       np.asarray(found_modes))
-    try:
-        chain = slice_chain(mass, factor_at, start, top, top_count, store, slice_modes,
-                            max_columns, progress)
-    except BaseException:
-        if upper is not None:
-            upper.cancel()
-        raise
+                       found_modes)
+    chain = slice_chain(mass, factor_at, start, top, top_count, sink, slice_modes, max_columns,
+                        progress)
     record.update(chain, factorizations=record["factorizations"] + chain["factorizations"],
                   modes_below_cutoff=int(total))
+    upper_values, upper_modes = np.zeros(0), []
     if upper is not None:
         record.update(split=float(split), split_count=int(split_count))
         try:
             waited = time.perf_counter()
             upper_values, upper_modes, record["upper"] = upper.join()
             record["join_wait_s"] = time.perf_counter() - waited   # idle here (a clock, not a result)
-            values.append(upper_values)
-            modes.append(upper_modes)
         except SlicingFailed as exc:      # the worker's part, again in this process
             record["upper_failed"] = str(exc)
             start = ChainStart(split, split_count, split, np.zeros(0),
-                               np.zeros((mass.shape[0], 0)))
-            rest = slice_chain(mass, factor_at, start, cutoff_omega2, total, store, slice_modes,
+                               sink.put(np.zeros((mass.shape[0], 0))))
+            rest = slice_chain(mass, factor_at, start, cutoff_omega2, total, sink, slice_modes,
                                max_columns, progress)
             record["factorizations"] += rest["factorizations"]
             for key in ("shifts", "columns", "negative_pivots"):
                 record[key] = record[key] + rest[key]
-    omega2 = np.concatenate(values) if values else np.zeros(0)
+    omega2 = np.concatenate([sink.values(), upper_values])
+    modes = sink.blocks() + upper_modes
     if np.any(np.diff(omega2) < 0):       # blocks are sorted and follow each other; make sure
         order = np.argsort(omega2)
         return omega2[order], [np.hstack(modes)[:, order]], record
@@ -370,8 +387,9 @@ class UpperSlices:
     ``splits()`` → whether the worker slices the upper part: it counted the eigenvalues below the
     cutoff and found enough to be worth a split (else it has exited). ``plan()`` → (total, lower,
     counted): that count, and the split λ_s with its count N(λ_s) — or (total, None, None)
-    without a split. ``join()`` → (λ ascending (k,), Φ (n, k) read from the worker's shared file,
-    the worker's record) for (λ_s, cutoff], or raises SlicingFailed."""
+    without a split. ``join()`` → (λ ascending (k,), Φ as column blocks mapped from the worker's
+    file (:class:`~sarfe.reduction.mode_sinks.FileSink`), the worker's record) for
+    (λ_s, cutoff], or raises SlicingFailed."""
 
     process: object
     connection: object
@@ -405,21 +423,16 @@ class UpperSlices:
 
     def join(self):
         try:
-            status, payload, record = self.connection.recv()
+            status, payload, record, kept = self.connection.recv()
         except EOFError:
-            status, payload, record = "error", "the slicing worker died", None
+            status, payload, record, kept = "error", "the slicing worker died", None, None
         self.process.join()
         self.connection.close()
-        try:
-            if status != "ok":
-                raise SlicingFailed(f"upper slices: {payload}")
-            count = os.path.getsize(self.path) // (8 * self.size)
-            # mapped, not read: the pages are freed once the caller has copied the block
-            modes = np.memmap(self.path, dtype=float, mode="r", shape=(self.size, count),
-                              order="F") if count else np.zeros((self.size, 0))
-        finally:
+        if status != "ok":
             _remove(self.path)
-        return payload, modes, record
+            raise SlicingFailed(f"upper slices: {payload}")
+        # mapped, not read: the pages are page cache, copied block by block by the caller
+        return payload, FileSink(self.size, path=self.path).blocks(kept), record
 
     def cancel(self):
         if self.process.is_alive():
@@ -442,20 +455,17 @@ def start_upper_slices(stiffness, mass, cutoff_omega2, lead, min_total, on_fork=
     ``min_total``, finds every eigenpair in (λ_s, cutoff], N(λ_s) ≈ (total + ``lead``)/2
     (:func:`split_count`, :func:`split_shift`; this process takes (0, λ_s]). K, M are shared
     copy-on-write; ``on_fork()`` runs first in the worker to free what it inherited and does not
-    need (the parent's factor of K_ii). The modes
-    go to a file in /dev/shm (memory, not disk, on Linux) that :meth:`UpperSlices.join` reads and
-    removes. Returns an :class:`UpperSlices`, or None where fork is not available or this
+    need (the parent's factor of K_ii). The modes go to a file in the temporary directory (a
+    :class:`~sarfe.reduction.mode_sinks.FileSink`: on disk, not in either process's memory) that
+    :meth:`UpperSlices.join` maps and removes. Returns an :class:`UpperSlices`, or None where fork is not available or this
     process is a daemon (a Dask or multiprocessing worker may not have children). The worker's
     results do not depend on timing: the split and its shifts follow from counts alone."""
     import multiprocessing
-    import tempfile
 
     if "fork" not in multiprocessing.get_all_start_methods() or \
             multiprocessing.current_process().daemon:      # e.g. a Dask worker: no children
         return None
-    directory = "/dev/shm" if os.path.isdir("/dev/shm") else None
-    handle, path = tempfile.mkstemp(prefix="sarfe-slices-", suffix=".f64", dir=directory)
-    os.close(handle)
+    path = FileSink(mass.shape[0]).path
     context = multiprocessing.get_context("fork")
     receive, send = context.Pipe(duplex=False)
     process = context.Process(target=_upper_worker, daemon=True,
@@ -471,9 +481,9 @@ def _upper_worker(connection, stiffness, mass, cutoff_omega2, lead, min_total, o
     """The forked side of :func:`start_upper_slices`: its own PARDISO analysis (the parent's
     instance is not shared), the count below the cutoff (sent at once: this process's run 0
     waits for it), the split by count (sent when placed: this process needs it after run 0),
-    then a chain from (λ_s, N(λ_s)) with nothing pending, each gap's modes appended to ``path``
-    in ascending order."""
-    values = []
+    then a chain from (λ_s, N(λ_s)) with nothing pending, its vectors appended to ``path`` as
+    they are formed (a :class:`~sarfe.reduction.mode_sinks.FileSink`; the kept columns go to
+    this process with the values)."""
     try:
         if on_fork is not None:
             on_fork()
@@ -490,20 +500,16 @@ def _upper_worker(connection, stiffness, mass, cutoff_omega2, lead, min_total, o
             return
         lower, counted = split_shift(count_at, cutoff_omega2, total, split_count(total, lead))
         connection.send(("plan", lower, counted))
-        with open(path, "wb") as out:
-            def store(lam, vectors):
-                np.asfortranarray(vectors).T.tofile(out)     # column-major: column after column
-                values.append(lam)
-
-            start = ChainStart(lower, counted, lower, np.zeros(0), np.zeros((mass.shape[0], 0)))
-            record = slice_chain(mass, factor_at, start, cutoff_omega2, total, store, slice_modes,
-                                 max_columns)
+        sink = FileSink(mass.shape[0], path=path)
+        start = ChainStart(lower, counted, lower, np.zeros(0), sink.put(np.zeros((sink.rows, 0))))
+        record = slice_chain(mass, factor_at, start, cutoff_omega2, total, sink, slice_modes,
+                             max_columns)
         record["factorizations"] += counting["factorizations"]    # the counts
-        omega2 = np.concatenate(values) if values else np.zeros(0)
+        omega2 = sink.values()
         if len(omega2) != total - counted or np.any(np.diff(omega2) < 0):
             raise SlicingFailed(f"{len(omega2)} modes for a count of {total - counted}")
-        connection.send(("ok", omega2, record))
+        connection.send(("ok", omega2, record, sink.kept()))
     except Exception as exc:  # noqa: BLE001 - reported to the parent, which falls back
-        connection.send(("error", f"{type(exc).__name__}: {exc}", None))
+        connection.send(("error", f"{type(exc).__name__}: {exc}", None, None))
     finally:
         connection.close()
