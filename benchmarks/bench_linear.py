@@ -161,15 +161,16 @@ P1_CASE = ROOT / "cases" / "door_trim_p1.yaml"
 
 
 def _tree_memory_gb():
-    """(RSS, PSS) summed over this process and its children [GB] (/proc smaps_rollup; PSS splits
-    shared pages — K, M after fork, the modes file — between the processes that map them)."""
+    """(RSS, PSS, PSS of this process alone) summed over this process and its children [GB]
+    (/proc smaps_rollup; PSS splits shared pages — K, M after fork, a mapped modes file —
+    between the processes that map them)."""
     me = os.getpid()
     pids = [me]
     try:
         pids += [int(p) for p in open(f"/proc/{me}/task/{me}/children").read().split()]
     except OSError:
         pass
-    rss = pss = 0.0
+    rss = pss = own = 0.0
     for pid in pids:
         try:
             for line in open(f"/proc/{pid}/smaps_rollup"):
@@ -177,9 +178,28 @@ def _tree_memory_gb():
                     rss += int(line.split()[1]) / 1e6
                 elif line.startswith("Pss:"):
                     pss += int(line.split()[1]) / 1e6
+                    own += int(line.split()[1]) / 1e6 if pid == me else 0.0
         except OSError:
             pass
-    return rss, pss
+    return rss, pss, own
+
+
+def _slicing_files_gb():
+    """Bytes [GB] in the spectrum-slicing files: found vectors waiting on disk (page cache, not
+    process memory; sarfe-modes-* in the temporary directory) and, before, the worker's
+    /dev/shm file (memory, though in no process's PSS)."""
+    import glob
+    import tempfile
+
+    paths = glob.glob(os.path.join(tempfile.gettempdir(), "sarfe-modes-*")) + \
+        glob.glob("/dev/shm/sarfe-slices-*")
+    total = 0
+    for path in paths:
+        try:
+            total += os.path.getsize(path)
+        except OSError:
+            pass
+    return total / 1e9
 
 
 def run_p1():
@@ -190,13 +210,16 @@ def run_p1():
 
     from sarfe.pipeline.linear import build_linear_model
 
-    peak = {"rss": 0.0, "pss": 0.0}
+    peak = {"rss": 0.0, "pss": 0.0, "pss_self": 0.0, "files": 0.0, "files_max": 0.0}
     stop = threading.Event()
 
     def watch():
         while not stop.wait(0.1):
-            rss, pss = _tree_memory_gb()
-            peak["rss"], peak["pss"] = max(peak["rss"], rss), max(peak["pss"], pss)
+            rss, pss, own = _tree_memory_gb()
+            files = _slicing_files_gb()
+            peak["rss"], peak["files_max"] = max(peak["rss"], rss), max(peak["files_max"], files)
+            if pss > peak["pss"]:        # the peak's split between this process and the worker
+                peak.update(pss=pss, pss_self=own, files=files)
 
     threading.Thread(target=watch, daemon=True).start()
     load = os.getloadavg()[0]
@@ -210,6 +233,8 @@ def run_p1():
             "cpu_s": own_cpu, "children_cpu_s": children.ru_utime + children.ru_stime,
             "peak_rss_self_gb": _rss_gb(), "peak_rss_children_gb": children.ru_maxrss / 1e6,
             "peak_tree_rss_gb": peak["rss"], "peak_tree_pss_gb": peak["pss"],
+            "peak_pss_self_gb": peak["pss_self"], "slicing_files_at_peak_gb": peak["files"],
+            "slicing_files_max_gb": peak["files_max"],
             "stage_s": stage.timings, "free_dofs": stage.info["free_dofs"],
             "modes": stage.info["modes"], "residual_vectors": stage.info["residual_vectors"],
             "cutoff_hz": stage.info["cutoff_hz"],
@@ -218,17 +243,19 @@ def run_p1():
             "frequencies_hz": stage.reduced.mode_frequencies_hz.tolist()}
 
 
-def p1_lines(p1):
-    """linear.md's section on the P1 linear stage (one core vs two; rows 3+ carry a ``note``)."""
+def p1_lines(p1, memory=None):
+    """linear.md's section on the P1 linear stage (one core vs two; rows 3+ carry a ``note``) and,
+    with ``memory`` (linear.json "p1_memory"), what is alive at the two-process peak."""
     lines = ["", f"## P1 linear stage (issue 15): door trim 5 mm, cutoff {p1[0]['cutoff_hz'] / 1e3:.2f} kHz, one core vs two", "",
              "`sarfe.pipeline.linear.build_linear_model(cases/door_trim_p1.yaml)` in a fresh process "
              "(mesh from the cache), pinned to one core with taskset or free on two; MKL/OpenBLAS one "
              "thread per process. CPU = this process + the slicing worker. Peak memory of the process "
              "tree sampled every 0.1 s: RSS summed (counts pages shared by the two processes twice) "
-             "and PSS summed (shared pages split). Modes: below the split (this process: run 0 and its "
+             "and PSS summed (shared pages split), with its split this process / worker at the peak "
+             "sample where recorded. Modes: below the split (this process: run 0 and its "
              "chain) / above it (the worker); wait: wall seconds this process idled at the join.", "",
              "| row | cores | load avg | wall [s] | CPU [s] (worker) | Craig–Bampton modes [s] wall (CPU) | shifts (this / worker) "
-             "| modes (this / worker) | wait [s] | peak tree RSS [GB] | peak tree PSS [GB] | modes | max rel. frequency difference to row 1 |",
+             "| modes (this / worker) | wait [s] | peak tree RSS [GB] | peak tree PSS [GB] (this / worker) | modes | max rel. frequency difference to row 1 |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     reference = np.asarray(p1[0]["frequencies_hz"])
     for index, run in enumerate(p1, start=1):
@@ -239,28 +266,38 @@ def p1_lines(p1):
         split = slicing.get("split_count")
         share = f"{split} / {run['modes'] - split}" if split is not None else f"{run['modes']} / 0"
         wait = slicing.get("join_wait_s")
+        own = run.get("peak_pss_self_gb")
+        split_pss = "" if own is None or not upper else \
+            f" ({own:.2f} / {run['peak_tree_pss_gb'] - own:.2f})"
         lines.append(
             f"| {index} | {run['cores']} | {run['load_average']} | {run['wall_s']:.1f} | {run['cpu_s'] + run['children_cpu_s']:.1f} "
             f"({run['children_cpu_s']:.1f}) | {run['cb_s']['normal_modes']:.1f} ({run['cb_s']['normal_modes_cpu']:.1f}) "
             f"| {len(slicing.get('shifts', []))} / {len(upper.get('shifts', []))} | {share} "
             f"| {'—' if wait is None else f'{wait:.1f}'} "
-            f"| {run['peak_tree_rss_gb']:.2f} | {run['peak_tree_pss_gb']:.2f} | {run['modes']} | {difference:.1e} |")
+            f"| {run['peak_tree_rss_gb']:.2f} | {run['peak_tree_pss_gb']:.2f}{split_pss} | {run['modes']} | {difference:.1e} |")
     one, two = p1[0], p1[1]
-    lines += ["", f"Two processes (rows 1, 2): the worker counts N(λ_c) and places the split by count, "
+    lines += ["", f"Rows 1, 2 (this code): the worker counts N(λ_c) and places the split by count, "
               f"N(λ_s) ≈ (N(λ_c) + lead)/2 with lead = 0.2 per column of run 0's cap (run 0's head start: it "
               f"finds its modes cheaper than the shifted runs), from one or two inertia counts. Wall "
               f"{one['wall_s']:.0f} s on one core → {two['wall_s']:.0f} s on two (load {one['load_average']} / "
               f"{two['load_average']}); CPU of this process {one['cpu_s']:.0f} → {two['cpu_s']:.0f} s, the "
               f"worker's {two['children_cpu_s']:.0f} s beside it; this process idled "
               f"{(two['slicing'] or {}).get('join_wait_s', float('nan')):.1f} s at the join. Peak tree PSS "
-              f"{two['peak_tree_pss_gb']:.2f} GB (budget 4 GB: both processes hold a full Krylov store and "
-              "a factor of K − σM at once). Rows measured on a shared machine: compare CPU seconds and "
+              f"{two['peak_tree_pss_gb']:.2f} GB on two processes, {one['peak_tree_pss_gb']:.2f} GB on one "
+              f"(budget 4 GB for the whole run); the vectors found so far wait on disk while both slice, "
+              f"up to {two.get('slicing_files_max_gb', float('nan')):.2f} GB in the files (page cache, not "
+              "process memory). Rows measured on a shared machine: compare CPU seconds and "
               "rows run one after the other. The earlier tables (60 modes, no slicing) are unchanged "
               "code paths and still hold."]
     for index, run in enumerate(p1[2:], start=3):
         lines += ["", f"Row {index}: {run.get('note', 'a rerun')} (load {run['load_average']}): wall "
                   f"{run['wall_s']:.0f} s, CPU {run['cpu_s']:.0f} s here + {run['children_cpu_s']:.0f} s in the "
                   f"worker, peak tree PSS {run['peak_tree_pss_gb']:.2f} GB."]
+    if memory:
+        lines += ["", "### What is alive at the two-process peak (P1 memory)", "", memory["note"], "",
+                  "| " + " | ".join(memory["columns"]) + " |", "|" + "---|" * len(memory["columns"])]
+        lines += ["| " + " | ".join(str(cell) for cell in row) + " |" for row in memory["rows"]]
+        lines += [""] + memory.get("after", [])
     return lines
 
 
@@ -419,10 +456,11 @@ def write_report(cases, quick, p1=None):
     previous = _stored()
     profile = previous.get("p1_profile") if isinstance(previous, dict) else None
     split_profile = previous.get("p1_split_profile") if isinstance(previous, dict) else None
+    memory = previous.get("p1_memory") if isinstance(previous, dict) else None
     if p1 is None and isinstance(previous, dict):
         p1 = previous.get("p1")
     if p1:
-        lines += p1_lines(p1)
+        lines += p1_lines(p1, memory)
     if split_profile:
         lines += profile_lines(split_profile, "The two-process split, per process (instrumented, "
                                               "before and after the split by count)")
@@ -430,8 +468,8 @@ def write_report(cases, quick, p1=None):
         lines += profile_lines(profile)
     (HERE / "results").mkdir(exist_ok=True)
     (HERE / "results" / "linear.md").write_text("\n".join(lines) + "\n")
-    data = {"cases": cases, "p1": p1, "p1_profile": profile, "p1_split_profile": split_profile} \
-        if p1 or profile or split_profile else cases
+    data = {"cases": cases, "p1": p1, "p1_profile": profile, "p1_split_profile": split_profile,
+            "p1_memory": memory} if p1 or profile or split_profile else cases
     (HERE / "results" / "linear.json").write_text(json.dumps(data, indent=1, default=float) + "\n")
     print("\n".join(lines))
 
@@ -454,6 +492,11 @@ def main():
             p1 = [_child(["--p1-case"], pin="0"), _child(["--p1-case"])]
             if any("error" in run for run in p1):
                 sys.exit(f"P1 linear stage failed: {[run.get('error') for run in p1]}")
+            earlier = stored.get("p1") if isinstance(stored, dict) else None
+            for run in earlier or []:      # kept below the new rows, each with its note
+                run.setdefault("note", f"the previous --p1 run ({run['cores']} "
+                                       f"core{'s' if run['cores'] > 1 else ''})")
+            p1 += earlier or []
         write_report(cases, quick=not cases[0].get("solver_comparison"), p1=p1)
         return
     quick = "--quick" in sys.argv

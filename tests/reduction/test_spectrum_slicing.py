@@ -173,9 +173,39 @@ def test_split_by_count_gives_the_same_modes(twin, one, capped):
     np.testing.assert_allclose(reduced.mode_frequencies_hz, one.mode_frequencies_hz, rtol=1e-12)
 
 
-def test_worker_failing_at_its_split_leaves_one_chain(twin, one, capped, monkeypatch):
+def test_two_processes_keep_found_vectors_on_disk(twin, one, capped, monkeypatch, tmp_path):
+    """Two processes: everything this process found (run 0's prefix, its chain's vectors) and
+    Ψ with the residual loads and statics wait in files while both slice — the reduced model is
+    the one-process one all the same (modes to 1e-12, statics exactly) — and no file is left."""
+    import tempfile
+
+    from sarfe.reduction.mode_sinks import FileSink
+
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))       # the forked worker's too
+    written = []
+    put = FileSink.put
+    monkeypatch.setattr(FileSink, "put", lambda self, vectors, width=16:
+                        written.append(vectors.shape[1]) or put(self, vectors, width))
+    reduced = reduce(twin, workers=2)
+    record = reduced.timings["slicing"]
+    assert "upper" in record and "upper_failed" not in record
+    n_b = one.boundary_count
+    statics = 3 * n_b                  # Ψ, the loads of unit boundary accelerations F_i, K_ii⁻¹ F_i
+    assert sum(written) >= statics + record["split_count"]         # this process's part
+    assert not list(tmp_path.iterdir())
+    np.testing.assert_allclose(reduced.mode_frequencies_hz, one.mode_frequencies_hz, rtol=1e-12)
+    np.testing.assert_array_equal(reduced.interior_basis[:, :n_b], one.interior_basis[:, :n_b])
+    np.testing.assert_allclose(reduced.stiffness[:n_b, :n_b], one.stiffness[:n_b, :n_b],
+                               rtol=1e-12)
+
+
+def test_worker_failing_at_its_split_leaves_one_chain(twin, one, capped, monkeypatch, tmp_path):
     """The worker sends its count, then fails placing the split: this process (run 0 already
-    done with the worker's count) slices the whole spectrum itself, with the same modes."""
+    done with the worker's count) slices the whole spectrum itself, with the same modes, and
+    leaves no file behind."""
+    import tempfile
+
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
     slicing = importlib.import_module("sarfe.reduction.spectrum_slicing")
 
     def broken(*args):
@@ -186,6 +216,7 @@ def test_worker_failing_at_its_split_leaves_one_chain(twin, one, capped, monkeyp
     record = reduced.timings["slicing"]
     assert "upper" not in record and "no split" in record["upper_failed"]
     np.testing.assert_allclose(reduced.mode_frequencies_hz, one.mode_frequencies_hz, rtol=1e-12)
+    assert not list(tmp_path.iterdir())
 
 
 def test_split_shift_hits_the_wanted_count():
