@@ -47,9 +47,6 @@ class MemorySink:
     def values(self):
         return np.concatenate(self._values) if self._values else np.zeros(0)
 
-    def kept(self):
-        return list(self._blocks)
-
     def blocks(self):
         blocks, self._blocks = self._blocks, []
         return blocks
