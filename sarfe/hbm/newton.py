@@ -7,6 +7,10 @@ smallest residual among those tried (nonsmooth contact laws can need a non-monot
 Convergence is relative: ‖R‖ ≤ tolerance · reference (the reference, e.g. ‖f̃_e‖, is given by the
 evaluation), or a scaled step ‖αΔ‖ / max(‖x‖, x_scale) ≤ step_tolerance while ‖R‖ ≤ √tolerance ·
 reference. A result that did not converge says why in ``reason``; it is never marked converged.
+
+With ``chord=True`` the LU of the last Jacobian is reused for further steps while each divides
+‖R‖ by at least 4 (:data:`CHORD_CONTRACTION`), and rebuilt at the current iterate otherwise
+(:func:`newton`); the convergence test is the same.
 """
 from __future__ import annotations
 
