@@ -367,7 +367,7 @@ def newton_step(model, contacts, excitation, U, omega, harmonics, samples_per_pe
             evaluate, to_x, to_displacement = make_evaluator(problem, contacts.row_count > 0, False)
             state = {"slider": initial_slider(problem, U)}
             result = newton(lambda x, jacobian: evaluate(x, omega, jacobian, state["slider"]),
-                            to_x(U), options, accept=slider_acceptor(state))
+                            to_x(U), options, accept=slider_acceptor(state), chord=True)
             if not (result.converged or result.residual_norm <= STALLED_RESIDUAL):
                 return None     # (stalled at a kink of the sampled forces close by: kept)
             U_new = np.asarray(to_displacement(result.x, omega, result.evaluation))

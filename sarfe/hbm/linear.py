@@ -154,7 +154,9 @@ class Condensation:
     """Dynamic compliance of the contact rows at one ω (see module docstring).
 
     compliance: C (P, P) real, P = (2H+1) n_rows, harmonic-major, block diagonal over harmonics
-    [m/N]; linear_response: r̃_lin (2H+1, n_rows) [m]; forced: y_k = Z_k⁻¹ f_k (m, n) complex;
+    [m/N]; linear_response: r̃_lin (2H+1, n_rows) [m]; forced: y_k = Z_k⁻¹ f_k (m, n) complex
+    (stored on the factorization path, ``solved_forced``; formed on first use on the modal path,
+    where Newton needs only G y_k = r̃_lin);
     orders: the m kept orders k (all 0 … H, or a harmonic set: then P counts the kept rows only
     and r̃_lin is zero in the dropped rows); admittance: Y_k = Z_k⁻¹ Gᵀ (m, n, n_rows) complex —
     stored on the factorization path (``solved_admittance``), formed on first use on the modal path
@@ -165,10 +167,21 @@ class Condensation:
     omega: float
     compliance: np.ndarray
     linear_response: np.ndarray
-    forced: np.ndarray
+    solved_forced: np.ndarray = None
     orders: np.ndarray = None
     solved_admittance: np.ndarray = None
     modal: ModalCompliance = None
+
+    @cached_property
+    def forced(self) -> np.ndarray:
+        """y_k = Z_k⁻¹ f_k (m, n) complex; modal: K⁻¹ f_k + V (q_k ⊙ Vᵀ f_k)."""
+        if self.solved_forced is not None:
+            return self.solved_forced
+        m = self.modal
+        y = m.static_load.copy()
+        loaded = np.flatnonzero(np.any(m.modal_load != 0, axis=1))    # (usually order 1 only)
+        y[loaded] += real_product(m.receptance[loaded] * m.modal_load[loaded], m.basis.modes.T)
+        return y
 
     @cached_property
     def admittance(self) -> np.ndarray:
@@ -241,12 +254,15 @@ class Condensation:
 class ModalCompliance:
     """The modal factors of one condensation, Y_k = K⁻¹Gᵀ + V diag(q_k) (GV)ᵀ: basis
     (:class:`ModalBasis`), receptance q_kj (m, n_modes) complex (dynamic part, at the kept orders
-    and ω), gap_modes GV (n_rows, n_modes), static_admittance K⁻¹Gᵀ (n, n_rows)."""
+    and ω), gap_modes GV (n_rows, n_modes), static_admittance K⁻¹Gᵀ (n, n_rows); static_load
+    K⁻¹ f_k (m, n) and modal_load Vᵀ f_k (m, n_modes) complex of the kept orders' excitation."""
 
     basis: ModalBasis
     receptance: np.ndarray
     gap_modes: np.ndarray
     static_admittance: np.ndarray
+    static_load: np.ndarray = None
+    modal_load: np.ndarray = None
 
 
 def _solve_factorized(model, Gd, forces, k, omega):
@@ -320,22 +336,23 @@ def condense(model, gap_map, excitation: np.ndarray, omega: float,
         # GV, K⁻¹Gᵀ, G K⁻¹ Gᵀ, K⁻¹ f_k and Vᵀ f_k do not depend on ω: once per sweep
         gap_modes, static, static_compliance = basis.gap_projection(Gd)
         static_forced, modal_forced = basis.load_projection(forces)
-        y = static_forced.copy()
-        loaded = np.flatnonzero(np.any(modal_forced != 0, axis=1))   # (usually order 1 only)
-        y[loaded] += real_product(g[loaded] * modal_forced[loaded], basis.modes.T)
+        # G y_k = G K⁻¹ f_k + (GV)(q_k ⊙ Vᵀ f_k): O(n_rows n_modes), y_k itself only on demand
+        gy = real_product(static_forced, Gd.T) + real_product(g * modal_forced, gap_modes.T)
         # Σ_j (G v_j)_r q_kj (G v_j)_s as one real product over the orders and rows
         Ck = static_compliance[None] + real_product(
             (gap_modes[None] * g[:, None, :]).reshape(-1, g.shape[1]),
             gap_modes.T).reshape(k.size, n_rows, n_rows)
-        factors = dict(modal=ModalCompliance(basis, g, gap_modes, static))
+        factors = dict(modal=ModalCompliance(basis, g, gap_modes, static, static_forced,
+                                             modal_forced))
     else:
         solved = _solve_factorized(model, Gd, forces, k, omega)
         if solved is None:
             return None
         Y, y = solved
         Ck = Gd @ Y                                         # (m, n_rows, n_rows)
-        factors = dict(solved_admittance=Y)
-    if not (np.all(np.isfinite(Ck)) and np.all(np.isfinite(y))):
+        gy = y @ Gd.T
+        factors = dict(solved_admittance=Y, solved_forced=y)
+    if not (np.all(np.isfinite(Ck)) and np.all(np.isfinite(gy))):
         return None
     # kept rows (orders sorted) in harmonic-major order: the mean if kept, then (cos, sin) per k
     mean = k == 0
@@ -349,9 +366,9 @@ def condense(model, gap_map, excitation: np.ndarray, omega: float,
     C[c, :, c, :], C[c, :, s, :] = Ck[~mean].real, Ck[~mean].imag
     C[s, :, c, :], C[s, :, s, :] = -Ck[~mean].imag, Ck[~mean].real
     lin = np.zeros((H + 1, n_rows), dtype=complex)
-    lin[k] = y @ Gd.T
+    lin[k] = gy
     r_lin = from_complex(lin)
-    return Condensation(float(omega), C.reshape(P_k * n_rows, P_k * n_rows), r_lin, y, k,
+    return Condensation(float(omega), C.reshape(P_k * n_rows, P_k * n_rows), r_lin, orders=k,
                         **factors)
 
 
@@ -368,6 +385,30 @@ def recover_displacement(condensation: Condensation, contact_force: np.ndarray) 
     z = np.zeros((H + 1, condensation.forced.shape[1]), dtype=complex)
     z[k] = condensation.forced - condensation.apply_admittance(L)
     return from_complex(z)
+
+
+def modal_omega_derivative(condensation: Condensation, contact_force: np.ndarray) -> np.ndarray:
+    """∂R_c/∂ω (2H+1, n_rows) of a modal condensation from λ̃ alone (no ũ): with
+    Z_k⁻¹ = K⁻¹ + V diag(q_k) Vᵀ and ũ_k = Z_k⁻¹ (f_k − Gᵀ λ_k),
+
+        ∂R_c/∂ω = −G (∂Z_k⁻¹/∂ω) (f_k − Gᵀ λ_k) = −(GV) [q'_k ⊙ (Vᵀ f_k − (GV)ᵀ λ_k)],
+        q'_kj = ∂q_kj/∂ω = a'_kj / (1 − a_kj)²,   a'_kj = 2k²ω μ_j − i k δ_j   [s],
+
+    O(n_rows n_modes) per order where :func:`condensed_omega_derivative` is O(n n_modes) (dropped
+    orders zero). Same value (the modal form of G Z⁻¹ Z' ũ)."""
+    m = condensation.modal
+    H = (np.asarray(contact_force).shape[0] - 1) // 2
+    orders = _kept_orders(condensation, H)
+    basis = m.basis
+    kw = orders[:, None].astype(float) * condensation.omega
+    a = kw**2 * basis.flexibility[None, :] - 1j * kw * basis.damping[None, :]
+    slope = (2 * orders[:, None].astype(float) * kw * basis.flexibility[None, :]
+             - 1j * orders[:, None] * basis.damping[None, :])
+    L = to_complex(np.asarray(contact_force, dtype=float))[orders]          # (m, n_rows)
+    modal = m.modal_load - real_product(L, m.gap_modes)                     # Vᵀ(f − Gᵀλ)
+    out = np.zeros((H + 1, m.gap_modes.shape[0]), dtype=complex)
+    out[orders] = -real_product(slope / (1.0 - a) ** 2 * modal, m.gap_modes.T)
+    return from_complex(out)
 
 
 def condensed_omega_derivative(model, condensation: Condensation, U: np.ndarray) -> np.ndarray:

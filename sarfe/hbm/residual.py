@@ -28,7 +28,8 @@ import scipy.sparse as sp
 from .aft import ContactForces, contact_forces, jacobian_matrix
 from .harmonic_set import coefficient_rows, expand_rows
 from .linear import (apply_dynamic_stiffness, apply_dynamic_stiffness_derivative,
-                     condensed_omega_derivative, dynamic_stiffness_matrix, recover_displacement)
+                     condensed_omega_derivative, dynamic_stiffness_matrix, modal_omega_derivative,
+                     recover_displacement)
 
 
 @dataclass(frozen=True)
@@ -155,8 +156,11 @@ def condensed_residual(problem: Problem, condensation, x, slider_start=None,
         J = condensation.apply_compliance(J_lam)
         J[np.diag_indices_from(J)] += 1.0
         if omega_derivative:
-            U = recover_displacement(condensation, forces.force)
-            dR = condensed_omega_derivative(problem.model, condensation, U).ravel()
+            if condensation.modal is not None:      # from λ̃ in modal coordinates (no ũ)
+                dR = modal_omega_derivative(condensation, forces.force).ravel()
+            else:
+                U = recover_displacement(condensation, forces.force)
+                dR = condensed_omega_derivative(problem.model, condensation, U).ravel()
             if keep is not None:
                 dR = dR[keep]
             if forces.omega_derivative is not None:

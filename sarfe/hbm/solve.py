@@ -45,6 +45,7 @@ from .stability_contacts import ContactOperator
 from .stability_rows import contact_row_count
 
 CONDENSED_ABOVE = 3000   # Hill matrix rows 2(2H+1)n above which 'auto' stability is condensed
+CHORD_STEPS = True       # fixed-ω Newton reuses its LU while it contracts (sarfe.hbm.newton)
 
 
 def make_problem(model, contacts, excitation, harmonics, samples_per_period, options=None,
@@ -511,7 +512,8 @@ def _newton(problem, omega, U0, options, slider=None):
         evaluate, to_x, to_displacement = make_evaluator(problem, condensed, False)
         try:
             result = newton(lambda x, jac: evaluate(x, omega, jac, state["slider"]), to_x(U0),
-                            options, x_scale=np.linalg.norm(to_x(U0)), accept=accept)
+                            options, x_scale=np.linalg.norm(to_x(U0)), accept=accept,
+                            chord=CHORD_STEPS)
         except SingularJacobian:
             continue            # S_k(ω) singular: fall back to the full residual
         break

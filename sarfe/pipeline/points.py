@@ -78,8 +78,14 @@ def linear_solution(nl: NonlinearModel, omega, H, N):
 
 
 def solve_point(nl, omega, H, N, options, previous):
-    """One HBM point; on failure retry once from a short time integration (its end state).
+    """One HBM point; on failure retry from the engine's cold start, then once from a short time
+    integration (its end state).
 
+    Starts, in turn, until one converges: ``previous`` (warm start, when given); the engine's cold
+    start (linearized guess, then its homotopies: :func:`sarfe.hbm.solve_frequency` without
+    ``initial``), when a warm start failed — tens of Newton iterations, where the time integration
+    costs 40 periods × max(N, 256) steps (on the door trim 0.16 s against 3.7 s); the end state
+    of 40 periods of time integration from rest.
     An engine exception or a point that still fails is returned with ``converged=False`` and the
     reason (the time-integration state stands in when the engine raised), never dropped.
     """
@@ -96,6 +102,16 @@ def solve_point(nl, omega, H, N, options, previous):
         solution, error = None, exc
     if solution is not None and (solution.converged or not contacts.count):
         return solution
+    if previous is not None:
+        try:
+            cold = solve_frequency(nl.model, contacts, nl.excitation, omega, H, N, options=options)
+            if cold.converged:
+                return dataclasses.replace(
+                    cold, iterations=cold.iterations + (solution.iterations if solution else 0),
+                    reason=f"{cold.reason} (cold start after the warm start failed: "
+                           f"{solution.reason if solution else error})")
+        except Exception:
+            pass
     guess = time_integration_point(nl.model, contacts, nl.excitation, omega, H, N,
                                             max_periods=40)
     try:

@@ -8,7 +8,9 @@ import scipy.sparse as sp
 import sarfe.hbm.linear as linear
 from sarfe.hbm import (ContinuationOptions, SolverOptions, continuation, make_contact_set,
                        make_linear_model, solve_frequency)
-from sarfe.hbm.linear import condense, condensed_omega_derivative, recover_displacement
+from sarfe.hbm.linear import (condense, condensed_omega_derivative, modal_omega_derivative,
+                              recover_displacement)
+from sarfe.hbm.harmonic_set import coefficient_rows
 from sarfe.hbm.modal import cached_modal_basis, modal_basis
 from sarfe.reduction import craig_bampton, free_dofs_system, reduced_modal_damping
 
@@ -81,6 +83,16 @@ def compare_paths(model, G, omega, orders=None):
     assert relative(recover_displacement(modal, force), U) < 1e-10
     assert relative(condensed_omega_derivative(model, modal, U),
                     condensed_omega_derivative(model, direct, U)) < 1e-10
+    # ∂R_c/∂ω from λ̃ in modal coordinates = G Z⁻¹ Z' ũ of the factorization, and = the central
+    # difference of R_c(r̃, ω) = r̃ − r̃_lin(ω) + C(ω) λ̃ at fixed r̃, λ̃
+    derivative = modal_omega_derivative(modal, force)
+    assert relative(derivative, condensed_omega_derivative(model, direct, U)) < 1e-10
+    h = 1e-6 * omega
+    plus, minus = (condense(model, G, F, omega + s, orders, modal=False) for s in (h, -h))
+    rows = np.arange(2 * H + 1) if orders is None else coefficient_rows(orders)
+    fd = ((plus.compliance - minus.compliance) @ force[rows].ravel()
+          - (plus.linear_response - minus.linear_response)[rows].ravel()) / (2 * h)
+    assert relative(derivative[rows].ravel(), fd) < 1e-5
     # C applied block by block (block diagonal over the kept orders) = the dense product
     B = np.random.default_rng(2).normal(size=(direct.compliance.shape[0], 7))
     for cond in (modal, direct):
