@@ -352,29 +352,52 @@ def winding_count(log_det, points, step=PHASE_STEP, budget=MAX_EVALUATIONS):
         evaluations += middle.size
 
 
-def real_zero(log_det, lower, upper, rounds=4, width=16):
-    """The zero of det F on the real segment (lower, upper) [1/s] where det F (real for real s)
-    changes sign exactly once, or None (no single sign change, or det F not finite there).
+def real_zero(log_det, lower, upper, relative=1e-9):
+    """The zero of det F on the real segment (lower, upper) [1/s], lower < 0 < upper, where det F
+    (real for real s) changes sign once — the count found one zero in Ω, so it is real and
+    simple — or None (det F not finite there, or of the same sign at both ends).
 
-    One geometric grid (the exponent of a fold lies near 0; ``upper`` is a crude bound), then
-    ``rounds`` subdivisions of the bracket into ``width`` parts: the bracket shrinks by
-    width^rounds (16⁴ ≈ 6.6·10⁴). Returns the bracket's midpoint."""
-    def signs(points):
-        values = log_det(points.astype(complex))
-        return np.sign(np.cos(values.imag)) if np.all(np.isfinite(values)) else None
+    The sign of det F brackets it: on (lower, 0], on (0, −lower], or by geometric bisection of
+    (−lower, upper] (a fold's exponent lies near 0 and ``upper`` is a crude bound: each evaluation
+    halves the bracket's log-ratio) down to a ratio ≤ 2; then Brent's method on
+    det F(s)/|det F(a)| to |Δs| ≤ ``relative``·|s| + 10⁻¹²|lower|. ≈ 15 evaluations in all (the
+    grid search this replaces took 108). Returns s* [1/s]."""
+    from scipy.optimize import brentq
 
-    small = max(-lower, 1e-12 * upper)
-    grid = np.concatenate([np.linspace(lower, 0.0, 4), np.geomspace(small, upper, 44)])
-    for _ in range(rounds + 1):
-        sign = signs(grid)
-        if sign is None:
+    def value(s):
+        v = log_det(np.array([s], dtype=complex))[0]
+        if not np.isfinite(v):
+            raise FloatingPointError(f"det F not finite at s = {s}")
+        return v
+
+    def sign(v):
+        return np.sign(np.cos(v.imag))
+
+    try:
+        low, zero, high = value(lower), value(0.0), value(upper)
+        if sign(low) == sign(high):
             return None
-        change = np.flatnonzero(sign[1:] != sign[:-1])
-        if change.size != 1:
-            return None
-        a, b = grid[change[0]], grid[change[0] + 1]
-        grid = np.linspace(a, b, width + 1)
-    return 0.5 * (a + b)
+        if sign(low) != sign(zero):
+            a, b, reference = lower, 0.0, low
+        else:
+            a, b, reference = -lower, upper, value(-lower)
+            if sign(reference) != sign(zero):
+                a, b, reference = 0.0, -lower, zero
+            while b > 2.0 * a > 0.0:
+                middle = np.sqrt(a * b)
+                v = value(middle)
+                if sign(v) == sign(reference):
+                    a, reference = middle, v
+                else:
+                    b = middle
+
+        def scaled(s):       # det F(s)/|det F(a)|: continuous, of order one across the bracket
+            v = value(s)
+            return np.cos(v.imag) * np.exp(np.clip(v.real - reference.real, -700.0, 700.0))
+
+        return float(brentq(scaled, a, b, xtol=1e-12 * abs(lower), rtol=relative))
+    except (FloatingPointError, ValueError):
+        return None
 
 
 def contact_row_stability(model, contacts, omega, harmonics, forces, operator=None,
