@@ -130,6 +130,8 @@ def _shift_invert(Mt, Dt, jacobian, sigma):
 
     def apply(z):
         z = np.asarray(z).reshape(-1)
+        if np.iscomplexobj(z) and not np.iscomplexobj(np.empty(0, dtype)):
+            return apply(z.real) + 1j * apply(z.imag)
         b1, b2 = z[:size], z[size:]
         x = -solve((b2 + coupling @ b1).astype(dtype))
         return np.concatenate([x, b1 + sigma * x])

@@ -393,6 +393,14 @@ def real_zero(log_det, lower, upper, relative=1e-9):
     def sign(v):
         return np.sign(np.cos(v.imag))
 
+    def scaled(s):          # det F(s)/|det F(a)|: continuous, of order one across the bracket
+        v = log_det(np.array([s], dtype=complex))[0]
+        if v.real == -np.inf:                        # det F = 0 exactly: s is the zero
+            return 0.0
+        if not np.isfinite(v):
+            raise FloatingPointError(f"det F not finite at s = {s}")
+        return np.cos(v.imag) * np.exp(np.clip(v.real - reference.real, -700.0, 700.0))
+
     try:
         low, zero, high = value(lower), value(0.0), value(upper)
         if sign(low) == sign(high):
@@ -410,10 +418,6 @@ def real_zero(log_det, lower, upper, relative=1e-9):
                     a, reference = middle, v
                 else:
                     b = middle
-
-        def scaled(s):       # det F(s)/|det F(a)|: continuous, of order one across the bracket
-            v = value(s)
-            return np.cos(v.imag) * np.exp(np.clip(v.real - reference.real, -700.0, 700.0))
 
         return float(brentq(scaled, a, b, xtol=1e-12 * abs(lower), rtol=relative))
     except (FloatingPointError, ValueError):
