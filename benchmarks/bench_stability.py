@@ -13,7 +13,15 @@ Section "contact rows" (``--rows``, issue 15 P1): the contact-row count
 the sweep solved without stability, then per point the count's CPU time, its det F evaluations
 and the LU order (2H+1)|R|; the verdict of every point. → results/stability_rows.json.
 
-Run: OPENBLAS_NUM_THREADS=1 python benchmarks/bench_stability.py [--skip-full] [--rows]
+Section "sweep" (``--sweep``, issue 15 P1, session hilltrack): the whole P1 sweep at 15 mm
+(cases/door_trim_p1.yaml, 40 → 80 Hz, its own continuation: ≈ 206 points) solved with the default
+options, Hill stability deferred (:mod:`sarfe.hbm.deferred`) and then computed per point in this
+process as the workers compute it (``stability_of``): per point the CPU time, the det F
+evaluations of the count (contour) and of the real-zero search, the path (zeros counted, Ritz
+hand-over), verdict and leading exponent. → results/stability_sweep.json (its verdicts are what
+a before/after comparison checks: ``--compare OLD.json NEW.json``).
+
+Run: OPENBLAS_NUM_THREADS=1 python benchmarks/bench_stability.py [--skip-full] [--rows] [--sweep]
 """
 import json
 import os
@@ -149,6 +157,114 @@ def rows_cost(path="cases/door_trim_p1.yaml", mesh=0.015, band=(60.0, 65.0)):
             "points": points}
 
 
+def sweep_cost(path="cases/door_trim_p1.yaml", mesh=0.015):
+    """Per point of the whole P1 sweep at ``mesh``: the deferred Hill stability computed serially,
+    with its det F evaluations by phase (module docstring)."""
+    import sarfe.hbm.solve as solve_module
+    import sarfe.hbm.stability_rows as rows_module
+    from sarfe.hbm.deferred import deferred_stability, pending, stability_of
+    from sarfe.pipeline.pruning import solve_points_pruned
+
+    data = yaml.safe_load(open(ROOT / path))
+    data["model"]["fe"]["generator"]["mesh_size_m"] = mesh
+    tmp = tempfile.NamedTemporaryFile("w", suffix=".yaml", delete=False, dir=ROOT / "cases")
+    yaml.safe_dump(data, tmp)
+    tmp.close()
+    try:
+        case = load_case(tmp.name)
+    finally:
+        os.unlink(tmp.name)
+    nl = nonlinear_model(case, build_linear_model(case, progress=False))
+    with deferred_stability() as jobs:
+        solutions, _ = solve_points_pruned(case.config.solver, case.config.excitation, nl)
+    jobs = [jobs[i] for i in pending(solutions)]
+
+    phase, counts = ["contour"], {}
+    original_ld = rows_module.ContactRowDeterminant.log_determinants
+    original_zero, original_ritz = rows_module.real_zero, solve_module.condensed_stability
+    original_count = solve_module.contact_row_count
+
+    def log_determinants(self, s, *args, **kwargs):
+        counts[phase[0]] = counts.get(phase[0], 0) + np.atleast_1d(s).size
+        return original_ld(self, s, *args, **kwargs)
+
+    def real_zero(*args, **kwargs):
+        phase[0] = "real_zero"
+        try:
+            return original_zero(*args, **kwargs)
+        finally:
+            phase[0] = "contour"
+
+    def contact_row_count(*args, **kwargs):
+        out = original_count(*args, **kwargs)
+        counts["zeros"] = out[1]
+        return out
+
+    def ritz(*args, **kwargs):
+        counts["ritz"] = True
+        return original_ritz(*args, **kwargs)
+
+    rows_module.ContactRowDeterminant.log_determinants = log_determinants
+    rows_module.real_zero, solve_module.condensed_stability = real_zero, ritz
+    solve_module.contact_row_count = contact_row_count
+    points = []
+    try:
+        for job in jobs:
+            counts.clear()
+            t = time.process_time()
+            r = stability_of(job)
+            points.append(dict(frequency_hz=job.omega / (2 * np.pi), cpu_s=time.process_time() - t,
+                               contour_evaluations=counts.get("contour", 0),
+                               real_zero_evaluations=counts.get("real_zero", 0),
+                               zeros=counts.get("zeros"), ritz=counts.get("ritz", False),
+                               verdict=r.stable, leading=r.leading, note=r.note))
+    finally:
+        rows_module.ContactRowDeterminant.log_determinants = original_ld
+        rows_module.real_zero, solve_module.condensed_stability = original_zero, original_ritz
+        solve_module.contact_row_count = original_count
+    H = case.data["solver"]["harmonics"]
+    return {"case": f"{path} at {mesh * 1e3:g} mm, its sweep, H = {H}, defaults",
+            "reduced_dofs": nl.model.dof_count, "contact_rows": nl.contacts.row_count,
+            "load_average": os.getloadavg()[0], "points": points}
+
+
+def sweep_lines(res):
+    pts = res["points"]
+    cpu = np.array([p["cpu_s"] for p in pts])
+    contour = np.array([p["contour_evaluations"] for p in pts])
+    paths = {}
+    for p in pts:
+        key = "Ritz" if p["ritz"] else f"{p['zeros']} zeros"
+        paths[key] = paths.get(key, 0) + 1
+    verdicts = {}
+    for p in pts:
+        verdicts[str(p["verdict"])] = verdicts.get(str(p["verdict"]), 0) + 1
+    ritz = cpu[[p["ritz"] for p in pts]]
+    return [SWEEP_HEADER, "",
+            f"{res['case']}: {res['reduced_dofs']} reduced DOFs, {res['contact_rows']} contact "
+            f"rows, {len(pts)} points (load average {res['load_average']:.1f} at the end). CPU per "
+            f"point (process time): mean {cpu.mean():.3f} s, median {np.median(cpu):.3f} s, max "
+            f"{cpu.max():.3f} s, total {cpu.sum():.1f} s (Ritz points {ritz.sum():.1f} s); det F "
+            f"evaluations per point (contour) mean {contour.mean():.1f} (min {contour.min()}, max "
+            f"{contour.max()}), real-zero search {sum(p['real_zero_evaluations'] for p in pts)} in "
+            f"all; paths {paths}; verdicts {verdicts}.", ""]
+
+
+def compare_sweeps(old, new):
+    """Points whose verdict, count or leading exponent (10⁻⁴ relative) differ between two
+    results/stability_sweep.json files of the same sweep."""
+    a, b = (json.loads(pathlib.Path(p).read_text())["points"] for p in (old, new))
+    assert len(a) == len(b), "not the same sweep"
+    differ = [i for i, (x, y) in enumerate(zip(a, b))
+              if x["verdict"] != y["verdict"] or x["zeros"] != y["zeros"]
+              or abs(x["leading"] - y["leading"]) > 1e-4 * abs(x["leading"])]
+    print(f"{len(a)} points, {len(differ)} differences: {differ}")
+    return differ
+
+
+SWEEP_HEADER = "## The whole P1 sweep at 15 mm, per point (issue 15 P1, session hilltrack)"
+
+
 def rows_lines(res):
     pts = res["points"]
     cpu = np.array([p["cpu_s"] for p in pts])
@@ -173,15 +289,50 @@ ROWS_BEFORE_AFTER = """Before → after (session hillfast, the same 46 converged
 ("Hill stability on the contact rows") for the per-point numbers and the machine load."""
 
 
+# measured in session hilltrack (not regenerated by this script): see docs/performance.md
+SWEEP_BEFORE_AFTER = """Before → after (session hilltrack; main and the branch alternated,
+A B A B, on the same 71 points of this sweep — every 3rd and the three that are not 'no zero' —,
+CPU s per point at load ≈ 1): 0.545 / 0.538 → 0.345 / 0.341; no-zero points 0.307 → 0.270 s
+(contour evaluations 38.8 → 37.8, 7.17 → 6.51 ms each); the one-zero point 1.21 → 0.49 s
+(real-zero search 116 → 17 evaluations); the two Ritz points 8.2 → 2.7 s. P1 at 5 mm
+(solve_case, 2 workers, load 1.4–1.7): Hill stability 39.1 → 29.7 s wall, verdicts and exponents
+of its 204 points equal. Verdicts, zero counts and leading exponents of all 206 points of this
+sweep equal (leading to 2e-6). Details: docs/performance.md ("Hill stability along the P1
+sweep")."""
+
+
 def write_rows_section(lines):
-    """Replace the contact-row section of results/stability.md (keep the sections before it)."""
+    """Replace the contact-row section of results/stability.md (keep the sections before it and
+    the sweep section after it)."""
     path = HERE / "results" / "stability.md"
     text = path.read_text() if path.exists() else ""
     head = text.split(ROWS_HEADER)[0].rstrip("\n")
-    path.write_text((head + "\n\n" if head else "") + "\n".join(lines + [ROWS_BEFORE_AFTER, ""]))
+    tail = SWEEP_HEADER + text.split(SWEEP_HEADER, 1)[1] if SWEEP_HEADER in text else ""
+    path.write_text((head + "\n\n" if head else "") + "\n".join(lines + [ROWS_BEFORE_AFTER, ""])
+                    + ("\n" + tail if tail else ""))
+
+
+def write_sweep_section(lines):
+    """Replace the sweep section of results/stability.md (keep everything before it)."""
+    path = HERE / "results" / "stability.md"
+    text = path.read_text() if path.exists() else ""
+    head = text.split(SWEEP_HEADER)[0].rstrip("\n")
+    path.write_text((head + "\n\n" if head else "") + "\n".join(lines + [SWEEP_BEFORE_AFTER, ""]))
 
 
 def main():
+    if "--compare" in sys.argv:
+        i = sys.argv.index("--compare")
+        compare_sweeps(sys.argv[i + 1], sys.argv[i + 2])
+        return
+    if "--sweep" in sys.argv:
+        res = sweep_cost()
+        (HERE / "results").mkdir(exist_ok=True)
+        (HERE / "results" / "stability_sweep.json").write_text(json.dumps(res, indent=1,
+                                                                           default=str))
+        write_sweep_section(sweep_lines(res))
+        print("\n".join(sweep_lines(res)))
+        return
     if "--rows" in sys.argv:
         res = rows_cost()
         (HERE / "results").mkdir(exist_ok=True)
@@ -221,6 +372,9 @@ def main():
     saved = HERE / "results" / "stability_rows.json"
     if saved.exists():                  # keep the contact-row section of the last --rows run
         write_rows_section(rows_lines(json.loads(saved.read_text())))
+    saved = HERE / "results" / "stability_sweep.json"
+    if saved.exists():                  # and the sweep section of the last --sweep run
+        write_sweep_section(sweep_lines(json.loads(saved.read_text())))
 
 
 if __name__ == "__main__":

@@ -67,13 +67,15 @@ def floquet_exponents(model, omega, harmonics, jacobian, dense_limit=3000, max_e
     size = Mt.shape[0]
     keep = 2 * n
     dense = 2 * size <= dense_limit
-    A, B = _first_order(Mt, Dt, jacobian, dense)
     if dense:
-        values = np.linalg.eigvals(A)
+        values = np.linalg.eigvals(_first_order(Mt, Dt, jacobian, dense)[0])
     else:
         keep = min(keep, max_exponents)
         count = min(2 * size - 2, keep + max(20, keep // 2))
-        values = spla.eigs(A, k=count, M=B, sigma=0.0, which="LM", return_eigenvectors=False)
+        OPinv = _shift_invert(Mt, Dt, jacobian, 0.0)
+        values = spla.eigs(_pencil_operator(Mt, Dt, jacobian, OPinv.dtype), k=count,
+                           M=sp.block_diag([sp.identity(size), Mt], format="csr"), sigma=0.0,
+                           which="LM", return_eigenvectors=False, OPinv=OPinv)
     return _select(values, omega, keep)
 
 
@@ -97,6 +99,60 @@ def _first_order(Mt, Dt, jacobian, dense):
     return A, B
 
 
+DENSE_FILL = 0.1     # Q(σ) with more non-zeros than this fraction of its entries: dense LU
+
+
+def _shift_invert(Mt, Dt, jacobian, sigma):
+    r"""(A − σB)⁻¹ of the first-order pencil (:func:`_first_order`) as a LinearOperator, through
+    the quadratic Q(σ) = σ² M̃ + σ D̃ + ∂R/∂ũ of half its order: (A − σB)(x, y) = (b₁, b₂) gives
+
+        x = −Q(σ)⁻¹ (b₂ + (D̃ + σ M̃) b₁),     y = b₁ + σ x,
+
+    one factorization of Q(σ): dense LU where ∂R/∂ũ fills more than ``DENSE_FILL`` of it (the
+    contact rows of a Ritz-basis problem couple all harmonics: a sparse LU of the first-order
+    pencil took 0.9 s there, a dense one of Q 0.1-0.5 s), else SuperLU. Real for real σ and real
+    matrices, else complex."""
+    import scipy.linalg as sla
+
+    size = Mt.shape[0]
+    dtype = np.result_type(jacobian.dtype, Dt.dtype, Mt.dtype,
+                           complex if np.iscomplexobj(sigma) else float)
+    coupling = (sp.csr_matrix(Dt) + sigma * sp.csr_matrix(Mt)).astype(dtype).tocsr()
+    if _filled(jacobian):
+        Q = _dense(jacobian).astype(dtype)
+        Q += sigma * Dt.toarray() if sp.issparse(Dt) else sigma * np.asarray(Dt)
+        Q += sigma * sigma * (Mt.toarray() if sp.issparse(Mt) else np.asarray(Mt))
+        factor = sla.lu_factor(Q, overwrite_a=True, check_finite=False)
+        solve = lambda b: sla.lu_solve(factor, b, check_finite=False)  # noqa: E731
+    else:
+        Q = sp.csc_matrix(jacobian) + sigma * sp.csc_matrix(Dt) + sigma * sigma * sp.csc_matrix(Mt)
+        solve = spla.splu(Q.astype(dtype).tocsc()).solve
+
+    def apply(z):
+        z = np.asarray(z).reshape(-1)
+        if np.iscomplexobj(z) and not np.iscomplexobj(np.empty(0, dtype)):
+            return apply(z.real) + 1j * apply(z.imag)
+        b1, b2 = z[:size], z[size:]
+        x = -solve((b2 + coupling @ b1).astype(dtype))
+        return np.concatenate([x, b1 + sigma * x])
+
+    return spla.LinearOperator((2 * size, 2 * size), matvec=apply, dtype=dtype)
+
+
+def _pencil_operator(Mt, Dt, jacobian, dtype):
+    """A of the first-order pencil as a LinearOperator z = (x, y) ↦ (y, −∂R/∂ũ x − D̃ y) (ARPACK's
+    shift-invert mode reads only its shape and type: no block matrix is assembled)."""
+    size = Mt.shape[0]
+    J = jacobian if isinstance(jacobian, np.ndarray) else sp.csr_matrix(jacobian)
+    D = sp.csr_matrix(Dt)
+
+    def apply(z):
+        z = np.asarray(z).reshape(-1)
+        return np.concatenate([z[size:], -(J @ z[:size]) - D @ z[size:]])
+
+    return spla.LinearOperator((2 * size, 2 * size), matvec=apply, dtype=dtype)
+
+
 def _select(values, omega, keep):
     """The ``keep`` values with the smallest |Im s| and every other one in |Im s| ≤ 1.01 ω/2."""
     values = values[np.isfinite(values)]
@@ -108,15 +164,19 @@ def _select(values, omega, keep):
 
 def _nearest(Mt, Dt, jacobian, target, dense, count=3):
     """Eigenvalues of the frozen pencil nearest ``target`` (complex allowed)."""
-    A, B = _first_order(Mt, Dt, jacobian, dense)
-    if dense and A.shape[0] <= 64:
-        values = np.linalg.eigvals(A)
-        return values[np.argsort(np.abs(values - target))[:count]]
-    if dense:      # shift-invert on a dense LU: the few values near the target, not all of them
+    if dense:
+        A, _ = _first_order(Mt, Dt, jacobian, dense)
+        if A.shape[0] <= 64:
+            values = np.linalg.eigvals(A)
+            return values[np.argsort(np.abs(values - target))[:count]]
+        # shift-invert on a dense LU: the few values near the target, not all of them
         return spla.eigs(A.astype(complex), k=count, sigma=target, which="LM",
                          return_eigenvectors=False)
-    return spla.eigs(A.astype(complex), k=count, M=B.astype(complex), sigma=target, which="LM",
-                     return_eigenvectors=False)
+    size = Mt.shape[0]
+    return spla.eigs(_pencil_operator(Mt, Dt, jacobian, complex), k=count,
+                     M=sp.block_diag([sp.identity(size), Mt], format="csr").astype(complex),
+                     sigma=target, which="LM", return_eigenvectors=False,
+                     OPinv=_shift_invert(Mt, Dt, jacobian, complex(target)))
 
 
 def refine_exponent(Mt, Dt, jacobian, operator, s0, dense, iterations=30, tolerance=1e-9):
@@ -133,14 +193,15 @@ def refine_exponent(Mt, Dt, jacobian, operator, s0, dense, iterations=30, tolera
     |μ(s_k) − s_k| ≤ tolerance · max(|μ(s_k)|, 1). Small (dense) problems build C(s) dense
     (``operator.dense_correction``) and keep ∂R/∂ũ dense once. Returns (s, converged)."""
     s = complex(s0)
-    dense_correction = getattr(operator, "dense_correction", None) if dense else None
-    base = _dense(jacobian) if dense else sp.csr_matrix(jacobian)
+    as_array = dense or _filled(jacobian)        # (a Ritz-basis problem: all harmonics coupled)
+    dense_correction = getattr(operator, "dense_correction", None) if as_array else None
+    base = _dense(jacobian) if as_array else sp.csr_matrix(jacobian)
     previous = None                                       # (s_{k−1}, f(s_{k−1}))
     for _ in range(iterations):
         if dense_correction is not None:
             J = base + dense_correction(s)
         else:
-            J = base + (operator.correction(s).toarray() if dense else operator.correction(s))
+            J = base + (operator.correction(s).toarray() if as_array else operator.correction(s))
         new = _nearest(Mt, Dt, J, s, dense, count=1)[0]
         residual = new - s
         if abs(residual) <= tolerance * max(abs(new), 1.0):
@@ -163,7 +224,10 @@ def hill_stability(model, omega, harmonics, jacobian, tolerance=1e-6, dense_limi
     None (the frozen problem on ``jacobian`` alone, smooth laws)."""
     try:
         if operator is not None:
-            jacobian = sp.csr_matrix(jacobian) + operator.correction(0.0).real
+            if _filled(jacobian) and hasattr(operator, "dense_correction"):
+                jacobian = _dense(jacobian) + operator.dense_correction(0.0).real
+            else:
+                jacobian = sp.csr_matrix(jacobian) + operator.correction(0.0).real
         values = floquet_exponents(model, omega, harmonics, jacobian, dense_limit,
                                    contact_damping=contact_damping)
         if values.size == 0:
@@ -219,6 +283,13 @@ def _refine_leading(model, omega, harmonics, jacobian, contact_damping, operator
     else:
         return values, "Hill exponents: refinement budget exhausted before the leading one"
     return values, ""
+
+
+def _filled(matrix):
+    """An ndarray, or a sparse matrix with more than ``DENSE_FILL`` of its entries non-zero."""
+    if not sp.issparse(matrix):
+        return True
+    return matrix.nnz > DENSE_FILL * matrix.shape[0] * matrix.shape[1]
 
 
 def _dense(matrix):

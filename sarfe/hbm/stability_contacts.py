@@ -72,10 +72,16 @@ def _memory_blocks(s, omega, P_march, n_rho_march, drho, k_t, H, N, chunk=8, set
     s = np.atleast_1d(np.asarray(s, dtype=complex))
     if setup is None:
         setup = _memory_setup(omega, P_march, n_rho_march, drho, H, N)
-    step, source, products, E, Edq, h = (setup[k] for k in ("step", "source", "products", "E",
-                                                             "Edq", "h"))
-    n, P = step.shape[1], 2 * H + 1
+    stuck = setup["stuck"]
+    n, P = stuck.size, 2 * H + 1
     out = np.empty((s.size, P, n, 2, 3 * P), complex)
+    # a contact stuck all period (P_j = I, b_j = 0) keeps δw ≡ 0: δλ̃_t = k_t E δq at every s
+    out[:, :, stuck] = k_t[stuck, None, None] * setup["Edq"][None, :, None]
+    if np.all(stuck):
+        return out
+    moving = ~stuck
+    step, source, products = (setup[k][:, moving] for k in ("step", "source", "products"))
+    E, Edq, h, k_t, n = setup["E"], setup["Edq"], setup["h"], k_t[moving], int(moving.sum())
     for first in range(0, s.size, chunk):
         sc = s[first:first + chunk]
         m = sc.size
@@ -91,14 +97,15 @@ def _memory_blocks(s, omega, P_march, n_rho_march, drho, k_t, H, N, chunk=8, set
         Edw = (E @ march.reshape(N, -1)).reshape(P, m, n, 2, 2, 3 * P)       # one real GEMM
         Edw = np.moveaxis(Edw[..., 0, :] + 1j * Edw[..., 1, :], 1, 0)          # (m, P, n, 2, 3P)
         coeff = Edq[None, :, None] - Edw - Eh @ dw0[:, None]
-        out[first:first + chunk] = k_t[None, None, :, None, None] * coeff
+        out[first:first + chunk, :, moving] = k_t[None, None, :, None, None] * coeff
     return out
 
 
 def _memory_setup(omega, P_march, n_rho_march, drho, H, N):
     """The s-independent arrays of :func:`_memory_blocks` (once per solution): step P_j
     (N, n, 2, 2), source b_j = (I − P_j) δq_j + n_j dρ_j δn_j (N, n, 2, 3P), products Π_j
-    (N, n, 2, 2), the DFT matrix E (2H+1, N), E δq (2H+1, 2, 3P), sample spacing h [s]."""
+    (N, n, 2, 2), the DFT matrix E (2H+1, N), E δq (2H+1, 2, 3P), sample spacing h [s], and
+    ``stuck`` (n,): contacts stuck at every sample (P_j = I, b_j = 0: no march needed)."""
     from .stability_march import step_products
 
     P = 2 * H + 1
@@ -110,8 +117,9 @@ def _memory_setup(omega, P_march, n_rho_march, drho, H, N):
     step = np.ascontiguousarray(P_march, dtype=float)
     source = (dq[:, None] - np.einsum("jcab,jbx->jcax", step, dq)
               + n_rho_march[..., None] * (drho[:, :, None, None] * dn[:, None, None, :]))
+    stuck = np.all(step == np.eye(2), axis=(0, 2, 3)) & np.all(source == 0.0, axis=(0, 2, 3))
     return dict(step=step, source=source, products=step_products(step), E=E,
-                Edq=np.einsum("hj,jcx->hcx", E, dq), h=2.0 * np.pi / (omega * N))
+                Edq=np.einsum("hj,jcx->hcx", E, dq), h=2.0 * np.pi / (omega * N), stuck=stuck)
 
 
 def _slider_march(q, rho, start, one_d=False):

@@ -24,11 +24,12 @@ loaded rows R enter (𝒥 vanishes elsewhere, so det(I + C𝒥) = det(I + C_LL �
 in the exponential basis W (per harmonic the rows (cos ∓ i sin)/√2, unitary) C is block diagonal,
 W C Wᴴ = ⊕_m A(s + imω), m = 0, ±1, …, ±H, so
 
-    det F = Π_m det A(s + imω) · det(⊕_m A(s + imω)⁻¹ + W 𝒥_LL Wᴴ):
+    det F = Π_m det A(s + imω) · det(C_LL⁻¹ + 𝒥_LL),   C_LL⁻¹ = Wᴴ (⊕_m A(s + imω)⁻¹) W
 
-one LU of order S per s and 2H+1 small |R|² blocks; GV, G K⁻¹ Gᵀ are per model
-(:func:`row_products`), the pointwise part of 𝒥 and the normal rows of the friction groups per
-point, the Jenkins memory rows per s by one compiled march for all s of a contour
+(C_LL⁻¹ is formed in the real basis of 𝒥 — per harmonic k a 2|R| block from A(s ± ikω)⁻¹ —, so
+𝒥 is never transformed): one LU of order S per s and 2H+1 small |R|² inverses; GV, G K⁻¹ Gᵀ are
+per model (:func:`row_products`), the pointwise part of 𝒥 and the normal rows of the friction
+groups per point, the Jenkins memory rows per s by one compiled march for all s of a contour
 (:mod:`sarfe.hbm.stability_march`).
 
 The verdict of the full method (:func:`sarfe.hbm.stability.hill_stability`) is decided by the
@@ -103,9 +104,10 @@ class ContactRowDeterminant:
     every harmonic: L = {(h, r): r ∈ R}, size S = P |R|): 𝒥 vanishes outside L × L, so
     det(I + C 𝒥) = det(I + C_LL 𝒥_LL) and neither 𝒥 nor C is formed on the other rows. 𝒥_LL(s)
     is the s-independent part (pointwise laws, the normal rows of the friction groups) plus the
-    tangent rows of the memory groups scattered at s, both held in the exponential basis W, where
-    C_LL(s) is block diagonal with the |R|² blocks A(s + imω) (:meth:`compliance_blocks`;
-    :meth:`log_determinants` inverts them, :meth:`matrices` forms I + C𝒥). ``probes`` [0, ω, 10ω, (0.37 + 0.21i)ω]: the
+    tangent rows of the memory groups scattered at s, both in the real (AFT) basis; C_LL(s) is
+    block diagonal over the harmonics, given by the |R|² blocks A(s + imω) of the exponential
+    basis (:meth:`compliance_blocks`; :meth:`log_determinants` inverts them, :meth:`matrices`
+    forms I + C𝒥). ``probes`` [0, ω, 10ω, (0.37 + 0.21i)ω]: the
     exponents at which the memory rows are first evaluated — their union of non-zero rows is R,
     the first three serve the norm of :func:`contact_row_stability`'s exponent bound
     (:attr:`probe_terms`)."""
@@ -141,11 +143,9 @@ class ContactRowDeterminant:
         self.loaded = (np.arange(P)[:, None] * n_rows + R[None]).ravel()       # L in (P n_rows)
         width = R.size
         self.size = S = P * width
-        square = (P, width, P, width)
-        self.fixed = _exponential(fixed[self.loaded][:, self.loaded].toarray().reshape(square),
-                                  0, 2).reshape(S, S)
-        self.damping = None if damping is None else _exponential(
-            damping[self.loaded][:, self.loaded].toarray().reshape(square), 0, 2).reshape(S, S)
+        self.fixed = fixed[self.loaded][:, self.loaded].toarray()               # real basis
+        self.damping = None if damping is None else \
+            damping[self.loaded][:, self.loaded].toarray()
         position = np.full(n_rows + 1, -1)
         position[R] = np.arange(width)                     # position[-1] = −1: an absent row
         self.scatter = [_scatter_index(rows, position, width, P) for rows, _ in coefficients]
@@ -159,8 +159,9 @@ class ContactRowDeterminant:
             (rows, coeff[:3]) for rows, coeff in coefficients]) if S else np.zeros((3, 0, 0))
 
     def contact_terms(self, s, coefficients=None):
-        """𝒥_LL(s) in the exponential basis, W 𝒥_LL W^H (n_s, S, S) complex, for s (n_s,)
-        (``coefficients``: the memory rows at s, when already evaluated)."""
+        """𝒥_LL(s) (n_s, S, S) complex, for s (n_s,), in the harmonic-major real basis of the
+        AFT (mean, cos 1, sin 1, …; ``coefficients``: the memory rows at s, when already
+        evaluated)."""
         s = np.asarray(s, dtype=complex)
         S = self.size
         J = np.empty((s.size, S, S), complex)
@@ -170,9 +171,7 @@ class ContactRowDeterminant:
                 coefficients = self.memory.memory_coefficients(s)
             flat = J.reshape(s.size, S * S)
             for (_, coeff), (mask, index, unique) in zip(coefficients, self.scatter):
-                shape = coeff.shape
-                coeff = _exponential(coeff.reshape(shape[:4] + (shape[4] // 3, 3)), 1, 4)
-                values = coeff.reshape(shape)[:, mask]                         # (n_s, entries)
+                values = coeff[:, mask]                                        # (n_s, entries)
                 if unique:
                     flat[:, index] += values
                 else:                   # contacts sharing a row: accumulate
@@ -200,15 +199,13 @@ class ContactRowDeterminant:
         return A.reshape(s.size, 2 * self.H + 1, width, width)
 
     def matrices(self, s, coefficients=None):
-        """W F(s) W^H = I + (W C W^H)(W 𝒥 W^H) (n_s, S, S) complex: F on the loaded rows in the
-        exponential basis W (per harmonic k the rows (cos, sin) → ((cos − i sin)/√2,
-        (cos + i sin)/√2), unitary: same determinant and singular values as F). There C is block
-        diagonal with the blocks A(s + ikω), A(s − ikω) (the real 2|R| block of the module
-        docstring diagonalized), one |R|² product per row block and column."""
+        """F(s) = I + C(s)𝒥(s) on the loaded rows (n_s, S, S) complex, in the real basis: C is
+        block diagonal over the harmonics, its (cos k, sin k) block formed from A(s ± ikω)
+        (:func:`_real_blocks`), one |R|² product per block row and column."""
         s = np.asarray(s, dtype=complex)
         width, S = self.rows.size, self.size
         J = self.contact_terms(s, coefficients).reshape(s.size, 2 * self.H + 1, width, S)
-        F = np.matmul(self.compliance_blocks(s), J).reshape(s.size, S, S)
+        F = _real_block_product(self.compliance_blocks(s), J).reshape(s.size, S, S)
         F[:, np.arange(S), np.arange(S)] += 1.0
         return F
 
@@ -216,16 +213,17 @@ class ContactRowDeterminant:
         """log det F(s) (n_s,) complex: log|det| + i arg det (nan where det F = 0); the memory
         rows for all s in one march, ``chunk`` exponents at a time.
 
-        With the compliance blocks A_b(s) regular, det F = det(W C W^H) · det((W C W^H)⁻¹ + W𝒥W^H):
-        the blocks are inverted (|R|² each) and added to the diagonal blocks of 𝒥, so no product
-        C𝒥 is formed, and Π_b det A_b is a product of small determinants. A block that does not
+        With the compliance blocks A_b(s) regular, det F = det C · det(C⁻¹ + 𝒥): the blocks are
+        inverted (|R|² each), C⁻¹ is block diagonal over the harmonics in the real basis (its
+        (cos k, sin k) block formed from A(s ± ikω)⁻¹, :func:`_real_blocks`) and added to 𝒥, so
+        no product C𝒥 is formed, and det C = Π_b det A_b (W C Wᴴ = ⊕_b A_b, W unitary) is a
+        product of small determinants. A block that does not
         invert to 10⁻⁸ (two loaded rows with dependent gap maps, a transmission zero) sends its s
         to the product form I + C𝒥 (:meth:`matrices`)."""
         s = np.asarray(s, dtype=complex)
         out = np.empty(s.size, complex)
         memory = self.memory.memory_coefficients(s) if self.memory is not None else None
         P, width, S = 2 * self.H + 1, self.rows.size, self.size
-        diagonal = np.arange(P)
         for first in range(0, s.size, chunk):
             sc = s[first:first + chunk]
             part = None if memory is None else [(rows, coeff[first:first + chunk])
@@ -242,15 +240,15 @@ class ContactRowDeterminant:
             value = np.empty(sc.size, complex)
             if np.any(regular):
                 M = (J if regular.all() else J[regular]).reshape(-1, P, width, P, width)
-                M[:, diagonal, :, diagonal, :] += np.moveaxis(inverse[regular], 1, 0)
+                _add_real_blocks(M, inverse[regular])
                 sign, logabs = np.linalg.slogdet(M.reshape(-1, S, S))
                 sign_A, logabs_A = np.linalg.slogdet(A[regular])
                 value[regular] = logabs + logabs_A.sum(axis=1) + 1j * np.angle(
                     sign * np.prod(sign_A, axis=1))
                 value[regular & ~(np.isfinite(logabs) & (sign != 0))] = np.nan
             if not np.all(regular):     # (J is intact: M was a copy when some s failed)
-                F = J[~regular].reshape(-1, P, width, S)
-                F = np.matmul(A[~regular], F).reshape(-1, S, S)
+                F = _real_block_product(A[~regular], J[~regular].reshape(-1, P, width, S))
+                F = F.reshape(-1, S, S)
                 F[:, np.arange(S), np.arange(S)] += 1.0
                 sign, logabs = np.linalg.slogdet(F)
                 bad = ~np.isfinite(logabs) | (sign == 0)
@@ -259,20 +257,41 @@ class ContactRowDeterminant:
         return out
 
 
-def _exponential(X, row_axis, column_axis):
-    """W X W^H for harmonic axes ``row_axis``, ``column_axis`` (length 2H+1, mean, cos 1, sin 1,
-    …): W maps the (cos, sin) pair of harmonic k to ((cos − i sin)/√2, (cos + i sin)/√2)
-    (unitary). Complex copy."""
-    X = np.moveaxis(np.asarray(X), (row_axis, column_axis), (0, 1))
-    out = np.empty(X.shape, complex)
-    r = 1.0 / np.sqrt(2.0)
-    out[0] = X[0]
-    out[1::2] = r * (X[1::2] - 1j * X[2::2])
-    out[2::2] = r * (X[1::2] + 1j * X[2::2])
-    Y = out.copy()
-    out[:, 1::2] = r * (Y[:, 1::2] + 1j * Y[:, 2::2])
-    out[:, 2::2] = r * (Y[:, 1::2] - 1j * Y[:, 2::2])
-    return np.moveaxis(out, (0, 1), (row_axis, column_axis))
+def _real_blocks(X):
+    """The real-basis blocks of a harmonic block-diagonal operator given in the exponential basis
+    by the blocks X_b (n_s, 2H+1, w, w), b ↔ m = 0, +1, −1, +2, −2, …: the mean block X₀ and per
+    harmonic k, with X± = X(±k) (W maps (cos, sin) to ((cos − i sin)/√2, (cos + i sin)/√2)),
+
+        Wᴴ diag(X₊, X₋) W = [[½(X₊ + X₋), ½i(X₋ − X₊)], [½i(X₊ − X₋), ½(X₊ + X₋)]].
+
+    Returns (X₀ (n_s, w, w), half = ½(X₊ + X₋), skew = ½i(X₋ − X₊)), the last two (n_s, H, w, w)."""
+    plus, minus = X[:, 1::2], X[:, 2::2]
+    return X[:, 0], 0.5 * (plus + minus), 0.5j * (minus - plus)
+
+
+def _add_real_blocks(M, X):
+    """M += the block-diagonal operator of the exponential blocks X (:func:`_real_blocks`),
+    M (n_s, P, w, P, w) in the real basis (in place)."""
+    mean, half, skew = _real_blocks(X)
+    P = M.shape[1]
+    cos, sin = np.arange(1, P, 2), np.arange(2, P, 2)
+    M[:, 0, :, 0, :] += mean
+    M[:, cos, :, cos, :] += np.moveaxis(half, 1, 0)
+    M[:, cos, :, sin, :] += np.moveaxis(skew, 1, 0)
+    M[:, sin, :, cos, :] -= np.moveaxis(skew, 1, 0)
+    M[:, sin, :, sin, :] += np.moveaxis(half, 1, 0)
+
+
+def _real_block_product(X, J):
+    """(block-diagonal operator of the exponential blocks X) @ J, J (n_s, P, w, S) in the real
+    basis → (n_s, P, w, S)."""
+    mean, half, skew = _real_blocks(X)
+    out = np.empty(J.shape, complex)
+    out[:, 0] = mean @ J[:, 0]
+    cos, sin = J[:, 1::2], J[:, 2::2]
+    out[:, 1::2] = half @ cos + skew @ sin
+    out[:, 2::2] = half @ sin - skew @ cos
+    return out
 
 
 def _nonzero_rows(matrix, n_rows):
@@ -316,11 +335,12 @@ def exponent_bound(basis, gap_modes, omega, harmonics, jacobian_norm, damping_no
 
 def _upper_contour(epsilon, X, top, pole_distance):
     """Samples of the upper half of the boundary of Ω, counter-clockwise: (X, 0) → (X, top) →
-    (−ε, top) → (−ε, 0); geometric spacing along the top edge, steps of at most twice the
-    distance of the nearest pole along the left edge (the poles lie left of −ε; a pole
-    at distance d turns arg det F by at most 2 atan(1) = π/2 over such a step, and the refinement
-    of :func:`winding_count` halves steps that turn it by more than π/3)."""
-    right = X + 1j * top * np.linspace(0.0, 1.0, 3)
+    (−ε, top) → (−ε, 0); the right edge by its ends (every zero and pole is ≥ X/11 away from it
+    and X ≫ top: it turns arg det F by nothing measurable), geometric spacing along the top edge,
+    steps of at most twice the distance of the nearest pole along the left edge (the poles lie
+    left of −ε; a pole at distance d turns arg det F by at most 2 atan(1) = π/2 over such a step,
+    and the refinement of :func:`winding_count` halves steps that turn it by more than π/3)."""
+    right = X + 1j * top * np.array([0.0, 1.0])
     depth = np.concatenate([np.geomspace(X + epsilon, 1e-2 * top, 12)[1:], [0.0]])
     count = int(np.clip(np.ceil(0.5 * top / pole_distance), 8, 64))
     left = 1j * top * np.linspace(1.0, 0.0, count + 1)[1:]
@@ -352,29 +372,56 @@ def winding_count(log_det, points, step=PHASE_STEP, budget=MAX_EVALUATIONS):
         evaluations += middle.size
 
 
-def real_zero(log_det, lower, upper, rounds=4, width=16):
-    """The zero of det F on the real segment (lower, upper) [1/s] where det F (real for real s)
-    changes sign exactly once, or None (no single sign change, or det F not finite there).
+def real_zero(log_det, lower, upper, relative=1e-9):
+    """The zero of det F on the real segment (lower, upper) [1/s], lower < 0 < upper, where det F
+    (real for real s) changes sign once — the count found one zero in Ω, so it is real and
+    simple — or None (det F not finite there, or of the same sign at both ends).
 
-    One geometric grid (the exponent of a fold lies near 0; ``upper`` is a crude bound), then
-    ``rounds`` subdivisions of the bracket into ``width`` parts: the bracket shrinks by
-    width^rounds (16⁴ ≈ 6.6·10⁴). Returns the bracket's midpoint."""
-    def signs(points):
-        values = log_det(points.astype(complex))
-        return np.sign(np.cos(values.imag)) if np.all(np.isfinite(values)) else None
+    The sign of det F brackets it: on (lower, 0], on (0, −lower], or by geometric bisection of
+    (−lower, upper] (a fold's exponent lies near 0 and ``upper`` is a crude bound: each evaluation
+    halves the bracket's log-ratio) down to a ratio ≤ 2; then Brent's method on
+    det F(s)/|det F(a)| to |Δs| ≤ ``relative``·|s| + 10⁻¹²|lower|. ≈ 15 evaluations in all (the
+    grid search this replaces took 108). Returns s* [1/s]."""
+    from scipy.optimize import brentq
 
-    small = max(-lower, 1e-12 * upper)
-    grid = np.concatenate([np.linspace(lower, 0.0, 4), np.geomspace(small, upper, 44)])
-    for _ in range(rounds + 1):
-        sign = signs(grid)
-        if sign is None:
+    def value(s):
+        v = log_det(np.array([s], dtype=complex))[0]
+        if not np.isfinite(v):
+            raise FloatingPointError(f"det F not finite at s = {s}")
+        return v
+
+    def sign(v):
+        return np.sign(np.cos(v.imag))
+
+    def scaled(s):          # det F(s)/|det F(a)|: continuous, of order one across the bracket
+        v = log_det(np.array([s], dtype=complex))[0]
+        if v.real == -np.inf:                        # det F = 0 exactly: s is the zero
+            return 0.0
+        if not np.isfinite(v):
+            raise FloatingPointError(f"det F not finite at s = {s}")
+        return np.cos(v.imag) * np.exp(np.clip(v.real - reference.real, -700.0, 700.0))
+
+    try:
+        low, zero, high = value(lower), value(0.0), value(upper)
+        if sign(low) == sign(high):
             return None
-        change = np.flatnonzero(sign[1:] != sign[:-1])
-        if change.size != 1:
-            return None
-        a, b = grid[change[0]], grid[change[0] + 1]
-        grid = np.linspace(a, b, width + 1)
-    return 0.5 * (a + b)
+        if sign(low) != sign(zero):
+            a, b, reference = lower, 0.0, low
+        else:
+            a, b, reference = -lower, upper, value(-lower)
+            if sign(reference) != sign(zero):
+                a, b, reference = 0.0, -lower, zero
+            while b > 2.0 * a > 0.0:
+                middle = np.sqrt(a * b)
+                v = value(middle)
+                if sign(v) == sign(reference):
+                    a, reference = middle, v
+                else:
+                    b = middle
+
+        return float(brentq(scaled, a, b, xtol=1e-12 * abs(lower), rtol=relative))
+    except (FloatingPointError, ValueError):
+        return None
 
 
 def contact_row_stability(model, contacts, omega, harmonics, forces, operator=None,

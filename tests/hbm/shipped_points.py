@@ -5,13 +5,16 @@ import numpy as np
 def shipped_case_points(name, max_harmonics=5, count=5):
     """The case ``cases/<name>.yaml`` at its own settings with H ≤ ``max_harmonics``: up to
     ``count`` of its frequencies (or points spread over its sweep band), each solved cold.
-    Returns (nl, H, [(frequency [Hz], converged HarmonicSolution)])."""
+    Returns (nl, H, [(frequency [Hz], converged HarmonicSolution)]); nl's excitation is truncated
+    to the 2H+1 rows of H (at the case's own H the solver rejected it and no point converged)."""
+    from dataclasses import replace
     from sarfe.pipeline import build_linear_model, load_case, nonlinear_model
     from sarfe.pipeline.points import solve_point, solver_options
 
     case = load_case(f"cases/{name}.yaml")
     nl = nonlinear_model(case, build_linear_model(case, progress=False))
     H = min(case.data["solver"]["harmonics"], max_harmonics)
+    nl = replace(nl, excitation=nl.excitation[:2 * H + 1])
     N = case.data["solver"]["samples_per_period"]
     options, _ = solver_options(case)
     excitation = case.data["excitation"]
