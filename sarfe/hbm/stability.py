@@ -75,8 +75,16 @@ def floquet_exponents(model, omega, harmonics, jacobian, dense_limit=3000, max_e
         OPinv = _shift_invert(Mt, Dt, jacobian, 0.0)
         values = spla.eigs(_pencil_operator(Mt, Dt, jacobian, OPinv.dtype), k=count,
                            M=sp.block_diag([sp.identity(size), Mt], format="csr"), sigma=0.0,
-                           which="LM", return_eigenvectors=False, OPinv=OPinv)
+                           which="LM", return_eigenvectors=False, OPinv=OPinv,
+                           v0=start_vector(2 * size, OPinv.dtype))
     return _select(values, omega, keep)
+
+
+def start_vector(size, dtype=float):
+    """A fixed ARPACK start vector (seeded, not ARPACK's random one): the same exponents to the
+    last bit in every run and every worker process."""
+    vector = np.random.default_rng(0).standard_normal(size)
+    return vector.astype(dtype)
 
 
 def _hill(model, omega, harmonics, contact_damping):
@@ -171,12 +179,13 @@ def _nearest(Mt, Dt, jacobian, target, dense, count=3):
             return values[np.argsort(np.abs(values - target))[:count]]
         # shift-invert on a dense LU: the few values near the target, not all of them
         return spla.eigs(A.astype(complex), k=count, sigma=target, which="LM",
-                         return_eigenvectors=False)
+                         return_eigenvectors=False, v0=start_vector(A.shape[0], complex))
     size = Mt.shape[0]
     return spla.eigs(_pencil_operator(Mt, Dt, jacobian, complex), k=count,
                      M=sp.block_diag([sp.identity(size), Mt], format="csr").astype(complex),
                      sigma=target, which="LM", return_eigenvectors=False,
-                     OPinv=_shift_invert(Mt, Dt, jacobian, complex(target)))
+                     OPinv=_shift_invert(Mt, Dt, jacobian, complex(target)),
+                     v0=start_vector(2 * size, complex))
 
 
 def refine_exponent(Mt, Dt, jacobian, operator, s0, dense, iterations=30, tolerance=1e-9):

@@ -135,3 +135,21 @@ def test_example03_points_agree_with_time_integration():
     low = solve_frequency(model, contacts, F, 0.70, H03, N03)
     check = perturbation_check(model, contacts, F, low, steps_per_period=1024, newton_steps=1)
     assert low.stable is True and check.stable
+
+
+def test_sparse_hill_path_is_repeatable_and_equals_the_dense_one():
+    """The ARPACK path (shift-invert at σ = 0) starts from a fixed vector: two calls give the
+    same exponents bit for bit (ARPACK's own random start differs run to run at round-off), and
+    they are the dense eigen-solve's (NLvib 03, H = 21, the impacting point at Ω = 0.70)."""
+    from sarfe.hbm.stability import floquet_exponents
+    from tests.hbm.test_solver import H03, N03, example03
+    model, contacts, F = example03()
+    s = solve_frequency(model, contacts, F, 0.70, H03, N03)
+    problem = Problem(model, contacts, F, H03, N03)
+    ev = full_residual(problem, s.displacement.ravel(), s.omega)
+    first = floquet_exponents(model, s.omega, H03, ev.jacobian, dense_limit=10)
+    second = floquet_exponents(model, s.omega, H03, ev.jacobian, dense_limit=10)
+    dense = floquet_exponents(model, s.omega, H03, ev.jacobian)
+    assert np.array_equal(first, second)
+    lead = first[np.argmax(first.real)]
+    assert np.min(np.abs(dense - lead)) <= 1e-8 * max(abs(lead), 1.0)
