@@ -325,22 +325,16 @@ def main():
         i = sys.argv.index("--compare")
         compare_sweeps(sys.argv[i + 1], sys.argv[i + 2])
         return
-    if "--sweep" in sys.argv:
-        res = sweep_cost()
-        (HERE / "results").mkdir(exist_ok=True)
-        (HERE / "results" / "stability_sweep.json").write_text(json.dumps(res, indent=1,
-                                                                           default=str))
-        write_sweep_section(sweep_lines(res))
-        print("\n".join(sweep_lines(res)))
-        return
-    if "--rows" in sys.argv:
-        res = rows_cost()
-        (HERE / "results").mkdir(exist_ok=True)
-        (HERE / "results" / "stability_rows.json").write_text(json.dumps(res, indent=1,
-                                                                          default=str))
-        write_rows_section(rows_lines(res))
-        print("\n".join(rows_lines(res)))
-        return
+    for flag, run, name, write, table in (
+            ("--sweep", sweep_cost, "stability_sweep.json", write_sweep_section, sweep_lines),
+            ("--rows", rows_cost, "stability_rows.json", write_rows_section, rows_lines)):
+        if flag in sys.argv:
+            res = run()
+            (HERE / "results").mkdir(exist_ok=True)
+            (HERE / "results" / name).write_text(json.dumps(res, indent=1, default=str))
+            write(table(res))
+            print("\n".join(table(res)))
+            return
     skip_full = "--skip-full" in sys.argv
     results = [compare("squeak_rig", "cases/squeak_rig.yaml", [50.0, 100.0, 150.0]),
                compare("door_trim 10 mm H=5", "cases/door_trim.yaml", [40.0, 52.0, 67.0, 80.0, 95.0],
