@@ -48,7 +48,11 @@ HERE = pathlib.Path(__file__).resolve().parent
 ROOT = HERE.parent
 
 
-def case_at(path, mesh=None, harmonics=None, samples=None):
+def case_at(path, mesh=None, harmonics=None, samples=None, sweep=None, solver=None):
+    """The case file ``path`` loaded through an edited temporary copy next to it: the generator's
+    mesh size ``mesh`` [m], solver.harmonics / samples_per_period, another sweep band
+    {start_hz, end_hz}, further solver keys; stability off unless ``solver`` says otherwise."""
+    path = pathlib.Path(path)
     data = yaml.safe_load(open(ROOT / path))
     if mesh:
         data["model"]["fe"]["generator"]["mesh_size_m"] = mesh
@@ -56,7 +60,10 @@ def case_at(path, mesh=None, harmonics=None, samples=None):
         data["solver"]["harmonics"] = harmonics
     if samples:
         data["solver"]["samples_per_period"] = samples
+    if sweep is not None:
+        data["excitation"]["sweep"] = sweep
     data["solver"]["stability"] = False
+    data["solver"].update(solver or {})
     tmp = tempfile.NamedTemporaryFile("w", suffix=".yaml", delete=False, dir=ROOT / path.parent)
     yaml.safe_dump(data, tmp)
     tmp.close()
@@ -106,18 +113,8 @@ def rows_cost(path="cases/door_trim_p1.yaml", mesh=0.015, band=(60.0, 65.0)):
     from sarfe.hbm.modal import cached_modal_basis
     from sarfe.pipeline.points import solver_options
 
-    data = yaml.safe_load(open(ROOT / path))
-    data["model"]["fe"]["generator"]["mesh_size_m"] = mesh
-    data["excitation"]["sweep"] = {"start_hz": band[0], "end_hz": band[1]}
-    data["solver"]["continuation"] = {"initial_step": 0.04, "max_step": 0.04}
-    data["solver"]["stability"] = False
-    tmp = tempfile.NamedTemporaryFile("w", suffix=".yaml", delete=False, dir=ROOT / "cases")
-    yaml.safe_dump(data, tmp)
-    tmp.close()
-    try:
-        case = load_case(tmp.name)
-    finally:
-        os.unlink(tmp.name)
+    case = case_at(path, mesh, sweep={"start_hz": band[0], "end_hz": band[1]},
+                   solver={"continuation": {"initial_step": 0.04, "max_step": 0.04}})
     nl = nonlinear_model(case, build_linear_model(case, progress=False))
     H, N = case.data["solver"]["harmonics"], case.data["solver"]["samples_per_period"]
     _, cont = solver_options(case)
@@ -165,15 +162,7 @@ def sweep_cost(path="cases/door_trim_p1.yaml", mesh=0.015):
     from sarfe.hbm.deferred import deferred_stability, pending, stability_of
     from sarfe.pipeline.pruning import solve_points_pruned
 
-    data = yaml.safe_load(open(ROOT / path))
-    data["model"]["fe"]["generator"]["mesh_size_m"] = mesh
-    tmp = tempfile.NamedTemporaryFile("w", suffix=".yaml", delete=False, dir=ROOT / "cases")
-    yaml.safe_dump(data, tmp)
-    tmp.close()
-    try:
-        case = load_case(tmp.name)
-    finally:
-        os.unlink(tmp.name)
+    case = case_at(path, mesh, solver={"stability": True})
     nl = nonlinear_model(case, build_linear_model(case, progress=False))
     with deferred_stability() as jobs:
         solutions, _ = solve_points_pruned(case.config.solver, case.config.excitation, nl)
