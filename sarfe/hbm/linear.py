@@ -399,15 +399,11 @@ def modal_omega_derivative(condensation: Condensation, contact_force: np.ndarray
     m = condensation.modal
     H = (np.asarray(contact_force).shape[0] - 1) // 2
     orders = _kept_orders(condensation, H)
-    basis = m.basis
-    kw = orders[:, None].astype(float) * condensation.omega
-    a = kw**2 * basis.flexibility[None, :] - 1j * kw * basis.damping[None, :]
-    slope = (2 * orders[:, None].astype(float) * kw * basis.flexibility[None, :]
-             - 1j * orders[:, None] * basis.damping[None, :])
+    slope = m.basis.receptance_slope(orders, condensation.omega)             # q'_k (m, n_modes)
     L = to_complex(np.asarray(contact_force, dtype=float))[orders]          # (m, n_rows)
     modal = m.modal_load - real_product(L, m.gap_modes)                     # Vᵀ(f − Gᵀλ)
     out = np.zeros((H + 1, m.gap_modes.shape[0]), dtype=complex)
-    out[orders] = -real_product(slope / (1.0 - a) ** 2 * modal, m.gap_modes.T)
+    out[orders] = -real_product(slope * modal, m.gap_modes.T)
     return from_complex(out)
 
 

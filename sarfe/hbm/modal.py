@@ -72,6 +72,14 @@ class ModalBasis:
         a = self._a(orders, omega)
         return a / (1.0 - a)
 
+    def receptance_slope(self, orders, omega: float) -> np.ndarray:
+        """∂q_kj/∂ω = a'_kj / (1 − a_kj)², a'_kj = 2k²ω μ_j − i k δ_j (n_orders, n_modes) complex
+        [s]: the ω-derivative of :meth:`dynamic_receptance`."""
+        k = np.asarray(orders, dtype=float)[:, None]
+        a = self._a(orders, omega)
+        slope = 2.0 * k**2 * omega * self.flexibility[None, :] - 1j * k * self.damping[None, :]
+        return slope / (1.0 - a) ** 2
+
     def static_solve(self, B: np.ndarray) -> np.ndarray:
         """K⁻¹ B for real or complex B (n, ...) [m per N]."""
         B = np.asarray(B)
