@@ -93,16 +93,9 @@ def cylindrical_panel_solid(radius, angle, length, thickness, n_arc, n_axial, la
 def gmsh_rectangle_triangles(length_x, length_y, size, algorithm=6):
     """Unstructured Gmsh triangle mesh of [0, length_x] × [0, length_y] (z = 0), target
     element size ``size`` [m]; algorithm 6 = Frontal-Delaunay. Returns points, triangles."""
-    import gmsh
+    from sarfe.mesh.gmsh_model import gmsh_session
 
-    from sarfe.mesh.gmsh_model import start_gmsh
-
-    started = gmsh.isInitialized()
-    if not started:
-        start_gmsh(gmsh, ["-noenv"], readConfigFiles=False)
-    try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.model.add("sarfe_fe_rectangle")
+    with gmsh_session() as gmsh:    # the process-wide lock, headless and seeded like every mesh
         gmsh.model.occ.addRectangle(0.0, 0.0, 0.0, length_x, length_y)
         gmsh.model.occ.synchronize()
         gmsh.option.setNumber("Mesh.MeshSizeMin", size)
@@ -111,10 +104,6 @@ def gmsh_rectangle_triangles(length_x, length_y, size, algorithm=6):
         gmsh.model.mesh.generate(2)
         tags, coords, _ = gmsh.model.mesh.getNodes()
         _, _, connectivity = gmsh.model.mesh.getElements(2)
-        gmsh.model.remove()
-    finally:
-        if not started:
-            gmsh.finalize()
     index = np.zeros(int(tags.max()) + 1, dtype=np.int64)
     index[tags.astype(np.int64)] = np.arange(len(tags))
     triangles = index[np.asarray(connectivity[0], dtype=np.int64).reshape(-1, 3)]
