@@ -74,6 +74,7 @@ TARGET_DB = 0.5        # ERP dB(A)
 SPREAD_PERIODIC = 1e-6  # Poincaré spread below which a response is T-periodic
 ERP_RANGE_DB = 40.0     # ERP compared where the reference is within this of the sweep's loudest
 SPREAD_CONFIRM = 1e-4   # spread of the last check periods that confirms a reference orbit
+TI_SETTING_CAP_S = float(os.environ.get("BENCH_TI_CAP_S", 400))  # a dearer TI setting ends its chain
 
 CASES = {
     "rattle_rig": dict(
@@ -413,9 +414,65 @@ def run_case(name, save=lambda out: None):
             break                                       # errors (the trade curve), in budget
 
     out["time"] = []
-    for richardson in (False, True):
+    try:
+        time_scan(out, cfg, nl, freqs, metrics, reference, compared, H_ref, save)
+    except KeyboardInterrupt:           # stopped by hand (SIGINT): the rows so far stand
+        out["time_scan_stopped"] = True
+        print("  time-integration scan stopped by hand", flush=True)
+    out["ratios"] = {}
+    for key, ok in (("e1", lambda r: r["e1_max"] <= TARGET),
+                    ("e1_and_erp", lambda r: r["e1_max"] <= TARGET and r["dL_max"] <= TARGET_DB)):
+        h = min((r for r in out["hbm"] if ok(r)), key=lambda r: r["s"], default=None)
+        t = min((r for r in out["time"] if ok(r)), key=lambda r: r["s"], default=None)
+        out["ratios"][key] = {"hbm": h and {k: h[k] for k in ("harmonics", "samples", "s")},
+                              "time": t and {k: t[k] for k in ("steps_per_period", "richardson",
+                                                               "s")},
+                              "ratio": (t["s"] / h["s"]) if h and t else None}
+    out["trade"] = trade_curve(out)
+    save(out)
+    chosen = out["ratios"]["e1_and_erp"]["hbm"] or out["ratios"]["e1"]["hbm"]
+    try:
+        extras(out, case, nl, freqs, cfg, chosen, save)
+    except KeyboardInterrupt:
+        print("  stability / continuation timing stopped by hand", flush=True)
+    return out
+
+
+def extras(out, case, nl, freqs, cfg, chosen, save):
+    """The chosen HBM setting with Hill stability (auto, condensed) and as a continuation."""
+    if chosen:
+        H, N = chosen["harmonics"], chosen["samples"]
+        out["hbm_with_stability"] = {}
+        for method in ("auto", "condensed"):
+            sols, seconds = hbm_sweep(case, nl, freqs, H, N, stability=True, method=method)
+            out["hbm_with_stability"][method] = {
+                "s": seconds, "stable": sum(s.stable is True for s in sols),
+                "unstable_hz": [float(f) for f, s in zip(freqs, sols) if s.stable is False]}
+            print(f"  HBM H={H} with stability ({method}): {seconds:.2f} s", flush=True)
+            save(out)
+        try:
+            out["continuation"] = {"harmonics": H, "samples": N,
+                                   **hbm_continuation(case, nl, cfg["band_hz"], H, N)}
+        except Exception as exc:       # reported, the rest of the results stand
+            out["continuation"] = {"error": repr(exc)}
+    return out
+
+
+def time_scan(out, cfg, nl, freqs, metrics, reference, compared, H_ref, save):
+    """Newmark sweeps over ``cfg['ti_steps']`` (plain, then with Richardson; ``BENCH_TI`` =
+    e.g. 'R256,R512,512' runs only those, Richardson chain first), each chain stopped at the
+    first setting meeting both targets or costing more than :data:`TI_SETTING_CAP_S`."""
+    chosen = os.environ.get("BENCH_TI")
+    if chosen:
+        chains = {}
+        for item in chosen.split(","):
+            chains.setdefault(item.startswith("R"), []).append(int(item.lstrip("R")))
+        chains = sorted(chains.items(), key=lambda kv: -kv[0])
+    else:
+        chains = [(False, cfg["ti_steps"]), (True, cfg["ti_steps"])]
+    for richardson, steps_list in chains:
         spent = 0.0
-        for steps in cfg["ti_steps"]:
+        for steps in steps_list:
             H_out = min(H_ref, (steps - 1) // 2)
             rs, seconds = ti_sweep(nl, freqs, steps, richardson, H_out)
             row = {"steps_per_period": steps, "richardson": richardson, "s": seconds,
@@ -429,36 +486,8 @@ def run_case(name, save=lambda out: None):
                   f"{row['e1_max']:.2e}, dL {row['dL_max']:.2f}, dLA {row['dLA_max']:.2f}",
                   flush=True)
             spent += seconds
-            if enough([row], spent) or seconds > 400:
+            if enough([row], spent) or seconds > TI_SETTING_CAP_S:
                 break
-
-    out["ratios"] = {}
-    for key, ok in (("e1", lambda r: r["e1_max"] <= TARGET),
-                    ("e1_and_erp", lambda r: r["e1_max"] <= TARGET and r["dL_max"] <= TARGET_DB)):
-        h = min((r for r in out["hbm"] if ok(r)), key=lambda r: r["s"], default=None)
-        t = min((r for r in out["time"] if ok(r)), key=lambda r: r["s"], default=None)
-        out["ratios"][key] = {"hbm": h and {k: h[k] for k in ("harmonics", "samples", "s")},
-                              "time": t and {k: t[k] for k in ("steps_per_period", "richardson",
-                                                               "s")},
-                              "ratio": (t["s"] / h["s"]) if h and t else None}
-    out["trade"] = trade_curve(out)
-    save(out)
-    chosen = out["ratios"]["e1_and_erp"]["hbm"] or out["ratios"]["e1"]["hbm"]
-    if chosen:
-        H, N = chosen["harmonics"], chosen["samples"]
-        out["hbm_with_stability"] = {}
-        for method in ("auto", "condensed"):
-            sols, seconds = hbm_sweep(case, nl, freqs, H, N, stability=True, method=method)
-            out["hbm_with_stability"][method] = {
-                "s": seconds, "stable": sum(s.stable is True for s in sols),
-                "unstable_hz": [float(f) for f, s in zip(freqs, sols) if s.stable is False]}
-            print(f"  HBM H={H} with stability ({method}): {seconds:.2f} s", flush=True)
-        try:
-            out["continuation"] = {"harmonics": H, "samples": N,
-                                   **hbm_continuation(case, nl, cfg["band_hz"], H, N)}
-        except Exception as exc:       # reported, the rest of the results stand
-            out["continuation"] = {"error": repr(exc)}
-    return out
 
 
 # ------------------------------------------------------------------------------ part 0
