@@ -229,8 +229,13 @@ def jacobian_matrix(blocks, n_rows: int, harmonics: int, dense: bool = False, ke
         V.append(block[mask])
     if dense:
         out = np.zeros((size, size))
+        rows_used = np.concatenate([rows[rows >= 0] for rows, _ in blocks]) if blocks else ()
+        distinct = np.unique(rows_used).size == len(rows_used)
         for i, j, v in zip(I, Jc, V):
-            np.add.at(out, (i, j), v)
+            if distinct:            # each row in one block: no (i, j) twice, plain assignment
+                out[i, j] = v
+            else:
+                np.add.at(out, (i, j), v)
         return out
     if not I:
         return sp.csr_matrix((size, size))

@@ -147,11 +147,12 @@ def condensed_residual(problem: Problem, condensation, x, slider_start=None,
     R = x - (r_lin if keep is None else r_lin[keep]) + C @ force
     J = dR = None
     if jacobian:
-        J_lam = jacobian_matrix(forces.blocks, n_rows, problem.harmonics, kept_rows=rows)
-        if J_lam.shape[0] <= DENSE_CONTACT_JACOBIAN:
-            J_lam = J_lam.toarray()
+        if x.size <= DENSE_CONTACT_JACOBIAN:     # assembled dense (no sparse detour)
+            J_lam = jacobian_matrix(forces.blocks, n_rows, problem.harmonics, dense=True,
+                                    kept_rows=rows)
             unit = np.flatnonzero(~J_lam.any(axis=0))       # rows without contact stiffness
         else:                                              # (stored entries may be zeros)
+            J_lam = jacobian_matrix(forces.blocks, n_rows, problem.harmonics, kept_rows=rows)
             unit = np.flatnonzero(abs(J_lam).sum(axis=0).A1 == 0)
         J = condensation.apply_compliance(J_lam)
         J[np.diag_indices_from(J)] += 1.0
