@@ -346,7 +346,7 @@ def truth_study(path="cases/rattle_rig.yaml", every=6):
             for p in json.loads(saved.read_text())["points"]:
                 for key, value in p.get("time_integration", {}).items():
                     cache[(round(p["frequency_hz"], 6), int(key))] = value
-    import sarfe.hbm.stability_trust as trust
+    import sarfe.hbm.solve as trust     # (its bound name 'checked' is patched)
 
     def label(job, method, check=True):
         original = trust.checked
@@ -394,6 +394,52 @@ def truth_study(path="cases/rattle_rig.yaml", every=6):
     return {"case": f"{path}, H = {H}, N = {case.data['solver']['samples_per_period']}, defaults",
             "reduced_dofs": nl.model.dof_count, "contact_rows": nl.contacts.row_count,
             "load_average": os.getloadavg()[0], "points": points}
+
+
+def truth_study_nlvib03():
+    """NLvib example 03 (H = 21, N = 1024; tests/hbm/test_solver.py's model), its continuation
+    0.5 → 0.8 with the default options (stability deferred): per point the three labels and the
+    integrator at 1024 and 2048 steps per period on every point (2 DOFs: cheap)."""
+    from dataclasses import replace
+    from sarfe.hbm import ContinuationOptions, continuation
+    from sarfe.hbm.deferred import deferred_stability, stability_of
+    from sarfe.hbm.stability_check import perturbation_check
+    import sarfe.hbm.solve as trust     # (its bound name 'checked' is patched)
+    sys.path.insert(0, str(ROOT))
+    from tests.hbm.test_solver import H03, N03, example03
+
+    model, contacts, F = example03()
+    with deferred_stability() as jobs:
+        solutions = continuation(model, contacts, F, 0.5, 0.8, H03, N03,
+                                 options=ContinuationOptions(max_step=0.3))
+    points = []
+    for s in solutions:
+        job = jobs[s.stability_job]
+        p = dict(frequency_hz=s.omega / (2 * np.pi), omega=s.omega)
+        for name, method, check in (("full", "full", True), ("count", "contact_rows", False),
+                                    ("auto", "auto", True)):
+            original = trust.checked
+            if not check:
+                trust.checked = lambda result, *args, **kwargs: result
+            try:
+                t = time.process_time()
+                r = stability_of(replace(job, options=replace(job.options,
+                                                              stability_method=method)))
+                p[name] = dict(stable=r.stable, leading=r.leading, note=r.note,
+                               cpu_s=time.process_time() - t)
+            finally:
+                trust.checked = original
+        p["time_integration"] = {}
+        for steps in (1024, 2048):
+            c = perturbation_check(model, contacts, F, s, steps_per_period=steps)
+            p["time_integration"][str(steps)] = dict(stable=c.stable, rate=c.rate,
+                                                    periodicity=c.periodicity)
+        points.append(p)
+        print(p["omega"], {k: p[k]["stable"] for k in ("full", "count", "auto")},
+              p["time_integration"], flush=True)
+    return {"case": f"NLvib example 03, H = {H03}, N = {N03}, continuation 0.5 → 0.8 rad/s",
+            "reduced_dofs": 2, "contact_rows": 1, "load_average": os.getloadavg()[0],
+            "points": points}
 
 
 def truth_of(p):
@@ -450,6 +496,19 @@ def truth_lines(res):
     return lines + [""]
 
 
+def write_truth_nlvib_section(lines):
+    """The NLvib 03 truth table under its own header (after the rattle rig's)."""
+    lines = [NLVIB_HEADER] + lines[1:]
+    path = HERE / "results" / "stability.md"
+    text = path.read_text() if path.exists() else ""
+    head, _, rest = text.partition(NLVIB_HEADER)
+    tail = "## " + rest.split("\n## ", 1)[1] if rest and "\n## " in rest else ""
+    path.write_text(head.rstrip("\n") + "\n\n" + "\n".join(lines) + ("\n" + tail if tail else ""))
+
+
+NLVIB_HEADER = "## Verdicts against time integration: NLvib example 03 (session hilltrust)"
+
+
 def write_truth_section(lines):
     """Replace (or append) the truth section of results/stability.md."""
     path = HERE / "results" / "stability.md"
@@ -469,6 +528,8 @@ def main():
     for flag, run, name, write, table in (
             ("--sweep", sweep_cost, "stability_sweep.json", write_sweep_section, sweep_lines),
             ("--rows", rows_cost, "stability_rows.json", write_rows_section, rows_lines),
+            ("--truth-nlvib03", truth_study_nlvib03, "stability_truth_nlvib03.json",
+             write_truth_nlvib_section, truth_lines),
             ("--truth", truth_study, "stability_truth.json", write_truth_section, truth_lines)):
         if flag in sys.argv:
             res = run()
