@@ -318,8 +318,11 @@ def write_sweep_section(lines):
     """Replace the sweep section of results/stability.md (keep everything before it)."""
     path = HERE / "results" / "stability.md"
     text = path.read_text() if path.exists() else ""
-    head = text.split(SWEEP_HEADER)[0].rstrip("\n")
-    path.write_text((head + "\n\n" if head else "") + "\n".join(lines + [SWEEP_BEFORE_AFTER, ""]))
+    head, _, rest = text.partition(SWEEP_HEADER)
+    head = head.rstrip("\n")
+    tail = "## " + rest.split("\n## ", 1)[1] if "\n## " in rest else ""   # (the truth sections)
+    path.write_text((head + "\n\n" if head else "") + "\n".join(lines + [SWEEP_BEFORE_AFTER, ""])
+                    + ("\n" + tail if tail else ""))
 
 
 TRUTH_HEADER = "## Verdicts against time integration: the rattle rig's whole sweep (session hilltrust)"
