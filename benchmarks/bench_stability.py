@@ -21,7 +21,20 @@ evaluations of the count (contour) and of the real-zero search, the path (zeros 
 hand-over), verdict and leading exponent. → results/stability_sweep.json (its verdicts are what
 a before/after comparison checks: ``--compare OLD.json NEW.json``).
 
+Section "truth" (``--truth``, session hilltrust): the verdicts against the time integrator's
+monodromy (:func:`sarfe.hbm.stability_check.perturbation_check`) over the whole sweep of
+cases/rattle_rig.yaml (H = 10, N = 256, defaults): per point the full Hill method, the contact-row
+count at H alone and the default (``auto``: the count checked at ⌊3H/4⌋,
+:mod:`sarfe.hbm.stability_trust`) with their CPU times; the integrator at 1024 steps per period on
+every point where full and count differ plus every 6th other one, at 2048 steps where its
+verdict disagrees with the count or the default label (and where an earlier run left one), and
+at 4096 where both disagree with the default label. An
+integrator verdict counts as truth only where its shooting closed the orbit (periodicity ≤ 10⁻³)
+and the verdicts at all its step counts agree. Integrator results are
+kept in results/stability_truth.json and reused by reruns (keyed by frequency and steps).
+
 Run: OPENBLAS_NUM_THREADS=1 python benchmarks/bench_stability.py [--skip-full] [--rows] [--sweep]
+[--truth]
 """
 import json
 import os
@@ -305,8 +318,209 @@ def write_sweep_section(lines):
     """Replace the sweep section of results/stability.md (keep everything before it)."""
     path = HERE / "results" / "stability.md"
     text = path.read_text() if path.exists() else ""
-    head = text.split(SWEEP_HEADER)[0].rstrip("\n")
-    path.write_text((head + "\n\n" if head else "") + "\n".join(lines + [SWEEP_BEFORE_AFTER, ""]))
+    head, _, rest = text.partition(SWEEP_HEADER)
+    head = head.rstrip("\n")
+    tail = "## " + rest.split("\n## ", 1)[1] if "\n## " in rest else ""   # (the truth sections)
+    path.write_text((head + "\n\n" if head else "") + "\n".join(lines + [SWEEP_BEFORE_AFTER, ""])
+                    + ("\n" + tail if tail else ""))
+
+
+TRUTH_HEADER = "## Verdicts against time integration: the rattle rig's whole sweep (session hilltrust)"
+TRUTH_PERIODICITY = 1e-3     # shooting residual above which the integrator's verdict is no truth
+
+
+def truth_study(path="cases/rattle_rig.yaml", every=6):
+    """The rattle rig's sweep with the default options (stability deferred), then per point the
+    labels of three stability paths and, on the selected points, the integrator's verdict."""
+    from sarfe.hbm.deferred import deferred_stability, stability_of
+    from sarfe.hbm.stability_check import perturbation_check
+    from sarfe.pipeline.pruning import solve_points_pruned
+    from dataclasses import replace
+
+    case = case_at(path, solver={"stability": True})
+    nl = nonlinear_model(case, build_linear_model(case, progress=False))
+    with deferred_stability() as jobs:
+        solutions, _ = solve_points_pruned(case.config.solver, case.config.excitation, nl)
+    saved = HERE / "results" / "stability_truth.json"
+    cache = {}
+
+    def read_saved():             # (re-read before each integration: another run may fill it)
+        if saved.exists():
+            for p in json.loads(saved.read_text())["points"]:
+                for key, value in p.get("time_integration", {}).items():
+                    cache[(round(p["frequency_hz"], 6), int(key))] = value
+    import sarfe.hbm.solve as trust     # (its bound name 'checked' is patched)
+
+    def label(job, method, check=True):
+        original = trust.checked
+        if not check:
+            trust.checked = lambda result, *args, **kwargs: result
+        try:
+            t = time.process_time()
+            r = stability_of(replace(job, options=replace(job.options, stability_method=method)))
+            return dict(stable=r.stable, leading=r.leading, note=r.note,
+                        cpu_s=time.process_time() - t)
+        finally:
+            trust.checked = original
+
+    points = []
+    for s in solutions:
+        job = jobs[s.stability_job]
+        points.append(dict(frequency_hz=s.omega / (2 * np.pi), full=label(job, "full"),
+                           count=label(job, "contact_rows", check=False),
+                           auto=label(job, "auto")))
+        print(points[-1]["frequency_hz"], {k: points[-1][k]["stable"] for k in
+                                            ("full", "count", "auto")}, flush=True)
+    differ = [i for i, p in enumerate(points) if p["full"]["stable"] != p["count"]["stable"]]
+    others = [i for i in range(len(points)) if i not in differ][::every]
+    for i in sorted(differ + others):
+        p, s = points[i], solutions[i]
+        p["time_integration"] = {}
+        read_saved()
+        for steps in (1024, 2048, 4096):
+            key = (round(p["frequency_hz"], 6), steps)
+            seen = {r["stable"] for r in p["time_integration"].values()}
+            if steps == 2048 and key not in cache and all(
+                    p[m]["stable"] in (None, *seen) for m in ("count", "auto")):
+                continue              # (the full method's own disagreements: where cached)
+            if steps == 4096 and (len(seen) > 1 or p["auto"]["stable"] in (None, *seen)):
+                continue              # only where 1024 and 2048 agree against a default label
+            if key not in cache:
+                t = time.process_time()
+                c = perturbation_check(nl.model, nl.contacts, nl.excitation, s,
+                                       steps_per_period=steps)
+                cache[key] = dict(stable=c.stable, rate=c.rate, periodicity=c.periodicity,
+                                  cpu_s=time.process_time() - t)
+            p["time_integration"][str(steps)] = cache[key]
+        print(p["frequency_hz"], p["time_integration"], flush=True)
+    H = case.data["solver"]["harmonics"]
+    return {"case": f"{path}, H = {H}, N = {case.data['solver']['samples_per_period']}, defaults",
+            "reduced_dofs": nl.model.dof_count, "contact_rows": nl.contacts.row_count,
+            "load_average": os.getloadavg()[0], "points": points}
+
+
+def truth_study_nlvib03():
+    """NLvib example 03 (H = 21, N = 1024; tests/hbm/test_solver.py's model), its continuation
+    0.5 → 0.8 with the default options (stability deferred): per point the three labels and the
+    integrator at 1024 and 2048 steps per period on every point (2 DOFs: cheap)."""
+    from dataclasses import replace
+    from sarfe.hbm import ContinuationOptions, continuation
+    from sarfe.hbm.deferred import deferred_stability, stability_of
+    from sarfe.hbm.stability_check import perturbation_check
+    import sarfe.hbm.solve as trust     # (its bound name 'checked' is patched)
+    sys.path.insert(0, str(ROOT))
+    from tests.hbm.test_solver import H03, N03, example03
+
+    model, contacts, F = example03()
+    with deferred_stability() as jobs:
+        solutions = continuation(model, contacts, F, 0.5, 0.8, H03, N03,
+                                 options=ContinuationOptions(max_step=0.3))
+    points = []
+    for s in solutions:
+        job = jobs[s.stability_job]
+        p = dict(frequency_hz=s.omega / (2 * np.pi), omega=s.omega)
+        for name, method, check in (("full", "full", True), ("count", "contact_rows", False),
+                                    ("auto", "auto", True)):
+            original = trust.checked
+            if not check:
+                trust.checked = lambda result, *args, **kwargs: result
+            try:
+                t = time.process_time()
+                r = stability_of(replace(job, options=replace(job.options,
+                                                              stability_method=method)))
+                p[name] = dict(stable=r.stable, leading=r.leading, note=r.note,
+                               cpu_s=time.process_time() - t)
+            finally:
+                trust.checked = original
+        p["time_integration"] = {}
+        for steps in (1024, 2048):
+            c = perturbation_check(model, contacts, F, s, steps_per_period=steps)
+            p["time_integration"][str(steps)] = dict(stable=c.stable, rate=c.rate,
+                                                    periodicity=c.periodicity)
+        points.append(p)
+        print(p["omega"], {k: p[k]["stable"] for k in ("full", "count", "auto")},
+              p["time_integration"], flush=True)
+    return {"case": f"NLvib example 03, H = {H03}, N = {N03}, continuation 0.5 → 0.8 rad/s",
+            "reduced_dofs": 2, "contact_rows": 1, "load_average": os.getloadavg()[0],
+            "points": points}
+
+
+def truth_of(p):
+    """The integrator's verdict at a point (True/False), or None when not computed or not
+    converged (shooting residual above ``TRUTH_PERIODICITY``, or 1024 and 2048 steps differ)."""
+    runs = p.get("time_integration") or {}
+    if not runs or any(r["periodicity"] > TRUTH_PERIODICITY for r in runs.values()):
+        return None
+    verdicts = {r["stable"] for r in runs.values()}
+    return verdicts.pop() if len(verdicts) == 1 else None
+
+
+def truth_lines(res):
+    pts = res["points"]
+    sym = {True: "stable", False: "unstable", None: "uncertain"}
+    lines = [TRUTH_HEADER, "",
+             f"{res['case']}: {res['reduced_dofs']} reduced DOFs, {res['contact_rows']} contact "
+             f"row(s), {len(pts)} points (load average {res['load_average']:.1f} at the end). "
+             "full: the Hill eigenproblem on all reduced DOFs (2n smallest |Im s| + the strip); "
+             "count: the contact-row count at H (Ritz method where it finds ≥ 2 zeros), no check; "
+             "auto: the default — the count checked at ⌊3H/4⌋ (sarfe/hbm/stability_trust.py). "
+             "TI: the integrator's monodromy (perturbation_check) at 1024 steps per period, "
+             "2048 where it disagrees with count or auto (or cached), 4096 where both disagree "
+             "with auto; 'n.c.': "
+             f"shooting residual > {TRUTH_PERIODICITY:g} or the step counts disagree (no truth).",
+             ""]
+    for m in ("full", "count", "auto"):
+        cpu = np.array([p[m]["cpu_s"] for p in pts])
+        counts = {sym[v]: sum(1 for p in pts if p[m]["stable"] is v) for v in (True, False, None)}
+        tally = {"agree": 0, "uncertain": 0, "contradict": 0}
+        for p in pts:
+            t = truth_of(p)
+            if t is None:
+                continue
+            v = p[m]["stable"]
+            tally["agree" if v is t else "uncertain" if v is None else "contradict"] += 1
+        lines.append(f"- {m}: {counts} over the sweep; CPU {cpu.sum():.1f} s "
+                     f"({1e3 * cpu.mean():.1f} ms per point); against converged TI: {tally}")
+    checked_points = [p for p in pts if p.get("time_integration")]
+    lines += ["", f"{len(checked_points)} points with the integrator, "
+              f"{sum(truth_of(p) is not None for p in checked_points)} with a converged verdict:", "",
+              "| f [Hz] | full (max Re s) | count (max Re s) | auto | TI 1024 rate [1/s] "
+              "(periodicity) | TI 2048 / 4096 rate | truth |", "|---|---|---|---|---|---|---|"]
+    for p in checked_points:
+        ti = p["time_integration"]
+        rate2 = " / ".join(f"{ti[k]['rate']:+.3g}" for k in ("2048", "4096") if k in ti) or "-"
+        lines.append(
+            f"| {p['frequency_hz']:.3f} | {sym[p['full']['stable']]} ({p['full']['leading']:.3g}) "
+            f"| {sym[p['count']['stable']]} ({p['count']['leading']:.3g}) | "
+            f"{sym[p['auto']['stable']]} | {ti['1024']['rate']:+.3g} "
+            f"({ti['1024']['periodicity']:.1e}) | "
+            f"{rate2} | "
+            f"{'n.c.' if truth_of(p) is None else sym[truth_of(p)]} |")
+    return lines + [""]
+
+
+def write_truth_nlvib_section(lines):
+    """The NLvib 03 truth table under its own header (after the rattle rig's)."""
+    lines = [NLVIB_HEADER] + lines[1:]
+    path = HERE / "results" / "stability.md"
+    text = path.read_text() if path.exists() else ""
+    head, _, rest = text.partition(NLVIB_HEADER)
+    tail = "## " + rest.split("\n## ", 1)[1] if rest and "\n## " in rest else ""
+    path.write_text(head.rstrip("\n") + "\n\n" + "\n".join(lines) + ("\n" + tail if tail else ""))
+
+
+NLVIB_HEADER = "## Verdicts against time integration: NLvib example 03 (session hilltrust)"
+
+
+def write_truth_section(lines):
+    """Replace (or append) the truth section of results/stability.md."""
+    path = HERE / "results" / "stability.md"
+    text = path.read_text() if path.exists() else ""
+    head, _, rest = text.partition(TRUTH_HEADER)
+    tail = ""
+    if rest and "\n## " in rest:
+        tail = "## " + rest.split("\n## ", 1)[1]
+    path.write_text(head.rstrip("\n") + "\n\n" + "\n".join(lines) + ("\n" + tail if tail else ""))
 
 
 def main():
@@ -316,7 +530,10 @@ def main():
         return
     for flag, run, name, write, table in (
             ("--sweep", sweep_cost, "stability_sweep.json", write_sweep_section, sweep_lines),
-            ("--rows", rows_cost, "stability_rows.json", write_rows_section, rows_lines)):
+            ("--rows", rows_cost, "stability_rows.json", write_rows_section, rows_lines),
+            ("--truth-nlvib03", truth_study_nlvib03, "stability_truth_nlvib03.json",
+             write_truth_nlvib_section, truth_lines),
+            ("--truth", truth_study, "stability_truth.json", write_truth_section, truth_lines)):
         if flag in sys.argv:
             res = run()
             (HERE / "results").mkdir(exist_ok=True)

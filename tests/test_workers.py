@@ -123,7 +123,8 @@ def test_two_workers_give_the_serial_points(serial):
     assert len(one) > 2 * 8                      # the stride subset of the estimates is used
     assert any(p["contacts"][0]["max_penetration_m"] > 0 for p in one)     # it rattles
     assert [p["stable"] for p in one] == [p["stable"] for p in two]
-    assert all(p["stable"] is not None for p in one if p["converged"])
+    assert all(p["stable"] is not None or "not resolved" in p["stability_note"]   # computed
+               for p in one if p["converged"])
     assert any(isinstance(p["error_estimate"], dict) and not p["error_estimate"].get(
         "interpolated") for p in two)
     assert _differences(one, two) == []

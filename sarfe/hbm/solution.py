@@ -30,8 +30,10 @@ class SolverOptions:
     stability_method: 'full' (the Hill eigenproblem on all DOFs, :mod:`sarfe.hbm.stability`),
         'condensed' (Hill on a bounded Ritz basis, :mod:`sarfe.hbm.stability_condensed`),
         'contact_rows' (the exponents right of the axis counted on the contact rows,
-        :mod:`sarfe.hbm.stability_rows`; the Ritz method where one is found) or 'auto':
-        contact_rows when the full Hill matrix exceeds ``CONDENSED_ABOVE`` (2(2H+1)n rows).
+        :mod:`sarfe.hbm.stability_rows`; the Ritz method where two or more are found; the verdict
+        None where the count with the contact coupling at ⌊3H/4⌋ disagrees,
+        :mod:`sarfe.hbm.stability_trust`) or 'auto': contact_rows for a model with contacts and a
+        modal basis, else full up to 3000 Hill rows 2(2H+1)n.
     friction_tolerance, friction_pass_cap: 2-D slider march, stop when the slider state repeats to
         friction_tolerance × (max |q| + max ρ), at most friction_pass_cap periods.
     harmonic_set: None | 'all' | 'odd' | 'auto' | a list of orders: the harmonic orders solved for

@@ -43,8 +43,8 @@ from .stability import hill_stability
 from .stability_condensed import condensed_stability
 from .stability_contacts import ContactOperator
 from .stability_rows import contact_row_count
+from .stability_trust import auto_method, checked
 
-CONDENSED_ABOVE = 3000   # Hill matrix rows 2(2H+1)n above which 'auto' stability is condensed
 CHORD_STEPS = True       # fixed-ω Newton reuses its LU while it contracts (sarfe.hbm.newton)
 
 
@@ -271,14 +271,11 @@ def contact_damping(problem, forces):
 
 
 def stability_method(problem, options) -> str:
-    """'full' | 'condensed' | 'contact_rows' (see :class:`SolverOptions`): 'auto' is the full Hill
-    method up to ``CONDENSED_ABOVE`` Hill rows 2(2H+1)n, else the contact-row count
-    (:mod:`sarfe.hbm.stability_rows`) with the Ritz method where it does not decide."""
+    """'full' | 'condensed' | 'contact_rows' (see :class:`SolverOptions`): 'auto' is the contact-row
+    count (:mod:`sarfe.hbm.stability_rows`) for every model with contacts and a modal basis, else
+    the full Hill method up to 3000 Hill rows (:func:`sarfe.hbm.stability_trust.auto_method`)."""
     method = options.stability_method
-    if method == "auto":
-        size = 2 * (2 * problem.harmonics + 1) * problem.model.dof_count
-        method = "contact_rows" if size > CONDENSED_ABOVE and problem.contacts.count else "full"
-    return method
+    return auto_method(problem) if method == "auto" else method
 
 
 def stability(problem, omega, U, ev, options):
@@ -289,15 +286,15 @@ def stability(problem, omega, U, ev, options):
         result, zeros = contact_row_count(problem.model, problem.contacts, omega,
                                           problem.harmonics, ev.forces, operator,
                                           tolerance=options.stability_tolerance)
-        if result is not None:
-            return result
-        ritz = condensed_stability(problem.model, problem.contacts, omega, problem.harmonics,
-                                   ev.forces, operator, tolerance=options.stability_tolerance)
-        if zeros and ritz.stable is True:   # the count is exact, the Ritz basis truncated
-            return replace(ritz, stable=None, note=(
-                f"the contact-row count finds {zeros} Floquet exponent(s) right of "
-                f"−1e-4·ω that the Ritz basis does not locate (it says {ritz.leading:.3g} 1/s)"))
-        return ritz
+        if result is None:
+            result = condensed_stability(problem.model, problem.contacts, omega, problem.harmonics,
+                                         ev.forces, operator, tolerance=options.stability_tolerance)
+            if zeros and result.stable is True:   # the count is exact, the Ritz basis truncated
+                return replace(result, stable=None, note=(
+                    f"the contact-row count finds {zeros} Floquet exponent(s) right of "
+                    f"−1e-4·ω that the Ritz basis does not locate (it says {result.leading:.3g} 1/s)"))
+        # the verdict at H stands where the count at a coarser contact coupling agrees
+        return checked(result, zeros, problem, omega, U, ev.forces, options.stability_tolerance)
     if method == "condensed":
         return condensed_stability(problem.model, problem.contacts, omega, problem.harmonics,
                                    ev.forces, operator, tolerance=options.stability_tolerance)

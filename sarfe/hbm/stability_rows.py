@@ -61,8 +61,9 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .aft import jacobian_matrix
-from .modal import cached_modal_basis
+from .modal import cached_modal_basis, modal_basis
 
+STABILITY_DAMPING_TOLERANCE = 1e-6   # modal-diagonal damping check of the count's basis (see below)
 PHASE_STEP = np.pi / 3       # largest change of arg det F between neighbouring contour samples
 MAX_EVALUATIONS = 1500       # det F evaluations per point before giving up (→ Ritz method)
 
@@ -76,6 +77,30 @@ def structural_exponents(flexibility, damping):
 
 
 _ROW_PRODUCTS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+_STABILITY_BASES: dict = {}
+
+
+def stability_basis(model):
+    r"""The modal basis of ``model`` for the count: :func:`sarfe.hbm.modal.cached_modal_basis`
+    (the one Newton's condensation uses), else — a dense model whose damping the Newton path
+    rejected as not modal-diagonal at 10⁻¹⁰ — :func:`modal_basis` with the damping check at
+    ``STABILITY_DAMPING_TOLERANCE`` (10⁻⁶), cached per model. Dropping the off-diagonal modal
+    damping Δ_ij perturbs every compliance block A(λ) relatively by at most
+    |Δ_ij|/√(δ_i δ_j) ≤ 10⁻⁶ (:mod:`sarfe.hbm.modal`), so arg det F moves by O(10⁻⁶) rad along a
+    contour whose steps turn it by ≤ π/3: the count is unchanged. (The shipped rattle rig's modal ζ
+    damping comes out of the Craig–Bampton reduction diagonal to 1.9·10⁻¹⁰: with the Newton
+    tolerance alone every point of its sweep went to the Ritz method instead of the count.)"""
+    basis = cached_modal_basis(model) or cached_modal_basis(model)
+    if basis is not None or sp.issparse(model.stiffness):
+        return basis
+    key = id(model)
+    if key not in _STABILITY_BASES:
+        try:
+            weakref.finalize(model, _STABILITY_BASES.pop, key, None)
+        except TypeError:         # not weak-referenceable: no cache
+            return modal_basis(model, tolerance=STABILITY_DAMPING_TOLERANCE)
+        _STABILITY_BASES[key] = modal_basis(model, tolerance=STABILITY_DAMPING_TOLERANCE)
+    return _STABILITY_BASES[key]
 
 
 def row_products(basis, gap_map):
@@ -452,7 +477,7 @@ def contact_row_count(model, contacts, omega, harmonics, forces, operator=None,
     """
     from .stability import StabilityResult, verdict
 
-    basis = cached_modal_basis(model) or cached_modal_basis(model)
+    basis = stability_basis(model)
     if basis is None or model.dof_count == 0:
         return None, None
     omega, H = abs(float(omega)), int(harmonics)

@@ -64,7 +64,10 @@ def test_example03_three_solutions_at_070_middle_unstable(sweep03):
     assert all(s.converged for s in found)
     low, mid, high = (s.amplitude(1) for s in found)
     assert low < mid - 0.1 and mid < high - 0.1
-    assert [s.stable for s in found] == [True, False, True]
+    assert [s.stable for s in found[:2]] == [True, False]
+    # the upper branch: stable, or (default stability) not resolved at H = 21 — the count with the
+    # contact coupling at 15 harmonics finds a real exponent there (sarfe/hbm/stability_trust.py)
+    assert found[2].stable is True or "not resolved in H" in found[2].stability_note
     assert found[1].floquet_exponent > 0 > found[0].floquet_exponent
 
 

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from sarfe.hbm import make_contact_set, make_linear_model, solve_frequency
+from sarfe.hbm import SolverOptions, make_contact_set, make_linear_model, solve_frequency
 from sarfe.hbm.residual import Problem, full_residual
 from sarfe.hbm.stability import hill_stability
 from sarfe.hbm.stability_check import perturbation_check
@@ -41,9 +41,12 @@ def test_friction_chain_hill_matches_time_integration(two_d, omega):
     s = solve_frequency(model, contacts, F, omega, H, N)
     assert s.converged
     check = perturbation_check(model, contacts, F, s, steps_per_period=256, newton_steps=1)
-    assert s.stable is check.stable
-    if omega != 1.0 and not two_d:
-        assert s.floquet_exponent == pytest.approx(check.rate, rel=0.4)
+    assert s.stable is check.stable                   # the default ('auto': the contact rows)
+    full = solve_frequency(model, contacts, F, omega, H, N, initial=s,
+                           options=SolverOptions(stability_method="full"))
+    assert full.stable is check.stable
+    if omega != 1.0 and not two_d:    # (the count locates no exponent of a stable orbit)
+        assert full.floquet_exponent == pytest.approx(check.rate, rel=0.4)
 
 
 def test_frozen_jacobian_is_the_operator_at_s_zero():
@@ -81,7 +84,9 @@ def test_squeak_rig_hill_matches_time_integration(squeak_rig):
         check = perturbation_check(nl.model, nl.contacts, nl.excitation, s, steps_per_period=256,
                                    newton_steps=1)
         assert s.stable is True and check.stable
-        assert s.floquet_exponent == pytest.approx(check.rate, rel=0.4)
+        full = hill_stability(nl.model, s.omega, 3, ev.jacobian, operator=ContactOperator(
+            problem, s.displacement, s.omega, ev.forces))
+        assert full.stable is True and full.leading == pytest.approx(check.rate, rel=0.4)
 
 
 @pytest.fixture(scope="module")
@@ -95,9 +100,10 @@ def sweep03_h21():
 
 
 def test_example03_sweep_structure(sweep03_h21):
-    """NLvib 03 (H = 21, N = 1024): stable below 0.58 and on the branch after the second fold,
-    unstable on the middle branch between the folds (its last third, away from the upper fold),
-    None only next to a fold; the two folds are where ω turns."""
+    """NLvib 03 (H = 21, N = 1024): stable below 0.58 and (but for unresolved points) on the branch
+    after the second fold, never stable on the middle branch between the folds (its last third,
+    away from the upper fold); None only next to a fold or where the contact-row counts at other
+    contact couplings disagree (the note says so); the two folds are where ω turns."""
     model, contacts, F, sols = sweep03_h21
     omega = np.array([s.omega for s in sols])
     d = np.diff(omega)
@@ -106,12 +112,14 @@ def test_example03_sweep_structure(sweep03_h21):
     verdicts = [s.stable for s in sols]
     for i, s in enumerate(sols):
         if s.stable is None:
-            assert min(abs(i - folds)) <= 2, (i, s.omega, s.stability_note)
+            assert min(abs(i - folds)) <= 2 or "not resolved in H" in s.stability_note, \
+                (i, s.omega, s.stability_note)
     low = [v for s, v in zip(sols, verdicts) if s.omega < 0.58]
     assert low and all(v is True for v in low)
-    assert all(v is True for v in verdicts[folds[1] + 1:])
+    after = verdicts[folds[1] + 1:]
+    assert False not in after and after.count(True) >= 0.8 * len(after)
     middle = verdicts[folds[1] - (folds[1] - folds[0]) // 3:folds[1]]
-    assert middle and all(v is False for v in middle)
+    assert middle and True not in middle and False in middle
 
 
 @pytest.mark.slow
@@ -124,7 +132,10 @@ def test_example03_hill_matches_time_integration(sweep03_h21, index_fraction):
     model, contacts, F, sols = sweep03_h21
     s = sols[int(index_fraction * (len(sols) - 1))]
     check = perturbation_check(model, contacts, F, s, steps_per_period=2048)
-    assert s.stable is check.stable, (s.omega, s.floquet_exponent, check.rate)
+    if s.stable is None:                  # reported as not resolved (the peak window)
+        assert "not resolved in H" in s.stability_note
+    else:
+        assert s.stable is check.stable, (s.omega, s.floquet_exponent, check.rate)
 
 
 def test_example03_points_agree_with_time_integration():

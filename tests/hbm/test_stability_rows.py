@@ -121,8 +121,8 @@ def test_example03_verdicts_equal_the_full_method(sweep03):
     either decides where the full method decides the same, or hands over (None). On the middle
     branch (one real exponent right of the axis) it decides 'unstable' by itself, with the full
     method's leading exponent located on the real axis. The solver with
-    stability_method='contact_rows' gives the full method's verdict everywhere (the middle branch
-    at Ω ≈ 0.70 unstable, the outer ones stable)."""
+    stability_method='contact_rows' gives the full method's verdict wherever it does not report
+    the point unresolved (:mod:`sarfe.hbm.stability_trust`)."""
     model, contacts, F, sols = sweep03
     decided, unstable = 0, 0
     for s in sols[::2]:
@@ -142,7 +142,10 @@ def test_example03_verdicts_equal_the_full_method(sweep03):
         via_rows = solve_frequency(model, contacts, F, s.omega, H, N, initial=s, options=opts)
         via_full = solve_frequency(model, contacts, F, s.omega, H, N, initial=s,
                                    options=SolverOptions(stability_method="full"))
-        assert via_rows.stable is via_full.stable, s.omega
+        if via_rows.stable is None:     # counts at other contact couplings disagree
+            assert "not resolved in H" in via_rows.stability_note, s.omega
+        else:
+            assert via_rows.stable is via_full.stable, s.omega
         verdicts.append(via_full.stable)
     assert True in verdicts and False in verdicts
 
