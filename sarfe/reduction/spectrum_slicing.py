@@ -56,28 +56,38 @@ import numpy as np
 
 from sarfe.fe.linear_solvers import shifted_factorizer
 from sarfe.reduction.mode_sinks import FileSink, MemorySink
-from sarfe.reduction.craig_bampton import _m_orthonormal, lanczos_extend
+from sarfe.reduction.craig_bampton import _m_orthonormal
 
 
 class SlicingFailed(RuntimeError):
     """A gap's eigenvalue count was not reached within the column cap (the caller falls back)."""
 
 
+# a step's older blocks' share of the full re-orthogonalization, ‖C_old‖ per column relative to
+# its M-norm, below which M w is updated from the last two blocks' M Q instead of a new product
+_DROP_TOLERANCE = 1e-14
+
+
 def shifted_block_lanczos(mass, operator, shift, satisfied, max_columns, block_size=16, tol=1e-8,
-                          seed=0):
+                          seed=0, stats=None):
     """Block Lanczos on A = (K − σM)⁻¹ M (``operator(Y)`` = (K − σM)⁻¹ Y, σ = ``shift``) in the
     M inner product with full re-orthogonalization; Q (n, m) is stored, M Q only for the last two
-    blocks (the three-term part), so a step costs two sparse products M·(n, b): one for the full
-    pass Qᵀ M w, one to M-orthonormalize the new block.
+    blocks (the three-term part). A step (:func:`_shifted_step`) costs ONE sparse product
+    M·(n, b) (two when the older blocks' correction is not negligible).
 
     After each block step ``satisfied(lam, converged)`` gets the Ritz eigenvalues λ = σ + 1/θ
     (m,) and their convergence flags (residual ≤ tol·|θ|) and returns True to stop. Returns
     (λ (m,), converged (m,), vectors(selection) → M-normalized eigenvectors (n, k)); stops at
-    ``max_columns`` columns or when the Krylov space is exhausted.
+    ``max_columns`` columns or when the Krylov space is exhausted. ``stats`` (a dict, optional)
+    counts "steps" and "mass_products".
     """
     n = mass.shape[0]
+    stats = {} if stats is None else stats
+    stats.setdefault("steps", 0)
+    stats.setdefault("mass_products", 0)
     rng = np.random.default_rng(seed)
     q, mq = _m_orthonormal(operator(mass @ rng.standard_normal((n, block_size))), mass)
+    stats["mass_products"] += 2
     store = np.empty((n, max(max_columns, q.shape[1])), order="F")
     m_new = q.shape[1]
     store[:, :m_new] = q
@@ -86,18 +96,12 @@ def shifted_block_lanczos(mass, operator, shift, satisfied, max_columns, block_s
     previous_start = 0
     while True:
         m_old = projected.shape[0]
-        w = operator(mq)                       # A q_block = (K − σM)⁻¹ M q_block
         basis = store[:, :m_new]
         mass_recent = recent[0] if len(recent) == 1 else np.hstack(recent)
-
-        def mass_products(cols, y, start=previous_start):
-            if cols.start == start:            # the last two blocks: (M Q_l)ᵀ y, no M product
-                return mass_recent.T @ y
-            return basis[:, cols].T @ (mass @ y)
-
-        w, projected = lanczos_extend(basis, mass_products, w, projected, previous_start)
+        w, mw, projected = _shifted_step(mass, basis, mass_recent, operator(mq), projected,
+                                         previous_start, stats)
         previous_start = m_old
-        q, mq = _m_orthonormal(w, mass)
+        q, mq = _m_orthonormal(w, mass, mw)
         coupling = mq.T @ w
         theta, vectors = np.linalg.eigh(projected)
         residual = np.linalg.norm(coupling @ vectors[m_old:], axis=0)
@@ -115,6 +119,48 @@ def shifted_block_lanczos(mass, operator, shift, satisfied, max_columns, block_s
         return basis @ vectors[:, selection]
 
     return lam, converged, eigenvectors
+
+
+def _shifted_step(mass, basis, mass_recent, w, projected, previous_start, stats):
+    r"""One block-Lanczos step in the M inner product with full re-orthogonalization and one
+    sparse product, for :func:`shifted_block_lanczos`.
+
+    basis Q (n, m), its last two blocks (columns from ``previous_start``) with M Q_l =
+    ``mass_recent`` (n, m − previous_start); w (n, b) = A q_block; projected T_old (m_old, m_old).
+
+        C_l = (M Q_l)ᵀ w,   w ← w − Q_l C_l                 (three-term part, no product)
+        z = M w,   C = Qᵀ z,   w ← w − Q C                  (one full pass, one product)
+        M w ← z − (M Q_l) C_l' − (M Q_old) C_old
+
+    C_l' (the local rows of C) is the second-pass correction; C_old = Q_oldᵀ M w, the older
+    blocks' share, is the loss of orthogonality since the last step: its term is dropped when
+    ‖C_old e_j‖ ≤ _DROP_TOLERANCE·‖w e_j‖_M for every column j (Q_old is M-orthonormal, so the
+    dropped vector's M⁻¹-norm is ‖C_old e_j‖), otherwise M w is formed anew. Returns (w, M w
+    (n, b), T_new (m, m) symmetrized). Products written as (Cᵀ Qᵀ)ᵀ keep the column-major layout.
+    """
+    m_new, m_old = basis.shape[1], projected.shape[0]
+    local = slice(previous_start, m_new)
+    coefficients = np.zeros((m_new, w.shape[1]))
+    coefficients[local] = mass_recent.T @ w
+    w = w - (coefficients[local].T @ basis[:, local].T).T
+    mw = mass @ w
+    correction = basis.T @ mw
+    stats["steps"] += 1
+    stats["mass_products"] += 1
+    w = w - (correction.T @ basis.T).T
+    norms = np.sqrt(np.maximum(np.einsum("ij,ij->j", w, mw), 0.0))
+    old = np.linalg.norm(correction[:previous_start], axis=0)
+    if np.all(old <= _DROP_TOLERANCE * norms):
+        mw = mw - (correction[local].T @ mass_recent.T).T
+    else:
+        mw = mass @ w
+        stats["mass_products"] += 1
+    coefficients = coefficients + correction
+    grown = np.zeros((m_new, m_new))
+    grown[:m_old, :m_old] = projected
+    grown[:, m_old:] = coefficients
+    grown[m_old:, :] = coefficients.T
+    return w, mw, 0.5 * (grown + grown.T)
 
 
 def _place_shift(factor_at, right_edge, known, wanted, top_omega2, total, rate, record):
@@ -143,7 +189,8 @@ def _place_shift(factor_at, right_edge, known, wanted, top_omega2, total, rate, 
     return shift, factor
 
 
-def _slice_run(mass, factor, shift, lower, counted, right_edge, pending, max_columns, last):
+def _slice_run(mass, factor, shift, lower, counted, right_edge, pending, max_columns, last,
+               stats=None):
     """One shifted Lanczos run for the gap (lower, shift] (module docstring). Returns (λ,
     converged, eigenvectors, take: the run's values kept for the gap, use_pending: whether the
     previous run's values ≤ shift complete it) or raises SlicingFailed."""
@@ -166,7 +213,7 @@ def _slice_run(mass, factor, shift, lower, counted, right_edge, pending, max_col
         return not open_right.any()
 
     lam, converged, eigenvectors = shifted_block_lanczos(mass, factor.solve, shift, satisfied,
-                                                         max_columns)
+                                                         max_columns, stats=stats)
     if state.get("left"):
         return lam, converged, eigenvectors, converged & (lam > right_edge) & (lam <= shift), True
     if state.get("alone"):
@@ -203,7 +250,8 @@ def slice_chain(mass, factor_at, start, top_omega2, total, sink, slice_modes=80,
     """
     pending, pending_modes = list(np.asarray(start.pending, dtype=float)), start.pending_modes
     lower, counted, right_edge = float(start.lower), int(start.counted), float(start.right_edge)
-    record = {"shifts": [], "columns": [], "negative_pivots": [], "factorizations": 0}
+    record = {"shifts": [], "columns": [], "negative_pivots": [], "factorizations": 0,
+              "steps": 0, "mass_products": 0}
     rate = None
     while counted < total:
         known = counted + len(pending)                 # ≈ N(right_edge)
@@ -214,7 +262,7 @@ def slice_chain(mass, factor_at, start, top_omega2, total, sink, slice_modes=80,
             try:
                 lam, converged, eigenvectors, take, use_pending = _slice_run(
                     mass, factor, shift, lower, counted, right_edge, pending, max_columns,
-                    shift >= top_omega2)
+                    shift >= top_omega2, record)
                 break
             except SlicingFailed:
                 if retry == 2:
