@@ -90,7 +90,8 @@ def shifted_block_lanczos(mass, operator, shift, satisfied, max_columns, block_s
     (T the projected matrix, the rounding term taken with the sign that makes it grow; the last
     two blocks' rows are the three-term part's ε ‖A‖ / σ_min(B_k)); a new block whose estimate
     max_j ‖W_{j,k+1}‖ exceeds _ORTHOGONALITY gets a full pass (C = Qᵀ M w, w ← w − Q C, its
-    estimate reset to ε) before it is stored, so Q stays M-orthonormal to ~1e-10 and the Ritz
+    estimate reset to ε; T keeps the three-term part, the pass's older-block coefficients are
+    discarded) before it is stored, so Q stays M-orthonormal to ~1e-10 and the Ritz
     pairs are those of a fully re-orthogonalized run to round-off (semi-orthogonality suffices,
     Simon 1984). The estimate tracks the measured Q_jᵀ M q within a factor 2.5 (twin plate); in
     shift-invert it grows ~1e2–1e3 per step, so about every second step needs the full pass.
