@@ -457,6 +457,8 @@ def write_report(cases, quick, p1=None):
     profile = previous.get("p1_profile") if isinstance(previous, dict) else None
     split_profile = previous.get("p1_split_profile") if isinstance(previous, dict) else None
     memory = previous.get("p1_memory") if isinstance(previous, dict) else None
+    # measured by hand (A/B runs, cProfile; linear.json "p1_lanczos": the section's lines)
+    lanczos = previous.get("p1_lanczos") if isinstance(previous, dict) else None
     if p1 is None and isinstance(previous, dict):
         p1 = previous.get("p1")
     if p1:
@@ -466,10 +468,12 @@ def write_report(cases, quick, p1=None):
                                               "before and after the split by count)")
     if profile:
         lines += profile_lines(profile)
+    if lanczos:
+        lines += [""] + list(lanczos)
     (HERE / "results").mkdir(exist_ok=True)
     (HERE / "results" / "linear.md").write_text("\n".join(lines) + "\n")
     data = {"cases": cases, "p1": p1, "p1_profile": profile, "p1_split_profile": split_profile,
-            "p1_memory": memory} if p1 or profile or split_profile else cases
+            "p1_memory": memory, "p1_lanczos": lanczos} if p1 or profile or split_profile else cases
     (HERE / "results" / "linear.json").write_text(json.dumps(data, indent=1, default=float) + "\n")
     print("\n".join(lines))
 
@@ -494,8 +498,9 @@ def main():
                 sys.exit(f"P1 linear stage failed: {[run.get('error') for run in p1]}")
             earlier = stored.get("p1") if isinstance(stored, dict) else None
             for run in earlier or []:      # kept below the new rows, each with its note
-                run.setdefault("note", f"the previous --p1 run ({run['cores']} "
-                                       f"core{'s' if run['cores'] > 1 else ''})")
+                if not run.get("note"):
+                    run["note"] = (f"the previous --p1 run ({run['cores']} "
+                                   f"core{'s' if run['cores'] > 1 else ''})")
             p1 += earlier or []
         write_report(cases, quick=not cases[0].get("solver_comparison"), p1=p1)
         return

@@ -216,10 +216,11 @@ def _fixed_interface_modes(stiffness_ii, mass_ii, operator, mode_count, cutoff_h
     return eigenvalues, modes
 
 
-def _m_orthonormal(block, mass):
+def _m_orthonormal(block, mass, mass_block=None):
     """Q, MQ with Qᵀ M Q = I spanning ``block`` (Gram-matrix eigendecomposition, twice; rank-deficient
-    columns dropped). One sparse product M·block: the second pass reuses M Q = (M block) T."""
-    mass_block = mass @ block
+    columns dropped). One sparse product M·block (none when ``mass_block`` = M·block is given):
+    the second pass reuses M Q = (M block) T."""
+    mass_block = mass @ block if mass_block is None else mass_block
     for _ in range(2):
         gram = block.T @ mass_block
         values, vectors = np.linalg.eigh(0.5 * (gram + gram.T))
