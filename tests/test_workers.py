@@ -161,3 +161,85 @@ def test_meshing_leaves_sigpipe_ignored():
     with gmsh_session():
         assert handler() == 1
     assert handler() == 1
+
+
+def _slow_square(x):
+    import time
+
+    time.sleep(0.02)
+    return x * x
+
+
+def test_a_stream_computes_items_while_they_arrive_on_one_other_process():
+    """Stream: items submitted one by one while this process works; finish() returns what was
+    computed (in another process), the rest is left to the caller; results as the function's."""
+    import time
+
+    with workers.Stream(_slow_square) as stream:
+        for x in range(30):
+            stream.submit(x, x)
+            time.sleep(0.01)             # this process "solves the next point"
+        time.sleep(0.3)
+        done = stream.finish()
+    assert done and all(done[k] == k * k for k in done)
+    assert set(done) <= set(range(30))
+    assert len(done) >= 20               # the worker kept up (0.3 s to finish its batch)
+    assert 1 <= stream.forks < 30        # batches: a fork per batch, not per item
+    with workers.Stream(_pid) as stream:
+        for x in range(5):
+            stream.submit(x, x)
+        time.sleep(0.5)
+        pids = stream.finish()
+    assert pids and os.getpid() not in pids.values()
+
+
+def test_a_stream_stops_early_and_reports_exceptions_and_dead_workers():
+    import time
+
+    with workers.Stream(_fails_on_three) as stream:
+        for x in range(6):
+            stream.submit(x, x)
+            time.sleep(0.1)
+        time.sleep(0.3)
+        done = stream.finish()
+    assert isinstance(done.get(3), ValueError)
+    assert all(done[k] == k for k in done if k != 3)
+
+    def sleeps(x):
+        time.sleep(0.2)
+        return x
+
+    with workers.Stream(sleeps) as stream:
+        for x in range(50):                      # one batch of 50 × 0.2 s
+            stream.submit(x, x)
+        start = time.perf_counter()
+        done = stream.finish()                   # stops after the current item
+    assert time.perf_counter() - start < 2.0 and len(done) < 50
+
+    parent = os.getpid()
+
+    def dies(x):
+        if x == 2 and os.getpid() != parent:
+            os.kill(os.getpid(), signal.SIGKILL)
+        return x
+
+    with workers.Stream(dies) as stream:
+        for x in range(5):
+            stream.submit(x, x)
+            time.sleep(0.1)
+        time.sleep(0.3)
+        done = stream.finish()
+    assert 2 not in done and all(done[k] == k for k in done) and len(done) >= 2
+
+
+def test_the_parallel_solve_computes_stability_during_the_sweep(serial):
+    """workers 2: part of the Hill stability is computed while the sweep runs, and the points are
+    the serial path's (same verdicts, same fields within 1e-12)."""
+    parallel = solve_case(_lumped(2), write=False)
+    record = parallel.summary["workers"]
+    assert record["processes"] == 2
+    assert record["stability_points"] == sum(p["converged"] for p in serial.summary["points"])
+    assert 0 < record["stability_during_sweep"] <= record["stability_points"]
+    assert record["stream_processes"] >= 1
+    assert _differences(serial.summary["points"], parallel.summary["points"]) == []
+    assert serial.summary["workers"] == {"processes": 1}

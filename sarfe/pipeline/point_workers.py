@@ -6,8 +6,9 @@ forked from the solve (:func:`sarfe.workers.map_points`: the reduced model and t
 shared copy-on-write, only the results come back):
 
 1. Hill stability — deferred during the sweep (:mod:`sarfe.hbm.deferred`: ``finalize`` records a
-   job per converged point), then mapped over the reported points (points the sweep dropped are
-   not computed);
+   job per converged point) and computed on one worker while the sweep goes on (:func:`stability_
+   stream`: the sweep holds one core, the stream the other), then the reported points left are
+   mapped over all workers;
 2. the error estimates (:func:`sarfe.pipeline.postprocess.error_estimates`, ``workers``);
 3. the point records: ERP, contact indicators, contributions, linear baseline
    (:func:`sarfe.pipeline.postprocess.point_record`).
@@ -25,7 +26,7 @@ import functools
 from sarfe.hbm.deferred import pending, stability_of, with_stability
 from sarfe.io.config import CaseConfig, SolverConfig
 from sarfe.pipeline.progress import bar as _bar
-from sarfe.workers import map_points, worker_count
+from sarfe.workers import Stream, map_points, worker_count
 
 
 def point_workers(solver: SolverConfig) -> int:
@@ -34,24 +35,37 @@ def point_workers(solver: SolverConfig) -> int:
     return worker_count(solver.workers)
 
 
-def stability_verdicts(solutions, jobs, workers, progress=False):
+def stability_stream() -> Stream:
+    """The Hill stability of the sweep's points on one worker while the sweep goes on (the jobs
+    of :func:`sarfe.hbm.deferred.deferred_stability` submitted as they are recorded)."""
+    return Stream(stability_of)
+
+
+def stability_verdicts(solutions, jobs, workers, progress=False, done=None):
     """The solutions with their deferred Hill stability (``jobs`` of a :func:`sarfe.hbm.deferred.
-    deferred_stability` block around the sweep) computed on ``workers`` processes; None when one
-    of them raised — the serial path ends the continuation there and goes on point by point, so
-    the caller solves the points again without deferring."""
+    deferred_stability` block around the sweep) computed on ``workers`` processes; ``done``: {job
+    index: StabilityResult or the exception it raised} of the jobs already computed during the
+    sweep (:class:`sarfe.workers.Stream`). None when one of them raised — the serial path ends
+    the continuation there and goes on point by point, so the caller solves the points again
+    without deferring."""
     indices = pending(solutions)
-    if not indices:             # (no converged point went through Newton: nothing to compute)
-        return solutions
-    bar = _bar(progress, f"Hill stability ({workers} processes)", len(indices), unit="point")
-    try:
-        results = map_points(stability_of, [jobs[i] for i in indices], workers,
-                             progress=None if bar is None else functools.partial(bar.update, 1))
-    except Exception:
+    done = done or {}
+    if any(isinstance(done.get(i), Exception) for i in indices):
         return None
-    finally:
-        if bar is not None:
-            bar.close()
-    return with_stability(solutions, indices, results)
+    rest = [i for i in indices if i not in done]
+    if rest:
+        bar = _bar(progress, f"Hill stability ({workers} processes, {len(indices) - len(rest)} "
+                   "of the points during the sweep)", len(rest), unit="point")
+        try:
+            results = map_points(stability_of, [jobs[i] for i in rest], workers,
+                                 progress=None if bar is None else functools.partial(bar.update, 1))
+        except Exception:
+            return None
+        finally:
+            if bar is not None:
+                bar.close()
+        done = {**done, **dict(zip(rest, results))}
+    return with_stability(solutions, indices, [done[i] for i in indices])
 
 
 def point_records(config: CaseConfig, stage, nl, solutions, estimates, workers,

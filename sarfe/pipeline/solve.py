@@ -4,6 +4,7 @@ directory next to the target and moved into place at the end).
 """
 from __future__ import annotations
 
+import contextlib
 import datetime as _dt
 import functools
 import time
@@ -12,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sarfe.hbm.deferred import deferred_stability
+from sarfe.hbm.deferred import deferred_stability, pending
 from sarfe.io.case import load_case
 from sarfe.io.errors import EXIT_NOT_CONVERGED
 from sarfe.pipeline.accuracy import accuracy_check
@@ -22,7 +23,8 @@ from sarfe.pipeline.nonlinear import NonlinearModel, nonlinear_model
 from sarfe.pipeline.outputs import write_outputs, results_table
 from sarfe.pipeline.points import common_samples, solve_points, sweep_status
 from sarfe.pipeline.progress import bar as _bar
-from sarfe.pipeline.point_workers import point_records, point_workers, stability_verdicts
+from sarfe.pipeline.point_workers import (point_records, point_workers, stability_stream,
+                                          stability_verdicts)
 from sarfe.pipeline.pruning import solve_points_pruned
 from sarfe.pipeline.postprocess import error_estimates, worst_of
 
@@ -106,15 +108,27 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
 
     clock = time.perf_counter()
     workers = point_workers(config.solver)     # processes for the per-point work (1: serial)
-    # with workers, Hill stability is recorded during the sweep and computed on them after it
-    with deferred_stability(enabled=workers > 1 and config.solver.stability) as jobs:
-        solutions, pruning = solve_points_pruned(config.solver, config.excitation, nl,
-                                                 progress=progress)
+    # with workers, Hill stability is recorded during the sweep, computed on one worker while the
+    # sweep goes on (the stream) and on all of them after it for the points left
+    deferring = workers > 1 and config.solver.stability
+    with stability_stream() if deferring else contextlib.nullcontext() as stream:
+        with deferred_stability(enabled=deferring,
+                                on_job=None if stream is None else stream.submit) as jobs:
+            solutions, pruning = solve_points_pruned(config.solver, config.excitation, nl,
+                                                     progress=progress)
+        done = stream.finish() if stream is not None else None
+    parallel = {"processes": workers}
     if jobs is not None:
         clock_stability = time.perf_counter()
-        solutions = stability_verdicts(solutions, jobs, workers, progress)
+        used = set(pending(solutions))
+        parallel.update(stability_points=len(used),
+                        stability_during_sweep=sum(i in done for i in used),
+                        stream_processes=stream.forks)
+        solutions = stability_verdicts(solutions, jobs, workers, progress, done)
         timings["stability_s"] = time.perf_counter() - clock_stability
     if solutions is None:      # a deferred stability raised: the serial path's sweep
+        parallel = {"processes": workers, "stability": "in place: a deferred stability raised, "
+                    "the sweep was solved again serially"}
         solutions, pruning = solve_points_pruned(config.solver, config.excitation, nl,
                                                  progress=progress)
     timings["hbm_s"] = time.perf_counter() - clock       # (with the deferred stability)
@@ -171,6 +185,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         "accuracy_check": accuracy_check(config.solver, points),   # estimates vs the accuracy budget
         "warnings": warnings,                    # inputs far outside the model's range
         "timings_s": timings,
+        "workers": parallel,      # processes; Hill points computed during the sweep (of all)
         "case_data": case.data,                  # the case with every default filled in
     }
     result = CaseResult(summary, rows, exit_code, solutions)
