@@ -2,7 +2,7 @@
 
     python benchmarks/stage_cpu.py CASE.yaml [OUT.json]
 
-Runs ``sarfe solve CASE --output <tmp>`` (one BLAS thread per process) and samples, every 0.1 s,
+Runs ``sarfe solve CASE --output <tmp>`` (the sarfe of this tree, or of $SARFE_ROOT) (one BLAS thread per process) and samples, every 0.1 s,
 the CPU seconds of the whole process tree (user + system of the live processes plus what the
 waited-for children used, /proc/<pid>/stat) and its PSS (/proc/<pid>/smaps_rollup, the forked
 workers sharing the model copy-on-write count once). Each stage runs from its stage line
@@ -23,7 +23,7 @@ import tempfile
 import threading
 import time
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
+ROOT = pathlib.Path(os.environ.get("SARFE_ROOT") or pathlib.Path(__file__).resolve().parent.parent)
 TICK = os.sysconf("SC_CLK_TCK")
 
 

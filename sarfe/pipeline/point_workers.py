@@ -68,6 +68,85 @@ def stability_verdicts(solutions, jobs, workers, progress=False, done=None):
     return with_stability(solutions, indices, [done[i] for i in indices])
 
 
+def first_estimates(config: CaseConfig, stage, nl, solutions) -> dict:
+    """{index: estimate} of the first point to estimate (:func:`sarfe.pipeline.postprocess.
+    estimated_points`), computed in this process: the caches it builds (the coarser Craig–Bampton
+    model, the modal bases) are inherited by the workers forked after it, as the serial loop's
+    later estimates find them, so every estimate has the serial path's round-off."""
+    from sarfe.pipeline.postprocess import estimated_points, point_estimate
+
+    return {i: point_estimate(config, stage, nl, solutions[i])
+            for i in estimated_points(config, nl, solutions)[:1]}
+
+
+def point_work(config: CaseConfig, stage, nl, solutions, jobs, done, first, workers,
+               progress=False):
+    """Everything per point after a sweep, on ``workers`` processes at once: the Hill stability
+    of the reported points the stream did not compute (``jobs``, ``done``: :func:`stability_
+    verdicts`; ``jobs`` None without stability), the error estimates left (``first``: those
+    computed in this process, :func:`first_estimates`) and every point's record (ERP, contact
+    indicators, contributions, linear baseline; :func:`sarfe.pipeline.postprocess.point_record`,
+    with the points at one time grid, :func:`sarfe.pipeline.points.common_samples`). One queue,
+    the longest items first (a Hill point ≈ 5× an estimate ≈ 5× a record), so the workers finish
+    together instead of waiting for each other at every stage.
+
+    Returns (solutions with their verdicts at one time grid, [(point dict, row, ErpResult, W)]),
+    or None when a deferred stability raised (the caller solves the sweep again serially). The
+    records are filled with the verdicts and estimates afterwards
+    (:func:`sarfe.pipeline.postprocess.with_verdict`, ``with_estimate``): the same records as the
+    serial path's."""
+    from sarfe.pipeline.points import common_samples
+    from sarfe.pipeline.postprocess import (error_estimates, estimated_points, point_estimate,
+                                            point_record, with_estimate, with_verdict)
+
+    indices = pending(solutions) if jobs is not None else []
+    done = done or {}
+    if any(isinstance(done.get(i), Exception) for i in indices):
+        return None
+    hill = [i for i in indices if i not in done]
+    estimates = [i for i in estimated_points(config, nl, solutions) if i not in first]
+    gridded = common_samples(nl, solutions)      # records at one N; estimates at each point's own
+    tasks = ([("stability", i) for i in hill] + [("estimate", i) for i in estimates]
+             + [("record", i) for i in range(len(gridded))])
+
+    def run(task):
+        kind, i = task
+        if kind == "stability":
+            try:
+                return stability_of(jobs[i])
+            except Exception as error:      # the serial path's sweep is solved instead
+                return error
+        if kind == "estimate":
+            return point_estimate(config, stage, nl, solutions[i])
+        return point_record(config, stage, nl, i, gridded[i], None)
+
+    n = len(gridded)
+    what = (f"{'ERP and error estimates' if config.solver.error_estimate else 'ERP'} "
+            f"({n} point{'s' if n != 1 else ''})"
+            + (f", Hill stability of the {len(hill)} left" if hill else "")
+            + (f" on {workers} processes" if len(tasks) > 1 else ""))
+    bar = _bar(progress, what, len(tasks), unit="item")
+    try:
+        results = map_points(run, tasks, workers,
+                             progress=None if bar is None else functools.partial(bar.update, 1))
+    finally:
+        if bar is not None:
+            bar.close()
+    by_task = dict(zip(tasks, results))
+    verdicts = {**done, **{i: by_task["stability", i] for i in hill}}
+    if any(isinstance(verdicts[i], Exception) for i in indices):
+        return None
+    if indices:
+        gridded = with_stability(gridded, indices, [verdicts[i] for i in indices])
+    computed = {**first, **{i: by_task["estimate", i] for i in estimates}}
+    per_point = error_estimates(config, stage, nl, solutions, computed=computed)
+    records = [by_task["record", i] for i in range(len(gridded))]
+    for (point, row, _, _), solution, estimate in zip(records, gridded, per_point):
+        with_verdict(point, row, solution)
+        with_estimate(point, row, estimate)
+    return gridded, records
+
+
 def point_records(config: CaseConfig, stage, nl, solutions, estimates, workers,
                   progress=None) -> list:
     """[(point dict, table row, ErpResult, radiating displacements W)] per solution
