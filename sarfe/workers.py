@@ -95,18 +95,75 @@ def _run(index):
 
 def map_points(function, items, workers, progress=None) -> list:
     """[function(item) for item in items] on ``workers`` forked processes (module docstring)."""
+    return start_map(function, items, workers).result(progress)
+
+
+class PendingMap:
+    """A :func:`start_map` in progress: ``result(progress)`` waits for it and returns the results
+    in order (``cancel()`` ends its workers). The items given to ``workers`` ≤ 1 are computed by
+    ``result`` in this process."""
+
+    def __init__(self, function, items, pool, pending):
+        self.function, self.items = function, items
+        self.pool, self.pending = pool, pending
+
+    def result(self, progress=None) -> list:
+        function, items = self.function, self.items
+        results = [None] * len(items)
+        if self.pool is None:
+            for i, item in enumerate(items):
+                results[i] = function(item)
+                if progress is not None:
+                    progress()
+            return results
+        done, pending, pool = set(), self.pending, self.pool
+        try:
+            while pending:
+                finished, _ = wait(pending, return_when=FIRST_COMPLETED)
+                for future in finished:
+                    i = pending.pop(future)
+                    try:
+                        results[i] = future.result()
+                    except BrokenProcessPool:     # a worker died: the parent computes what is left
+                        continue
+                    done.add(i)
+                    if progress is not None:
+                        progress()
+        except BaseException:                     # Ctrl-C or an item's exception: stop the workers
+            self.cancel()
+            raise
+        self._release()
+        pool.shutdown(wait=True)
+        for i in range(len(items)):               # items of a worker that died
+            if i not in done:
+                results[i] = function(items[i])
+                if progress is not None:
+                    progress()
+        return results
+
+    def cancel(self):
+        _stop(self.pool)
+        self._release()
+
+    def _release(self):
+        global _TASK
+        if self.pool is not None and _TASK is not None:
+            _TASK = None
+            gc.unfreeze()
+
+
+def start_map(function, items, workers) -> PendingMap:
+    """Fork the workers of :func:`map_points` and hand them the items, without waiting: this
+    process goes on with other work and collects the results with ``.result()`` (one map at a
+    time: the next starts after this one's result)."""
     global _TASK
     items = list(items)
-    results = [None] * len(items)
     if workers <= 1 or len(items) <= 1 or multiprocessing.current_process().daemon:
-        for i, item in enumerate(items):
-            results[i] = function(item)
-            if progress is not None:
-                progress()
-        return results
+        return PendingMap(function, items, None, None)
     from threadpoolctl import threadpool_limits
 
-    done = set()
+    if _TASK is not None:
+        raise RuntimeError("a map is already in progress")
     _TASK = (function, items)
     pool = None
     gc.freeze()         # the workers' garbage collector leaves the parent's objects (and pages) alone
@@ -116,30 +173,12 @@ def map_points(function, items, workers, progress=None) -> list:
                                        mp_context=multiprocessing.get_context("fork"),
                                        initializer=_start_worker)
             pending = {pool.submit(_run, i): i for i in range(len(items))}
-        while pending:
-            finished, _ = wait(pending, return_when=FIRST_COMPLETED)
-            for future in finished:
-                i = pending.pop(future)
-                try:
-                    results[i] = future.result()
-                except BrokenProcessPool:     # a worker died: the parent computes what is left
-                    continue
-                done.add(i)
-                if progress is not None:
-                    progress()
-    except BaseException:                     # Ctrl-C or an item's exception: stop the workers
+    except BaseException:
         _stop(pool)
-        raise
-    finally:
         _TASK = None
         gc.unfreeze()
-    pool.shutdown(wait=True)
-    for i in range(len(items)):               # items of a worker that died
-        if i not in done:
-            results[i] = function(items[i])
-            if progress is not None:
-                progress()
-    return results
+        raise
+    return PendingMap(function, items, pool, pending)
 
 
 def _stop(pool):
