@@ -77,14 +77,15 @@ def pss_gb(pids) -> float:
 
 
 def run(case, out_dir=None) -> dict:
-    out_dir = out_dir or tempfile.mkdtemp(prefix="stage_cpu_")
+    out_dir = pathlib.Path(out_dir or tempfile.mkdtemp(prefix="stage_cpu_")).resolve()
     env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1",
                MPLBACKEND="Agg", PYTHONPATH=str(ROOT))
-    cmd = [sys.executable, "-m", "sarfe.cli", "solve", str(case), "--output",
-           str(pathlib.Path(out_dir) / "out"), "--force"]
+    cmd = [sys.executable, "-m", "sarfe.cli", "solve", str(pathlib.Path(case).resolve()),
+           "--output", str(out_dir / "out"), "--force"]
     load_start = os.getloadavg()
     start = time.perf_counter()
-    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                            cwd=ROOT)          # (python -m puts the current folder first)
     lines = []
 
     def read():

@@ -166,7 +166,7 @@ def start_map(function, items, workers) -> PendingMap:
         raise RuntimeError("a map is already in progress")
     _TASK = (function, items)
     pool = None
-    gc.freeze()         # the workers' garbage collector leaves the parent's objects (and pages) alone
+    gc.freeze()     # the workers' garbage collector leaves the parent's objects (and pages) alone
     try:
         with threadpool_limits(limits=1):     # fork with one BLAS thread (no pool to inherit)
             pool = ProcessPoolExecutor(max_workers=min(int(workers), len(items)),
