@@ -244,3 +244,22 @@ def test_the_parallel_solve_computes_stability_during_the_sweep(serial):
     assert record["stream_processes"] >= 1
     assert _differences(serial.summary["points"], parallel.summary["points"]) == []
     assert serial.summary["workers"] == {"processes": 1}
+
+
+def test_an_error_in_a_worker_is_one_error_and_leaves_no_result_folder(tmp_path, monkeypatch):
+    """A point record that raises on a worker ends the solve with that exception (the CLI's one
+    line), and neither the result folder nor a temporary sibling is left behind."""
+    from sarfe.pipeline import postprocess
+
+    original, parent = postprocess.point_record, os.getpid()
+
+    def fails_in_a_worker(config, stage, nl, index, solution, error_estimate=False):
+        if index == 5 and os.getpid() != parent:
+            raise RuntimeError("record of point 5 failed")
+        return original(config, stage, nl, index, solution, error_estimate)
+
+    monkeypatch.setattr(postprocess, "point_record", fails_in_a_worker)
+    target = tmp_path / "result"
+    with pytest.raises(RuntimeError, match="record of point 5 failed"):
+        solve_case(_lumped(2), output_dir=target)
+    assert list(tmp_path.iterdir()) == []
