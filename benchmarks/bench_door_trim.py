@@ -128,6 +128,9 @@ def p1_case(mesh_m=None, frequencies=None, harmonics=None, spots=None):
         case["excitation"].pop("sweep", None)
         case["excitation"]["frequency_hz"] = list(frequencies)
         case["solver"].pop("continuation", None)
+        # P4's "HBM s/point" is Newton + Hill stability of one process: with workers the stability
+        # streams to another process and hbm_s holds Newton only
+        case["solver"]["workers"] = 1
     if harmonics is not None:
         case["solver"]["harmonics"] = harmonics
     if spots is not None:               # (rattle, squeak): the first of each kind in the case
