@@ -1,6 +1,7 @@
 """Where the wall time of a ``sarfe solve`` goes, stage by stage, and how busy the cores are.
 
     python benchmarks/stage_cpu.py CASE.yaml [OUT.json]
+    python benchmarks/stage_cpu.py --table LABEL=OUT.json …     (markdown of saved runs)
 
 Runs ``sarfe solve CASE --output <tmp>`` (the sarfe of this tree, or of $SARFE_ROOT) (one BLAS thread per process) and samples, every 0.1 s,
 the CPU seconds of the whole process tree (user + system of the live processes plus what the
@@ -123,7 +124,27 @@ def run(case, out_dir=None) -> dict:
             "stages": stages}
 
 
+def table(label, result) -> list[str]:
+    """Markdown lines of one run: a heading with the totals and load, the stage table."""
+    lines = [f"### {label}", "",
+             f"`{result['case']}`: exit {result['exit']}, wall {result['wall_s']} s, CPU "
+             f"{result['cpu_s']} s, peak tree PSS {result['peak_pss_gb']} GB; load average "
+             f"{', '.join(f'{x:.1f}' for x in result['load_average_start'])} at the start, "
+             f"{', '.join(f'{x:.1f}' for x in result['load_average_end'])} at the end.", "",
+             "| stage | start s | wall s | CPU s | busy cores | peak PSS GB |",
+             "|---|---|---|---|---|---|"]
+    for s in result["stages"]:
+        lines.append(f"| {s['stage']} | {s['start_s']:.1f} | {s['wall_s']:.1f} | {s['cpu_s']:.1f} "
+                     f"| {s['busy_cores']:.2f} | {s['peak_pss_gb']:.2f} |")
+    return lines + [""]
+
+
 def main():
+    if sys.argv[1] == "--table":        # --table LABEL=run.json …  → markdown on stdout
+        for arg in sys.argv[2:]:
+            label, path = arg.split("=", 1)
+            print("\n".join(table(label, json.loads(pathlib.Path(path).read_text()))))
+        return
     result = run(sys.argv[1])
     print(f"{result['case']}: exit {result['exit']}, wall {result['wall_s']} s, CPU "
           f"{result['cpu_s']} s, peak tree PSS {result['peak_pss_gb']} GB; load average "
