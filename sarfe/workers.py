@@ -230,8 +230,12 @@ class Stream:
 
     def submit(self, key, item):
         self.pending.append((key, item))
+        self.poll()
+
+    def poll(self):
+        """Collect the finished results; start a worker for the items waiting if none runs."""
         self._collect()
-        if self._process is None:
+        if self._process is None and self.pending:
             self._start()
 
     def finish(self) -> dict:

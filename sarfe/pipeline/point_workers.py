@@ -7,11 +7,14 @@ shared copy-on-write, only the results come back):
 
 1. Hill stability — deferred during the sweep (:mod:`sarfe.hbm.deferred`: ``finalize`` records a
    job per converged point) and computed on one worker while the sweep goes on (:func:`stability_
-   stream`: the sweep holds one core, the stream the other), then the reported points left are
-   mapped over all workers;
-2. the error estimates (:func:`sarfe.pipeline.postprocess.error_estimates`, ``workers``);
+   stream`: the sweep holds one core, the stream the other), then the reported points left;
+2. the error estimates (:func:`sarfe.pipeline.postprocess.error_estimates`; the first in the
+   solving process, :func:`first_estimates`);
 3. the point records: ERP, contact indicators, contributions, linear baseline
    (:func:`sarfe.pipeline.postprocess.point_record`).
+
+After the sweep 1–3 go to the workers as one queue (:func:`point_work`), so no stage waits for
+the slowest worker of the one before.
 
 ``workers`` = 1 is the serial path (stability in place during the sweep, plain loops). The results
 do not depend on ``workers``: every point is computed by the same function from the same inputs.
@@ -41,33 +44,6 @@ def stability_stream() -> Stream:
     return Stream(stability_of)
 
 
-def stability_verdicts(solutions, jobs, workers, progress=False, done=None):
-    """The solutions with their deferred Hill stability (``jobs`` of a :func:`sarfe.hbm.deferred.
-    deferred_stability` block around the sweep) computed on ``workers`` processes; ``done``: {job
-    index: StabilityResult or the exception it raised} of the jobs already computed during the
-    sweep (:class:`sarfe.workers.Stream`). None when one of them raised — the serial path ends
-    the continuation there and goes on point by point, so the caller solves the points again
-    without deferring."""
-    indices = pending(solutions)
-    done = done or {}
-    if any(isinstance(done.get(i), Exception) for i in indices):
-        return None
-    rest = [i for i in indices if i not in done]
-    if rest:
-        bar = _bar(progress, f"Hill stability ({workers} processes, {len(indices) - len(rest)} "
-                   "of the points during the sweep)", len(rest), unit="point")
-        try:
-            results = map_points(stability_of, [jobs[i] for i in rest], workers,
-                                 progress=None if bar is None else functools.partial(bar.update, 1))
-        except Exception:
-            return None
-        finally:
-            if bar is not None:
-                bar.close()
-        done = {**done, **dict(zip(rest, results))}
-    return with_stability(solutions, indices, [done[i] for i in indices])
-
-
 def first_estimates(config: CaseConfig, stage, nl, solutions) -> dict:
     """{index: estimate} of the first point to estimate (:func:`sarfe.pipeline.postprocess.
     estimated_points`), computed in this process: the caches it builds (the coarser Craig–Bampton
@@ -82,9 +58,11 @@ def first_estimates(config: CaseConfig, stage, nl, solutions) -> dict:
 def point_work(config: CaseConfig, stage, nl, solutions, jobs, done, first, workers,
                progress=False):
     """Everything per point after a sweep, on ``workers`` processes at once: the Hill stability
-    of the reported points the stream did not compute (``jobs``, ``done``: :func:`stability_
-    verdicts`; ``jobs`` None without stability), the error estimates left (``first``: those
-    computed in this process, :func:`first_estimates`) and every point's record (ERP, contact
+    of the reported points the stream did not compute (``jobs`` of the :func:`sarfe.hbm.deferred.
+    deferred_stability` block around the sweep, None without stability; ``done``: {job index:
+    StabilityResult or the exception it raised} of the stream, :func:`stability_stream`), the
+    error estimates left (``first``: those computed in this process, :func:`first_estimates`) and
+    every point's record (ERP, contact
     indicators, contributions, linear baseline; :func:`sarfe.pipeline.postprocess.point_record`,
     with the points at one time grid, :func:`sarfe.pipeline.points.common_samples`). One queue,
     the longest items first (a Hill point ≈ 5× an estimate ≈ 5× a record), so the workers finish
