@@ -78,14 +78,14 @@ def run_case(case, timeout):
     reader.start()
     timed_out, status, usage = False, None, None
     sys.path.insert(0, str(HERE))
-    from stage_cpu import pss_gb, tree       # tree PSS: the forked workers share the model
+    from stage_cpu import tree_pss_gb      # tree PSS: the forked workers share the model
 
     peak_pss = 0.0
     while True:
         pid, status, usage = os.wait4(proc.pid, os.WNOHANG)
         if pid:
             break
-        peak_pss = max(peak_pss, pss_gb(tree(proc.pid)))
+        peak_pss = max(peak_pss, tree_pss_gb(proc.pid) or 0.0)
         if time.perf_counter() - start > timeout:
             os.killpg(proc.pid, 9)
             _, status, usage = os.wait4(proc.pid, 0)

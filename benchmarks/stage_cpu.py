@@ -6,7 +6,8 @@
 Runs ``sarfe solve CASE --output <tmp>`` (the sarfe of this tree, or of $SARFE_ROOT) (one BLAS thread per process) and samples, every 0.1 s,
 the CPU seconds of the whole process tree (user + system of the live processes plus what the
 waited-for children used, /proc/<pid>/stat) and its PSS (/proc/<pid>/smaps_rollup, the forked
-workers sharing the model copy-on-write count once). Each stage runs from its stage line
+workers sharing the model copy-on-write count once; a sample during which a process started or
+ended is dropped: a fork between two reads counts the shared pages up to twice). Each stage runs from its stage line
 (``sarfe: <stage> …`` on stderr) to the next; per stage it prints the wall seconds, the tree CPU
 seconds, the mean busy cores (CPU / wall; 2.0 = both cores of the P1 machine) and the peak tree
 PSS. The idle core-seconds of a 2-core machine are 2 × wall − CPU. On a loaded machine the
@@ -77,6 +78,14 @@ def pss_gb(pids) -> float:
     return total / 1024 ** 2
 
 
+def tree_pss_gb(pid) -> float | None:
+    """PSS of the tree of ``pid`` [GB]; None when a process started or ended while the files were
+    read (a fork between two reads counts the shared pages once in full and again in shares)."""
+    pids = tree(pid)
+    value = pss_gb(pids)
+    return value if set(tree(pid)) == set(pids) else None
+
+
 def run(case, out_dir=None) -> dict:
     out_dir = pathlib.Path(out_dir or tempfile.mkdtemp(prefix="stage_cpu_")).resolve()
     env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1",
@@ -100,7 +109,9 @@ def run(case, out_dir=None) -> dict:
     samples = []            # (t, cpu, pss)
     while proc.poll() is None:
         pids = tree(proc.pid)
-        samples.append((time.perf_counter() - start, cpu_seconds(pids, proc.pid), pss_gb(pids)))
+        pss = tree_pss_gb(proc.pid)
+        samples.append((time.perf_counter() - start, cpu_seconds(pids, proc.pid),
+                        0.0 if pss is None else pss))
         time.sleep(0.1)
     wall = time.perf_counter() - start
     usage = os.times()
