@@ -77,10 +77,15 @@ def run_case(case, timeout):
     reader = threading.Thread(target=read, daemon=True)
     reader.start()
     timed_out, status, usage = False, None, None
+    sys.path.insert(0, str(HERE))
+    from stage_cpu import tree_pss_gb      # tree PSS: the forked workers share the model
+
+    peak_pss = 0.0
     while True:
         pid, status, usage = os.wait4(proc.pid, os.WNOHANG)
         if pid:
             break
+        peak_pss = max(peak_pss, tree_pss_gb(proc.pid) or 0.0)
         if time.perf_counter() - start > timeout:
             os.killpg(proc.pid, 9)
             _, status, usage = os.wait4(proc.pid, 0)
@@ -95,7 +100,8 @@ def run_case(case, timeout):
     if path.exists():
         summary = json.loads(path.read_text())
     return {"wall_s": wall, "cpu_s": usage.ru_utime + usage.ru_stime,
-            "peak_rss_gb": usage.ru_maxrss / 1024 ** 2, "timed_out": timed_out,
+            "peak_rss_gb": usage.ru_maxrss / 1024 ** 2, "peak_tree_pss_gb": peak_pss,
+            "timed_out": timed_out,
             "exit": proc.returncode, "stderr_tail": "\n".join(tail[-4:])[-400:],
             "summary": summary, "stages": stages, "load_average": os.getloadavg()}
 
@@ -122,6 +128,9 @@ def p1_case(mesh_m=None, frequencies=None, harmonics=None, spots=None):
         case["excitation"].pop("sweep", None)
         case["excitation"]["frequency_hz"] = list(frequencies)
         case["solver"].pop("continuation", None)
+        # P4's "HBM s/point" is Newton + Hill stability of one process: with workers the stability
+        # streams to another process and hbm_s holds Newton only
+        case["solver"]["workers"] = 1
     if harmonics is not None:
         case["solver"]["harmonics"] = harmonics
     if spots is not None:               # (rattle, squeak): the first of each kind in the case
@@ -139,8 +148,9 @@ def p1_case(mesh_m=None, frequencies=None, harmonics=None, spots=None):
 def run_record(r, **extra):
     """The numbers of one run kept in the results."""
     s = r["summary"]
-    out = dict(extra, **{k: r[k] for k in ("wall_s", "cpu_s", "peak_rss_gb", "timed_out", "exit",
-                                           "stages", "load_average")})
+    out = dict(extra, **{k: r.get(k) for k in ("wall_s", "cpu_s", "peak_rss_gb",
+                                               "peak_tree_pss_gb", "timed_out", "exit",
+                                               "stages", "load_average")})
     if s:
         t = s["timings_s"]
         n = len(s["points"])
@@ -148,7 +158,8 @@ def run_record(r, **extra):
             "free_dofs", "modes", "reduced_dofs", "boundary_dofs", "cutoff_hz")},
             contacts=len(s["contacts"]), hbm_s_per_point=t.get("hbm_s", 0) / max(n, 1),
             per_point_s=(t.get("hbm_s", 0) + t.get("error_estimate_s", 0)
-                         + t.get("postprocess_s", 0)) / max(n, 1),
+                         + t.get("postprocess_s", 0) + t.get("point_work_s", 0)) / max(n, 1),
+            workers=s.get("workers"),
             converged=sum(bool(p["converged"]) for p in s["points"]),
             stable=sum(p["stable"] is True for p in s["points"]),
             loudest=(s.get("worst") or {}).get("erp_level_dba"),
@@ -325,13 +336,19 @@ def p1_lines(e, p4):
          "40 → 80 Hz (max_step 0.05: ≈ 200 reported points), default options, mesh → VTU", "",
          "The whole sweep, one `sarfe solve` process (mesh from the cache after the first run; "
          "the cache is what `sarfe solve` uses). Target ≤ 60 s, ≤ 4 GB.", "",
-         "| points | converged | wall s | CPU s | peak RSS GB | linear stage s | HBM s | estimate s | "
-         "post s | outputs s | reached |", "|---|---|---|---|---|---|---|---|---|---|---|",
+         "| points | converged | wall s | CPU s | peak RSS GB | tree PSS GB | linear stage s | "
+         "HBM s | estimate s | post s | point work s | outputs s | reached |",
+         "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
          f"| {e.get('points_n', '-')} | {e.get('converged', '-')} | {e['wall_s']:.1f}"
-         f"{' (TIMEOUT)' if e['timed_out'] else ''} | {e.get('cpu_s', 0):.1f} | {e['peak_rss_gb']:.2f} | "
+         f"{' (TIMEOUT)' if e['timed_out'] else ''} | {e.get('cpu_s', 0):.1f} | "
+         f"{e['peak_rss_gb']:.2f} | {fmt(e.get('peak_tree_pss_gb'), '.2f')} | "
          f"{fmt(t.get('linear_stage_s'))} | {fmt(t.get('hbm_s'))} | {fmt(t.get('error_estimate_s'))} | "
-         f"{fmt(t.get('postprocess_s'))} | {fmt(t.get('outputs_s'))} | "
-         f"{'done' if e.get('summary_ok', e.get('points_n')) else stage_of(e)} |", ""]
+         f"{fmt(t.get('postprocess_s'))} | {fmt(t.get('point_work_s'))} | {fmt(t.get('outputs_s'))} | "
+         f"{'done' if e.get('summary_ok', e.get('points_n')) else stage_of(e)} |", "",
+         "HBM s: the sweep (Newton; with workers the Hill stability of its points streams to one "
+         "worker meanwhile); point work s (with workers): the Hill stability left, the error "
+         "estimates and the point records in one queue on the workers (`post s` on one process); "
+         f"workers: {e.get('workers')}.", ""]
     L.append(f"Stage lines (s since start): {e.get('stages')}; load average during the run "
              f"{fmt(e['load_average'][0], '.1f')}.")
     five = next((g for g in (p4 or {}).get("sizes", []) if g["mesh_m"] == 0.005 and g.get("timings_s")),

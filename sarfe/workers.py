@@ -95,51 +95,90 @@ def _run(index):
 
 def map_points(function, items, workers, progress=None) -> list:
     """[function(item) for item in items] on ``workers`` forked processes (module docstring)."""
+    return start_map(function, items, workers).result(progress)
+
+
+class PendingMap:
+    """A :func:`start_map` in progress: ``result(progress)`` waits for it and returns the results
+    in order (``cancel()`` ends its workers). The items given to ``workers`` ≤ 1 are computed by
+    ``result`` in this process."""
+
+    def __init__(self, function, items, pool, pending):
+        self.function, self.items = function, items
+        self.pool, self.pending = pool, pending
+
+    def result(self, progress=None) -> list:
+        function, items = self.function, self.items
+        results = [None] * len(items)
+        if self.pool is None:
+            for i, item in enumerate(items):
+                results[i] = function(item)
+                if progress is not None:
+                    progress()
+            return results
+        done, pending, pool = set(), self.pending, self.pool
+        try:
+            while pending:
+                finished, _ = wait(pending, return_when=FIRST_COMPLETED)
+                for future in finished:
+                    i = pending.pop(future)
+                    try:
+                        results[i] = future.result()
+                    except BrokenProcessPool:     # a worker died: the parent computes what is left
+                        continue
+                    done.add(i)
+                    if progress is not None:
+                        progress()
+        except BaseException:                     # Ctrl-C or an item's exception: stop the workers
+            self.cancel()
+            raise
+        self._release()
+        pool.shutdown(wait=True)
+        for i in range(len(items)):               # items of a worker that died
+            if i not in done:
+                results[i] = function(items[i])
+                if progress is not None:
+                    progress()
+        return results
+
+    def cancel(self):
+        _stop(self.pool)
+        self._release()
+
+    def _release(self):
+        global _TASK
+        if self.pool is not None and _TASK is not None:
+            _TASK = None
+            gc.unfreeze()
+
+
+def start_map(function, items, workers) -> PendingMap:
+    """Fork the workers of :func:`map_points` and hand them the items, without waiting: this
+    process goes on with other work and collects the results with ``.result()`` (one map at a
+    time: the next starts after this one's result)."""
     global _TASK
     items = list(items)
-    results = [None] * len(items)
     if workers <= 1 or len(items) <= 1 or multiprocessing.current_process().daemon:
-        for i, item in enumerate(items):
-            results[i] = function(item)
-            if progress is not None:
-                progress()
-        return results
+        return PendingMap(function, items, None, None)
     from threadpoolctl import threadpool_limits
 
-    done = set()
+    if _TASK is not None:
+        raise RuntimeError("a map is already in progress")
     _TASK = (function, items)
     pool = None
-    gc.freeze()         # the workers' garbage collector leaves the parent's objects (and pages) alone
+    gc.freeze()     # the workers' garbage collector leaves the parent's objects (and pages) alone
     try:
         with threadpool_limits(limits=1):     # fork with one BLAS thread (no pool to inherit)
             pool = ProcessPoolExecutor(max_workers=min(int(workers), len(items)),
                                        mp_context=multiprocessing.get_context("fork"),
                                        initializer=_start_worker)
             pending = {pool.submit(_run, i): i for i in range(len(items))}
-        while pending:
-            finished, _ = wait(pending, return_when=FIRST_COMPLETED)
-            for future in finished:
-                i = pending.pop(future)
-                try:
-                    results[i] = future.result()
-                except BrokenProcessPool:     # a worker died: the parent computes what is left
-                    continue
-                done.add(i)
-                if progress is not None:
-                    progress()
-    except BaseException:                     # Ctrl-C or an item's exception: stop the workers
+    except BaseException:
         _stop(pool)
-        raise
-    finally:
         _TASK = None
         gc.unfreeze()
-    pool.shutdown(wait=True)
-    for i in range(len(items)):               # items of a worker that died
-        if i not in done:
-            results[i] = function(items[i])
-            if progress is not None:
-                progress()
-    return results
+        raise
+    return PendingMap(function, items, pool, pending)
 
 
 def _stop(pool):
@@ -153,3 +192,121 @@ def _stop(pool):
             process.terminate()
     for process in processes:
         process.join(timeout=5)
+
+
+class Stream:
+    r"""``function(item)`` for items that arrive one at a time, on one forked process while this
+    one goes on producing them (the Hill stability of the points of a sweep while Newton solves
+    the next ones).
+
+        stream = Stream(function)
+        stream.submit(key, item)        # returns at once
+        …
+        done = stream.finish()          # {key: result} of the items computed so far
+
+    There is never more than one worker. ``submit`` collects the finished results and, when no
+    worker runs, forks one for the items submitted since the last fork (a fork inherits them:
+    nothing is pickled on the way there, only the results come back). ``finish`` asks the worker
+    to stop after its current item and returns what was computed; the caller computes the rest
+    (:func:`map_points`), so the results do not depend on how far the stream got. An item whose
+    function raised is in ``done`` as the exception (the caller decides), a worker that died
+    leaves its items undone. ``forks`` counts the workers started. Use it as a context manager:
+    leaving the block (Ctrl-C, an exception) ends the worker.
+    """
+
+    def __init__(self, function):
+        self.function = function
+        self.pending = []           # (key, item) submitted since the last fork
+        self.done = {}              # key → result (or the exception an item raised)
+        self.forks = 0
+        self._process = self._connection = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self._end(stop=True)
+        return False
+
+    def submit(self, key, item):
+        self.pending.append((key, item))
+        self.poll()
+
+    def poll(self):
+        """Collect the finished results; start a worker for the items waiting if none runs."""
+        self._collect()
+        if self._process is None and self.pending:
+            self._start()
+
+    def finish(self) -> dict:
+        """Stop the worker after its current item; {key: result} of the items computed."""
+        if self._process is not None:
+            try:
+                self._connection.send("stop")
+            except OSError:
+                pass
+            self._collect(wait=True)
+        self._end(stop=False)
+        return self.done
+
+    def _start(self):
+        from threadpoolctl import threadpool_limits
+
+        batch, self.pending = self.pending, []
+        parent, child = multiprocessing.get_context("fork").Pipe()
+        with threadpool_limits(limits=1):
+            process = multiprocessing.get_context("fork").Process(
+                target=_stream_worker, args=(self.function, batch, child), daemon=True)
+            process.start()
+        child.close()
+        self._process, self._connection = process, parent
+        self.forks += 1
+
+    def _collect(self, wait=False):
+        """Read the finished results; the worker's end (sentinel or death) clears it."""
+        if self._process is None:
+            return
+        connection = self._connection
+        try:
+            while wait or connection.poll():
+                message = connection.recv()
+                if message is None:            # the worker finished its batch (or stopped)
+                    break
+                key, result = message
+                self.done[key] = result
+            else:
+                return
+        except (EOFError, OSError):            # it died: its undone items stay undone
+            pass
+        self._end(stop=False)
+
+    def _end(self, stop):
+        process, self._process = self._process, None
+        if process is None:
+            return
+        if stop and process.is_alive():
+            process.terminate()
+        process.join(timeout=None if not stop else 5)
+        self._connection.close()
+        self._connection = None
+
+
+def _stream_worker(function, batch, connection):
+    """Body of a :class:`Stream` worker: the batch in order, each result sent as soon as it is
+    computed, until the parent says stop; then the sentinel None."""
+    _start_worker()
+    gc.freeze()       # this process's collections leave the inherited objects (and pages) alone
+    try:
+        for key, item in batch:
+            if connection.poll():
+                break
+            try:
+                result = function(item)
+            except Exception as error:       # the caller decides (e.g. solve serially)
+                result = error
+            connection.send((key, result))
+        connection.send(None)
+    except (BrokenPipeError, EOFError, OSError):
+        pass
+    finally:
+        connection.close()

@@ -128,7 +128,7 @@ def test_two_workers_give_the_serial_points(serial):
     assert any(isinstance(p["error_estimate"], dict) and not p["error_estimate"].get(
         "interpolated") for p in two)
     assert _differences(one, two) == []
-    assert "stability_s" in parallel.summary["timings_s"]
+    assert "point_work_s" in parallel.summary["timings_s"]
     assert all(s.stability_job is None for s in parallel.solutions)
 
 
@@ -138,7 +138,8 @@ def test_a_failing_deferred_stability_gives_the_serial_result(serial, monkeypatc
 
     monkeypatch.setattr(point_workers, "stability_of", broken)
     result = solve_case(_lumped(2), write=False)
-    assert "stability_s" in result.summary["timings_s"]
+    assert "point_work_s" in result.summary["timings_s"]
+    assert "in place" in result.summary["workers"]["stability"]
     assert _differences(serial.summary["points"], result.summary["points"]) == []
 
 
@@ -162,3 +163,114 @@ def test_meshing_leaves_sigpipe_ignored():
     with gmsh_session():
         assert handler() == 1
     assert handler() == 1
+
+
+def _slow_square(x):
+    import time
+
+    time.sleep(0.02)
+    return x * x
+
+
+def test_a_stream_computes_items_while_they_arrive_on_one_other_process():
+    """Stream: items submitted one by one while this process works; finish() returns what was
+    computed (in another process), the rest is left to the caller; results as the function's."""
+    import time
+
+    def settle(stream, count):      # poll until the worker has computed ``count`` items
+        start = time.perf_counter()
+        while len(stream.done) < count and time.perf_counter() - start < 120:
+            stream.poll()
+            time.sleep(0.02)
+
+    with workers.Stream(_slow_square) as stream:
+        for x in range(30):
+            stream.submit(x, x)
+            time.sleep(0.01)             # this process "solves the next point"
+        settle(stream, 30)
+        done = stream.finish()
+    assert done == {x: x * x for x in range(30)}
+    assert 1 <= stream.forks <= 30       # a fork per batch of the items waiting
+    with workers.Stream(_pid) as stream:
+        for x in range(5):
+            stream.submit(x, x)
+        settle(stream, 5)
+        pids = stream.finish()
+    assert len(pids) == 5 and os.getpid() not in pids.values()
+
+
+def test_a_stream_stops_early_and_reports_exceptions_and_dead_workers():
+    import time
+
+    def settle(stream, count):
+        start = time.perf_counter()
+        while len(stream.done) < count and time.perf_counter() - start < 120:
+            stream.poll()
+            time.sleep(0.02)
+
+    with workers.Stream(_fails_on_three) as stream:
+        for x in range(6):
+            stream.submit(x, x)
+        settle(stream, 6)
+        done = stream.finish()
+    assert isinstance(done[3], ValueError)
+    assert {k: v for k, v in done.items() if k != 3} == {0: 0, 1: 1, 2: 2, 4: 4, 5: 5}
+
+    def sleeps(x):
+        time.sleep(0.2)
+        return x
+
+    with workers.Stream(sleeps) as stream:
+        for x in range(50):                      # one batch of 50 × 0.2 s
+            stream.submit(x, x)
+        done = stream.finish()                   # stops after the current item
+    assert len(done) < 50
+
+    parent = os.getpid()
+
+    def dies(x):
+        if x == 2 and os.getpid() != parent:
+            os.kill(os.getpid(), signal.SIGKILL)
+        return x
+
+    with workers.Stream(dies) as stream:
+        for x in range(5):
+            stream.submit(x, x)
+        start = time.perf_counter()
+        while (stream.pending or stream._process is not None) and time.perf_counter() - start < 120:
+            stream.poll()                       # batches until every item was handed out
+            time.sleep(0.02)
+        done = stream.finish()
+    assert 2 not in done and all(done[k] == k for k in done) and {0, 1} <= set(done)
+
+
+def test_the_parallel_solve_computes_stability_during_the_sweep(serial):
+    """workers 2: part of the Hill stability is computed while the sweep runs, and the points are
+    the serial path's (same verdicts, same fields within 1e-12)."""
+    parallel = solve_case(_lumped(2), write=False)
+    record = parallel.summary["workers"]
+    assert record["processes"] == 2
+    assert record["stability_points"] == sum(p["converged"] for p in serial.summary["points"])
+    assert 0 < record["stability_during_sweep"] <= record["stability_points"]
+    assert record["stream_processes"] >= 1
+    assert _differences(serial.summary["points"], parallel.summary["points"]) == []
+    assert serial.summary["workers"] == {"processes": 1}
+
+
+def test_an_error_in_a_worker_is_one_error_and_leaves_no_result_folder(tmp_path, monkeypatch):
+    """A point record that raises on a worker ends the solve with that exception (the CLI's one
+    line), and neither the result folder nor a temporary sibling is left behind."""
+    from sarfe.pipeline import postprocess
+
+    original, parent = postprocess.point_record, os.getpid()
+
+    def fails_in_a_worker(config, stage, nl, index, solution, error_estimate=False):
+        if index == 5 and os.getpid() != parent:
+            raise RuntimeError("record of point 5 failed")
+        return original(config, stage, nl, index, solution, error_estimate)
+
+    monkeypatch.setattr(postprocess, "point_record", fails_in_a_worker)
+    target = tmp_path / "result"
+    with pytest.raises(RuntimeError, match="record of point 5 failed"):
+        solve_case(_lumped(2), output_dir=target)
+    assert list(tmp_path.iterdir()) == []

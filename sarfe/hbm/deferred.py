@@ -12,8 +12,9 @@ without it and the verdicts be computed afterwards over the reported points:
 
 :func:`stability_of` evaluates the converged point exactly as ``finalize`` does in place (the full
 residual with the slider start of the solve, then :func:`sarfe.hbm.solve.stability`): same inputs,
-same arithmetic, so the verdicts and exponents are those of the serial path. Points dropped by the
-sweep (backed-up corners, replaced near-duplicates) are never computed.
+same arithmetic, so the verdicts and exponents are those of the serial path. Jobs may also be
+computed while the sweep goes on (``on_job``: :class:`sarfe.workers.Stream`); the verdicts of points
+the sweep then drops (backed-up corners, replaced near-duplicates) are simply not used.
 """
 from __future__ import annotations
 
@@ -23,6 +24,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 _JOBS = None     # the StabilityJob list of the active deferred_stability() block (None: in place)
+_ON_JOB = None   # its callback on_job(index, job), or None
 
 
 @dataclass(frozen=True)
@@ -39,18 +41,21 @@ class StabilityJob:
 
 
 @contextmanager
-def deferred_stability(enabled=True):
+def deferred_stability(enabled=True, on_job=None):
     """Inside the block ``finalize`` records a :class:`StabilityJob` instead of computing stability
-    (yields the job list; ``enabled=False``: yields None and nothing is deferred)."""
-    global _JOBS
+    (yields the job list; ``enabled=False``: yields None and nothing is deferred). ``on_job(index,
+    job)`` is called as each job is recorded (e.g. :meth:`sarfe.workers.Stream.submit`: the job
+    computed on another process while the sweep goes on)."""
+    global _JOBS, _ON_JOB
     if not enabled:
         yield None
         return
-    outer, _JOBS = _JOBS, []
+    outer, _JOBS = (_JOBS, _ON_JOB), []
+    _ON_JOB = on_job
     try:
         yield _JOBS
     finally:
-        _JOBS = outer
+        _JOBS, _ON_JOB = outer
 
 
 def defer(problem, omega, U, slider, options) -> int | None:
@@ -58,7 +63,10 @@ def defer(problem, omega, U, slider, options) -> int | None:
     :func:`deferred_stability` block (compute it in place)."""
     if _JOBS is None:
         return None
-    _JOBS.append(StabilityJob(problem, float(omega), U, slider, options))
+    job = StabilityJob(problem, float(omega), U, slider, options)
+    _JOBS.append(job)
+    if _ON_JOB is not None:
+        _ON_JOB(len(_JOBS) - 1, job)
     return len(_JOBS) - 1
 
 

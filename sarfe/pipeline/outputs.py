@@ -18,22 +18,26 @@ def write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, d
     report maps) uses ``summary["worst"]["index"]`` (:func:`sarfe.pipeline.postprocess.loudest_point`).
     summary.json itself is written by the caller, last (it lists these files and the timings).
     The report's surface renders run in a child process from the moment the loudest point's
-    arrays exist until the report is written (the ERP maps, animation and PNGs are written
-    meanwhile); it is stopped if a writer fails."""
-    renders = []
+    arrays exist until the report is written, and a large sweep's ERP maps on the run's workers
+    (:func:`map_workers`) while this process writes response.h5, the animation and the PNGs;
+    both are stopped if a writer fails."""
+    started = []        # ('render', run) | ('maps', writer) in progress in other processes
     try:
         return _write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w,
-                              directory, renders)
+                              directory, started)
     except BaseException:
         from sarfe.io.outputs.render import cancel_render
 
-        for run in renders:
-            cancel_render(run)
+        for kind, run in started:
+            if kind == "render":
+                cancel_render(run)
+            else:
+                run.cancel()
         raise
 
 
 def _write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, directory,
-                   started_renders):
+                   started):
     from sarfe.io import outputs
 
     files = config.output.files
@@ -46,17 +50,8 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, 
         written["table"] = "table.txt"
     if not solutions:
         return written
-    if "response" in files:
-        outputs.write_response_h5(
-            directory / "response.h5", solutions, contacts=nl.contacts, excitation=nl.excitation,
-            boundary_dofs=getattr(stage.reduced, "boundary_dofs", None),
-            mode_frequencies_hz=stage.mode_frequencies_hz, erp=erps,
-            radiating_nodes=stage.erp_nodes if stage.erp_map.shape[0] else None,
-            extra_groups=result_groups(summary["points"], nl),   # contributions, bands, …
-            attributes={"case": config.name, "linear_model_key": stage.key})
-        written["response"] = "response.h5"
     loudest = (summary.get("worst") or {}).get("index")
-    maps, renders = {}, None
+    maps, renders, series = {}, None, None
     if stage.kind == "fe" and ("erp_vtu" in files or "animation" in files or "report" in files):
         from sarfe.reduction.recovery import recover_displacement
 
@@ -108,17 +103,18 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, 
                                          contact_nodes={name: int(g.nodes_a[0])
                                                         for name, g in stage.contacts.items()
                                                         if len(g.nodes_a)})
-            started_renders.append(renders)
+            started.append(("render", renders))
         if "erp_vtu" in files:
             frequencies = [float(s.omega) / (2 * np.pi) for s in solutions]
             if len(solutions) == 1:
                 outputs.write_erp_vtu(directory / "erp.vtu", mesh.points, mesh.triangles,
                                       point_data(0))
                 written["erp_vtu"] = "erp.vtu"
-            else:
-                outputs.write_erp_sweep(directory / "erp", mesh.points, mesh.triangles,
-                                        point_data, frequencies,
-                                        workers=map_workers(config, mesh, len(solutions)))
+            else:       # on the workers while this process writes the files below
+                series = outputs.start_erp_sweep(directory / "erp", mesh.points, mesh.triangles,
+                                                 point_data, frequencies,
+                                                 workers=map_workers(config, mesh, len(solutions)))
+                started.append(("maps", series))
                 written["erp_vtu"] = "erp/erp.pvd"
         if "animation" in files and loudest is not None:
             outputs.write_deflection_animation(directory / "animation", mesh.points,
@@ -129,6 +125,15 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, 
                                                    if getattr(stage, "node_ids", None) is not None
                                                    else {}))
             written["animation"] = "animation/deflection.pvd"
+    if "response" in files:
+        outputs.write_response_h5(
+            directory / "response.h5", solutions, contacts=nl.contacts, excitation=nl.excitation,
+            boundary_dofs=getattr(stage.reduced, "boundary_dofs", None),
+            mode_frequencies_hz=stage.mode_frequencies_hz, erp=erps,
+            radiating_nodes=stage.erp_nodes if stage.erp_map.shape[0] else None,
+            extra_groups=result_groups(summary["points"], nl),   # contributions, bands, …
+            attributes={"case": config.name, "linear_model_key": stage.key})
+        written["response"] = "response.h5"
     images = {}
     if "plots" in files or "report" in files:
         from sarfe.pipeline.figures import point_figures
@@ -137,6 +142,8 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, 
         images = point_figures(config, stage, nl, summary, solutions, erps, plot_dir, loudest)
         if "plots" in files:
             written["plots"] = ", ".join(sorted(Path(v).name for v in images.values()))
+    if series is not None:
+        series.finish()
     if renders is not None:
         from sarfe.pipeline.figures import finish_surface_maps
 

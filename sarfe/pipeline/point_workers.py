@@ -6,11 +6,15 @@ forked from the solve (:func:`sarfe.workers.map_points`: the reduced model and t
 shared copy-on-write, only the results come back):
 
 1. Hill stability — deferred during the sweep (:mod:`sarfe.hbm.deferred`: ``finalize`` records a
-   job per converged point), then mapped over the reported points (points the sweep dropped are
-   not computed);
-2. the error estimates (:func:`sarfe.pipeline.postprocess.error_estimates`, ``workers``);
+   job per converged point) and computed on one worker while the sweep goes on (:func:`stability_
+   stream`: the sweep holds one core, the stream the other), then the reported points left;
+2. the error estimates (:func:`sarfe.pipeline.postprocess.error_estimates`; the first in the
+   solving process, :func:`first_estimates`);
 3. the point records: ERP, contact indicators, contributions, linear baseline
    (:func:`sarfe.pipeline.postprocess.point_record`).
+
+After the sweep 1–3 go to the workers as one queue (:func:`point_work`), so no stage waits for
+the slowest worker of the one before.
 
 ``workers`` = 1 is the serial path (stability in place during the sweep, plain loops). The results
 do not depend on ``workers``: every point is computed by the same function from the same inputs.
@@ -25,7 +29,7 @@ import functools
 from sarfe.hbm.deferred import pending, stability_of, with_stability
 from sarfe.io.config import CaseConfig, SolverConfig
 from sarfe.pipeline.progress import bar as _bar
-from sarfe.workers import map_points, worker_count
+from sarfe.workers import Stream, map_points, worker_count
 
 
 def point_workers(solver: SolverConfig) -> int:
@@ -34,24 +38,91 @@ def point_workers(solver: SolverConfig) -> int:
     return worker_count(solver.workers)
 
 
-def stability_verdicts(solutions, jobs, workers, progress=False):
-    """The solutions with their deferred Hill stability (``jobs`` of a :func:`sarfe.hbm.deferred.
-    deferred_stability` block around the sweep) computed on ``workers`` processes; None when one
-    of them raised — the serial path ends the continuation there and goes on point by point, so
-    the caller solves the points again without deferring."""
-    indices = pending(solutions)
-    if not indices:             # (no converged point went through Newton: nothing to compute)
-        return solutions
-    bar = _bar(progress, f"Hill stability ({workers} processes)", len(indices), unit="point")
-    try:
-        results = map_points(stability_of, [jobs[i] for i in indices], workers,
-                             progress=None if bar is None else functools.partial(bar.update, 1))
-    except Exception:
+def stability_stream() -> Stream:
+    """The Hill stability of the sweep's points on one worker while the sweep goes on (the jobs
+    of :func:`sarfe.hbm.deferred.deferred_stability` submitted as they are recorded)."""
+    return Stream(stability_of)
+
+
+def first_estimates(config: CaseConfig, stage, nl, solutions) -> dict:
+    """{index: estimate} of the first point to estimate (:func:`sarfe.pipeline.postprocess.
+    estimated_points`), computed in this process: the caches it builds (the coarser Craig–Bampton
+    model, the modal bases) are inherited by the workers forked after it, as the serial loop's
+    later estimates find them, so every estimate has the serial path's round-off."""
+    from sarfe.pipeline.postprocess import estimated_points, point_estimate
+
+    return {i: point_estimate(config, stage, nl, solutions[i])
+            for i in estimated_points(config, nl, solutions)[:1]}
+
+
+def point_work(config: CaseConfig, stage, nl, solutions, jobs, done, first, workers,
+               progress=False):
+    """Everything per point after a sweep, on ``workers`` processes at once: the Hill stability
+    of the reported points the stream did not compute (``jobs`` of the :func:`sarfe.hbm.deferred.
+    deferred_stability` block around the sweep, None without stability; ``done``: {job index:
+    StabilityResult or the exception it raised} of the stream, :func:`stability_stream`), the
+    error estimates left (``first``: those computed in this process, :func:`first_estimates`) and
+    every point's record (ERP, contact
+    indicators, contributions, linear baseline; :func:`sarfe.pipeline.postprocess.point_record`,
+    with the points at one time grid, :func:`sarfe.pipeline.points.common_samples`). One queue,
+    the longest items first (a Hill point ≈ 5× an estimate ≈ 5× a record), so the workers finish
+    together instead of waiting for each other at every stage.
+
+    Returns (solutions with their verdicts at one time grid, [(point dict, row, ErpResult, W)]),
+    or None when a deferred stability raised (the caller solves the sweep again serially). The
+    records are filled with the verdicts and estimates afterwards
+    (:func:`sarfe.pipeline.postprocess.with_verdict`, ``with_estimate``): the same records as the
+    serial path's."""
+    from sarfe.pipeline.points import common_samples
+    from sarfe.pipeline.postprocess import (error_estimates, estimated_points, point_estimate,
+                                            point_record, with_estimate, with_verdict)
+
+    indices = pending(solutions) if jobs is not None else []
+    done = done or {}
+    if any(isinstance(done.get(i), Exception) for i in indices):
         return None
+    hill = [i for i in indices if i not in done]
+    estimates = [i for i in estimated_points(config, nl, solutions) if i not in first]
+    gridded = common_samples(nl, solutions)      # records at one N; estimates at each point's own
+    tasks = ([("stability", i) for i in hill] + [("estimate", i) for i in estimates]
+             + [("record", i) for i in range(len(gridded))])
+
+    def run(task):
+        kind, i = task
+        if kind == "stability":
+            try:
+                return stability_of(jobs[i])
+            except Exception as error:      # the serial path's sweep is solved instead
+                return error
+        if kind == "estimate":
+            return point_estimate(config, stage, nl, solutions[i])
+        return point_record(config, stage, nl, i, gridded[i], None)
+
+    n = len(gridded)
+    what = (f"{'ERP and error estimates' if config.solver.error_estimate else 'ERP'} "
+            f"({n} point{'s' if n != 1 else ''})"
+            + (f", Hill stability of the {len(hill)} left" if hill else "")
+            + (f" on {workers} processes" if len(tasks) > 1 else ""))
+    bar = _bar(progress, what, len(tasks), unit="item")
+    try:
+        results = map_points(run, tasks, workers,
+                             progress=None if bar is None else functools.partial(bar.update, 1))
     finally:
         if bar is not None:
             bar.close()
-    return with_stability(solutions, indices, results)
+    by_task = dict(zip(tasks, results))
+    verdicts = {**done, **{i: by_task["stability", i] for i in hill}}
+    if any(isinstance(verdicts[i], Exception) for i in indices):
+        return None
+    if indices:
+        gridded = with_stability(gridded, indices, [verdicts[i] for i in indices])
+    computed = {**first, **{i: by_task["estimate", i] for i in estimates}}
+    per_point = error_estimates(config, stage, nl, solutions, computed=computed)
+    records = [by_task["record", i] for i in range(len(gridded))]
+    for (point, row, _, _), solution, estimate in zip(records, gridded, per_point):
+        with_verdict(point, row, solution)
+        with_estimate(point, row, estimate)
+    return gridded, records
 
 
 def point_records(config: CaseConfig, stage, nl, solutions, estimates, workers,

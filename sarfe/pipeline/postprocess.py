@@ -252,10 +252,35 @@ def _estimates_in_order(estimate, solutions, first, workers):
     return out
 
 
+def estimated_points(config: CaseConfig, nl, solutions, stride=ESTIMATE_STRIDE) -> list:
+    """Indices of the points whose error estimate is computed (:func:`error_estimates`), in the
+    order they are computed (the first in the solving process: it builds the caches the others
+    share); empty when estimates are off."""
+    if not config.solver.error_estimate or not nl.contacts.count:
+        return []
+    eligible = [i for i, s in enumerate(solutions) if s.converged]
+    if config.excitation.sweep is None or len(eligible) <= 2 * stride:
+        return eligible
+    G = nl.contacts.gap_map
+
+    def amplitude(i):
+        U = np.asarray(solutions[i].displacement)
+        return float(np.max(np.hypot(G @ U[1], G @ U[2]), initial=0.0))
+
+    return sorted(set(eligible[::stride]) | {eligible[0], eligible[-1],
+                                             max(eligible, key=amplitude)})
+
+
+def point_estimate(config: CaseConfig, stage, nl, solution):
+    """The error estimate dict of one point (or None): :func:`_error_estimate`."""
+    return _error_estimate(config.solver, stage, nl, solution)
+
+
 def error_estimates(config: CaseConfig, stage, nl, solutions, stride=ESTIMATE_STRIDE,
-                    workers=1) -> list:
+                    workers=1, computed=None) -> list:
     """Per point: the error estimate dict, or None (see :func:`_error_estimate`); the estimates
-    are computed on ``workers`` processes (:func:`sarfe.workers.map_points`).
+    are computed on ``workers`` processes (:func:`sarfe.workers.map_points`), or taken from
+    ``computed`` ({point index: estimate} of the points :func:`estimated_points` lists).
 
     A sweep's points are estimated on a subset and the others take the larger estimate of their
     two estimated neighbours in continuation order (``interpolated: true``, ``from_points``): every
@@ -267,20 +292,13 @@ def error_estimates(config: CaseConfig, stage, nl, solutions, stride=ESTIMATE_ST
     solver = config.solver
     if not solver.error_estimate or not nl.contacts.count:
         return [None] * n
-    eligible = [i for i, s in enumerate(solutions) if s.converged]
-    estimate = functools.partial(_error_estimate, solver, stage, nl)
-    if config.excitation.sweep is None or len(eligible) <= 2 * stride:
-        return _estimates_in_order(estimate, solutions, eligible[:1], workers)
-    G = nl.contacts.gap_map
-
-    def amplitude(i):
-        U = np.asarray(solutions[i].displacement)
-        return float(np.max(np.hypot(G @ U[1], G @ U[2]), initial=0.0))
-
-    chosen = set(eligible[::stride]) | {eligible[0], eligible[-1], max(eligible, key=amplitude)}
-    chosen = sorted(chosen)
-    computed = dict(zip(chosen, _estimates_in_order(estimate, [solutions[i] for i in chosen],
-                                                    [0], workers)))
+    chosen = estimated_points(config, nl, solutions, stride)
+    if computed is None:
+        estimate = functools.partial(_error_estimate, solver, stage, nl)
+        computed = dict(zip(chosen, _estimates_in_order(estimate, [solutions[i] for i in chosen],
+                                                        chosen[:1] and [0], workers)))
+    if len(chosen) == sum(s.converged for s in solutions):      # every converged point
+        return [computed.get(i) if s.converged else None for i, s in enumerate(solutions)]
     usable = [i for i in sorted(computed) if computed[i] is not None and "failed" not in computed[i]
               and np.isfinite(computed[i]["amplitude_rel"])]    # (unknown: that point alone)
     out = []
@@ -347,29 +365,28 @@ def point_record(config: CaseConfig, stage, nl, index, solution, error_estimate=
             record.update({"erp_level_dba": source.get("level_dba", float("nan")),
                            "erp_share_a": source.get("share_a", float("nan"))})
     linear = linear_baseline(config.erp, stage, nl, omega, condensation)
-    stable = solution.stable
     point = {
         "index": index, "frequency_hz": omega / (2 * np.pi), "omega_rad_s": omega,
-        "converged": bool(solution.converged), "stable": None if stable is None else bool(stable),
-        "stability_note": str(solution.stability_note),
-        "floquet_exponent_1_s": float(solution.floquet_exponent),
+        "converged": bool(solution.converged), "stable": None, "stability_note": "",
+        "floquet_exponent_1_s": float("nan"),
         "iterations": int(solution.iterations),
         "residual_norm": float(solution.residual_norm),
         "reason": str(solution.reason),
         "erp": _erp_dict(erp), "contacts": contacts, "linear": linear,
-        "error_estimate": (_error_estimate(config.solver, stage, nl, solution)
-                           if error_estimate is False else error_estimate),
+        "error_estimate": None,
         "harmonic_set": harmonic_set_record(config.solver, solution),
         "bands": band_record(erp, linear, omega),
         "contributions": contributions,
     }
     row = {"case": config.name, "point": index, "frequency_hz": point["frequency_hz"],
-           "converged": point["converged"], "stable": point["stable"],
+           "converged": point["converged"], "stable": None,
            "iterations": point["iterations"], "erp_W": erp.power_total,
            "erp_db": erp.level_total_db, "erp_dba": erp.level_total_a_db,
            "linear_erp_db": linear["erp_level_db"], "linear_erp_dba": linear["erp_level_dba"],
-           "erp_error_db": (abs(float(point["error_estimate"]["erp_db"])) if point["error_estimate"]
-                            and "erp_db" in point["error_estimate"] else float("nan"))}
+           "erp_error_db": float("nan")}
+    with_verdict(point, row, solution)
+    with_estimate(point, row, _error_estimate(config.solver, stage, nl, solution)
+                  if error_estimate is False else error_estimate)
     for c in contacts:
         for key in ("max_penetration_m", "peak_normal_force_N", "peak_friction_force_N",
                     "open_fraction", "slip_fraction", "impacts_per_period", "erp_share_a"):
@@ -378,6 +395,23 @@ def point_record(config: CaseConfig, stage, nl, index, solution, error_estimate=
     for c in linear["contacts"]:
         row[f"{c['name']}.linear_rattle_risk"] = c["rattle_risk"]
     return point, row, erp, W
+
+
+def with_verdict(point, row, solution):
+    """Fill the stability fields of a point record (:func:`point_record`) from its solution: a
+    record computed before the solution's deferred Hill stability gets them afterwards."""
+    stable = solution.stable
+    point["stable"] = row["stable"] = None if stable is None else bool(stable)
+    point["stability_note"] = str(solution.stability_note)
+    point["floquet_exponent_1_s"] = float(solution.floquet_exponent)
+
+
+def with_estimate(point, row, estimate):
+    """Fill the error-estimate fields of a point record (:func:`point_record`): the estimate dict
+    (or None) and the table's ±dB."""
+    point["error_estimate"] = estimate
+    row["erp_error_db"] = (abs(float(estimate["erp_db"])) if estimate and "erp_db" in estimate
+                           else float("nan"))
 
 
 def loudest_point(points) -> int | None:

@@ -4,6 +4,7 @@ directory next to the target and moved into place at the end).
 """
 from __future__ import annotations
 
+import contextlib
 import datetime as _dt
 import functools
 import time
@@ -12,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sarfe.hbm.deferred import deferred_stability
+from sarfe.hbm.deferred import deferred_stability, pending
 from sarfe.io.case import load_case
 from sarfe.io.errors import EXIT_NOT_CONVERGED
 from sarfe.pipeline.accuracy import accuracy_check
@@ -22,7 +23,8 @@ from sarfe.pipeline.nonlinear import NonlinearModel, nonlinear_model
 from sarfe.pipeline.outputs import write_outputs, results_table
 from sarfe.pipeline.points import common_samples, solve_points, sweep_status
 from sarfe.pipeline.progress import bar as _bar
-from sarfe.pipeline.point_workers import point_records, point_workers, stability_verdicts
+from sarfe.pipeline.point_workers import (first_estimates, point_records, point_work,
+                                          point_workers, stability_stream)
 from sarfe.pipeline.pruning import solve_points_pruned
 from sarfe.pipeline.postprocess import error_estimates, worst_of
 
@@ -106,39 +108,60 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
 
     clock = time.perf_counter()
     workers = point_workers(config.solver)     # processes for the per-point work (1: serial)
-    # with workers, Hill stability is recorded during the sweep and computed on them after it
-    with deferred_stability(enabled=workers > 1 and config.solver.stability) as jobs:
-        solutions, pruning = solve_points_pruned(config.solver, config.excitation, nl,
-                                                 progress=progress)
-    if jobs is not None:
-        clock_stability = time.perf_counter()
-        solutions = stability_verdicts(solutions, jobs, workers, progress)
-        timings["stability_s"] = time.perf_counter() - clock_stability
-    if solutions is None:      # a deferred stability raised: the serial path's sweep
-        solutions, pruning = solve_points_pruned(config.solver, config.excitation, nl,
-                                                 progress=progress)
-    timings["hbm_s"] = time.perf_counter() - clock       # (with the deferred stability)
-
+    # with workers, Hill stability is recorded during the sweep and computed on one worker while
+    # the sweep goes on (the stream); after it the points' stability left, their error estimates
+    # and records go to all workers at once (sarfe.pipeline.point_workers)
+    deferring = workers > 1 and config.solver.stability
+    parallel, work = {"processes": workers}, None
+    with stability_stream() if deferring else contextlib.nullcontext() as stream:
+        with deferred_stability(enabled=deferring,
+                                on_job=None if stream is None else stream.submit) as jobs:
+            solutions, pruning = solve_points_pruned(config.solver, config.excitation, nl,
+                                                     progress=progress)
+        timings["hbm_s"] = time.perf_counter() - clock
+        if workers > 1:
+            # the first estimate in this process (it builds the caches the others share) while
+            # the stream's worker goes on with the stability
+            clock = time.perf_counter()
+            first = first_estimates(config, stage, nl, solutions)
+            timings["error_estimate_s"] = time.perf_counter() - clock
+        done = stream.finish() if stream is not None else {}
+    if workers > 1:
+        if jobs is not None:
+            used = set(pending(solutions))
+            parallel.update(stability_points=len(used),
+                            stability_during_sweep=sum(i in done for i in used),
+                            stream_processes=stream.forks)
+        clock = time.perf_counter()
+        work = point_work(config, stage, nl, solutions, jobs, done, first, workers, progress)
+        timings["point_work_s"] = time.perf_counter() - clock
+        if work is None:      # a deferred stability raised: the serial path's sweep
+            parallel = {"processes": workers, "stability": "in place: a deferred stability "
+                        "raised, the sweep was solved again serially"}
+            clock = time.perf_counter()
+            solutions, pruning = solve_points_pruned(config.solver, config.excitation, nl,
+                                                     progress=progress)
+            timings["hbm_s"] += time.perf_counter() - clock
     clock = time.perf_counter()
-    points, rows, erps, normal_w = [], [], [], []
-    bar = _bar(progress, "ERP and error estimates" if config.solver.error_estimate else "ERP",
-               len(solutions), unit="point")
-    try:
-        # each at the N it was solved with
-        estimates = error_estimates(config, stage, nl, solutions, workers=workers)
-        timings["error_estimate_s"] = time.perf_counter() - clock
-        solutions = common_samples(nl, solutions)                # one time grid for the files
-        for point, row, erp, W in point_records(
+    if work is not None:
+        solutions, records = work
+    else:
+        bar = _bar(progress, "ERP and error estimates" if config.solver.error_estimate else "ERP",
+                   len(solutions), unit="point")
+        try:
+            # each at the N it was solved with
+            estimates = error_estimates(config, stage, nl, solutions, workers=workers)
+            timings["error_estimate_s"] = time.perf_counter() - clock
+            solutions = common_samples(nl, solutions)                # one time grid for the files
+            records = point_records(
                 config, stage, nl, solutions, estimates, workers,
-                progress=None if bar is None else functools.partial(bar.update, 1)):
-            points.append(point)
-            rows.append(row)
-            erps.append(erp)
-            normal_w.append(W)
-    finally:
-        if bar is not None:
-            bar.close()
-    timings["postprocess_s"] = time.perf_counter() - clock
+                progress=None if bar is None else functools.partial(bar.update, 1))
+        finally:
+            if bar is not None:
+                bar.close()
+        timings["postprocess_s"] = time.perf_counter() - clock
+    points, rows, erps, normal_w = (list(column) for column in zip(*records)) if records \
+        else ([], [], [], [])
     not_converged = [p["index"] for p in points if not p["converged"]]
     # None entries without a sweep
     sweep = sweep_status(config.excitation, config.solver.continuation, solutions)
@@ -171,6 +194,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         "accuracy_check": accuracy_check(config.solver, points),   # estimates vs the accuracy budget
         "warnings": warnings,                    # inputs far outside the model's range
         "timings_s": timings,
+        "workers": parallel,      # processes; Hill points computed during the sweep (of all)
         "case_data": case.data,                  # the case with every default filled in
     }
     result = CaseResult(summary, rows, exit_code, solutions)

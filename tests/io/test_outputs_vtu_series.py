@@ -57,6 +57,33 @@ def test_series_reads_back_equal_and_pvd_lists_the_frequencies(tmp_path, how):
             assert back.point_data[name].dtype == values.dtype
 
 
+def test_a_started_series_is_written_while_this_process_writes_other_files(tmp_path):
+    """start_erp_sweep: the maps on 2 forked workers while this process goes on; finish() gives
+    the same files as write_erp_sweep; a cancelled series leaves no map in progress."""
+    from sarfe import workers
+    from sarfe.io.outputs import start_erp_sweep
+
+    points, triangles = strip()
+    n = points.shape[0]
+    frequencies = [40.0, 45.0, 50.0, 55.0]
+    data = [fields(n, j) for j in range(len(frequencies))]
+    writer = start_erp_sweep(tmp_path / "erp", points, triangles, data.__getitem__, frequencies,
+                             workers=2)
+    (tmp_path / "other.txt").write_text("written meanwhile")      # this process works on
+    pvd = writer.finish()
+    serial = write_erp_sweep(tmp_path / "serial", points, triangles, data, frequencies)
+    for j in range(len(frequencies)):
+        a = pv.read(pvd.parent / f"erp_{j:04d}.vtu")
+        b = pv.read(serial.parent / f"erp_{j:04d}.vtu")
+        for name in data[j]:
+            np.testing.assert_array_equal(a.point_data[name], b.point_data[name])
+    writer = start_erp_sweep(tmp_path / "cancelled", points, triangles, data.__getitem__,
+                             frequencies, workers=2)
+    writer.cancel()
+    assert workers._TASK is None
+    assert workers.map_points(abs, [-1, -2, -3], 2) == [1, 2, 3]   # the next map starts
+
+
 def test_excursion_equals_dense_sampling_across_blocks():
     """max_j |u(θ_j) − U0| block by block equals the whole-field sampling (period_samples), for a
     field longer than a block and not a multiple of it, and a closed form for one harmonic."""

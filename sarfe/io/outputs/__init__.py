@@ -17,6 +17,8 @@ response_h5.py (response.h5), vtk.py (VTU/PVD arrays), plots.py (PNGs).
     write_pvd(path, [(time_or_frequency, vtu_filename), ...]) -> Path
     write_erp_sweep(directory, points, triangles, point_data_per_frequency (list | j → dict),
                     frequencies_hz, basename="erp", workers=1) -> Path (.pvd)
+    start_erp_sweep(...same...) -> writer; writer.finish() -> Path (.pvd)   (the maps written on
+                    the workers while the caller writes the other files)
     write_deflection_animation(directory, points, triangles, displacement_harmonics (2H+1, n, 3),
                                n_frames=24, omega=None, basename="deflection", point_data=None) -> Path (.pvd)
     plot_erp_sweep(path, frequencies_hz, level_db, stable=None, level_a_db=None, title=None,
@@ -43,13 +45,14 @@ _EXPORTS = {
     "console_table": ".summary", "to_jsonable": ".summary", "write_summary_json": ".summary",
     "contact_markers": ".vtk", "erp_point_data": ".vtk", "period_samples": ".vtk",
     "write_deflection_animation": ".vtk", "write_erp_sweep": ".vtk", "write_erp_vtu": ".vtk",
-    "write_pvd": ".vtk",
+    "write_pvd": ".vtk", "start_erp_sweep": ".vtk",
 }
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
 
 __all__ = [
     "write_summary_json", "console_table", "to_jsonable", "write_response_h5", "read_response_h5",
     "write_erp_vtu", "erp_point_data", "contact_markers", "write_pvd", "write_erp_sweep",
+    "start_erp_sweep",
     "write_deflection_animation", "period_samples", "plot_erp_sweep", "plot_contact_forces",
     "plot_erp_spectrum", "plot_friction", "plot_third_octave", "plot_contributions",
     "write_report_html",

@@ -43,6 +43,7 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 __all__ = ["write_erp_vtu", "write_pvd", "write_deflection_animation", "write_erp_sweep",
+           "start_erp_sweep",
            "erp_point_data", "contact_markers", "period_samples", "excursion_amplitude",
            "contact_point_values", "erp_level_db_m2", "DB_MAP_RANGE"]
 
@@ -283,7 +284,31 @@ def write_erp_sweep(directory, points, triangles, point_data_per_frequency, freq
     back through a fold visits a frequency more than once, and then the time is the point index
     0, 1, … (ParaView sorts and merges equal times). Returns the PVD path.
     """
-    from sarfe.workers import map_points
+    return start_erp_sweep(directory, points, triangles, point_data_per_frequency,
+                           frequencies_hz, basename, workers).finish()
+
+
+class ErpSweepWriter:
+    """The maps of :func:`start_erp_sweep` being written: ``finish()`` waits for them and writes
+    the PVD (returns its path), ``cancel()`` stops the workers."""
+
+    def __init__(self, pending, pvd, entries):
+        self.pending, self.pvd, self.entries = pending, pvd, entries
+
+    def finish(self) -> Path:
+        self.pending.result()
+        return write_pvd(self.pvd, self.entries)
+
+    def cancel(self):
+        self.pending.cancel()
+
+
+def start_erp_sweep(directory, points, triangles, point_data_per_frequency, frequencies_hz,
+                    basename: str = "erp", workers: int = 1) -> ErpSweepWriter:
+    """:func:`write_erp_sweep` started on ``workers`` processes without waiting for them: this
+    process writes the run's other files meanwhile and calls ``finish()`` (with ``workers`` ≤ 1
+    the maps are written by ``finish()``)."""
+    from sarfe.workers import start_map
 
     directory = Path(directory)
     frequencies = np.asarray(frequencies_hz, dtype=float)
@@ -304,10 +329,10 @@ def write_erp_sweep(directory, points, triangles, point_data_per_frequency, freq
     import vtkmodules.vtkIOXML  # noqa: F401
 
     directory.mkdir(parents=True, exist_ok=True)
-    map_points(write, range(frequencies.size), workers)
+    pending = start_map(write, range(frequencies.size), workers)
     unique = np.unique(frequencies).size == frequencies.size
     entries = [(f if unique else j, name) for j, (f, name) in enumerate(zip(frequencies, names))]
-    return write_pvd(directory / f"{basename}.pvd", entries)
+    return ErpSweepWriter(pending, directory / f"{basename}.pvd", entries)
 
 
 def write_deflection_animation(directory, points, triangles, displacement_harmonics,
