@@ -347,7 +347,7 @@ def p1_lines(e, p4):
          f"{'done' if e.get('summary_ok', e.get('points_n')) else stage_of(e)} |", "",
          "HBM s: the sweep (Newton; with workers the Hill stability of its points streams to one "
          "worker meanwhile); point work s (with workers): the Hill stability left, the error "
-         "estimates and the point records in one queue on the workers (`post s` on one process); "
+         "estimates (one pool) and then the point records (a second pool) on the workers (`post s` on one process); "
          f"workers: {e.get('workers')}.", ""]
     L.append(f"Stage lines (s since start): {e.get('stages')}; load average during the run "
              f"{fmt(e['load_average'][0], '.1f')}.")
