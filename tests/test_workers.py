@@ -172,29 +172,33 @@ def _slow_square(x):
     return x * x
 
 
+def _settle(stream, count):
+    """Poll ``stream`` until its worker has computed ``count`` items (at most 120 s)."""
+    import time
+
+    start = time.perf_counter()
+    while len(stream.done) < count and time.perf_counter() - start < 120:
+        stream.poll()
+        time.sleep(0.02)
+
+
 def test_a_stream_computes_items_while_they_arrive_on_one_other_process():
     """Stream: items submitted one by one while this process works; finish() returns what was
     computed (in another process), the rest is left to the caller; results as the function's."""
     import time
 
-    def settle(stream, count):      # poll until the worker has computed ``count`` items
-        start = time.perf_counter()
-        while len(stream.done) < count and time.perf_counter() - start < 120:
-            stream.poll()
-            time.sleep(0.02)
-
     with workers.Stream(_slow_square) as stream:
         for x in range(30):
             stream.submit(x, x)
             time.sleep(0.01)             # this process "solves the next point"
-        settle(stream, 30)
+        _settle(stream, 30)
         done = stream.finish()
     assert done == {x: x * x for x in range(30)}
     assert 1 <= stream.forks <= 30       # a fork per batch of the items waiting
     with workers.Stream(_pid) as stream:
         for x in range(5):
             stream.submit(x, x)
-        settle(stream, 5)
+        _settle(stream, 5)
         pids = stream.finish()
     assert len(pids) == 5 and os.getpid() not in pids.values()
 
@@ -202,16 +206,10 @@ def test_a_stream_computes_items_while_they_arrive_on_one_other_process():
 def test_a_stream_stops_early_and_reports_exceptions_and_dead_workers():
     import time
 
-    def settle(stream, count):
-        start = time.perf_counter()
-        while len(stream.done) < count and time.perf_counter() - start < 120:
-            stream.poll()
-            time.sleep(0.02)
-
     with workers.Stream(_fails_on_three) as stream:
         for x in range(6):
             stream.submit(x, x)
-        settle(stream, 6)
+        _settle(stream, 6)
         done = stream.finish()
     assert isinstance(done[3], ValueError)
     assert {k: v for k, v in done.items() if k != 3} == {0: 0, 1: 1, 2: 2, 4: 4, 5: 5}
