@@ -60,6 +60,11 @@ def cmd_solve(args) -> int:
     if summary["non_converged_points"]:
         print(f"sarfe: {len(summary['non_converged_points'])} point(s) did not converge: "
               f"{summary['non_converged_points']} (see summary.json)", file=sys.stderr)
+    from sarfe.io.outputs.summary import stability_line
+
+    unresolved = stability_line(summary.get("points") or [])
+    if unresolved:
+        print(f"sarfe: {unresolved}", file=sys.stderr)
     if (summary.get("accuracy_check") or {}).get("warning"):
         print(f"sarfe: {summary['accuracy_check']['warning']}", file=sys.stderr)
     if summary.get("sweep_complete") is False:

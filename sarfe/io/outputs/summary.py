@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["to_jsonable", "write_summary_json", "console_table", "pruning_line", "NULL_NOTE",
-           "SILENT_LEVEL_DB", "shown_level", "level_text", "loudest_lines"]
+           "SILENT_LEVEL_DB", "shown_level", "level_text", "loudest_lines", "stability_line"]
 
 # Levels below this are a motionless surface (round-off: a solve's 1e-19 m noise radiates
 # −180 dB re 1 pW): the console, table.txt and the report show them as "-"; the files keep the value.
@@ -240,3 +240,19 @@ def loudest_lines(worst: dict | None, count: int = 5) -> list[str]:
         lines.append(f"  (the excitation through the structure without contact forces: "
                      f"{level_text(excitation.get('level_dba'), unit='dB(A)')}, {share})")
     return lines
+
+
+def stability_line(points) -> str | None:
+    """One console line when converged points of summary.json have no stability verdict
+    (``stable`` None with a ``stability_note``: '-' in the table), naming how many, the first
+    frequency and its note; None when every converged point has a verdict or none was asked."""
+    unresolved = [p for p in points if p.get("converged") and p.get("stable") is None
+                  and p.get("stability_note")]
+    if not unresolved:
+        return None
+    first = unresolved[0]
+    converged = sum(bool(p.get("converged")) for p in points)
+    return (f"stability: not resolved at {len(unresolved)} of {converged} converged points "
+            f"('-' in the stable column; stability_note in summary.json), e.g. "
+            f"{first['frequency_hz']:.2f} Hz: {first['stability_note']}; raise solver.harmonics "
+            "or check a frequency with `sarfe verify`")
