@@ -303,6 +303,14 @@ def stability(problem, omega, U, ev, options):
                           contact_damping=contact_damping(problem, ev.forces), operator=operator)
 
 
+def kept_residual_norm(problem, ev) -> float:
+    """‖R‖/‖f̃_e‖ of a full-residual evaluation ``ev`` on the kept coefficient rows of ``problem``
+    (all rows for the full harmonic set): what ``full_tolerance`` is compared with."""
+    R = ev.residual.reshape(-1, problem.model.dof_count)
+    rows = kept_rows(problem)
+    return float(np.linalg.norm(R if rows is None else R[rows]) / ev.reference)
+
+
 def finalize(problem, omega, U, converged, reason, iterations, slider, options) -> HarmonicSolution:
     """Residual on all DOFs and all harmonic rows, contact fields, Hill stability → HarmonicSolution
     (inside a :func:`sarfe.hbm.deferred.deferred_stability` block the stability is recorded as a
@@ -314,12 +322,10 @@ def finalize(problem, omega, U, converged, reason, iterations, slider, options) 
     with np.errstate(all="ignore"):     # ∂R/∂ũ on all DOFs only for the full Hill method
         ev = full_residual(full, U.ravel(), omega, slider, jacobian=options.stability,
                            assemble=stability_method(full, options) == "full")
-    n = problem.model.dof_count
-    R = ev.residual.reshape(-1, n)
-    rows = kept_rows(problem)
-    residual = float(np.linalg.norm(R if rows is None else R[rows]) / ev.reference)
+    residual = kept_residual_norm(problem, ev)
     G = problem.contacts.gap_map
     f_nl = np.asarray(G.T @ ev.forces.force.T).T
+    rows = kept_rows(problem)
     candidate = rows if rows is not None else coefficient_rows(
         harmonic_set_orders(AUTO_CANDIDATE, problem.harmonics))
     with np.errstate(all="ignore"):
@@ -521,10 +527,7 @@ def _polish(problem, omega, U, result, slider, options):
     full = replace(problem, harmonic_orders=None)
     with np.errstate(all="ignore"):
         ev = full_residual(full, U.ravel(), omega, slider, jacobian=False)
-    n = problem.model.dof_count
-    R = ev.residual.reshape(-1, n)
-    rows = kept_rows(problem)
-    residual = float(np.linalg.norm(R if rows is None else R[rows]) / ev.reference)
+    residual = kept_residual_norm(problem, ev)
     if not np.isfinite(residual) or residual <= options.full_tolerance:
         return U, result, slider, 0
     tighter = replace(options, tolerance=options.tolerance * POLISH_MARGIN
