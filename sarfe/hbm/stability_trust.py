@@ -4,8 +4,9 @@ count at a coarser contact coupling agrees.
 Hill's truncation at H harmonics has two parts. The linear structure is truncated on the full
 Hill matrix (:mod:`sarfe.hbm.stability`): its modes above ~Hω cannot be folded into the strip
 |Im s| ≤ ω/2 and come back as edge eigenvalues at Im s ≈ 2…5ω, whose real parts are artefacts
-(on the shipped rattle rig at H = 10 they made the full method call 52 of 363 points unstable
-where time integration sees perturbations decay). On the contact rows
+(on the shipped rattle rig at H = 10 the full method called 307 of 363 points unstable and
+contradicted time integration at 24 of the 34 points where the integrator's verdict converged,
+benchmarks/results/stability.md). On the contact rows
 (:mod:`sarfe.hbm.stability_rows`) the structure is exact, C(s) from the modal compliance at every
 shifted exponent s ± ikω, and only the contact coupling 𝒥(s) is truncated at H: this is the
 verdict used. What remains is the contact truncation itself: an impact's Jacobian is a train of
