@@ -13,8 +13,8 @@ shared copy-on-write, only the results come back):
 3. the point records: ERP, contact indicators, contributions, linear baseline
    (:func:`sarfe.pipeline.postprocess.point_record`).
 
-After the sweep 1–3 go to the workers as one queue (:func:`point_work`), so no stage waits for
-the slowest worker of the one before.
+After the sweep 1–3 go to the workers in two pools (:func:`point_work`): the Hill points left
+and the estimates, longest first, then the records on freshly forked workers (memory).
 
 ``workers`` = 1 is the serial path (stability in place during the sweep, plain loops). The results
 do not depend on ``workers``: every point is computed by the same function from the same inputs.
@@ -64,10 +64,10 @@ def point_work(config: CaseConfig, stage, nl, solutions, jobs, done, first, work
     error estimates left (``first``: those computed in this process, :func:`first_estimates`) and
     every point's record (ERP, contact
     indicators, contributions, linear baseline; :func:`sarfe.pipeline.postprocess.point_record`,
-    with the points at one time grid, :func:`sarfe.pipeline.points.common_samples`). One queue,
-    the longest items first (a Hill point ≈ 5× an estimate ≈ 5× a record), so the workers finish
-    together instead of waiting for each other at every stage — in two pools: the Hill points and
-    estimates, then the records on freshly forked workers (memory: see the code).
+    with the points at one time grid, :func:`sarfe.pipeline.points.common_samples`). Two pools: the
+    Hill points and estimates, longest first (a Hill point ≈ 5× an estimate), so the workers
+    finish together, then the records (≈ 1/5 of an estimate each) on freshly forked workers
+    (memory: see the code).
 
     Returns (solutions with their verdicts at one time grid, [(point dict, row, ErpResult, W)]),
     or None when a deferred stability raised (the caller solves the sweep again serially). The
@@ -85,8 +85,12 @@ def point_work(config: CaseConfig, stage, nl, solutions, jobs, done, first, work
     hill = [i for i in indices if i not in done]
     estimates = [i for i in estimated_points(config, nl, solutions) if i not in first]
     gridded = common_samples(nl, solutions)      # records at one N; estimates at each point's own
-    tasks = ([("stability", i) for i in hill] + [("estimate", i) for i in estimates]
-             + [("record", i) for i in range(len(gridded))])
+    # two pools: the Hill and estimate items first, then the records on freshly forked workers
+    # (a worker's heap keeps its high-water mark: Hill's working arrays beside the records sent
+    # back to this process put P1's tree PSS at 4.1–4.3 GB in one pool, over its 4 GB budget)
+    first_pool = [("stability", i) for i in hill] + [("estimate", i) for i in estimates]
+    second_pool = [("record", i) for i in range(len(gridded))]
+    tasks = first_pool + second_pool
 
     def run(task):
         kind, i = task
@@ -106,18 +110,13 @@ def point_work(config: CaseConfig, stage, nl, solutions, jobs, done, first, work
             + (f" on {workers} processes" if len(tasks) > 1 else ""))
     bar = _bar(progress, what, len(tasks), unit="item")
     tick = None if bar is None else functools.partial(bar.update, 1)
-    # two pools: the Hill and estimate items first, then the records on freshly forked workers
-    # (a worker's heap keeps its high-water mark: Hill's working arrays beside the records sent
-    # back to this process put P1's tree PSS at 4.1–4.3 GB in one pool, over its 4 GB budget)
-    first_pool = [task for task in tasks if task[0] != "record"]
-    second_pool = [task for task in tasks if task[0] == "record"]
     try:
         results = (map_points(run, first_pool, workers, progress=tick)
                    + map_points(run, second_pool, workers, progress=tick))
     finally:
         if bar is not None:
             bar.close()
-    by_task = dict(zip(first_pool + second_pool, results))
+    by_task = dict(zip(tasks, results))
     verdicts = {**done, **{i: by_task["stability", i] for i in hill}}
     if any(isinstance(verdicts[i], Exception) for i in indices):
         return None
