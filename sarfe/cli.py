@@ -30,7 +30,7 @@ def _warn(line):
 
 
 def cmd_solve(args) -> int:
-    from sarfe.io.outputs.summary import pruning_line
+    from sarfe.io.outputs.summary import loudest_lines, pruning_line, stability_line
     from sarfe.pipeline import load_case, results_table, solve_case
     from sarfe.pipeline.checks import output_target
 
@@ -52,16 +52,12 @@ def cmd_solve(args) -> int:
             print(pruning)
         types = {c["name"]: c["type"] for c in summary["contacts"]}
         print(results_table(result.rows, types))
-        from sarfe.io.outputs.summary import loudest_lines
-
         for line in loudest_lines(summary.get("worst")):
             print(line)
         print(f"results: {result.output_dir}  ({time.perf_counter() - clock:.1f} s)")
     if summary["non_converged_points"]:
         print(f"sarfe: {len(summary['non_converged_points'])} point(s) did not converge: "
               f"{summary['non_converged_points']} (see summary.json)", file=sys.stderr)
-    from sarfe.io.outputs.summary import stability_line
-
     unresolved = stability_line(summary.get("points") or [])
     if unresolved:
         print(f"sarfe: {unresolved}", file=sys.stderr)
