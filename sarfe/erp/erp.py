@@ -150,9 +150,17 @@ def equivalent_radiated_power(
     if not np.isfinite(radiation_loss_factor) or radiation_loss_factor < 0:
         raise ValueError(f"radiation_loss_factor must be >= 0, got {radiation_loss_factor!r}")
 
-    velocity = normal_velocity_amplitudes(W, omega)                       # (H, n)
-    H = velocity.shape[0]
-    erp_density = 0.5 * density * sound_speed * radiation_loss_factor * velocity**2
+    if W.shape[0] < 3 or W.shape[0] % 2 == 0:
+        raise ValueError(
+            f"normal_displacement must have 2H+1 >= 3 rows (odd), got shape {W.shape}")
+    H = (W.shape[0] - 1) // 2
+    # e_k,i = ½ρc·RLF (kω)² (w_kc² + w_ks²): |v_n,k|² without its square root
+    # (:func:`normal_velocity_amplitudes` squared), one pass over the (H, n) field
+    scale = 0.5 * density * sound_speed * radiation_loss_factor \
+        * (np.arange(1, H + 1) * omega) ** 2
+    erp_density = W[1::2] ** 2
+    erp_density += W[2::2] ** 2
+    erp_density *= scale[:, None]
     power = erp_density @ areas                                            # (H,)
     power_total = float(power.sum())
     frequencies = np.arange(1, H + 1) * omega / (2.0 * np.pi)
