@@ -11,9 +11,11 @@ import numpy as np
 from sarfe.pipeline.result_data import contact_pair_fields, result_groups
 
 
-def write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, directory: Path):
+def write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, directory: Path):
     """Write the result files asked for in ``output.files`` into ``directory``; returns
-    {file kind: file name}. ``config``: the case's :class:`sarfe.io.config.CaseConfig`.
+    {file kind: file name}. ``config``: the case's :class:`sarfe.io.config.CaseConfig`;
+    ``erps``, ``fields``: each point's ErpResult and map fields (:func:`sarfe.pipeline.
+    postprocess.map_fields`).
     Everything "at the loudest point" (spectrum, contact plots, animation,
     report maps) uses ``summary["worst"]["index"]`` (:func:`sarfe.pipeline.postprocess.loudest_point`).
     summary.json itself is written by the caller, last (it lists these files and the timings).
@@ -23,7 +25,7 @@ def write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, d
     both are stopped if a writer fails."""
     started = []        # ('render', run) | ('maps', writer) in progress in other processes
     try:
-        return _write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w,
+        return _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields,
                               directory, started)
     except BaseException:
         from sarfe.io.outputs.render import cancel_render
@@ -36,7 +38,7 @@ def write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, d
         raise
 
 
-def _write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, directory,
+def _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, directory,
                    started):
     from sarfe.io import outputs
 
@@ -80,8 +82,8 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, normal_w, 
             if j in loudest_data:     # the loudest point's arrays serve its map and the report's
                 return loudest_data[j]
             force, motion = contact_pair_fields(stage, nl, solutions[j], mesh.n_nodes)
-            data = outputs.erp_point_data(mesh.n_nodes, erps[j], normal_w[j],
-                                          float(solutions[j].omega),
+            data = outputs.erp_point_data(mesh.n_nodes, erps[j], None,
+                                          float(solutions[j].omega), fields=fields[j],
                                           displacement=nodal_translations(j),
                                           radiating_nodes=stage.erp_nodes,
                                           contact_marker=markers, contact_force=force,

@@ -44,7 +44,8 @@ import numpy as np
 
 __all__ = ["write_erp_vtu", "write_pvd", "write_deflection_animation", "write_erp_sweep",
            "start_erp_sweep",
-           "erp_point_data", "contact_markers", "period_samples", "excursion_amplitude",
+           "erp_point_data", "radiating_fields", "contact_markers", "period_samples",
+           "excursion_amplitude",
            "contact_point_values", "erp_level_db_m2", "DB_MAP_RANGE"]
 
 DB_MAP_RANGE = 60.0  # [dB] span of erp_level_db_m2 below its maximum
@@ -246,14 +247,35 @@ def contact_markers(n_points: int, contact_nodes) -> np.ndarray:
     return marker
 
 
+def radiating_fields(erp, normal_displacement, omega: float) -> np.ndarray:
+    """(H + 2, n_r) the per-point map fields of the radiating nodes that :func:`erp_point_data`
+    scatters into the mesh: rows 0 … H−1 the ERP density e_k of ``erp`` [W/m²], H the normal
+    velocity amplitude √(Σ_k (kω)² (w_kc² + w_ks²)) [m/s], H+1 the normal excursion
+    max_θ |w(θ) − w0| [m] (:func:`excursion_amplitude`, max(64, 16H) samples) of the normal
+    displacement harmonics W (2H+1, n_r) [m] at ω [rad/s]. Computed where the point's W is (a
+    record worker), it replaces W and the density in what travels to the map writer: 17 rows
+    instead of 46 at H = 15."""
+    density = np.asarray(erp.density, dtype=float)
+    W = np.asarray(normal_displacement, dtype=float)
+    H = density.shape[0]
+    fields = np.empty((H + 2, density.shape[1]))
+    fields[:H] = density
+    # √(Σ_k |v_k|²) = √(Σ_k (kω)² (w_kc² + w_ks²))  [m/s]  (sarfe.erp.normal_velocity_amplitudes)
+    speed_sq = (np.arange(1, H + 1) * float(omega)) ** 2
+    fields[H] = np.sqrt(speed_sq @ (W[1::2] ** 2 + W[2::2] ** 2))
+    fields[H + 1] = excursion_amplitude(W, max(64, 16 * H))
+    return fields
+
+
 def erp_point_data(n_points: int, erp, normal_displacement, omega: float, displacement=None,
                    radiating_nodes=None, contact_marker=None, node_ids=None,
-                   contact_force=None, contact_displacement=None) -> dict:
+                   contact_force=None, contact_displacement=None, fields=None) -> dict:
     """The standard ERP arrays (module docstring) for :func:`write_erp_vtu`.
 
     n_points : number of mesh points n.
-    erp : :class:`sarfe.erp.ErpResult` of the radiating nodes (density (H, n_r)).
-    normal_displacement : (2H+1, n_r) [m] harmonics W used for ``erp``.
+    erp : :class:`sarfe.erp.ErpResult` of the radiating nodes (density (H, n_r); only its
+        density_total and reference_power when ``fields`` are given).
+    normal_displacement : (2H+1, n_r) [m] harmonics W used for ``erp`` (unused with ``fields``).
     omega : [rad/s].
     displacement : (2H+1, n, 3) [m] nodal translation harmonics of all points, or None (then
         ``displacement_amplitude_m`` is all zeros; ``normal_displacement_amplitude_m`` is always set).
@@ -261,23 +283,22 @@ def erp_point_data(n_points: int, erp, normal_displacement, omega: float, displa
     contact_marker : (n,) int, e.g. from :func:`contact_markers` (default zeros).
     node_ids : (n,) int deck ids of the points, written as ``node_id`` (default: not written).
     contact_force, contact_displacement : optional (n,) [N], [m] from :func:`contact_point_values`.
+    fields : (H + 2, n_r) :func:`radiating_fields` of (erp, W, ω) when computed beforehand.
     """
     n = int(n_points)
     nodes = np.arange(n) if radiating_nodes is None else np.asarray(radiating_nodes, dtype=int)
-    density = np.asarray(erp.density, dtype=float)
-    if density.shape[1] != nodes.size:
-        raise ValueError(f"erp has {density.shape[1]} radiating nodes, radiating_nodes {nodes.size}")
-    W = np.asarray(normal_displacement, dtype=float)
-    H = density.shape[0]
+    if fields is None:
+        fields = radiating_fields(erp, normal_displacement, omega)
+    fields = np.asarray(fields, dtype=float)
+    if fields.shape[1] != nodes.size:
+        raise ValueError(f"erp has {fields.shape[1]} radiating nodes, radiating_nodes {nodes.size}")
+    H = fields.shape[0] - 2
     # every radiating-node field scattered into one (H + 3, n) block, zero at the other points:
     # rows 0 … H−1 e_k, then Σ_k e_k, the velocity amplitude, the normal excursion
     full = np.zeros((H + 3, n))
-    full[:H, nodes] = density
+    full[:H, nodes] = fields[:H]
     full[H, nodes] = erp.density_total
-    # √(Σ_k |v_k|²) = √(Σ_k (kω)² (w_kc² + w_ks²))  [m/s]  (sarfe.erp.normal_velocity_amplitudes)
-    speed_sq = (np.arange(1, H + 1) * float(omega)) ** 2
-    full[H + 1, nodes] = np.sqrt(speed_sq @ (W[1::2] ** 2 + W[2::2] ** 2))
-    full[H + 2, nodes] = excursion_amplitude(W, max(64, 16 * H))
+    full[H + 1:, nodes] = fields[H:]
     data = {"erp_density_W_m2": full[H],
             "erp_level_db_m2": erp_level_db_m2(full[H],
                                                float(getattr(erp, "reference_power", 1e-12)))}
