@@ -1,7 +1,7 @@
 """Compare two sarfe result folders number by number (issue 15: the output files of a faster tree
 must hold main's numbers).
 
-    python benchmarks/compare_outputs.py REFERENCE NEW [--rtol 1e-12] [--json OUT.json]
+    python benchmarks/compare_outputs.py REFERENCE NEW [--rtol 1e-12] [--json OUT.json] [--skip KEY]
 
 Every file of REFERENCE must exist in NEW (and no file more), and:
 
@@ -199,7 +199,11 @@ def main(argv=None):
     parser.add_argument("new", type=pathlib.Path)
     parser.add_argument("--rtol", type=float, default=1e-12)
     parser.add_argument("--json", type=pathlib.Path, help="write the worst differences here")
+    parser.add_argument("--skip", action="append", default=[],
+                        help="a summary.json key to leave out as well (e.g. workers, when the "
+                             "two runs used different solver.workers)")
     args = parser.parse_args(argv)
+    SKIP_KEYS.update(args.skip)
     report = compare_folders(args.reference, args.new, args.rtol)
     print(f"{args.new}: {report.files} files compared with {args.reference}")
     for kind, (value, where) in sorted(report.worst.items()):

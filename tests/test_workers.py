@@ -260,14 +260,14 @@ def test_an_error_in_a_worker_is_one_error_and_leaves_no_result_folder(tmp_path,
     line), and neither the result folder nor a temporary sibling is left behind."""
     from sarfe.pipeline import postprocess
 
-    original, parent = postprocess.point_record, os.getpid()
+    original, parent = postprocess.point_records, os.getpid()
 
-    def fails_in_a_worker(config, stage, nl, index, solution, error_estimate=False):
-        if index == 5 and os.getpid() != parent:
+    def fails_in_a_worker(config, stage, nl, points):      # the records of a chunk of points
+        if any(index == 5 for index, _, _ in points) and os.getpid() != parent:
             raise RuntimeError("record of point 5 failed")
-        return original(config, stage, nl, index, solution, error_estimate)
+        return original(config, stage, nl, points)
 
-    monkeypatch.setattr(postprocess, "point_record", fails_in_a_worker)
+    monkeypatch.setattr(postprocess, "point_records", fails_in_a_worker)
     target = tmp_path / "result"
     with pytest.raises(RuntimeError, match="record of point 5 failed"):
         solve_case(_lumped(2), output_dir=target)

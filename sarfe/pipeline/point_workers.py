@@ -11,7 +11,7 @@ shared copy-on-write, only the results come back):
 2. the error estimates (:func:`sarfe.pipeline.postprocess.error_estimates`; the first in the
    solving process, :func:`first_estimates`);
 3. the point records: ERP, contact indicators, contributions, linear baseline
-   (:func:`sarfe.pipeline.postprocess.point_record`).
+   (:func:`sarfe.pipeline.postprocess.point_records`, by chunks of points).
 
 After the sweep 1–3 go to the workers in two pools (:func:`point_work`): the Hill points left
 and the estimates, longest first, then the records on freshly forked workers (memory).
@@ -63,7 +63,7 @@ def point_work(config: CaseConfig, stage, nl, solutions, jobs, done, first, work
     StabilityResult or the exception it raised} of the stream, :func:`stability_stream`), the
     error estimates left (``first``: those computed in this process, :func:`first_estimates`) and
     every point's record (ERP, contact
-    indicators, contributions, linear baseline; :func:`sarfe.pipeline.postprocess.point_record`,
+    indicators, contributions, linear baseline; :func:`sarfe.pipeline.postprocess.point_records`,
     with the points at one time grid, :func:`sarfe.pipeline.points.common_samples`). Two pools: the
     Hill points and estimates, longest first (a Hill point ≈ 5× an estimate), so the workers
     finish together, then the records (≈ 1/5 of an estimate each) on freshly forked workers
@@ -76,7 +76,8 @@ def point_work(config: CaseConfig, stage, nl, solutions, jobs, done, first, work
     serial path's."""
     from sarfe.pipeline.points import common_samples
     from sarfe.pipeline.postprocess import (error_estimates, estimated_points, point_estimate,
-                                            point_record, with_estimate, with_verdict)
+                                            point_records, record_chunks, with_estimate,
+                                            with_verdict)
 
     indices = pending(solutions) if jobs is not None else []
     done = done or {}
@@ -89,7 +90,8 @@ def point_work(config: CaseConfig, stage, nl, solutions, jobs, done, first, work
     # (a worker's heap keeps its high-water mark: Hill's working arrays beside the records sent
     # back to this process put P1's tree PSS at 4.1–4.3 GB in one pool, over its 4 GB budget)
     first_pool = [("stability", i) for i in hill] + [("estimate", i) for i in estimates]
-    second_pool = [("record", i) for i in range(len(gridded))]
+    # records by chunks of points: one product with the ERP map per chunk (postprocess)
+    second_pool = [("records", tuple(chunk)) for chunk in record_chunks(len(gridded))]
     tasks = first_pool + second_pool
 
     def run(task):
@@ -101,7 +103,7 @@ def point_work(config: CaseConfig, stage, nl, solutions, jobs, done, first, work
                 return error
         if kind == "estimate":
             return point_estimate(config, stage, nl, solutions[i])
-        return point_record(config, stage, nl, i, gridded[i], None)
+        return point_records(config, stage, nl, [(j, gridded[j], None) for j in i])
 
     n = len(gridded)
     what = (f"{'ERP and error estimates' if config.solver.error_estimate else 'ERP'} "
@@ -124,7 +126,7 @@ def point_work(config: CaseConfig, stage, nl, solutions, jobs, done, first, work
         gridded = with_stability(gridded, indices, [verdicts[i] for i in indices])
     computed = {**first, **{i: by_task["estimate", i] for i in estimates}}
     per_point = error_estimates(config, stage, nl, solutions, computed=computed)
-    records = [by_task["record", i] for i in range(len(gridded))]
+    records = [record for _, chunk in second_pool for record in by_task["records", chunk]]
     for (point, row, _, _), solution, estimate in zip(records, gridded, per_point):
         with_verdict(point, row, solution)
         with_estimate(point, row, estimate)
@@ -133,12 +135,24 @@ def point_work(config: CaseConfig, stage, nl, solutions, jobs, done, first, work
 
 def point_records(config: CaseConfig, stage, nl, solutions, estimates, workers,
                   progress=None) -> list:
-    """[(point dict, table row, ErpResult, radiating displacements W)] per solution
-    (:func:`sarfe.pipeline.postprocess.point_record`), on ``workers`` processes; ``progress()``
-    once per finished point."""
-    from sarfe.pipeline.postprocess import point_record
+    """[(point dict, table row, ErpResult, map fields)] per solution (:func:`sarfe.pipeline.
+    postprocess.point_records`, by chunks of points), on ``workers`` processes; ``progress()``
+    once per point (a chunk's when it finishes)."""
+    from sarfe.pipeline.postprocess import point_records as records_of, record_chunks
 
-    def record(index):
-        return point_record(config, stage, nl, index, solutions[index], estimates[index])
+    chunks = record_chunks(len(solutions))
 
-    return map_points(record, range(len(solutions)), workers, progress=progress)
+    def record(chunk):
+        return records_of(config, stage, nl, [(i, solutions[i], estimates[i]) for i in chunk])
+
+    finished = []
+
+    def tick():     # chunks finish in any order: the last one counts what is left
+        finished.append(1)
+        size = len(chunks[0]) if len(finished) < len(chunks) else \
+            len(solutions) - len(chunks[0]) * (len(chunks) - 1)
+        for _ in range(size):
+            progress()
+
+    results = map_points(record, chunks, workers, progress=None if progress is None else tick)
+    return [r for chunk in results for r in chunk]
