@@ -29,8 +29,17 @@ the same script runs against it so the two columns are the same work):
 Each number is the fastest of ``--repeats`` runs (the machine is shared). Files go to a
 temporary directory (≈ 1.1 GB for 200 maps) removed afterwards.
 
+5. ``--records CASE [CASE …]``: the point records and the result files of real solves
+   (``solve_case`` of each case with ``solver.workers: 1``, so all of it runs in one process and
+   its CPU seconds are exact): CPU and wall of ``point_records`` (ERP, contributions, linear
+   baseline, map fields), ``write_outputs`` and ``write_summary_json``, per tree, the trees run
+   in turn (A B A B with ``--repeats`` 2); the fastest CPU of the repeats. The result folders
+   of the trees are compared file by file (benchmarks/compare_outputs.py). Saved in
+   results/outputs_records.json and shown as the last section of outputs.md.
+
 Run: python benchmarks/bench_outputs.py [--before TREE [--before-commit C]] [--points 200]
      [--repeats 3] [--whole]   (--whole: ≈ 2 min per tree on a quiet machine)
+     python benchmarks/bench_outputs.py --records CASE.yaml … --before TREE [--repeats 1]
 """
 import argparse
 import json
@@ -276,6 +285,96 @@ def compare_results(a, b) -> dict:
             "summary_points_identical": points[0] == points[1]}
 
 
+def records_child(case_path, out):
+    """Solve ``case_path`` with ``solver.workers: 1`` timing the point records and the writers
+    (CPU of this process: with one worker everything runs here); prints one JSON line."""
+    import sarfe.io.outputs as io_outputs
+    import sarfe.pipeline.solve as solve
+    from sarfe.io.case import read_yaml
+    from sarfe.pipeline import load_case, solve_case
+
+    record = {}
+
+    def timed(name, function):
+        def run(*args, **kwargs):
+            cpu, clock = time.process_time(), time.perf_counter()
+            value = function(*args, **kwargs)
+            record[f"{name}_cpu_s"] = time.process_time() - cpu
+            record[f"{name}_wall_s"] = time.perf_counter() - clock
+            return value
+        return run
+
+    solve.point_records = timed("records", solve.point_records)
+    solve.write_outputs = timed("write_outputs", solve.write_outputs)
+    io_outputs.write_summary_json = timed("summary_json", io_outputs.write_summary_json)
+    data, _ = read_yaml(case_path)
+    data.setdefault("solver", {})["workers"] = 1
+    case = load_case(data, base_dir=pathlib.Path(case_path).resolve().parent)
+    clock = time.perf_counter()
+    result = solve_case(case, output_dir=out, force=True)
+    record.update(points=len(result.summary["points"]), total_wall_s=time.perf_counter() - clock,
+                  load_average=os.getloadavg()[0])
+    print(json.dumps(record))
+
+
+def measure_records(cases, trees, repeats) -> dict:
+    """{case name: {tree label: fastest record of records_child, "difference": compare}}."""
+    sys.path.insert(0, str(HERE))
+    from compare_outputs import compare_folders
+
+    out = {}
+    with tempfile.TemporaryDirectory(prefix="bench_records_") as work:
+        work = pathlib.Path(work)
+        for case in cases:
+            case = pathlib.Path(case).resolve()
+            runs = {label: [] for label in trees}
+            for _ in range(repeats):
+                for label, tree in trees.items():        # A B A B: the same load for both
+                    env = dict(os.environ, PYTHONPATH=str(tree), OPENBLAS_NUM_THREADS="1",
+                               OMP_NUM_THREADS="1", MPLBACKEND="Agg")
+                    done = subprocess.run([sys.executable, __file__, "--records-child",
+                                           str(case), str(work / label)], env=env,
+                                          capture_output=True, text=True, cwd=case.parent)
+                    if done.returncode:
+                        raise RuntimeError(f"{case} on {tree} failed:\n{done.stderr[-3000:]}")
+                    runs[label].append(json.loads(done.stdout.strip().splitlines()[-1]))
+            entry = {label: min(r, key=lambda x: x["records_cpu_s"] + x["write_outputs_cpu_s"])
+                     for label, r in runs.items()}
+            if len(trees) == 2:
+                report = compare_folders(*(work / label for label in trees))
+                entry["difference"] = {"files": report.files, "same": not report.failed(),
+                                       "worst": report.worst, "problems": report.problems}
+            out[case.stem] = entry
+    return out
+
+
+def records_report(records) -> list:
+    lines = ["", "## Point records and result files of real solves (`--records`)", "",
+             "`solve_case` with `solver.workers: 1` (everything in one process, exact CPU); "
+             "`point_records`: ERP, contributions, linear baseline, contact indicators, map "
+             "fields of every point; `write_outputs`: VTU maps, animation, response.h5, PNGs, "
+             "report; summary.json apart. CPU s (wall s); fastest of the A/B repeats.", "",
+             "| case | tree | points | records | write_outputs | summary.json | records ms/point "
+             "| load |", "|---|---|---|---|---|---|---|---|"]
+    both = lambda r, k: f"{r[k + '_cpu_s']:.2f} ({r[k + '_wall_s']:.2f})"  # noqa: E731
+    for case, entry in records.items():
+        for label, r in entry.items():
+            if label == "difference":
+                continue
+            lines.append(f"| {case} | {label} | {r['points']} | {both(r, 'records')} | "
+                         f"{both(r, 'write_outputs')} | {both(r, 'summary_json')} | "
+                         f"{1e3 * r['records_cpu_s'] / r['points']:.1f} | "
+                         f"{r['load_average']:.1f} |")
+    for case, entry in records.items():
+        d = entry.get("difference")
+        if d:
+            worst = "; ".join(f"{k} {v[0]:.1e} ({v[1]})" for k, v in sorted(d["worst"].items()))
+            lines.append(f"\n{case}: {d['files']} files compared, "
+                         f"{'same within 1e-12' if d['same'] else 'DIFFERENT'}: {worst}"
+                         + (f"; problems: {d['problems']}" if d["problems"] else ""))
+    return lines
+
+
 def measure(tree, points, repeats):
     env = dict(os.environ, PYTHONPATH=str(tree), OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1",
                MPLBACKEND="Agg")
@@ -358,6 +457,9 @@ def report(runs, points, repeats):
                       f"identical: {d['pvd_identical']}; response.h5 datasets differing: "
                       f"{d['h5_differing'] or 'none'}; summary.json points identical: "
                       f"{d['summary_points_identical']}."]
+    saved = HERE / "results" / "outputs_records.json"
+    if saved.is_file():
+        lines += records_report(json.loads(saved.read_text()))
     return "\n".join(lines) + "\n"
 
 
@@ -368,9 +470,28 @@ def main():
     parser.add_argument("--points", type=int, default=200)
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--whole", action="store_true", help="also the whole pipeline (section 4)")
+    parser.add_argument("--records", nargs="+", metavar="CASE",
+                        help="the records and files of these cases' solves (section 5) only")
     parser.add_argument("--child", help=argparse.SUPPRESS)
     parser.add_argument("--whole-child", nargs=2, help=argparse.SUPPRESS)
+    parser.add_argument("--records-child", nargs=2, help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.records_child:
+        records_child(*args.records_child)
+        return
+    if args.records:
+        trees = {"before": pathlib.Path(args.before).resolve()} if args.before else {}
+        records = measure_records(args.records, {**trees, "now": ROOT}, args.repeats)
+        saved = HERE / "results" / "outputs_records.json"
+        old = json.loads(saved.read_text()) if saved.is_file() else {}
+        saved.write_text(json.dumps({**old, **records}, indent=1) + "\n")
+        print("\n".join(records_report(records)))
+        previous = HERE / "results" / "outputs.json"
+        if previous.is_file():
+            runs = json.loads(previous.read_text())
+            (HERE / "results" / "outputs.md").write_text(
+                report(runs, runs["now"]["points"], runs.get("repeats", 3)))
+        return
     if args.child:
         child(args.points, args.repeats, pathlib.Path(args.child))
         return
