@@ -88,7 +88,8 @@ def compare_vtu(a, b, name, report):
     for label, first, second in (("point", x.point_data, y.point_data),
                                  ("field", x.field_data, y.field_data)):
         if set(first.keys()) != set(second.keys()):
-            report.problem(f"{name}: {label} arrays {sorted(set(first.keys()) ^ set(second.keys()))}")
+            odd = sorted(set(first.keys()) ^ set(second.keys()))
+            report.problem(f"{name}: {label} arrays {odd}")
             continue
         for key in first.keys():
             p, q = np.asarray(first[key]), np.asarray(second[key])

@@ -27,7 +27,8 @@ def radiating_displacement(stage, displacement) -> np.ndarray:
     """W = U Nᵀ (rows, n_s) [m]: the radiating-node normal displacements of reduced displacement
     rows U (rows, n) [m], N = ``stage.erp_map`` (n_s, n). One matrix product over every row
     given: a point's harmonics and its linear baseline's share one pass over N (:func:`point_
-    record`), the largest per-point product of the records on a fine mesh (N: 24,100 × 757 at 5 mm)."""
+    records`), the largest per-point product of the records on a fine mesh (N: 24,100 × 613 at
+    5 mm)."""
     return np.asarray(displacement) @ stage.erp_map.T
 
 

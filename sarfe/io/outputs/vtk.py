@@ -122,8 +122,10 @@ def excursion_amplitude(harmonics, n_samples: int) -> np.ndarray:
     odd, even = np.arange(1, H + 1, 2), np.arange(2, H + 1, 2)
     flat = U.reshape(U.shape[0], -1)
     # harmonic k: cos at row 2k − 1, sin at 2k → odd k: rows 1, 5, …; even k: rows 3, 7, …
-    parts = [(np.cos(np.outer(theta, even)), flat[3::4]), (np.sin(np.outer(theta, even)), flat[4::4]),
-             (np.cos(np.outer(theta, odd)), flat[1::4]), (np.sin(np.outer(theta, odd)), flat[2::4])]
+    parts = [(np.cos(np.outer(theta, even)), flat[3::4]),
+             (np.sin(np.outer(theta, even)), flat[4::4]),
+             (np.cos(np.outer(theta, odd)), flat[1::4]),
+             (np.sin(np.outer(theta, odd)), flat[2::4])]
     out = np.empty(flat.shape[1])
     for start in range(0, out.size, EXCURSION_BLOCK):                     # blocks of entries
         block = slice(start, start + EXCURSION_BLOCK)
