@@ -70,8 +70,8 @@ def point_work(config: CaseConfig, stage, nl, solutions, jobs, done, first, work
     (memory: see the code).
 
     Returns (solutions with their verdicts at one time grid, [(point dict, row, ErpResult, map
-    fields)]), or None when a deferred stability raised (the caller solves the sweep again serially). The
-    records are filled with the verdicts and estimates afterwards
+    fields)]), or None when a deferred stability raised (the caller solves the sweep again
+    serially). The records are filled with the verdicts and estimates afterwards
     (:func:`sarfe.pipeline.postprocess.with_verdict`, ``with_estimate``): the same records as the
     serial path's."""
     from sarfe.pipeline.points import common_samples
