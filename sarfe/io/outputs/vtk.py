@@ -295,6 +295,9 @@ def erp_point_data(n_points: int, erp, normal_displacement, omega: float, displa
     if fields.shape[1] != nodes.size:
         raise ValueError(f"erp has {fields.shape[1]} radiating nodes, radiating_nodes {nodes.size}")
     H = fields.shape[0] - 2
+    if H != np.size(erp.frequencies_hz):
+        raise ValueError(f"fields must be (H + 2, n_r) with H = {np.size(erp.frequencies_hz)} "
+                         f"(radiating_fields), got {fields.shape}")
     # every radiating-node field scattered into one (H + 3, n) block, zero at the other points:
     # rows 0 … H−1 e_k, then Σ_k e_k, the velocity amplitude, the normal excursion
     full = np.zeros((H + 3, n))
