@@ -160,7 +160,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
             if bar is not None:
                 bar.close()
         timings["postprocess_s"] = time.perf_counter() - clock
-    points, rows, erps, normal_w = (list(column) for column in zip(*records)) if records \
+    points, rows, erps, map_fields = (list(column) for column in zip(*records)) if records \
         else ([], [], [], [])
     not_converged = [p["index"] for p in points if not p["converged"]]
     # None entries without a sweep
@@ -209,7 +209,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         summary["timings_s"]["outputs_s"] = 0.0
         summary["timings_s"]["total_s"] = time.perf_counter() - started
         summary["files"] = write_outputs(config, stage, nl, summary, rows, solutions, erps,
-                                         normal_w, folder)
+                                         map_fields, folder)
         summary["timings_s"]["outputs_s"] = time.perf_counter() - clock
         summary["timings_s"]["total_s"] = time.perf_counter() - started
         write_summary_json(folder / "summary.json", summary)
