@@ -396,20 +396,18 @@ def _two_processes(workers):
     return workers >= 2 and "pardiso" in available_solvers()
 
 
-def _start_upper_slices(k_ii, m_ii, cutoff_hz, cap, held):
-    """Before run 0, a forked worker that counts the modes below the cutoff and, when they
-    outnumber what run 0 finds in its capped space, slices the upper part of the spectrum while
-    this process runs run 0 and the lower part
+def _start_upper_slices(k_ii, m_ii, cutoff_hz, cap):
+    """Right after the partition (before K_ii is factorized), a forked worker that counts the
+    modes below the cutoff and, when they outnumber what run 0 finds in its capped space, slices
+    the upper part of the spectrum while this process factorizes K_ii, forms Ψ and the residual
+    statics, runs run 0 and the lower part
     (:func:`sarfe.reduction.spectrum_slicing.start_upper_slices`). None where it cannot start."""
     from sarfe.reduction.spectrum_slicing import start_upper_slices
-
-    def drop_inherited_factor():
-        held["factor"] = None     # the worker's copy of K_ii's factor (it has its own shifts)
 
     try:
         return start_upper_slices(k_ii, m_ii, (2 * np.pi * cutoff_hz) ** 2,
                                   _RUN0_LEAD_PER_COLUMN * cap,
-                                  int(_PARALLEL_MODES_PER_COLUMN * cap), drop_inherited_factor)
+                                  int(_PARALLEL_MODES_PER_COLUMN * cap))
     except OSError:               # no temporary file or no process: one process does it all
         return None
 
@@ -563,89 +561,98 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
     m_ib = mass[interior][:, boundary].tocsc()          # per matrix at 206k DOFs
     k_bb = stiffness[boundary][:, boundary].toarray()
     m_bb = mass[boundary][:, boundary].toarray()
+    wants_modes = (mode_count or 0) > 0 or (cutoff_hz is not None and mode_count is None)
+    if wants_modes and eigensolver not in ("block", "arpack"):
+        raise ValueError(f"eigensolver must be 'block' or 'arpack', got {eigensolver!r}")
+    # many modes up to a cutoff: cap run 0's Krylov space (two n × m arrays), slice the rest
+    cap = max(_SLICE_COLUMNS, int(_SLICE_ENTRIES // max(len(interior), 1))) \
+        if wants_modes and eigensolver == "block" and cutoff_hz is not None \
+        and mode_count is None else None
+    two = cap is not None and cap < len(interior) and _two_processes(workers)
+    # the worker is forked now, before K_ii's factor, Ψ and the statics exist (it needs none of
+    # them): its PARDISO analysis and count run beside this process's factorization
+    upper = _start_upper_slices(k_ii, m_ii, cutoff_hz, cap) if two else None
     lap("partition")
 
-    factor = factorize(k_ii, solver=solver, structure="spd")
-    lap("factorization")
+    try:
+        factor = factorize(k_ii, solver=solver, structure="spd")
+        lap("factorization")
 
-    psi = -factor.solve(k_ib.toarray()) if len(boundary) else np.empty((len(interior), 0))
-    lap("constraint_modes")
+        psi = -factor.solve(k_ib.toarray()) if len(boundary) else np.empty((len(interior), 0))
+        lap("constraint_modes")
 
-    applications = [0]
-    held, solver_name = {"factor": factor}, factor.name
-    del factor
+        applications = [0]
+        held, solver_name = {"factor": factor}, factor.name
+        del factor
 
-    def inverse(y):
-        applications[0] += 1 if y.ndim == 1 else y.shape[1]
-        if held["factor"] is None:        # freed for spectrum slicing, needed again (fallback)
-            held["factor"] = factorize(k_ii, solver=solver, structure="spd")
-        return held["factor"].solve(y)
+        def inverse(y):
+            applications[0] += 1 if y.ndim == 1 else y.shape[1]
+            if held["factor"] is None:        # freed for spectrum slicing, needed again (fallback)
+                held["factor"] = factorize(k_ii, solver=solver, structure="spd")
+            return held["factor"].solve(y)
 
-    # residual-vector loads and their static responses K_ii⁻¹ F_i, before any mode search (the
-    # factor of K_ii may be freed while slicing the spectrum)
-    # F_b = M_ib + M_ii Ψ: the interior load of unit boundary accelerations (also M_r's coupling
-    # block F_bᵀ Φ); built in place, and shared with the residual-vector loads
-    n_b = len(boundary)
-    extra = None if residual_loads is None else np.asarray(residual_loads, dtype=float)
-    extra = None if extra is None else (extra[:, None] if extra.ndim == 1 else extra)[interior]
-    with_boundary = bool(residual_vectors and n_b)
-    width = (n_b if with_boundary else 0) + (0 if extra is None else extra.shape[1])
-    loads = np.empty((len(interior), width)) if width else None
-    boundary_load = loads[:, :n_b] if with_boundary else np.empty((len(interior), n_b))
-    boundary_load[:] = m_ii @ psi
-    psi_m_psi = psi.T @ boundary_load                               # Ψᵀ M_ii Ψ
-    coo = m_ib.tocoo()
-    np.add.at(boundary_load, (coo.row, coo.col), coo.data)
-    if extra is not None:
-        loads[:, width - extra.shape[1]:] = extra
-        del extra
-    static = inverse(loads) if loads is not None else None
-    lap("residual_static")
-    restore = None                  # set when the statics wait on disk (two slicing processes)
+        # residual-vector loads and their static responses K_ii⁻¹ F_i, before any mode search (the
+        # factor of K_ii may be freed while slicing the spectrum)
+        # F_b = M_ib + M_ii Ψ: the interior load of unit boundary accelerations (also M_r's coupling
+        # block F_bᵀ Φ); built in place, and shared with the residual-vector loads
+        n_b = len(boundary)
+        extra = None if residual_loads is None else np.asarray(residual_loads, dtype=float)
+        extra = None if extra is None else (extra[:, None] if extra.ndim == 1 else extra)[interior]
+        with_boundary = bool(residual_vectors and n_b)
+        width = (n_b if with_boundary else 0) + (0 if extra is None else extra.shape[1])
+        loads = np.empty((len(interior), width)) if width else None
+        boundary_load = loads[:, :n_b] if with_boundary else np.empty((len(interior), n_b))
+        boundary_load[:] = m_ii @ psi
+        psi_m_psi = psi.T @ boundary_load                               # Ψᵀ M_ii Ψ
+        coo = m_ib.tocoo()
+        np.add.at(boundary_load, (coo.row, coo.col), coo.data)
+        if extra is not None:
+            loads[:, width - extra.shape[1]:] = extra
+            del extra
+        static = inverse(loads) if loads is not None else None
+        lap("residual_static")
+        restore = None                  # set when the statics wait on disk (two slicing processes)
 
-    if (mode_count or 0) > 0 or (cutoff_hz is not None and mode_count is None):
-        if eigensolver not in ("block", "arpack"):
-            raise ValueError(f"eigensolver must be 'block' or 'arpack', got {eigensolver!r}")
-        found = None
-        if eigensolver == "block":
-            # many modes up to a cutoff: cap run 0's Krylov space (two n × m arrays), slice the rest
-            cap = max(_SLICE_COLUMNS, int(_SLICE_ENTRIES // max(len(interior), 1))) \
-                if cutoff_hz is not None and mode_count is None else None
-            two = cap is not None and cap < len(interior) and _two_processes(workers)
-            if two:
-                # two processes will each hold a Krylov store and a factor: Ψ, the residual loads
-                # and their statics wait on disk, dropped before the fork so neither keeps them
-                restore = _park(psi, None if with_boundary else boundary_load, loads, static)
-                psi = boundary_load = loads = static = None
-            upper = _start_upper_slices(k_ii, m_ii, cutoff_hz, cap, held) if two else None
-            if upper is not None and not _worker_splits(upper):
-                upper = None              # few modes: run 0 as in one process
-            # two processes: the found vectors wait on disk while both slice (mode_sinks)
-            sink = _file_sink(len(interior)) if upper is not None else None
+        if wants_modes:
+            found = None
+            if eigensolver == "block":
+                if upper is not None:
+                    # two processes will each hold a Krylov store and a factor: Ψ, the residual loads
+                    # and their statics (formed after the fork: the worker has no copy) wait on disk
+                    restore = _park(psi, None if with_boundary else boundary_load, loads, static)
+                    psi = boundary_load = loads = static = None
+                if upper is not None and not _worker_splits(upper):
+                    upper = None              # few modes: run 0 as in one process
+                # two processes: the found vectors wait on disk while both slice (mode_sinks)
+                sink = _file_sink(len(interior)) if upper is not None else None
 
-            def release_factor():         # run 0 is over: K_ii's factor goes before its modes
-                held["factor"] = None     # (inverse() factorizes again if a fallback needs it)
+                def release_factor():         # run 0 is over: K_ii's factor goes before its modes
+                    held["factor"] = None     # (inverse() factorizes again if a fallback needs it)
 
-            found = _block_lanczos_modes(m_ii, inverse, mode_count, cutoff_hz, progress,
-                                         max_columns=cap, store_mass_products=upper is None,
-                                         release_operator=release_factor if cap else None,
-                                         keep_prefix=None if sink is None else sink.put)
-            if isinstance(found, _Partial):
-                held["factor"] = None     # K_ii's factor is not used by the shifted runs
-                found = _slice(k_ii, m_ii, cutoff_hz, found, progress, timings, upper, sink)
-            elif upper is not None:
-                upper.cancel()            # run 0 found them all after all
-                sink.remove()
-            upper = sink = None
-            if found is None and cap is not None:   # slicing impossible: one uncapped run
-                found = _block_lanczos_modes(m_ii, inverse, mode_count, cutoff_hz, progress)
-        if found is None:
-            found = _fixed_interface_modes(k_ii, m_ii, inverse, mode_count, cutoff_hz, progress)
-            eigensolver = "arpack"
-        omega2, blocks = found
-        timings["eigensolver"] = eigensolver
-    else:
-        omega2, blocks = np.empty(0), np.empty((len(interior), 0))
+                found = _block_lanczos_modes(m_ii, inverse, mode_count, cutoff_hz, progress,
+                                             max_columns=cap, store_mass_products=upper is None,
+                                             release_operator=release_factor if cap else None,
+                                             keep_prefix=None if sink is None else sink.put)
+                if isinstance(found, _Partial):
+                    held["factor"] = None     # K_ii's factor is not used by the shifted runs
+                    found = _slice(k_ii, m_ii, cutoff_hz, found, progress, timings, upper, sink)
+                elif upper is not None:
+                    upper.cancel()            # run 0 found them all after all
+                    sink.remove()
+                upper = sink = None
+                if found is None and cap is not None:   # slicing impossible: one uncapped run
+                    found = _block_lanczos_modes(m_ii, inverse, mode_count, cutoff_hz, progress)
+            if found is None:
+                found = _fixed_interface_modes(k_ii, m_ii, inverse, mode_count, cutoff_hz, progress)
+                eigensolver = "arpack"
+            omega2, blocks = found
+            timings["eigensolver"] = eigensolver
+        else:
+            omega2, blocks = np.empty(0), np.empty((len(interior), 0))
+    except BaseException:      # the worker forked above goes too
+        if upper is not None:
+            upper.cancel()
+        raise
     held["factor"] = None
     if restore is not None:
         psi, boundary_load, loads, static = restore()

@@ -552,13 +552,13 @@ def _remove(path):
         pass
 
 
-def start_upper_slices(stiffness, mass, cutoff_omega2, lead, min_total, on_fork=None,
-                       slice_modes=80, max_columns=400):
+def start_upper_slices(stiffness, mass, cutoff_omega2, lead, min_total, slice_modes=80,
+                       max_columns=400):
     """Fork a worker that counts the eigenvalues below the cutoff and, when there are more than
     ``min_total``, finds every eigenpair in (λ_s, cutoff], N(λ_s) ≈ (total + ``lead``)/2
     (:func:`split_count`, :func:`split_shift`; this process takes (0, λ_s]). K, M are shared
-    copy-on-write; ``on_fork()`` runs first in the worker to free what it inherited and does not
-    need (the parent's factor of K_ii). The modes go to a file in the temporary directory (a
+    copy-on-write (fork it before anything large the worker does not need exists, e.g. the
+    factor of K_ii: Craig–Bampton forks right after the partition). The modes go to a file in the temporary directory (a
     :class:`~sarfe.reduction.mode_sinks.FileSink`: on disk, not in either process's memory) that
     :meth:`UpperSlices.join` maps and removes. Returns an :class:`UpperSlices`, or None where fork is not available or this
     process is a daemon (a Dask or multiprocessing worker may not have children). The worker's
@@ -573,14 +573,14 @@ def start_upper_slices(stiffness, mass, cutoff_omega2, lead, min_total, on_fork=
     receive, send = context.Pipe(duplex=False)
     process = context.Process(target=_upper_worker, daemon=True,
                               args=(send, stiffness, mass, cutoff_omega2, lead, min_total,
-                                    on_fork, path, slice_modes, max_columns))
+                                    path, slice_modes, max_columns))
     process.start()
     send.close()
     return UpperSlices(process, receive, path, mass.shape[0])
 
 
-def _upper_worker(connection, stiffness, mass, cutoff_omega2, lead, min_total, on_fork,
-                  path, slice_modes, max_columns):
+def _upper_worker(connection, stiffness, mass, cutoff_omega2, lead, min_total, path,
+                  slice_modes, max_columns):
     """The forked side of :func:`start_upper_slices`: its own PARDISO analysis (the parent's
     instance is not shared), the count below the cutoff (sent at once: this process's run 0
     waits for it), the split by count (sent when placed: this process needs it after run 0),
@@ -588,8 +588,6 @@ def _upper_worker(connection, stiffness, mass, cutoff_omega2, lead, min_total, o
     they are formed (a :class:`~sarfe.reduction.mode_sinks.FileSink`; the kept columns go to
     this process with the values)."""
     try:
-        if on_fork is not None:
-            on_fork()
         factor_at = shifted_factorizer(stiffness, mass, solver="pardiso")
         counting = {"factorizations": 0}
 
