@@ -259,12 +259,62 @@ def lanczos_extend(basis, mass_products, w, projected, previous_start):
 
 @dataclass(frozen=True, eq=False)
 class _Partial:
-    """A σ = 0 Lanczos run stopped at its column cap: its converged eigenpairs, all ω² ≤ boundary."""
+    """A σ = 0 Lanczos run stopped at its column cap: its converged eigenpairs, all ω² ≤ boundary
+    (``stats``: its steps, full re-orthogonalization passes and sparse products M·(n, b))."""
 
     omega2: np.ndarray
     modes: np.ndarray
     boundary: float
     columns: int
+    stats: dict = field(default_factory=dict)
+
+
+def _capped_run0(mass_ii, operator, cutoff_hz, progress, max_columns, release_operator=None,
+                 keep_prefix=None, block_size=16, tol=1e-8, seed=0):
+    """Run 0 of spectrum slicing: block Lanczos on K_ii⁻¹ M_ii (σ = 0) from a block of
+    ``block_size`` columns, stopped at ``max_columns`` columns, with the shifted runs' partial
+    re-orthogonalization (:func:`sarfe.reduction.spectrum_slicing.shifted_block_lanczos` at
+    σ = 0: a full M-re-orthogonalization pass only when Simon's estimate of the lost
+    orthogonality exceeds 1e-10, one sparse product M·(n, b) per step without it). A Ritz pair
+    is converged when ‖A φ − θ φ‖_M ≤ tol·θ, θ = 1/ω², relative to its own θ.
+
+    Returns (ω² (k,) ascending, Φ (n, k), Φᵀ M Φ = I) when every mode up to the cutoff has
+    converged within the cap; else the converged prefix as :class:`_Partial` (its boundary
+    halfway to the next Ritz value; ``keep_prefix(modes)``, when given, returns what it holds
+    instead of the vectors: the sink's handle); None when nothing converged. ``release_operator()``
+    is called after the last operator application, before the Ritz vectors are formed.
+    """
+    from sarfe.reduction.spectrum_slicing import shifted_block_lanczos
+
+    cutoff_omega2 = (2 * np.pi * cutoff_hz) ** 2
+
+    def converged_prefix(lam, converged):
+        order = np.argsort(lam)
+        flags = converged[order]
+        prefix = int(np.argmin(flags)) if not flags.all() else len(flags)
+        return order, prefix, int(np.count_nonzero(lam <= cutoff_omega2))
+
+    def satisfied(lam, converged):
+        _, prefix, wanted = converged_prefix(lam, converged)
+        if progress is not None:
+            progress(min(prefix, wanted), None)
+        return prefix > wanted              # every mode up to the cutoff, and one above it
+
+    stats = {}
+    lam, converged, eigenvectors = shifted_block_lanczos(mass_ii, operator, 0.0, satisfied,
+                                                         max_columns, block_size, tol, seed, stats)
+    if release_operator is not None:
+        release_operator()
+    order, prefix, wanted = converged_prefix(lam, converged)
+    if prefix > wanted:
+        return lam[order[:wanted]], eigenvectors(order[:wanted])
+    if prefix == 0:
+        return None
+    modes = eigenvectors(order[:prefix])
+    boundary = 0.5 * (lam[order[prefix - 1]] + lam[order[prefix]]) if prefix < len(lam) \
+        else float(lam[order[-1]])
+    return _Partial(lam[order[:prefix]], modes if keep_prefix is None else keep_prefix(modes),
+                    boundary, len(lam), stats)
 
 
 def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, block_size=16, tol=1e-8,
@@ -474,7 +524,8 @@ def _slice(k_ii, m_ii, cutoff_hz, partial, progress, timings, upper, sink):
     except SlicingFailed as exc:
         timings["slicing"] = {"failed": str(exc)}
         return None
-    timings["slicing"] = dict(record, run0_columns=partial.columns, run0_modes=len(partial.omega2))
+    timings["slicing"] = dict(record, run0_columns=partial.columns, run0_modes=len(partial.omega2),
+                              **{"run0_" + key: value for key, value in partial.stats.items()})
     return omega2, modes
 
 
@@ -568,7 +619,8 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
     cap = max(_SLICE_COLUMNS, int(_SLICE_ENTRIES // max(len(interior), 1))) \
         if wants_modes and eigensolver == "block" and cutoff_hz is not None \
         and mode_count is None else None
-    two = cap is not None and cap < len(interior) and _two_processes(workers)
+    cap = cap if cap is not None and cap < len(interior) else None     # a cap ≥ n: no cap
+    two = cap is not None and _two_processes(workers)
     # the worker is forked now, before K_ii's factor, Ψ and the statics exist (it needs none of
     # them): its PARDISO analysis and count run beside this process's factorization
     upper = _start_upper_slices(k_ii, m_ii, cutoff_hz, cap) if two else None
@@ -629,10 +681,11 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
                 def release_factor():         # run 0 is over: K_ii's factor goes before its modes
                     held["factor"] = None     # (inverse() factorizes again if a fallback needs it)
 
-                found = _block_lanczos_modes(m_ii, inverse, mode_count, cutoff_hz, progress,
-                                             max_columns=cap, store_mass_products=upper is None,
-                                             release_operator=release_factor if cap else None,
-                                             keep_prefix=None if sink is None else sink.put)
+                if cap is None:
+                    found = _block_lanczos_modes(m_ii, inverse, mode_count, cutoff_hz, progress)
+                else:
+                    found = _capped_run0(m_ii, inverse, cutoff_hz, progress, cap, release_factor,
+                                         None if sink is None else sink.put)
                 if isinstance(found, _Partial):
                     held["factor"] = None     # K_ii's factor is not used by the shifted runs
                     found = _slice(k_ii, m_ii, cutoff_hz, found, progress, timings, upper, sink)
