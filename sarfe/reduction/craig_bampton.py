@@ -543,18 +543,21 @@ def residual_modes(stiffness_ii, mass_ii, operator, loads, modes, relative_toler
         return np.empty(0), np.empty((n, 0))
     if static is None:
         static = operator(np.asarray(loads, dtype=float))
-    norms = np.sqrt(np.einsum("ij,ij->j", static, mass_ii @ static))
+    mass_static = mass_ii @ static
+    norms = np.sqrt(np.einsum("ij,ij->j", static, mass_static))
     static = static[:, norms > 0] / norms[norms > 0]  # unit M-norm before deflation
+    mass_static = mass_static[:, norms > 0] / norms[norms > 0]
     for _ in range(2):  # deflate Φ twice (classical Gram–Schmidt, re-orthogonalized)
-        static = static - modes @ (modes.T @ (mass_ii @ static))
-    gram = static.T @ (mass_ii @ static)
+        static = static - modes @ (modes.T @ mass_static)
+        mass_static = mass_ii @ static        # (one sparse product per pass; reused below)
+    gram = static.T @ mass_static
     values, vectors = np.linalg.eigh(0.5 * (gram + gram.T))
     keep = values > relative_tolerance ** 2   # what is left of a unit column outside span Φ
     if not keep.any():
         return np.empty(0), np.empty((n, 0))
-    basis = static @ (vectors[:, keep] / np.sqrt(values[keep]))
-    basis, mass_basis = _m_orthonormal(basis, mass_ii)
-    basis = basis - modes @ (modes.T @ mass_basis)  # last clean-up against Φ
+    transform = vectors[:, keep] / np.sqrt(values[keep])
+    basis, mass_basis = _m_orthonormal(static @ transform, mass_ii, mass_static @ transform)
+    basis = basis - modes @ (modes.T @ mass_basis)  # the clean-up against Φ
     basis, _ = _m_orthonormal(basis, mass_ii)
     if basis.shape[1] == 0:
         return np.empty(0), np.empty((n, 0))
