@@ -54,12 +54,13 @@ _MODE_BLOCK = 24  # fixed-interface modes requested per Lanczos run when searchi
 _SLICE_COLUMNS = 400
 _SLICE_ENTRIES = 8e7
 # a second process slices the upper part of the spectrum when the modes below the cutoff
-# outnumber what run 0 finds in its capped space (≈ 0.3 modes per column on the door trim). The
+# outnumber what run 0 finds in its capped space (≈ 0.35 modes per column on the door trim). The
 # split is by count: this process (run 0 and the shifted runs up to λ_s) takes N(λ_s) ≈ (N(λ_c) +
-# lead)/2 modes, lead = _RUN0_LEAD_PER_COLUMN · run 0's column cap — run 0 finds its modes (125 at
-# a cap of 400 on the door trim at 5 mm) for the CPU time of ≈ 60 shifted-run modes (12 s against
-# 0.2 s per mode), and the worker spends ≈ 3 s on its PARDISO analysis and counts: lead ≈ 125 − 60
-# + 15 ≈ 0.2 per column (benchmarks/results/linear.md, P1 split)
+# lead)/2 modes, lead = _RUN0_LEAD_PER_COLUMN · run 0's column cap — run 0 finds its modes (141 at
+# a cap of 400 on the door trim at 5 mm) for the CPU time of ≈ 75 shifted-run modes (11 s against
+# 0.15 s per mode): lead ≈ 0.2 per column. The runs are whole (≈ 9 s each), so the two processes
+# finish within a run's fraction: at 0.12 the door trim's worker needed a fourth, tiny run and
+# this process waited 3 s for it; at 0.2 the worker waits ≈ 3 s (benchmarks/results/linear.md)
 _PARALLEL_MODES_PER_COLUMN = 0.5
 _RUN0_LEAD_PER_COLUMN = 0.2
 
@@ -270,7 +271,7 @@ class _Partial:
 
 
 def _capped_run0(mass_ii, operator, cutoff_hz, progress, max_columns, release_operator=None,
-                 keep_prefix=None, block_size=16, tol=1e-8, seed=0):
+                 keep_prefix=None, block_size=12, tol=1e-8, seed=0):
     """Run 0 of spectrum slicing: block Lanczos on K_ii⁻¹ M_ii (σ = 0) from a block of
     ``block_size`` columns, stopped at ``max_columns`` columns, with the shifted runs' partial
     re-orthogonalization (:func:`sarfe.reduction.spectrum_slicing.shifted_block_lanczos` at

@@ -74,7 +74,7 @@ _ORTHOGONALITY = 1e-10
 _EPS = np.finfo(float).eps
 
 
-def shifted_block_lanczos(mass, operator, shift, satisfied, max_columns, block_size=16, tol=1e-8,
+def shifted_block_lanczos(mass, operator, shift, satisfied, max_columns, block_size=12, tol=1e-8,
                           seed=0, stats=None, partial=True):
     r"""Block Lanczos on A = (K − σM)⁻¹ M (``operator(Y)`` = (K − σM)⁻¹ Y, σ = ``shift``) in the
     M inner product; Q (n, m) is stored, M Q only for the last two blocks (the three-term part).
