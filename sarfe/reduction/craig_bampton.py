@@ -50,17 +50,21 @@ from sarfe.fe.linear_solvers import factorize
 
 _MODE_BLOCK = 24  # fixed-interface modes requested per Lanczos run when searching up to a cutoff
 # a σ = 0 block Lanczos run keeps at most max(_SLICE_COLUMNS, _SLICE_ENTRIES / n) Krylov columns;
-# past that the modes up to the cutoff come from spectrum slicing (1.3 GB of Q, MQ at n = 206k)
-_SLICE_COLUMNS = 400
+# past that the modes up to the cutoff come from spectrum slicing (Q: 0.79 GB at n = 206k). Run 0
+# finds its modes at half the CPU per mode of a shifted run (door trim at 5 mm: 0.08 against
+# 0.15 s), so its cap is above the shifted runs' 400 columns: 480 columns found 191 modes in
+# 15 s CPU (400: 141 in 11 s), and the two processes then finish within 0.5 s of each other
+_SLICE_COLUMNS = 480
 _SLICE_ENTRIES = 8e7
 # a second process slices the upper part of the spectrum when the modes below the cutoff
 # outnumber what run 0 finds in its capped space (≈ 0.35 modes per column on the door trim). The
 # split is by count: this process (run 0 and the shifted runs up to λ_s) takes N(λ_s) ≈ (N(λ_c) +
-# lead)/2 modes, lead = _RUN0_LEAD_PER_COLUMN · run 0's column cap — run 0 finds its modes (141 at
-# a cap of 400 on the door trim at 5 mm) for the CPU time of ≈ 75 shifted-run modes (11 s against
+# lead)/2 modes, lead = _RUN0_LEAD_PER_COLUMN · run 0's column cap — run 0 finds its modes (191 at
+# a cap of 480 on the door trim at 5 mm) for the CPU time of ≈ 100 shifted-run modes (15 s against
 # 0.15 s per mode): lead ≈ 0.2 per column. The runs are whole (≈ 9 s each), so the two processes
-# finish within a run's fraction: at 0.12 the door trim's worker needed a fourth, tiny run and
-# this process waited 3 s for it; at 0.2 the worker waits ≈ 3 s (benchmarks/results/linear.md)
+# finish within a run's fraction: at a cap of 400, lead 0.12 gave the door trim's worker a
+# fourth, tiny run (this process waited 3 s for it) and 0.2 left the worker 3 s idle
+# (benchmarks/results/linear.md)
 _PARALLEL_MODES_PER_COLUMN = 0.5
 _RUN0_LEAD_PER_COLUMN = 0.2
 
