@@ -323,8 +323,7 @@ def _capped_run0(mass_ii, operator, cutoff_hz, progress, max_columns, release_op
 
 
 def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, block_size=16, tol=1e-8,
-                         seed=0, max_columns=None, store_mass_products=True, release_operator=None,
-                         keep_prefix=None):
+                         seed=0):
     """Lowest modes of K_ii φ = ω² M_ii φ by block shift-invert Lanczos (σ = 0), full M-reorthogonalization.
 
     Krylov space of A = K_ii⁻¹ M_ii from a block of ``block_size`` columns: every step is ONE
@@ -333,16 +332,9 @@ def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, blo
     Stops when the wanted Ritz pairs have residual < tol·ν (eigenvalue error ~ residual², so 1e-8
     gives frequencies to ~1e-15; 11 % fewer solves than 1e-10 on the door trim). Returns ω²
     (ascending), Φ (Φᵀ M Φ = I), or None when the Krylov space fills the interior before that (tiny
-    models). With ``max_columns``, a run that would outgrow it stops and returns the converged
-    prefix as ``_Partial`` (for :mod:`sarfe.reduction.spectrum_slicing` to go on from). Door trim at 5 mm (206k DOFs, 60 modes, one thread): 10.8 s CPU, down from 17.8 s with
-    two full Gram–Schmidt passes, row-major blocks and a too-small initial store.
-    ``store_mass_products=False`` keeps M Q only for the last two blocks (half the memory, one
-    more sparse product M·(n, b) per step: the full pass's Qᵀ (M w)); the spectrum-slicing worker
-    runs beside this process then. ``release_operator()``, when given, is called after the last
-    operator application, before the Ritz vectors are formed (the caller frees its factor there:
-    the factor, the Krylov store and the modes are not alive at once). ``keep_prefix(modes)``,
-    when given, receives a capped run's converged prefix (n, k) and returns what ``_Partial``
-    holds instead (the spectrum-slicing sink's handle: the vectors wait on disk).
+    models). Door trim at 5 mm (206k DOFs, 60 modes, one thread): 10.8 s CPU, down from 17.8 s with
+    two full Gram–Schmidt passes, row-major blocks and a too-small initial store. (A cutoff with
+    many modes caps the σ = 0 run instead: :func:`_capped_run0`, then spectrum slicing.)
     """
     n = mass_ii.shape[0]
     rng = np.random.default_rng(seed)
@@ -353,33 +345,22 @@ def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, blo
     # doubling below) — never n columns up front, which is two dense n×n arrays
     guess = min(target, n) if mode_count is not None else 64
     capacity = min(n, max(4 * block_size, 5 * guess + 2 * block_size))  # measured: ~4.8 columns per mode
-    if max_columns is not None:
-        # the whole capped store up front: growing it copies, and old + new store at 206k DOFs
-        # were 2.6 GB at once
-        capacity = min(n, max_columns + 2 * block_size)
     # Q, M Q preallocated column-major: a block of columns is then contiguous, which the sparse
     # solvers want (no copy per solve)
     store = np.empty((n, capacity), order="F")
-    mass_store = np.empty((n, capacity if store_mass_products else 0), order="F")
+    mass_store = np.empty((n, capacity), order="F")
     m_new = q.shape[1]
     store[:, :m_new] = q
-    if store_mass_products:
-        mass_store[:, :m_new] = mq
-    recent = [mq]                # M Q of the previous and the current block
+    mass_store[:, :m_new] = mq
     projected = np.zeros((0, 0))
     previous_start = 0  # first column of the block before the current one
     while True:
         m_old = projected.shape[0]
-        w = operator(recent[-1])
+        w = operator(mq)
         basis, mass_basis = store[:, :m_new], mass_store[:, :m_new]
-        mass_recent = None if store_mass_products else np.hstack(recent)
 
-        def mass_products(cols, y, start=previous_start):
-            if store_mass_products:
-                return mass_basis[:, cols].T @ y
-            if cols.start == start:            # the last two blocks: (M Q_l)ᵀ y
-                return mass_recent.T @ y
-            return basis[:, cols].T @ (mass_ii @ y)
+        def mass_products(cols, y):
+            return mass_basis[:, cols].T @ y
 
         # three-term part first (the current and previous block carry the large components of
         # A q), then ONE full M-orthogonalization pass against all of Q removes the rest: as
@@ -406,37 +387,18 @@ def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, blo
         done = leading >= wanted and above_cutoff and (wanted == target or cutoff_hz is not None)
         if done or m_new + q.shape[1] > n - 1 or q.shape[1] == 0:
             break
-        if max_columns is not None and m_new + q.shape[1] > max_columns:
-            # many modes: hand the converged prefix on to spectrum slicing — converged relative to
-            # each own ν, as the shifted runs test (ν_1-relative is loose for the higher modes and
-            # would leave them 1e-7 from M-orthogonal to the next slice's); the boundary lies
-            # halfway to the next Ritz value
-            strict = residual <= tol * np.abs(values)
-            prefix = int(np.argmin(strict)) if not strict.all() else len(strict)
-            if 0 < prefix < len(values):
-                if release_operator is not None:
-                    release_operator()
-                modes = basis @ vectors[:, :prefix]
-                return _Partial(omega2[:prefix], modes if keep_prefix is None else
-                                keep_prefix(modes), 0.5 * (omega2[prefix - 1] + omega2[prefix]),
-                                m_new)
         if m_new + q.shape[1] > capacity:
             capacity = min(n, max(2 * capacity, m_new + q.shape[1]))
             grown_store = np.empty((n, capacity), order="F")
-            grown_mass = np.empty((n, capacity), order="F") if store_mass_products else None
+            grown_mass = np.empty((n, capacity), order="F")
             grown_store[:, :m_new] = store[:, :m_new]
-            if store_mass_products:
-                grown_mass[:, :m_new] = mass_store[:, :m_new]
-            store, mass_store = grown_store, grown_mass if store_mass_products else mass_store
+            grown_mass[:, :m_new] = mass_store[:, :m_new]
+            store, mass_store = grown_store, grown_mass
         store[:, m_new:m_new + q.shape[1]] = q
-        if store_mass_products:
-            mass_store[:, m_new:m_new + q.shape[1]] = mq
-        recent = [recent[-1], mq]
+        mass_store[:, m_new:m_new + q.shape[1]] = mq
         m_new += q.shape[1]
     if not done:
         return None  # Krylov space exhausted before convergence (tiny interior): caller uses ARPACK
-    if release_operator is not None:
-        release_operator()
     modes = basis @ vectors[:, :wanted]
     return omega2[:wanted], modes
 
