@@ -585,7 +585,7 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
     wants_modes = (mode_count or 0) > 0 or (cutoff_hz is not None and mode_count is None)
     if wants_modes and eigensolver not in ("block", "arpack"):
         raise ValueError(f"eigensolver must be 'block' or 'arpack', got {eigensolver!r}")
-    # many modes up to a cutoff: cap run 0's Krylov space (two n × m arrays), slice the rest
+    # many modes up to a cutoff: cap run 0's Krylov store (Q, n × cap), slice the rest
     cap = max(_SLICE_COLUMNS, int(_SLICE_ENTRIES // max(len(interior), 1))) \
         if wants_modes and eigensolver == "block" and cutoff_hz is not None \
         and mode_count is None else None
