@@ -459,6 +459,8 @@ def write_report(cases, quick, p1=None):
     memory = previous.get("p1_memory") if isinstance(previous, dict) else None
     # measured by hand (A/B runs, cProfile; linear.json "p1_lanczos": the section's lines)
     lanczos = previous.get("p1_lanczos") if isinstance(previous, dict) else None
+    # the same for the idle cores, run 0 and block size (branch lanczos2): "p1_lanczos2"
+    lanczos2 = previous.get("p1_lanczos2") if isinstance(previous, dict) else None
     if p1 is None and isinstance(previous, dict):
         p1 = previous.get("p1")
     if p1:
@@ -470,10 +472,13 @@ def write_report(cases, quick, p1=None):
         lines += profile_lines(profile)
     if lanczos:
         lines += [""] + list(lanczos)
+    if lanczos2:
+        lines += [""] + list(lanczos2)
     (HERE / "results").mkdir(exist_ok=True)
     (HERE / "results" / "linear.md").write_text("\n".join(lines) + "\n")
     data = {"cases": cases, "p1": p1, "p1_profile": profile, "p1_split_profile": split_profile,
-            "p1_memory": memory, "p1_lanczos": lanczos} if p1 or profile or split_profile else cases
+            "p1_memory": memory, "p1_lanczos": lanczos,
+            "p1_lanczos2": lanczos2} if p1 or profile or split_profile else cases
     (HERE / "results" / "linear.json").write_text(json.dumps(data, indent=1, default=float) + "\n")
     print("\n".join(lines))
 

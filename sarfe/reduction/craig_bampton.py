@@ -50,16 +50,21 @@ from sarfe.fe.linear_solvers import factorize
 
 _MODE_BLOCK = 24  # fixed-interface modes requested per Lanczos run when searching up to a cutoff
 # a σ = 0 block Lanczos run keeps at most max(_SLICE_COLUMNS, _SLICE_ENTRIES / n) Krylov columns;
-# past that the modes up to the cutoff come from spectrum slicing (1.3 GB of Q, MQ at n = 206k)
-_SLICE_COLUMNS = 400
+# past that the modes up to the cutoff come from spectrum slicing (Q: 0.79 GB at n = 206k). Run 0
+# finds its modes at half the CPU per mode of a shifted run (door trim at 5 mm: 0.08 against
+# 0.15 s), so its cap is above the shifted runs' 400 columns: 480 columns found 191 modes in
+# 15 s CPU (400: 141 in 11 s), and the two processes then finish within 0.5 s of each other
+_SLICE_COLUMNS = 480
 _SLICE_ENTRIES = 8e7
 # a second process slices the upper part of the spectrum when the modes below the cutoff
-# outnumber what run 0 finds in its capped space (≈ 0.3 modes per column on the door trim). The
+# outnumber what run 0 finds in its capped space (≈ 0.35 modes per column on the door trim). The
 # split is by count: this process (run 0 and the shifted runs up to λ_s) takes N(λ_s) ≈ (N(λ_c) +
-# lead)/2 modes, lead = _RUN0_LEAD_PER_COLUMN · run 0's column cap — run 0 finds its modes (125 at
-# a cap of 400 on the door trim at 5 mm) for the CPU time of ≈ 60 shifted-run modes (12 s against
-# 0.2 s per mode), and the worker spends ≈ 3 s on its PARDISO analysis and counts: lead ≈ 125 − 60
-# + 15 ≈ 0.2 per column (benchmarks/results/linear.md, P1 split)
+# lead)/2 modes, lead = _RUN0_LEAD_PER_COLUMN · run 0's column cap — run 0 finds its modes (191 at
+# a cap of 480 on the door trim at 5 mm) for the CPU time of ≈ 100 shifted-run modes (15 s against
+# 0.15 s per mode): lead ≈ 0.2 per column. The runs are whole (≈ 9 s each), so the two processes
+# finish within a run's fraction: at a cap of 400, lead 0.12 gave the door trim's worker a
+# fourth, tiny run (this process waited 3 s for it) and 0.2 left the worker 3 s idle
+# (benchmarks/results/linear.md)
 _PARALLEL_MODES_PER_COLUMN = 0.5
 _RUN0_LEAD_PER_COLUMN = 0.2
 
@@ -259,17 +264,66 @@ def lanczos_extend(basis, mass_products, w, projected, previous_start):
 
 @dataclass(frozen=True, eq=False)
 class _Partial:
-    """A σ = 0 Lanczos run stopped at its column cap: its converged eigenpairs, all ω² ≤ boundary."""
+    """A σ = 0 Lanczos run stopped at its column cap: its converged eigenpairs, all ω² ≤ boundary
+    (``stats``: its steps, full re-orthogonalization passes and sparse products M·(n, b))."""
 
     omega2: np.ndarray
     modes: np.ndarray
     boundary: float
     columns: int
+    stats: dict = field(default_factory=dict)
+
+
+def _capped_run0(mass_ii, operator, cutoff_hz, progress, max_columns, release_operator=None,
+                 keep_prefix=None, block_size=12, tol=1e-8, seed=0):
+    """Run 0 of spectrum slicing: block Lanczos on K_ii⁻¹ M_ii (σ = 0) from a block of
+    ``block_size`` columns, stopped at ``max_columns`` columns, with the shifted runs' partial
+    re-orthogonalization (:func:`sarfe.reduction.spectrum_slicing.shifted_block_lanczos` at
+    σ = 0: a full M-re-orthogonalization pass only when Simon's estimate of the lost
+    orthogonality exceeds 1e-10, one sparse product M·(n, b) per step without it). A Ritz pair
+    is converged when ‖A φ − θ φ‖_M ≤ tol·θ, θ = 1/ω², relative to its own θ.
+
+    Returns (ω² (k,) ascending, Φ (n, k), Φᵀ M Φ = I) when every mode up to the cutoff has
+    converged within the cap; else the converged prefix as :class:`_Partial` (its boundary
+    halfway to the next Ritz value; ``keep_prefix(modes)``, when given, returns what it holds
+    instead of the vectors: the sink's handle); None when nothing converged. ``release_operator()``
+    is called after the last operator application, before the Ritz vectors are formed.
+    """
+    from sarfe.reduction.spectrum_slicing import shifted_block_lanczos
+
+    cutoff_omega2 = (2 * np.pi * cutoff_hz) ** 2
+
+    def converged_prefix(lam, converged):
+        order = np.argsort(lam)
+        flags = converged[order]
+        prefix = int(np.argmin(flags)) if not flags.all() else len(flags)
+        return order, prefix, int(np.count_nonzero(lam <= cutoff_omega2))
+
+    def satisfied(lam, converged):
+        _, prefix, wanted = converged_prefix(lam, converged)
+        if progress is not None:
+            progress(min(prefix, wanted), None)
+        return prefix > wanted              # every mode up to the cutoff, and one above it
+
+    stats = {}
+    lam, converged, eigenvectors = shifted_block_lanczos(mass_ii, operator, 0.0, satisfied,
+                                                         max_columns, block_size, tol, seed, stats)
+    if release_operator is not None:
+        release_operator()
+    order, prefix, wanted = converged_prefix(lam, converged)
+    if prefix > wanted:
+        return lam[order[:wanted]], eigenvectors(order[:wanted])
+    if prefix == 0:
+        return None
+    modes = eigenvectors(order[:prefix])
+    boundary = 0.5 * (lam[order[prefix - 1]] + lam[order[prefix]]) if prefix < len(lam) \
+        else float(lam[order[-1]])
+    return _Partial(lam[order[:prefix]], modes if keep_prefix is None else keep_prefix(modes),
+                    boundary, len(lam), stats)
 
 
 def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, block_size=16, tol=1e-8,
-                         seed=0, max_columns=None, store_mass_products=True, release_operator=None,
-                         keep_prefix=None):
+                         seed=0):
     """Lowest modes of K_ii φ = ω² M_ii φ by block shift-invert Lanczos (σ = 0), full M-reorthogonalization.
 
     Krylov space of A = K_ii⁻¹ M_ii from a block of ``block_size`` columns: every step is ONE
@@ -278,16 +332,9 @@ def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, blo
     Stops when the wanted Ritz pairs have residual < tol·ν (eigenvalue error ~ residual², so 1e-8
     gives frequencies to ~1e-15; 11 % fewer solves than 1e-10 on the door trim). Returns ω²
     (ascending), Φ (Φᵀ M Φ = I), or None when the Krylov space fills the interior before that (tiny
-    models). With ``max_columns``, a run that would outgrow it stops and returns the converged
-    prefix as ``_Partial`` (for :mod:`sarfe.reduction.spectrum_slicing` to go on from). Door trim at 5 mm (206k DOFs, 60 modes, one thread): 10.8 s CPU, down from 17.8 s with
-    two full Gram–Schmidt passes, row-major blocks and a too-small initial store.
-    ``store_mass_products=False`` keeps M Q only for the last two blocks (half the memory, one
-    more sparse product M·(n, b) per step: the full pass's Qᵀ (M w)); the spectrum-slicing worker
-    runs beside this process then. ``release_operator()``, when given, is called after the last
-    operator application, before the Ritz vectors are formed (the caller frees its factor there:
-    the factor, the Krylov store and the modes are not alive at once). ``keep_prefix(modes)``,
-    when given, receives a capped run's converged prefix (n, k) and returns what ``_Partial``
-    holds instead (the spectrum-slicing sink's handle: the vectors wait on disk).
+    models). Door trim at 5 mm (206k DOFs, 60 modes, one thread): 10.8 s CPU, down from 17.8 s with
+    two full Gram–Schmidt passes, row-major blocks and a too-small initial store. (A cutoff with
+    many modes caps the σ = 0 run instead: :func:`_capped_run0`, then spectrum slicing.)
     """
     n = mass_ii.shape[0]
     rng = np.random.default_rng(seed)
@@ -298,33 +345,22 @@ def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, blo
     # doubling below) — never n columns up front, which is two dense n×n arrays
     guess = min(target, n) if mode_count is not None else 64
     capacity = min(n, max(4 * block_size, 5 * guess + 2 * block_size))  # measured: ~4.8 columns per mode
-    if max_columns is not None:
-        # the whole capped store up front: growing it copies, and old + new store at 206k DOFs
-        # were 2.6 GB at once
-        capacity = min(n, max_columns + 2 * block_size)
     # Q, M Q preallocated column-major: a block of columns is then contiguous, which the sparse
     # solvers want (no copy per solve)
     store = np.empty((n, capacity), order="F")
-    mass_store = np.empty((n, capacity if store_mass_products else 0), order="F")
+    mass_store = np.empty((n, capacity), order="F")
     m_new = q.shape[1]
     store[:, :m_new] = q
-    if store_mass_products:
-        mass_store[:, :m_new] = mq
-    recent = [mq]                # M Q of the previous and the current block
+    mass_store[:, :m_new] = mq
     projected = np.zeros((0, 0))
     previous_start = 0  # first column of the block before the current one
     while True:
         m_old = projected.shape[0]
-        w = operator(recent[-1])
+        w = operator(mq)
         basis, mass_basis = store[:, :m_new], mass_store[:, :m_new]
-        mass_recent = None if store_mass_products else np.hstack(recent)
 
-        def mass_products(cols, y, start=previous_start):
-            if store_mass_products:
-                return mass_basis[:, cols].T @ y
-            if cols.start == start:            # the last two blocks: (M Q_l)ᵀ y
-                return mass_recent.T @ y
-            return basis[:, cols].T @ (mass_ii @ y)
+        def mass_products(cols, y):
+            return mass_basis[:, cols].T @ y
 
         # three-term part first (the current and previous block carry the large components of
         # A q), then ONE full M-orthogonalization pass against all of Q removes the rest: as
@@ -351,37 +387,18 @@ def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, blo
         done = leading >= wanted and above_cutoff and (wanted == target or cutoff_hz is not None)
         if done or m_new + q.shape[1] > n - 1 or q.shape[1] == 0:
             break
-        if max_columns is not None and m_new + q.shape[1] > max_columns:
-            # many modes: hand the converged prefix on to spectrum slicing — converged relative to
-            # each own ν, as the shifted runs test (ν_1-relative is loose for the higher modes and
-            # would leave them 1e-7 from M-orthogonal to the next slice's); the boundary lies
-            # halfway to the next Ritz value
-            strict = residual <= tol * np.abs(values)
-            prefix = int(np.argmin(strict)) if not strict.all() else len(strict)
-            if 0 < prefix < len(values):
-                if release_operator is not None:
-                    release_operator()
-                modes = basis @ vectors[:, :prefix]
-                return _Partial(omega2[:prefix], modes if keep_prefix is None else
-                                keep_prefix(modes), 0.5 * (omega2[prefix - 1] + omega2[prefix]),
-                                m_new)
         if m_new + q.shape[1] > capacity:
             capacity = min(n, max(2 * capacity, m_new + q.shape[1]))
             grown_store = np.empty((n, capacity), order="F")
-            grown_mass = np.empty((n, capacity), order="F") if store_mass_products else None
+            grown_mass = np.empty((n, capacity), order="F")
             grown_store[:, :m_new] = store[:, :m_new]
-            if store_mass_products:
-                grown_mass[:, :m_new] = mass_store[:, :m_new]
-            store, mass_store = grown_store, grown_mass if store_mass_products else mass_store
+            grown_mass[:, :m_new] = mass_store[:, :m_new]
+            store, mass_store = grown_store, grown_mass
         store[:, m_new:m_new + q.shape[1]] = q
-        if store_mass_products:
-            mass_store[:, m_new:m_new + q.shape[1]] = mq
-        recent = [recent[-1], mq]
+        mass_store[:, m_new:m_new + q.shape[1]] = mq
         m_new += q.shape[1]
     if not done:
         return None  # Krylov space exhausted before convergence (tiny interior): caller uses ARPACK
-    if release_operator is not None:
-        release_operator()
     modes = basis @ vectors[:, :wanted]
     return omega2[:wanted], modes
 
@@ -396,20 +413,18 @@ def _two_processes(workers):
     return workers >= 2 and "pardiso" in available_solvers()
 
 
-def _start_upper_slices(k_ii, m_ii, cutoff_hz, cap, held):
-    """Before run 0, a forked worker that counts the modes below the cutoff and, when they
-    outnumber what run 0 finds in its capped space, slices the upper part of the spectrum while
-    this process runs run 0 and the lower part
+def _start_upper_slices(k_ii, m_ii, cutoff_hz, cap):
+    """Right after the partition (before K_ii is factorized), a forked worker that counts the
+    modes below the cutoff and, when they outnumber what run 0 finds in its capped space, slices
+    the upper part of the spectrum while this process factorizes K_ii, forms Ψ and the residual
+    statics, runs run 0 and the lower part
     (:func:`sarfe.reduction.spectrum_slicing.start_upper_slices`). None where it cannot start."""
     from sarfe.reduction.spectrum_slicing import start_upper_slices
-
-    def drop_inherited_factor():
-        held["factor"] = None     # the worker's copy of K_ii's factor (it has its own shifts)
 
     try:
         return start_upper_slices(k_ii, m_ii, (2 * np.pi * cutoff_hz) ** 2,
                                   _RUN0_LEAD_PER_COLUMN * cap,
-                                  int(_PARALLEL_MODES_PER_COLUMN * cap), drop_inherited_factor)
+                                  int(_PARALLEL_MODES_PER_COLUMN * cap))
     except OSError:               # no temporary file or no process: one process does it all
         return None
 
@@ -476,7 +491,8 @@ def _slice(k_ii, m_ii, cutoff_hz, partial, progress, timings, upper, sink):
     except SlicingFailed as exc:
         timings["slicing"] = {"failed": str(exc)}
         return None
-    timings["slicing"] = dict(record, run0_columns=partial.columns, run0_modes=len(partial.omega2))
+    timings["slicing"] = dict(record, run0_columns=partial.columns, run0_modes=len(partial.omega2),
+                              **{"run0_" + key: value for key, value in partial.stats.items()})
     return omega2, modes
 
 
@@ -494,18 +510,21 @@ def residual_modes(stiffness_ii, mass_ii, operator, loads, modes, relative_toler
         return np.empty(0), np.empty((n, 0))
     if static is None:
         static = operator(np.asarray(loads, dtype=float))
-    norms = np.sqrt(np.einsum("ij,ij->j", static, mass_ii @ static))
+    mass_static = mass_ii @ static
+    norms = np.sqrt(np.einsum("ij,ij->j", static, mass_static))
     static = static[:, norms > 0] / norms[norms > 0]  # unit M-norm before deflation
+    mass_static = mass_static[:, norms > 0] / norms[norms > 0]
     for _ in range(2):  # deflate Φ twice (classical Gram–Schmidt, re-orthogonalized)
-        static = static - modes @ (modes.T @ (mass_ii @ static))
-    gram = static.T @ (mass_ii @ static)
+        static = static - modes @ (modes.T @ mass_static)
+        mass_static = mass_ii @ static        # (one sparse product per pass; reused below)
+    gram = static.T @ mass_static
     values, vectors = np.linalg.eigh(0.5 * (gram + gram.T))
     keep = values > relative_tolerance ** 2   # what is left of a unit column outside span Φ
     if not keep.any():
         return np.empty(0), np.empty((n, 0))
-    basis = static @ (vectors[:, keep] / np.sqrt(values[keep]))
-    basis, mass_basis = _m_orthonormal(basis, mass_ii)
-    basis = basis - modes @ (modes.T @ mass_basis)  # last clean-up against Φ
+    transform = vectors[:, keep] / np.sqrt(values[keep])
+    basis, mass_basis = _m_orthonormal(static @ transform, mass_ii, mass_static @ transform)
+    basis = basis - modes @ (modes.T @ mass_basis)  # the clean-up against Φ
     basis, _ = _m_orthonormal(basis, mass_ii)
     if basis.shape[1] == 0:
         return np.empty(0), np.empty((n, 0))
@@ -563,89 +582,100 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
     m_ib = mass[interior][:, boundary].tocsc()          # per matrix at 206k DOFs
     k_bb = stiffness[boundary][:, boundary].toarray()
     m_bb = mass[boundary][:, boundary].toarray()
+    wants_modes = (mode_count or 0) > 0 or (cutoff_hz is not None and mode_count is None)
+    if wants_modes and eigensolver not in ("block", "arpack"):
+        raise ValueError(f"eigensolver must be 'block' or 'arpack', got {eigensolver!r}")
+    # many modes up to a cutoff: cap run 0's Krylov store (Q, n × cap), slice the rest
+    cap = max(_SLICE_COLUMNS, int(_SLICE_ENTRIES // max(len(interior), 1))) \
+        if wants_modes and eigensolver == "block" and cutoff_hz is not None \
+        and mode_count is None else None
+    cap = cap if cap is not None and cap < len(interior) else None     # a cap ≥ n: no cap
+    two = cap is not None and _two_processes(workers)
+    # the worker is forked now, before K_ii's factor, Ψ and the statics exist (it needs none of
+    # them): its PARDISO analysis and count run beside this process's factorization
+    upper = _start_upper_slices(k_ii, m_ii, cutoff_hz, cap) if two else None
     lap("partition")
 
-    factor = factorize(k_ii, solver=solver, structure="spd")
-    lap("factorization")
+    try:
+        factor = factorize(k_ii, solver=solver, structure="spd")
+        lap("factorization")
 
-    psi = -factor.solve(k_ib.toarray()) if len(boundary) else np.empty((len(interior), 0))
-    lap("constraint_modes")
+        psi = -factor.solve(k_ib.toarray()) if len(boundary) else np.empty((len(interior), 0))
+        lap("constraint_modes")
 
-    applications = [0]
-    held, solver_name = {"factor": factor}, factor.name
-    del factor
+        applications = [0]
+        held, solver_name = {"factor": factor}, factor.name
+        del factor
 
-    def inverse(y):
-        applications[0] += 1 if y.ndim == 1 else y.shape[1]
-        if held["factor"] is None:        # freed for spectrum slicing, needed again (fallback)
-            held["factor"] = factorize(k_ii, solver=solver, structure="spd")
-        return held["factor"].solve(y)
+        def inverse(y):
+            applications[0] += 1 if y.ndim == 1 else y.shape[1]
+            if held["factor"] is None:        # freed for spectrum slicing, needed again (fallback)
+                held["factor"] = factorize(k_ii, solver=solver, structure="spd")
+            return held["factor"].solve(y)
 
-    # residual-vector loads and their static responses K_ii⁻¹ F_i, before any mode search (the
-    # factor of K_ii may be freed while slicing the spectrum)
-    # F_b = M_ib + M_ii Ψ: the interior load of unit boundary accelerations (also M_r's coupling
-    # block F_bᵀ Φ); built in place, and shared with the residual-vector loads
-    n_b = len(boundary)
-    extra = None if residual_loads is None else np.asarray(residual_loads, dtype=float)
-    extra = None if extra is None else (extra[:, None] if extra.ndim == 1 else extra)[interior]
-    with_boundary = bool(residual_vectors and n_b)
-    width = (n_b if with_boundary else 0) + (0 if extra is None else extra.shape[1])
-    loads = np.empty((len(interior), width)) if width else None
-    boundary_load = loads[:, :n_b] if with_boundary else np.empty((len(interior), n_b))
-    boundary_load[:] = m_ii @ psi
-    psi_m_psi = psi.T @ boundary_load                               # Ψᵀ M_ii Ψ
-    coo = m_ib.tocoo()
-    np.add.at(boundary_load, (coo.row, coo.col), coo.data)
-    if extra is not None:
-        loads[:, width - extra.shape[1]:] = extra
-        del extra
-    static = inverse(loads) if loads is not None else None
-    lap("residual_static")
-    restore = None                  # set when the statics wait on disk (two slicing processes)
+        # residual-vector loads and their static responses K_ii⁻¹ F_i, before any mode search (the
+        # factor of K_ii may be freed while slicing the spectrum)
+        # F_b = M_ib + M_ii Ψ: the interior load of unit boundary accelerations (also M_r's coupling
+        # block F_bᵀ Φ); built in place, and shared with the residual-vector loads
+        n_b = len(boundary)
+        extra = None if residual_loads is None else np.asarray(residual_loads, dtype=float)
+        extra = None if extra is None else (extra[:, None] if extra.ndim == 1 else extra)[interior]
+        with_boundary = bool(residual_vectors and n_b)
+        width = (n_b if with_boundary else 0) + (0 if extra is None else extra.shape[1])
+        loads = np.empty((len(interior), width)) if width else None
+        boundary_load = loads[:, :n_b] if with_boundary else np.empty((len(interior), n_b))
+        boundary_load[:] = m_ii @ psi
+        psi_m_psi = psi.T @ boundary_load                               # Ψᵀ M_ii Ψ
+        coo = m_ib.tocoo()
+        np.add.at(boundary_load, (coo.row, coo.col), coo.data)
+        if extra is not None:
+            loads[:, width - extra.shape[1]:] = extra
+            del extra
+        static = inverse(loads) if loads is not None else None
+        lap("residual_static")
+        restore = None                  # set when the statics wait on disk (two slicing processes)
 
-    if (mode_count or 0) > 0 or (cutoff_hz is not None and mode_count is None):
-        if eigensolver not in ("block", "arpack"):
-            raise ValueError(f"eigensolver must be 'block' or 'arpack', got {eigensolver!r}")
-        found = None
-        if eigensolver == "block":
-            # many modes up to a cutoff: cap run 0's Krylov space (two n × m arrays), slice the rest
-            cap = max(_SLICE_COLUMNS, int(_SLICE_ENTRIES // max(len(interior), 1))) \
-                if cutoff_hz is not None and mode_count is None else None
-            two = cap is not None and cap < len(interior) and _two_processes(workers)
-            if two:
-                # two processes will each hold a Krylov store and a factor: Ψ, the residual loads
-                # and their statics wait on disk, dropped before the fork so neither keeps them
-                restore = _park(psi, None if with_boundary else boundary_load, loads, static)
-                psi = boundary_load = loads = static = None
-            upper = _start_upper_slices(k_ii, m_ii, cutoff_hz, cap, held) if two else None
-            if upper is not None and not _worker_splits(upper):
-                upper = None              # few modes: run 0 as in one process
-            # two processes: the found vectors wait on disk while both slice (mode_sinks)
-            sink = _file_sink(len(interior)) if upper is not None else None
+        if wants_modes:
+            found = None
+            if eigensolver == "block":
+                if upper is not None:
+                    # two processes will each hold a Krylov store and a factor: Ψ, the residual loads
+                    # and their statics (formed after the fork: the worker has no copy) wait on disk
+                    restore = _park(psi, None if with_boundary else boundary_load, loads, static)
+                    psi = boundary_load = loads = static = None
+                if upper is not None and not _worker_splits(upper):
+                    upper = None              # few modes: run 0 as in one process
+                # two processes: the found vectors wait on disk while both slice (mode_sinks)
+                sink = _file_sink(len(interior)) if upper is not None else None
 
-            def release_factor():         # run 0 is over: K_ii's factor goes before its modes
-                held["factor"] = None     # (inverse() factorizes again if a fallback needs it)
+                def release_factor():         # run 0 is over: K_ii's factor goes before its modes
+                    held["factor"] = None     # (inverse() factorizes again if a fallback needs it)
 
-            found = _block_lanczos_modes(m_ii, inverse, mode_count, cutoff_hz, progress,
-                                         max_columns=cap, store_mass_products=upper is None,
-                                         release_operator=release_factor if cap else None,
-                                         keep_prefix=None if sink is None else sink.put)
-            if isinstance(found, _Partial):
-                held["factor"] = None     # K_ii's factor is not used by the shifted runs
-                found = _slice(k_ii, m_ii, cutoff_hz, found, progress, timings, upper, sink)
-            elif upper is not None:
-                upper.cancel()            # run 0 found them all after all
-                sink.remove()
-            upper = sink = None
-            if found is None and cap is not None:   # slicing impossible: one uncapped run
-                found = _block_lanczos_modes(m_ii, inverse, mode_count, cutoff_hz, progress)
-        if found is None:
-            found = _fixed_interface_modes(k_ii, m_ii, inverse, mode_count, cutoff_hz, progress)
-            eigensolver = "arpack"
-        omega2, blocks = found
-        timings["eigensolver"] = eigensolver
-    else:
-        omega2, blocks = np.empty(0), np.empty((len(interior), 0))
+                if cap is None:
+                    found = _block_lanczos_modes(m_ii, inverse, mode_count, cutoff_hz, progress)
+                else:
+                    found = _capped_run0(m_ii, inverse, cutoff_hz, progress, cap, release_factor,
+                                         None if sink is None else sink.put)
+                if isinstance(found, _Partial):
+                    held["factor"] = None     # K_ii's factor is not used by the shifted runs
+                    found = _slice(k_ii, m_ii, cutoff_hz, found, progress, timings, upper, sink)
+                elif upper is not None:
+                    upper.cancel()            # run 0 found them all after all
+                    sink.remove()
+                upper = sink = None
+                if found is None and cap is not None:   # slicing impossible: one uncapped run
+                    found = _block_lanczos_modes(m_ii, inverse, mode_count, cutoff_hz, progress)
+            if found is None:
+                found = _fixed_interface_modes(k_ii, m_ii, inverse, mode_count, cutoff_hz, progress)
+                eigensolver = "arpack"
+            omega2, blocks = found
+            timings["eigensolver"] = eigensolver
+        else:
+            omega2, blocks = np.empty(0), np.empty((len(interior), 0))
+    except BaseException:      # the worker forked above goes too
+        if upper is not None:
+            upper.cancel()
+        raise
     held["factor"] = None
     if restore is not None:
         psi, boundary_load, loads, static = restore()

@@ -26,7 +26,8 @@ once (:func:`sarfe.fe.linear_solvers.shifted_factorizer`), each shift only its n
 
 Two processes (two usable cores): a chain of runs needs nothing from another chain but a
 certified count at its bottom, so the spectrum is split at a shift λ_s chosen by count. A worker
-forked before run 0 counts N(λ_c) and tells this process whether it splits; it then places λ_s so
+forked right after Craig–Bampton's partition (while this process factorizes K_ii and forms Ψ and
+the residual statics) counts N(λ_c) and tells this process whether it splits; it then places λ_s so
 that N(λ_s) ≈ (N(λ_c) + lead)/2 (:func:`split_count`: this process's run 0 finds its modes at a
 lower cost per mode than the shifted runs, ``lead`` modes ahead) from one or two factorizations
 whose inertia gives exact counts (:func:`split_shift`), and runs the chain over (λ_s, λ_c] from
@@ -45,10 +46,12 @@ benchmarks/results/linear.md, P1 memory).
 
 All runs use the M inner product; a Ritz pair is converged when ‖A φ − θ φ‖_M ≤ tol·|θ| (relative
 to its own θ: a value next to the shift, with a huge θ, must not loosen the test for the others).
-A shifted run re-orthogonalizes a new block against the whole stored basis only when Simon's
-recurrence estimates its M-orthogonality to an older block above 1e-10 (partial
-re-orthogonalization, :func:`shifted_block_lanczos`): about every second step on the door trim,
-17 % less CPU per run, the same Ritz values to ~1e-14.
+Every run (run 0 at σ = 0 too) re-orthogonalizes a new block against the whole stored basis
+only when Simon's recurrence estimates its M-orthogonality to an older block above 1e-10
+(partial re-orthogonalization, :func:`shifted_block_lanczos`): about every second step on the
+door trim, 15–17 % less CPU per run, the same Ritz values to ~1e-14. Blocks of 12 columns: on
+the door trim a window converges in 10 % fewer columns than with 16 for 6 % less CPU (the
+multi-RHS solves cost a little more per column); 24 and 32 took 24 % and 42 % more CPU.
 """
 from __future__ import annotations
 
@@ -74,7 +77,7 @@ _ORTHOGONALITY = 1e-10
 _EPS = np.finfo(float).eps
 
 
-def shifted_block_lanczos(mass, operator, shift, satisfied, max_columns, block_size=16, tol=1e-8,
+def shifted_block_lanczos(mass, operator, shift, satisfied, max_columns, block_size=12, tol=1e-8,
                           seed=0, stats=None, partial=True):
     r"""Block Lanczos on A = (K − σM)⁻¹ M (``operator(Y)`` = (K − σM)⁻¹ Y, σ = ``shift``) in the
     M inner product; Q (n, m) is stored, M Q only for the last two blocks (the three-term part).
@@ -552,13 +555,13 @@ def _remove(path):
         pass
 
 
-def start_upper_slices(stiffness, mass, cutoff_omega2, lead, min_total, on_fork=None,
-                       slice_modes=80, max_columns=400):
+def start_upper_slices(stiffness, mass, cutoff_omega2, lead, min_total, slice_modes=80,
+                       max_columns=400):
     """Fork a worker that counts the eigenvalues below the cutoff and, when there are more than
     ``min_total``, finds every eigenpair in (λ_s, cutoff], N(λ_s) ≈ (total + ``lead``)/2
     (:func:`split_count`, :func:`split_shift`; this process takes (0, λ_s]). K, M are shared
-    copy-on-write; ``on_fork()`` runs first in the worker to free what it inherited and does not
-    need (the parent's factor of K_ii). The modes go to a file in the temporary directory (a
+    copy-on-write (fork it before anything large the worker does not need exists, e.g. the
+    factor of K_ii: Craig–Bampton forks right after the partition). The modes go to a file in the temporary directory (a
     :class:`~sarfe.reduction.mode_sinks.FileSink`: on disk, not in either process's memory) that
     :meth:`UpperSlices.join` maps and removes. Returns an :class:`UpperSlices`, or None where fork is not available or this
     process is a daemon (a Dask or multiprocessing worker may not have children). The worker's
@@ -573,14 +576,14 @@ def start_upper_slices(stiffness, mass, cutoff_omega2, lead, min_total, on_fork=
     receive, send = context.Pipe(duplex=False)
     process = context.Process(target=_upper_worker, daemon=True,
                               args=(send, stiffness, mass, cutoff_omega2, lead, min_total,
-                                    on_fork, path, slice_modes, max_columns))
+                                    path, slice_modes, max_columns))
     process.start()
     send.close()
     return UpperSlices(process, receive, path, mass.shape[0])
 
 
-def _upper_worker(connection, stiffness, mass, cutoff_omega2, lead, min_total, on_fork,
-                  path, slice_modes, max_columns):
+def _upper_worker(connection, stiffness, mass, cutoff_omega2, lead, min_total, path,
+                  slice_modes, max_columns):
     """The forked side of :func:`start_upper_slices`: its own PARDISO analysis (the parent's
     instance is not shared), the count below the cutoff (sent at once: this process's run 0
     waits for it), the split by count (sent when placed: this process needs it after run 0),
@@ -588,8 +591,6 @@ def _upper_worker(connection, stiffness, mass, cutoff_omega2, lead, min_total, o
     they are formed (a :class:`~sarfe.reduction.mode_sinks.FileSink`; the kept columns go to
     this process with the values)."""
     try:
-        if on_fork is not None:
-            on_fork()
         factor_at = shifted_factorizer(stiffness, mass, solver="pardiso")
         counting = {"factorizations": 0}
 

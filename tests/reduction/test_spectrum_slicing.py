@@ -219,6 +219,32 @@ def test_worker_failing_at_its_split_leaves_one_chain(twin, one, capped, monkeyp
     assert not list(tmp_path.iterdir())
 
 
+def test_failure_after_the_early_fork_stops_the_worker(twin, capped, monkeypatch, tmp_path):
+    """The worker is forked right after the partition, before K_ii is factorized: when the
+    factorization fails (a singular K_ii, say) the error reaches the caller, the worker is
+    stopped and its file removed."""
+    import multiprocessing
+    import tempfile
+
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    module = importlib.import_module("sarfe.reduction.craig_bampton")
+    started = []
+    start = module._start_upper_slices
+    monkeypatch.setattr(module, "_start_upper_slices",
+                        lambda *args: started.append(start(*args)) or started[-1])
+
+    def singular(*args, **kwargs):
+        raise RuntimeError("singular K_ii")
+
+    monkeypatch.setattr(module, "factorize", singular)
+    with pytest.raises(RuntimeError, match="singular K_ii"):
+        reduce(twin, workers=2)
+    assert started and started[0] is not None              # the worker was running
+    assert not started[0].process.is_alive()
+    assert started[0].process not in multiprocessing.active_children()
+    assert not list(tmp_path.iterdir())
+
+
 def test_split_shift_hits_the_wanted_count():
     """split_shift from real inertia counts (PARDISO LDLᵀ of K − σM of the plate): the count it
     returns is N(λ_s) of the dense spectrum, within 2 % of the total of the wanted count or the
