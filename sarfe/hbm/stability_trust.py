@@ -81,15 +81,14 @@ def count_at(problem, omega, U, forces, harmonics, tolerance):
                              tolerance=tolerance)
 
 
-def checked(result, zeros, problem, omega, U, forces, tolerance):
+def checked(result, zeros, coarse, problem):
     """``result`` (the verdict at H; ``zeros``: exponents counted right of −ε, or None) unless the
-    count at H' = :func:`check_harmonics` contradicts it (module docstring): then None with a
-    note. A single real exponent right of the band (a fold's middle branch) is not checked."""
+    count at H' = :func:`check_harmonics` (``coarse``, from the same contour:
+    :func:`sarfe.hbm.stability_rows.contact_row_counts`; None where it did not close) contradicts
+    it (module docstring): then None with a note. A single real exponent right of the band (a
+    fold's middle branch) is not checked."""
     H_coarse = check_harmonics(problem.harmonics)
-    if result.stable is None or zeros is None or zeros == 1 or H_coarse < 1:
-        return result
-    _, coarse = count_at(problem, omega, U, forces, H_coarse, tolerance)
-    if coarse is None:
+    if result.stable is None or zeros is None or zeros == 1 or H_coarse < 1 or coarse is None:
         return result
     if (result.stable is True and coarse > 0) or (result.stable is False and coarse == 0):
         return replace(result, stable=None, note=(
