@@ -59,6 +59,7 @@ import weakref
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from scipy.linalg import get_lapack_funcs
 
 from .aft import jacobian_matrix
 from .modal import cached_modal_basis, modal_basis
@@ -66,6 +67,7 @@ from .modal import cached_modal_basis, modal_basis
 STABILITY_DAMPING_TOLERANCE = 1e-6   # modal-diagonal damping check of the count's basis (see below)
 PHASE_STEP = np.pi / 3       # largest change of arg det F between neighbouring contour samples
 MAX_EVALUATIONS = 1500       # det F evaluations per point before giving up (→ Ritz method)
+GROWTH_LIMIT = 1e6           # block LU of det F and its leading block: largest eliminated part
 
 
 def structural_exponents(flexibility, damping):
@@ -284,25 +286,64 @@ class ContactRowDeterminant:
             if np.any(regular):
                 M = (J if regular.all() else J[regular]).reshape(-1, P, width, P, width)
                 _add_real_blocks(M, inverse[regular])
-                M = M.reshape(-1, S, S)
                 sign_A, logabs_A = np.linalg.slogdet(A[regular])
-                for column, (size, count) in enumerate(zip(sizes, blocks)):
-                    sign, logabs = np.linalg.slogdet(M if size == S else M[:, :size, :size])
-                    v = logabs + logabs_A[:, :count].sum(axis=1) + 1j * np.angle(
-                        sign * np.prod(sign_A[:, :count], axis=1))
-                    v[~(np.isfinite(logabs) & (sign != 0))] = np.nan
-                    value[regular, column] = v
+                logdet_A = logabs_A + 1j * np.angle(sign_A)                       # (m, P)
+                v = _log_determinants(M.reshape(-1, S, S), sizes)
+                for column, count in enumerate(blocks):
+                    v[:, column] += logdet_A[:, :count].sum(axis=1)
+                value[regular] = v
             if not np.all(regular):     # (J is intact: M was a copy when some s failed)
                 F = _real_block_product(A[~regular], J[~regular].reshape(-1, P, width, S))
                 F = F.reshape(-1, S, S)
                 F[:, np.arange(S), np.arange(S)] += 1.0
-                for column, size in enumerate(sizes):
-                    sign, logabs = np.linalg.slogdet(F if size == S else F[:, :size, :size])
-                    bad = ~np.isfinite(logabs) | (sign == 0)
-                    value[~regular, column] = np.where(bad, np.nan,
-                                                       logabs + 1j * np.angle(sign))
+                value[~regular] = _log_determinants(F, sizes)
             out[first:first + chunk] = value
+        out.imag = np.angle(np.exp(1j * out.imag))                             # arg in (−π, π]
         return out[:, 0] if coarse is None else out
+
+
+def _log_determinants(M, sizes, growth=GROWTH_LIMIT):
+    """log det of M (n, S, S) and, for ``sizes`` = [S, S'], of its leading S' × S' block:
+    (n, len(sizes)) complex, log|det| + i arg det, nan where det = 0.
+
+    One size: LAPACK's LU (np.linalg.slogdet). Two: one LU of the leading block,
+    M = [[M₁₁, M₁₂], [M₂₁, M₂₂]], det M = det M₁₁ · det(M₂₂ − M₂₁ M₁₁⁻¹ M₁₂): M₁₁'s LU gives
+    det M₁₁ and the solve, the Schur complement (order S − S') its own LU — about one LU of order
+    S for both determinants instead of S³ + S'³. Partial pivoting inside M₁₁ only is backward
+    stable while the eliminated part stays small: where max|M₂₁ M₁₁⁻¹ M₁₂| > ``growth``·max|M|
+    (M₁₁ nearly singular: s near a zero of det M₁₁) or M₁₁ is singular, det M is taken from its
+    own LU (np.linalg.slogdet)."""
+    n, S = M.shape[0], M.shape[1]
+    out = np.empty((n, len(sizes)), complex)
+    if len(sizes) == 1:
+        sign, logabs = np.linalg.slogdet(M)
+        out[:, 0] = np.where(np.isfinite(logabs) & (sign != 0), logabs + 1j * np.angle(sign),
+                             np.nan)
+        return out
+    size = sizes[1]
+    getrf, getrs = get_lapack_funcs(("getrf", "getrs"), (M,))
+    fallback = []
+    for k in range(n):
+        lu, piv, info = getrf(M[k, :size, :size])
+        diagonal = np.diagonal(lu)
+        if info != 0 or not np.all(np.isfinite(diagonal)):     # det M₁₁ = 0 (or not finite)
+            out[k, 1] = np.nan
+            fallback.append(k)
+            continue
+        swaps = np.count_nonzero(piv != np.arange(size))
+        out[k, 1] = np.log(np.abs(diagonal)).sum() + 1j * np.angle(
+            np.prod(diagonal / np.abs(diagonal)) * (-1.0) ** swaps)
+        solved, info = getrs(lu, piv, M[k, :size, size:])
+        eliminated = M[k, size:, :size] @ solved
+        if info != 0 or not np.abs(eliminated).max(initial=0.0) <= growth * np.abs(M[k]).max():
+            fallback.append(k)
+            continue
+        sign, logabs = np.linalg.slogdet(M[k, size:, size:] - eliminated)
+        out[k, 0] = out[k, 1] + logabs + 1j * np.angle(sign) if (
+            np.isfinite(logabs) and sign != 0) else np.nan
+    if fallback:
+        out[fallback, :1] = _log_determinants(M[fallback], sizes[:1])
+    return out
 
 
 def _real_blocks(X):
