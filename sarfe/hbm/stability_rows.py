@@ -48,7 +48,9 @@ exponents left of −ε are not located). One zero in Ω: it is real (a fold's e
 the real axis by the sign of det F, and decides the verdict (:func:`contact_row_stability`). Two
 or more zeros in Ω, a pole near the contour, a model without a modal basis or a contour that does
 not close on a multiple of π: ``None`` — the caller then locates the exponents by the Ritz-basis
-Hill method (:mod:`sarfe.hbm.stability_condensed`).
+Hill method (:mod:`sarfe.hbm.stability_condensed`). The check of :mod:`sarfe.hbm.stability_trust` (the contact
+coupling cut to H' < H) is counted along the same contour from the same LU
+(:func:`contact_row_counts`, :meth:`ContactRowDeterminant.log_determinants`).
 Measured against the full Hill method in tests/hbm/test_stability_rows.py and
 benchmarks/bench_stability.py.
 """

@@ -14,7 +14,9 @@ steps in time, whose Fourier series converges slowly, and near a fold or a grazi
 nearest the axis move by more than their distance from it when H changes. So the count is
 repeated with the contact coupling cut to H' = ⌊3H/4⌋ harmonics (the same orbit, the same AFT
 Jacobian, its (2H'+1)-row Galerkin block — no re-solve; the leading (cos, sin) rows of each block
-in the harmonic-major order, and the friction memory at H'), and
+in the harmonic-major order, and the friction memory at H', the leading block of that at H),
+on the contour of the count at H and from the same LU
+(:func:`sarfe.hbm.stability_rows.contact_row_counts`), and
 
     unstable at H (an exponent right of −ε located or counted) and no zero right of −ε at H',
     or stable at H (no zero right of −ε) and zeros right of −ε at H'
@@ -71,7 +73,8 @@ def truncated_forces(forces, harmonics: int):
 def count_at(problem, omega, U, forces, harmonics, tolerance):
     """(StabilityResult or None, zeros) of the contact-row count of the same orbit with the
     contact coupling cut to ``harmonics`` < H (:func:`truncated_forces`; the friction memory
-    rebuilt at that order)."""
+    rebuilt at that order), on its own contour: the check the default computed before it shared
+    the count's contour (:func:`checked`), kept as the reference of that shared count (tests)."""
     forces = truncated_forces(forces, harmonics)
     coarse = Problem(problem.model, problem.contacts, problem.excitation[:2 * harmonics + 1],
                      harmonics, problem.samples_per_period, problem.friction_tolerance,
