@@ -184,7 +184,7 @@ def sweep_cost(path="cases/door_trim_p1.yaml", mesh=0.015):
     phase, counts = ["contour"], {}
     original_ld = rows_module.ContactRowDeterminant.log_determinants
     original_zero, original_ritz = rows_module.real_zero, solve_module.condensed_stability
-    original_count = solve_module.contact_row_count
+    original_count = solve_module.contact_row_counts
 
     def log_determinants(self, s, *args, **kwargs):
         counts[phase[0]] = counts.get(phase[0], 0) + np.atleast_1d(s).size
@@ -197,9 +197,9 @@ def sweep_cost(path="cases/door_trim_p1.yaml", mesh=0.015):
         finally:
             phase[0] = "contour"
 
-    def contact_row_count(*args, **kwargs):
+    def contact_row_counts(*args, **kwargs):
         out = original_count(*args, **kwargs)
-        counts["zeros"] = out[1]
+        counts["zeros"], counts["check_zeros"] = out[1], out[2]
         return out
 
     def ritz(*args, **kwargs):
@@ -208,7 +208,7 @@ def sweep_cost(path="cases/door_trim_p1.yaml", mesh=0.015):
 
     rows_module.ContactRowDeterminant.log_determinants = log_determinants
     rows_module.real_zero, solve_module.condensed_stability = real_zero, ritz
-    solve_module.contact_row_count = contact_row_count
+    solve_module.contact_row_counts = contact_row_counts
     points = []
     try:
         for job in jobs:
@@ -218,12 +218,13 @@ def sweep_cost(path="cases/door_trim_p1.yaml", mesh=0.015):
             points.append(dict(frequency_hz=job.omega / (2 * np.pi), cpu_s=time.process_time() - t,
                                contour_evaluations=counts.get("contour", 0),
                                real_zero_evaluations=counts.get("real_zero", 0),
-                               zeros=counts.get("zeros"), ritz=counts.get("ritz", False),
+                               zeros=counts.get("zeros"), check_zeros=counts.get("check_zeros"),
+                               ritz=counts.get("ritz", False),
                                verdict=r.stable, leading=r.leading, note=r.note))
     finally:
         rows_module.ContactRowDeterminant.log_determinants = original_ld
         rows_module.real_zero, solve_module.condensed_stability = original_zero, original_ritz
-        solve_module.contact_row_count = original_count
+        solve_module.contact_row_counts = original_count
     H = case.data["solver"]["harmonics"]
     return {"case": f"{path} at {mesh * 1e3:g} mm, its sweep, H = {H}, defaults",
             "reduced_dofs": nl.model.dof_count, "contact_rows": nl.contacts.row_count,

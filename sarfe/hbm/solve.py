@@ -42,8 +42,9 @@ from .solution import HarmonicSolution, SolverOptions
 from .stability import hill_stability
 from .stability_condensed import condensed_stability
 from .stability_contacts import ContactOperator
-from .stability_rows import contact_row_count
+from .stability_rows import contact_row_counts
 from .stability_trust import auto_method, checked
+from .stability_trust import check_harmonics as checked_harmonics
 
 CHORD_STEPS = True       # fixed-ω Newton reuses its LU while it contracts (sarfe.hbm.newton)
 
@@ -283,9 +284,10 @@ def stability(problem, omega, U, ev, options):
     operator = ContactOperator(problem, U, omega, ev.forces)
     method = stability_method(problem, options)
     if method == "contact_rows":
-        result, zeros = contact_row_count(problem.model, problem.contacts, omega,
-                                          problem.harmonics, ev.forces, operator,
-                                          tolerance=options.stability_tolerance)
+        result, zeros, coarse = contact_row_counts(
+            problem.model, problem.contacts, omega, problem.harmonics, ev.forces, operator,
+            tolerance=options.stability_tolerance,
+            check_harmonics=checked_harmonics(problem.harmonics))
         if result is None:
             result = condensed_stability(problem.model, problem.contacts, omega, problem.harmonics,
                                          ev.forces, operator, tolerance=options.stability_tolerance)
@@ -294,7 +296,7 @@ def stability(problem, omega, U, ev, options):
                     f"the contact-row count finds {zeros} Floquet exponent(s) right of "
                     f"−1e-4·ω that the Ritz basis does not locate (it says {result.leading:.3g} 1/s)"))
         # the verdict at H stands where the count at a coarser contact coupling agrees
-        return checked(result, zeros, problem, omega, U, ev.forces, options.stability_tolerance)
+        return checked(result, zeros, coarse, problem)
     if method == "condensed":
         return condensed_stability(problem.model, problem.contacts, omega, problem.harmonics,
                                    ev.forces, operator, tolerance=options.stability_tolerance)

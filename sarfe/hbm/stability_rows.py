@@ -48,7 +48,9 @@ exponents left of −ε are not located). One zero in Ω: it is real (a fold's e
 the real axis by the sign of det F, and decides the verdict (:func:`contact_row_stability`). Two
 or more zeros in Ω, a pole near the contour, a model without a modal basis or a contour that does
 not close on a multiple of π: ``None`` — the caller then locates the exponents by the Ritz-basis
-Hill method (:mod:`sarfe.hbm.stability_condensed`).
+Hill method (:mod:`sarfe.hbm.stability_condensed`). The check of :mod:`sarfe.hbm.stability_trust` (the contact
+coupling cut to H' < H) is counted along the same contour from the same LU
+(:func:`contact_row_counts`, :meth:`ContactRowDeterminant.log_determinants`).
 Measured against the full Hill method in tests/hbm/test_stability_rows.py and
 benchmarks/bench_stability.py.
 """
@@ -59,6 +61,7 @@ import weakref
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from scipy.linalg import get_lapack_funcs
 
 from .aft import jacobian_matrix
 from .modal import cached_modal_basis, modal_basis
@@ -66,6 +69,7 @@ from .modal import cached_modal_basis, modal_basis
 STABILITY_DAMPING_TOLERANCE = 1e-6   # modal-diagonal damping check of the count's basis (see below)
 PHASE_STEP = np.pi / 3       # largest change of arg det F between neighbouring contour samples
 MAX_EVALUATIONS = 1500       # det F evaluations per point before giving up (→ Ritz method)
+GROWTH_LIMIT = 1e6           # block LU of det F and its leading block: largest eliminated part
 
 
 def structural_exponents(flexibility, damping):
@@ -234,7 +238,12 @@ class ContactRowDeterminant:
         F[:, np.arange(S), np.arange(S)] += 1.0
         return F
 
-    def log_determinants(self, s, chunk=8):
+    def coarse_size(self, harmonics):
+        """S' = (2H'+1)|R|: the leading rows of the harmonic-major loaded rows L that carry the
+        contact coupling cut to H' ≤ H harmonics (:meth:`log_determinants`)."""
+        return (2 * int(harmonics) + 1) * self.rows.size
+
+    def log_determinants(self, s, chunk=8, coarse=None):
         """log det F(s) (n_s,) complex: log|det| + i arg det (nan where det F = 0); the memory
         rows for all s in one march, ``chunk`` exponents at a time.
 
@@ -244,11 +253,24 @@ class ContactRowDeterminant:
         no product C𝒥 is formed, and det C = Π_b det A_b (W C Wᴴ = ⊕_b A_b, W unitary) is a
         product of small determinants. A block that does not
         invert to 10⁻⁸ (two loaded rows with dependent gap maps, a transmission zero) sends its s
-        to the product form I + C𝒥 (:meth:`matrices`)."""
+        to the product form I + C𝒥 (:meth:`matrices`).
+
+        ``coarse`` = H' < H: also log det F' of the contact coupling cut to H' harmonics, as a
+        second column ((n_s, 2)). In the harmonic-major order 𝒥 at H' is the leading S' × S'
+        block of 𝒥 at H (the AFT Jacobian's Galerkin block, the pointwise parts, and the friction
+        memory rows, whose march is linear column by column:
+        tests/hbm/test_stability_trust.py) and C⁻¹ is block diagonal over the harmonics, so
+
+            det F' = Π_{|m| ≤ H'} det A(s + imω) · det (C⁻¹ + 𝒥)[:S', :S']
+
+        (in the product form: F' = F[:S', :S'], C being block diagonal). Both come from the same
+        compliance blocks, contact terms and memory march; the leading block is a second LU."""
         s = np.asarray(s, dtype=complex)
-        out = np.empty(s.size, complex)
+        out = np.empty((s.size, 1 if coarse is None else 2), complex)
         memory = self.memory.memory_coefficients(s) if self.memory is not None else None
         P, width, S = 2 * self.H + 1, self.rows.size, self.size
+        sizes = [S] if coarse is None else [S, self.coarse_size(coarse)]
+        blocks = [P] if coarse is None else [P, 2 * int(coarse) + 1]
         for first in range(0, s.size, chunk):
             sc = s[first:first + chunk]
             part = None if memory is None else [(rows, coeff[first:first + chunk])
@@ -262,24 +284,68 @@ class ContactRowDeterminant:
                 except np.linalg.LinAlgError:
                     inverse, check = None, np.full(sc.size, np.inf)
             regular = np.isfinite(check) & (check <= 1e-8)
-            value = np.empty(sc.size, complex)
+            value = np.empty((sc.size, len(sizes)), complex)
             if np.any(regular):
                 M = (J if regular.all() else J[regular]).reshape(-1, P, width, P, width)
                 _add_real_blocks(M, inverse[regular])
-                sign, logabs = np.linalg.slogdet(M.reshape(-1, S, S))
                 sign_A, logabs_A = np.linalg.slogdet(A[regular])
-                value[regular] = logabs + logabs_A.sum(axis=1) + 1j * np.angle(
-                    sign * np.prod(sign_A, axis=1))
-                value[regular & ~(np.isfinite(logabs) & (sign != 0))] = np.nan
+                logdet_A = logabs_A + 1j * np.angle(sign_A)                       # (m, P)
+                v = _log_determinants(M.reshape(-1, S, S), sizes)
+                for column, count in enumerate(blocks):
+                    v[:, column] += logdet_A[:, :count].sum(axis=1)
+                value[regular] = v
             if not np.all(regular):     # (J is intact: M was a copy when some s failed)
                 F = _real_block_product(A[~regular], J[~regular].reshape(-1, P, width, S))
                 F = F.reshape(-1, S, S)
                 F[:, np.arange(S), np.arange(S)] += 1.0
-                sign, logabs = np.linalg.slogdet(F)
-                bad = ~np.isfinite(logabs) | (sign == 0)
-                value[~regular] = np.where(bad, np.nan, logabs + 1j * np.angle(sign))
+                value[~regular] = _log_determinants(F, sizes)
             out[first:first + chunk] = value
+        out.imag = np.angle(np.exp(1j * out.imag))                             # arg in (−π, π]
+        return out[:, 0] if coarse is None else out
+
+
+def _log_determinants(M, sizes, growth=GROWTH_LIMIT):
+    """log det of M (n, S, S) and, for ``sizes`` = [S, S'], of its leading S' × S' block:
+    (n, len(sizes)) complex, log|det| + i arg det, nan where det = 0.
+
+    One size: LAPACK's LU (np.linalg.slogdet). Two: one LU of the leading block,
+    M = [[M₁₁, M₁₂], [M₂₁, M₂₂]], det M = det M₁₁ · det(M₂₂ − M₂₁ M₁₁⁻¹ M₁₂): M₁₁'s LU gives
+    det M₁₁ and the solve, the Schur complement (order S − S') its own LU — about one LU of order
+    S for both determinants instead of S³ + S'³. Partial pivoting inside M₁₁ only is backward
+    stable while the eliminated part stays small: where max|M₂₁ M₁₁⁻¹ M₁₂| > ``growth``·max|M|
+    (M₁₁ nearly singular: s near a zero of det M₁₁) or M₁₁ is singular, det M is taken from its
+    own LU (np.linalg.slogdet)."""
+    n, S = M.shape[0], M.shape[1]
+    out = np.empty((n, len(sizes)), complex)
+    if len(sizes) == 1:
+        sign, logabs = np.linalg.slogdet(M)
+        out[:, 0] = np.where(np.isfinite(logabs) & (sign != 0), logabs + 1j * np.angle(sign),
+                             np.nan)
         return out
+    size = sizes[1]
+    getrf, getrs = get_lapack_funcs(("getrf", "getrs"), (M,))
+    fallback = []
+    for k in range(n):
+        lu, piv, info = getrf(M[k, :size, :size])
+        diagonal = np.diagonal(lu)
+        if info != 0 or not np.all(np.isfinite(diagonal)):     # det M₁₁ = 0 (or not finite)
+            out[k, 1] = np.nan
+            fallback.append(k)
+            continue
+        swaps = np.count_nonzero(piv != np.arange(size))
+        out[k, 1] = np.log(np.abs(diagonal)).sum() + 1j * np.angle(
+            np.prod(diagonal / np.abs(diagonal)) * (-1.0) ** swaps)
+        solved, info = getrs(lu, piv, M[k, :size, size:])
+        eliminated = M[k, size:, :size] @ solved
+        if info != 0 or not np.abs(eliminated).max(initial=0.0) <= growth * np.abs(M[k]).max():
+            fallback.append(k)
+            continue
+        sign, logabs = np.linalg.slogdet(M[k, size:, size:] - eliminated)
+        out[k, 0] = out[k, 1] + logabs + 1j * np.angle(sign) if (
+            np.isfinite(logabs) and sign != 0) else np.nan
+    if fallback:
+        out[fallback, :1] = _log_determinants(M[fallback], sizes[:1])
+    return out
 
 
 def _real_blocks(X):
@@ -377,23 +443,46 @@ def winding_count(log_det, points, step=PHASE_STEP, budget=MAX_EVALUATIONS):
     vectorized over s; a segment is halved while its change of arg exceeds ``step``. Returns
     (Δarg/π, evaluations), or (nan, evaluations) when f vanishes on the path or the budget runs
     out."""
+    counts, evaluations = winding_counts(log_det, points, step, budget)
+    return float(counts[0]), evaluations
+
+
+def winding_counts(log_det, points, step=PHASE_STEP, budget=MAX_EVALUATIONS):
+    """:func:`winding_count` of several functions f_c = exp(log_det(s)[:, c]) on one node set:
+    log_det returns (n_s,) or (n_s, n_f); a segment is halved while the arg of any f_c that is
+    still counted changes by more than ``step`` along it, so every f_c is sampled at least as
+    finely as alone. Returns (Δarg/π per function (n_f,), evaluations). A function that vanishes
+    on a node, or needs a segment shorter than 10⁻⁹|s|, gets nan and stops steering the
+    refinement; when the budget runs out the last function still counted is dropped first (the
+    first is the primary count: it is refined alone as long as the budget allows)."""
     points = np.asarray(points, dtype=complex)
-    values = log_det(points)
+    values = np.asarray(log_det(points))
+    values = values.reshape(points.size, -1)
     evaluations = points.size
+    counts = np.full(values.shape[1], np.nan)
+    active = np.ones(values.shape[1], bool)
     while True:
-        if np.any(np.isnan(values)):
-            return float("nan"), evaluations
-        change = np.diff(values)
-        phase = np.angle(np.exp(1j * change.imag))
-        coarse = np.flatnonzero(np.abs(phase) > step)
-        if coarse.size == 0:
-            return float(phase.sum() / np.pi), evaluations
-        middle = 0.5 * (points[coarse] + points[coarse + 1])
-        if evaluations + middle.size > budget or np.any(
-                np.abs(points[coarse + 1] - points[coarse]) < 1e-9 * np.abs(middle).clip(1.0)):
-            return float("nan"), evaluations
+        active &= ~np.any(np.isnan(values), axis=0)
+        phase = np.angle(np.exp(1j * np.diff(values.imag, axis=0)))           # (n − 1, n_f)
+        wide = np.abs(phase) > step
+        done = active & ~wide.any(axis=0)
+        counts[done] = phase[:, done].sum(axis=0) / np.pi
+        active &= ~done
+        while active.any():
+            coarse = np.flatnonzero(wide[:, active].any(axis=1))
+            middle = 0.5 * (points[coarse] + points[coarse + 1])
+            tiny = np.abs(points[coarse + 1] - points[coarse]) < 1e-9 * np.abs(middle).clip(1.0)
+            failed = active & wide[coarse[tiny]].any(axis=0)
+            if evaluations + middle.size > budget and not failed.any():
+                failed[np.flatnonzero(active)[-1]] = True
+            if not failed.any():
+                break
+            active &= ~failed
+        if not active.any():
+            return counts, evaluations
         points = np.insert(points, coarse + 1, middle)
-        values = np.insert(values, coarse + 1, log_det(middle))
+        values = np.insert(values, coarse + 1, np.asarray(log_det(middle)).reshape(
+            middle.size, -1), axis=0)
         evaluations += middle.size
 
 
@@ -459,8 +548,19 @@ def contact_row_stability(model, contacts, omega, harmonics, forces, operator=No
 
 def contact_row_count(model, contacts, omega, harmonics, forces, operator=None,
                       uncertain_band=1e-4, tolerance=1e-6):
-    """(StabilityResult or None, zeros): zeros = the number of Floquet exponents right of −ε
-    (None where the count did not close). The result when the count decides it, else None.
+    """(StabilityResult or None, zeros) of :func:`contact_row_counts` without the coarse count."""
+    return contact_row_counts(model, contacts, omega, harmonics, forces, operator, uncertain_band,
+                              tolerance)[:2]
+
+
+def contact_row_counts(model, contacts, omega, harmonics, forces, operator=None,
+                       uncertain_band=1e-4, tolerance=1e-6, check_harmonics=0):
+    """(StabilityResult or None, zeros, coarse): zeros = the number of Floquet exponents right of
+    −ε (None where the count did not close); coarse = the same count with the contact coupling
+    cut to ``check_harmonics`` = H' (1 ≤ H' < H; else None), on the same contour and nodes
+    (:meth:`ContactRowDeterminant.log_determinants`, :func:`winding_counts`: X of the coupling at
+    H bounds every exponent at H' too, ‖𝒥'‖ ≤ ‖𝒥‖ being a leading block). The result when the
+    count decides it, else None.
 
     No zero of det F right of −ε: stable (for every stability tolerance ≥ 0 of the full method).
     Exactly one: it is real (zeros off the real axis come in conjugate pairs) and it is the leading
@@ -479,19 +579,21 @@ def contact_row_count(model, contacts, omega, harmonics, forces, operator=None,
 
     basis = stability_basis(model)
     if basis is None or model.dof_count == 0:
-        return None, None
+        return None, None, None
     omega, H = abs(float(omega)), int(harmonics)
+    coarse = int(check_harmonics) if 1 <= int(check_harmonics) < H else None
     epsilon = uncertain_band * omega
     structure = structural_exponents(basis.flexibility, basis.damping)
     least_damped = float(structure.real.max())
     if not least_damped < -2.0 * epsilon:       # a pole on or right of the contour
-        return None, None
+        return None, None, None
     n_rows = contacts.row_count
     J = jacobian_matrix(forces.blocks, n_rows, H)
     Jd = jacobian_matrix(forces.damping_blocks, n_rows, H) if forces.damping_blocks else None
     det = ContactRowDeterminant(basis, contacts.gap_map, omega, H, J, Jd, operator)
+    stable = StabilityResult(True, least_damped, "", structure)
     if det.loaded.size == 0:
-        return StabilityResult(True, least_damped, "", structure), 0
+        return stable, 0, None if coarse is None else 0
     # ‖𝒥(s)‖₂ for Re s ≥ 0: twice its largest value at s = 0, ω, 10ω (the memory factors e^{−shd}
     # have modulus ≤ 1 there; the pointwise part does not depend on s), each bounded above by the
     # Frobenius norm (‖·‖₂ ≤ ‖·‖_F: X only grows, the contour still encloses every exponent)
@@ -499,13 +601,16 @@ def contact_row_count(model, contacts, omega, harmonics, forces, operator=None,
     damping_norm = 0.0 if Jd is None else float(spla.norm(Jd))
     X = exponent_bound(basis, det.gap_modes, omega, H, jacobian_norm, damping_norm)
     contour = _upper_contour(epsilon, X, 0.505 * omega, -least_damped)
-    count, _ = winding_count(det.log_determinants, contour)
-    if not np.isfinite(count) or abs(count - round(count)) > 0.1:
-        return None, None
-    zeros = int(round(count))
+    counts, _ = winding_counts(lambda s: det.log_determinants(s, coarse=coarse), contour)
+    closed = [None if not np.isfinite(c) or abs(c - round(c)) > 0.1 else int(round(c))
+              for c in counts]
+    zeros, coarse_zeros = closed[0], (closed[1] if coarse is not None else None)
+    if zeros is None:
+        return None, None, coarse_zeros
     if zeros == 0:
-        return StabilityResult(True, least_damped, "", structure), 0
+        return stable, 0, coarse_zeros
     lead = real_zero(det.log_determinants, -epsilon, X) if zeros == 1 else None
     if lead is None:
-        return None, zeros
-    return verdict(lead, np.append(lead, structure), omega, tolerance, uncertain_band), 1
+        return None, zeros, coarse_zeros
+    return verdict(lead, np.append(lead, structure), omega, tolerance, uncertain_band), 1, \
+        coarse_zeros

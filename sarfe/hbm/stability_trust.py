@@ -14,7 +14,9 @@ steps in time, whose Fourier series converges slowly, and near a fold or a grazi
 nearest the axis move by more than their distance from it when H changes. So the count is
 repeated with the contact coupling cut to H' = ⌊3H/4⌋ harmonics (the same orbit, the same AFT
 Jacobian, its (2H'+1)-row Galerkin block — no re-solve; the leading (cos, sin) rows of each block
-in the harmonic-major order, and the friction memory at H'), and
+in the harmonic-major order, and the friction memory at H', the leading block of that at H),
+on the contour of the count at H and from the same LU
+(:func:`sarfe.hbm.stability_rows.contact_row_counts`), and
 
     unstable at H (an exponent right of −ε located or counted) and no zero right of −ε at H',
     or stable at H (no zero right of −ε) and zeros right of −ε at H'
@@ -71,7 +73,8 @@ def truncated_forces(forces, harmonics: int):
 def count_at(problem, omega, U, forces, harmonics, tolerance):
     """(StabilityResult or None, zeros) of the contact-row count of the same orbit with the
     contact coupling cut to ``harmonics`` < H (:func:`truncated_forces`; the friction memory
-    rebuilt at that order)."""
+    rebuilt at that order), on its own contour: the check the default computed before it shared
+    the count's contour (:func:`checked`), kept as the reference of that shared count (tests)."""
     forces = truncated_forces(forces, harmonics)
     coarse = Problem(problem.model, problem.contacts, problem.excitation[:2 * harmonics + 1],
                      harmonics, problem.samples_per_period, problem.friction_tolerance,
@@ -81,15 +84,14 @@ def count_at(problem, omega, U, forces, harmonics, tolerance):
                              tolerance=tolerance)
 
 
-def checked(result, zeros, problem, omega, U, forces, tolerance):
+def checked(result, zeros, coarse, problem):
     """``result`` (the verdict at H; ``zeros``: exponents counted right of −ε, or None) unless the
-    count at H' = :func:`check_harmonics` contradicts it (module docstring): then None with a
-    note. A single real exponent right of the band (a fold's middle branch) is not checked."""
+    count at H' = :func:`check_harmonics` (``coarse``, from the same contour:
+    :func:`sarfe.hbm.stability_rows.contact_row_counts`; None where it did not close) contradicts
+    it (module docstring): then None with a note. A single real exponent right of the band (a
+    fold's middle branch) is not checked."""
     H_coarse = check_harmonics(problem.harmonics)
-    if result.stable is None or zeros is None or zeros == 1 or H_coarse < 1:
-        return result
-    _, coarse = count_at(problem, omega, U, forces, H_coarse, tolerance)
-    if coarse is None:
+    if result.stable is None or zeros is None or zeros == 1 or H_coarse < 1 or coarse is None:
         return result
     if (result.stable is True and coarse > 0) or (result.stable is False and coarse == 0):
         return replace(result, stable=None, note=(

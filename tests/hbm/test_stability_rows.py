@@ -246,3 +246,50 @@ def test_a_ritz_verdict_that_contradicts_the_count_is_reported_uncertain(sweep03
         assert verdict.stable is None and f"finds {zeros} Floquet" in verdict.note
         checked += 1
     assert checked >= 1
+
+
+def shared_and_separate_counts(model, contacts, F, s, check):
+    """(result, zeros, coarse) of the count at H with the check at H' = ``check`` on one contour
+    (contact_row_counts), and the two counts run separately: at H alone (contact_row_count) and
+    at H' with its own contour and its friction memory rebuilt at H' (stability_trust.count_at)."""
+    from sarfe.hbm.stability_rows import contact_row_count, contact_row_counts
+    from sarfe.hbm.stability_trust import count_at
+    problem = Problem(model, contacts, F, s.harmonics, s.samples_per_period)
+    ev = full_residual(problem, s.displacement.ravel(), s.omega)
+    op = ContactOperator(problem, s.displacement, s.omega, ev.forces)
+    shared = contact_row_counts(model, contacts, s.omega, s.harmonics, ev.forces, op,
+                                check_harmonics=check)
+    alone = contact_row_count(model, contacts, s.omega, s.harmonics, ev.forces, op)[1]
+    coarse = count_at(problem, s.omega, s.displacement, ev.forces, check, 1e-6)[1]
+    return shared, alone, coarse
+
+
+def test_shared_contour_counts_equal_separate_counts_rattle(sweep03):
+    """NLvib 03 (unilateral spring, H = 11, both folds and the middle branch): the count at H and
+    the check at H' = 8 evaluated on one contour (det F and its leading block from one LU) give
+    the zeros of the two separate counts at every point; where the count decides, its verdict is
+    the full Hill method's."""
+    model, contacts, F, sols = sweep03
+    seen = set()
+    for s in sols[::2]:
+        (result, zeros, coarse), alone, separate = shared_and_separate_counts(
+            model, contacts, F, s, 8)
+        assert (zeros, coarse) == (alone, separate), s.omega
+        seen.add(zeros)
+        if result is not None:
+            full, _, _ = full_hill(model, contacts, F, s)
+            assert result.stable is full.stable, s.omega
+    assert 0 in seen and len(seen - {0, None}) >= 1     # stable points and counted exponents
+
+
+def test_shared_contour_counts_equal_separate_counts_friction(squeak_rig):
+    """Friction memory (the squeak rig's Jenkins elements, H = 3, check at H' = 2): the memory
+    rows at H' taken as the leading block of those at H give the separate counts (the memory
+    rebuilt at H'), and the verdict is the full Hill method's (stable)."""
+    nl, sols = squeak_rig
+    for s in sols:
+        (result, zeros, coarse), alone, separate = shared_and_separate_counts(
+            nl.model, nl.contacts, nl.excitation, s, 2)
+        assert (zeros, coarse) == (alone, separate) == (0, 0)
+        full, _, _ = full_hill(nl.model, nl.contacts, nl.excitation, s)
+        assert result.stable is full.stable is True

@@ -93,3 +93,32 @@ def test_rattle_rig_edge_eigenvalue_is_not_an_instability(rattle_rig):
     assert lead.real > 0 and abs(lead.imag) > 2 * omega
     check = perturbation_check(nl.model, nl.contacts, nl.excitation, s, steps_per_period=1024)
     assert check.stable and check.rate < -5.0
+
+
+def test_friction_memory_at_the_check_is_the_leading_block(squeak_rig):
+    """The check's contact coupling at H' is the leading (2H'+1)-row block of the one at H, also
+    for the friction memory: the Jenkins rows of a ContactOperator built at H' (truncated AFT
+    blocks, same orbit and slider start) equal the leading rows and columns of those at H at
+    exponents on and off the axis (the linearized march is linear column by column, the DFT rows
+    of H' are the leading rows of H's)."""
+    from sarfe.hbm.stability_contacts import ContactOperator
+    nl, sols = squeak_rig
+    for s in sols:
+        problem = Problem(nl.model, nl.contacts, nl.excitation, 3, s.samples_per_period)
+        ev = full_residual(problem, s.displacement.ravel(), s.omega)
+        fine = ContactOperator(problem, s.displacement, s.omega, ev.forces)
+        coarse_problem = Problem(nl.model, nl.contacts, nl.excitation[:5], 2,
+                                 s.samples_per_period)
+        coarse = ContactOperator(coarse_problem, s.displacement, s.omega,
+                                 truncated_forces(ev.forces, 2))
+        exponents = s.omega * np.array([0.0, 0.3j, -0.01 + 0.45j, 0.2 - 0.1j])
+        assert fine.has_memory
+        for (rows_h, at_h), (rows_c, at_c) in zip(fine.memory_coefficients(exponents),
+                                                  coarse.memory_coefficients(exponents)):
+            np.testing.assert_array_equal(rows_h, rows_c)
+            scale = np.abs(at_h).max()
+            assert scale > 0
+            np.testing.assert_allclose(at_h[:, :5, :, :, :15], at_c, rtol=0, atol=1e-12 * scale)
+        P = 5 * nl.contacts.row_count
+        np.testing.assert_array_equal(fine.pointwise_correction.toarray()[:P, :P],
+                                      coarse.pointwise_correction.toarray())
