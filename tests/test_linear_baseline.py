@@ -11,9 +11,10 @@ M0, K0, M1, K1, C = 0.2, 2.0e4, 0.5, 5.0e4, 4.0
 K_T, K_N, F0, F1 = 1.0e4, 1.0e5, 1.0, 2.0
 
 
-def _case(frequency_hz):
+def lumped_case(frequencies_hz, areas_m2=(0.05, 0.05)):
     """DOF 0: a squeak spot (constant normal load 5 N, k_t) and a rattle stop 1 m away (open);
-    DOF 1: a rattle contact preloaded with 2 N (closed at rest). Own damping matrix C·I."""
+    DOF 1: a rattle contact preloaded with 2 N (closed at rest). Own damping matrix C·I; ERP on
+    both DOFs with ``areas_m2``. (Also the model of tests/erp/test_point_records.py.)"""
     return {
         "name": "baseline",
         "model": {"matrices": {"mass": [[M0, 0.0], [0.0, M1]], "stiffness": [[K0, 0.0], [0.0, K1]],
@@ -27,16 +28,16 @@ def _case(frequency_hz):
              "normal_stiffness_N_m": K_N},
         ],
         "excitation": {"forces": [{"dof": 0, "force_N": F0}, {"dof": 1, "force_N": F1}],
-                       "frequency_hz": [frequency_hz]},
+                       "frequency_hz": list(frequencies_hz)},
         "solver": {"harmonics": 3, "samples_per_period": 64, "error_estimate": False,
                    "stability": False},
-        "erp": {"dofs": [0, 1], "areas_m2": [0.05, 0.05]},
+        "erp": {"dofs": [0, 1], "areas_m2": list(areas_m2)},
     }
 
 
 @pytest.mark.parametrize("frequency_hz", [20.0, 45.0, 60.0])
 def test_baseline_keeps_preloaded_contacts_as_springs(frequency_hz):
-    result = solve_case(_case(frequency_hz), write=False)
+    result = solve_case(lumped_case([frequency_hz]), write=False)
     point = result.summary["points"][0]
     erp = result.summary["case_data"]["erp"]
     w = 2 * math.pi * frequency_hz

@@ -9,32 +9,18 @@ import pytest
 from sarfe.io.outputs.vtk import excursion_amplitude, period_samples
 from sarfe.pipeline import load_case, solve_case
 
-M0, K0, M1, K1, C = 0.2, 2.0e4, 0.5, 5.0e4, 4.0
-K_T, K_N, F0, F1 = 1.0e4, 1.0e5, 1.0, 2.0
+from tests.test_linear_baseline import C, F0, F1, K0, K1, K_N, K_T, M0, M1, lumped_case
+
 FREQUENCIES = [20.0, 30.0, 45.0, 52.0, 60.0, 75.0, 90.0, 110.0, 130.0, 150.0, 170.0]  # 2 chunks
 
 
 def _case():
-    """Two DOFs: a stuck squeak spot (constant normal load, k_t) and an open far stop on DOF 0, a
-    preloaded clip on DOF 1 (as tests/test_linear_baseline.py), at 11 frequencies."""
-    return {
-        "name": "records",
-        "model": {"matrices": {"mass": [[M0, 0.0], [0.0, M1]], "stiffness": [[K0, 0.0], [0.0, K1]],
-                               "damping": [[C, 0.0], [0.0, C]]}},
-        "contacts": [
-            {"name": "squeak_spot", "type": "squeak", "tangential_dofs": [0], "preload_N": 5.0,
-             "tangential_stiffness_N_m": K_T, "friction_coefficient": 0.5},
-            {"name": "far_stop", "type": "rattle", "normal_dof": 0, "gap_m": 1.0,
-             "normal_stiffness_N_m": 1.0e6},
-            {"name": "clip", "type": "rattle", "normal_dof": 1, "preload_N": 2.0,
-             "normal_stiffness_N_m": K_N},
-        ],
-        "excitation": {"forces": [{"dof": 0, "force_N": F0}, {"dof": 1, "force_N": F1}],
-                       "frequency_hz": FREQUENCIES},
-        "solver": {"harmonics": 3, "samples_per_period": 64, "error_estimate": False,
-                   "stability": False, "workers": 1},
-        "erp": {"dofs": [0, 1], "areas_m2": [0.05, 0.03]},
-    }
+    """tests/test_linear_baseline.py's two DOFs (a stuck squeak spot and an open far stop on DOF 0,
+    a preloaded clip on DOF 1) at 11 frequencies, ERP areas 0.05 and 0.03 m², one process."""
+    case = lumped_case(FREQUENCIES, areas_m2=(0.05, 0.03))
+    case["name"] = "records"
+    case["solver"]["workers"] = 1
+    return case
 
 
 @pytest.fixture(scope="module")
