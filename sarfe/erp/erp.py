@@ -93,13 +93,18 @@ def power_level_db(power, reference_power: float = REFERENCE_POWER) -> np.ndarra
         return 10.0 * np.log10(power / reference_power)
 
 
-def normal_velocity_amplitudes(normal_displacement, omega: float) -> np.ndarray:
-    """|v_n,k| = k ω √(w_kc² + w_ks²) [m/s], shape (H, ...) from coefficients (2H+1, ...) [m]."""
-    W = np.asarray(normal_displacement, dtype=float)
+def _harmonic_count(W) -> int:
+    """H of normal displacement harmonics W (2H+1, ...) [m]; ValueError unless 2H+1 ≥ 3 rows."""
     if W.ndim < 1 or W.shape[0] < 3 or W.shape[0] % 2 == 0:
         raise ValueError(
             f"normal_displacement must have 2H+1 >= 3 rows (odd), got shape {W.shape}")
-    H = (W.shape[0] - 1) // 2
+    return (W.shape[0] - 1) // 2
+
+
+def normal_velocity_amplitudes(normal_displacement, omega: float) -> np.ndarray:
+    """|v_n,k| = k ω √(w_kc² + w_ks²) [m/s], shape (H, ...) from coefficients (2H+1, ...) [m]."""
+    W = np.asarray(normal_displacement, dtype=float)
+    H = _harmonic_count(W)
     k = np.arange(1, H + 1).reshape((H,) + (1,) * (W.ndim - 1))
     return k * float(omega) * np.hypot(W[1::2], W[2::2])
 
@@ -150,10 +155,7 @@ def equivalent_radiated_power(
     if not np.isfinite(radiation_loss_factor) or radiation_loss_factor < 0:
         raise ValueError(f"radiation_loss_factor must be >= 0, got {radiation_loss_factor!r}")
 
-    if W.shape[0] < 3 or W.shape[0] % 2 == 0:
-        raise ValueError(
-            f"normal_displacement must have 2H+1 >= 3 rows (odd), got shape {W.shape}")
-    H = (W.shape[0] - 1) // 2
+    H = _harmonic_count(W)
     # e_k,i = ½ρc·RLF (kω)² (w_kc² + w_ks²): |v_n,k|² without its square root
     # (:func:`normal_velocity_amplitudes` squared), one pass over the (H, n) field
     scale = 0.5 * density * sound_speed * radiation_loss_factor \

@@ -216,7 +216,7 @@ def linear_baseline(erp: ErpConfig, stage, nl: NonlinearModel, omega, condensati
     U1 = baseline_response(nl, omega, condensation) if response is None else response
     H = (nl.excitation.shape[0] - 1) // 2
     U = np.zeros((2 * H + 1, stage.dof_count))
-    U[1], U[2] = U1.real, -U1.imag
+    U[:3] = baseline_harmonics(U1)
     W = None                                    # it radiates at ω only: W = [0, W_1c, W_1s]
     if normal_displacement is not None:
         W = np.concatenate([np.zeros((1, np.shape(normal_displacement)[1])),
