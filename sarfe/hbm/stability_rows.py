@@ -424,18 +424,55 @@ def exponent_bound(basis, gap_modes, omega, harmonics, jacobian_norm, damping_no
     return 1.1 * (d + np.sqrt(k))
 
 
-def _upper_contour(epsilon, X, top, pole_distance):
+def shifted_exponents(structure, omega, harmonics):
+    """The poles of det F(s): the structure's exponents λ_j (:func:`structural_exponents`) shifted
+    to s = λ_j − imω, m = −H…H, where A(s + imω) has its poles ((2H+1)·2 n_modes,) complex [1/s]."""
+    m = np.arange(-int(harmonics), int(harmonics) + 1)
+    return (np.asarray(structure)[:, None] - 1j * omega * m[None]).ravel()
+
+
+def _left_step(y, epsilon, poles):
+    r"""Largest L [1/s] with L ≤ 2 dist(p, [−ε + i(y − L), −ε + iy]) for every pole p (min over
+    the poles): the vertical step down from −ε + iy whose every pole stays at least L/2 away. A
+    pole p = −ε − a + ib (a > 0, every pole lies left of −ε) with c = y − b: above the start
+    (c ≤ 0) its distance √(a² + c²) is that of the start; below, the distance falls with L to a
+    once the step passes b, so L_p = 2a where c ≤ √3 a, else the first root of
+    L = 2√(a² + (c − L)²), L_p = (4c − 2√(c² − 3a²))/3 (< c)."""
+    a = -epsilon - poles.real
+    c = y - poles.imag
+    below = c > np.sqrt(3.0) * a
+    step = np.where(c <= 0.0, 2.0 * np.hypot(a, c), 2.0 * a)
+    cb, ab = c[below], a[below]
+    step[below] = (4.0 * cb - 2.0 * np.sqrt(cb ** 2 - 3.0 * ab ** 2)) / 3.0
+    return float(step.min(initial=np.inf))
+
+
+def _upper_contour(epsilon, X, top, poles):
     """Samples of the upper half of the boundary of Ω, counter-clockwise: (X, 0) → (X, top) →
-    (−ε, top) → (−ε, 0); the right edge by its ends (every zero and pole is ≥ X/11 away from it
-    and X ≫ top: it turns arg det F by nothing measurable), geometric spacing along the top edge,
-    steps of at most twice the distance of the nearest pole along the left edge (the poles lie
-    left of −ε; a pole at distance d turns arg det F by at most 2 atan(1) = π/2 over such a step,
-    and the refinement of :func:`winding_count` halves steps that turn it by more than π/3)."""
+    (−ε, top) → (−ε, 0). The right edge by its ends (every zero and pole is ≥ X/11 away from it
+    and X ≫ top: it turns arg det F by nothing measurable). Along the top and left edges every
+    step L keeps each pole p of det F (``poles``, :func:`shifted_exponents`; all left of −ε) at
+    least L/2 from the step, so a pole turns arg det F by at most 2 atan(1) = π/2 over it: on the
+    top edge (the poles lie left of its start) L = 2 min_p |p − a| from a, steps that grow about
+    threefold with the depth; on the left edge L from :func:`_left_step`, within [top/64, top/8].
+    (The refinement of :func:`winding_count` halves steps that turn arg det F by more than π/3.)
+    Before, the left edge was sampled uniformly at twice the distance of the nearest pole to the
+    line and the top edge geometrically (12 depths down to 10⁻²·top): the same bound per pole,
+    ≈ 4 more evaluations per point on the P1 door trim (benchmarks/results/stability.md)."""
+    poles = np.asarray(poles, dtype=complex)
+    depth = [0.0]                                       # top edge, from the corner rightwards
+    while depth[-1] < X + epsilon:
+        corner = depth[-1] - epsilon + 1j * top
+        depth.append(depth[-1] + max(2.0 * float(np.abs(poles - corner).min(initial=np.inf)),
+                                     1e-2 * top))
+    depth[-1] = X + epsilon
+    height = [top]                                      # left edge, downwards
+    while height[-1] > 0.0:
+        step = float(np.clip(_left_step(height[-1], epsilon, poles), top / 64, top / 8))
+        height.append(max(height[-1] - step, 0.0))
     right = X + 1j * top * np.array([0.0, 1.0])
-    depth = np.concatenate([np.geomspace(X + epsilon, 1e-2 * top, 12)[1:], [0.0]])
-    count = int(np.clip(np.ceil(0.5 * top / pole_distance), 8, 64))
-    left = 1j * top * np.linspace(1.0, 0.0, count + 1)[1:]
-    return np.concatenate([right, depth - epsilon + 1j * top, left - epsilon])
+    return np.concatenate([right, np.array(depth[-2::-1]) - epsilon + 1j * top,
+                           1j * np.array(height[1:]) - epsilon])
 
 
 def winding_count(log_det, points, step=PHASE_STEP, budget=MAX_EVALUATIONS):
@@ -600,7 +637,8 @@ def contact_row_counts(model, contacts, omega, harmonics, forces, operator=None,
     jacobian_norm = 2.0 * float(np.linalg.norm(det.probe_terms, axis=(1, 2)).max())
     damping_norm = 0.0 if Jd is None else float(spla.norm(Jd))
     X = exponent_bound(basis, det.gap_modes, omega, H, jacobian_norm, damping_norm)
-    contour = _upper_contour(epsilon, X, 0.505 * omega, -least_damped)
+    contour = _upper_contour(epsilon, X, 0.505 * omega,
+                             shifted_exponents(structure, omega, H))
     counts, _ = winding_counts(lambda s: det.log_determinants(s, coarse=coarse), contour)
     closed = [None if not np.isfinite(c) or abs(c - round(c)) > 0.1 else int(round(c))
               for c in counts]
