@@ -312,9 +312,11 @@ def _log_determinants(M, sizes, growth=GROWTH_LIMIT):
     M = [[M₁₁, M₁₂], [M₂₁, M₂₂]], det M = det M₁₁ · det(M₂₂ − M₂₁ M₁₁⁻¹ M₁₂): M₁₁'s LU gives
     det M₁₁ and the solve, the Schur complement (order S − S') its own LU — about one LU of order
     S for both determinants instead of S³ + S'³. Partial pivoting inside M₁₁ only is backward
-    stable while the eliminated part stays small: where max|M₂₁ M₁₁⁻¹ M₁₂| > ``growth``·max|M|
+    stable while the eliminated part stays small: where max|M₂₁ M₁₁⁻¹ M₁₂| > ``growth``·max|M₂₂|
     (M₁₁ nearly singular: s near a zero of det M₁₁) or M₁₁ is singular, det M is taken from its
-    own LU (np.linalg.slogdet)."""
+    own LU (np.linalg.slogdet). (max|M₂₂| ≤ max|M|: at least as strict as the guard against
+    max|M| it replaces, without reading all S² entries per s; measured on P1 15 mm, the rattle
+    rig and NLvib 03: max|M|/max|M₂₂| ≤ 8.4, the eliminated part ≤ 45·max|M₂₂|, far below 10⁶.)"""
     n, S = M.shape[0], M.shape[1]
     out = np.empty((n, len(sizes)), complex)
     if len(sizes) == 1:
@@ -337,10 +339,12 @@ def _log_determinants(M, sizes, growth=GROWTH_LIMIT):
             np.prod(diagonal / np.abs(diagonal)) * (-1.0) ** swaps)
         solved, info = getrs(lu, piv, M[k, :size, size:])
         eliminated = M[k, size:, :size] @ solved
-        if info != 0 or not np.abs(eliminated).max(initial=0.0) <= growth * np.abs(M[k]).max():
+        schur = M[k, size:, size:] - eliminated
+        if info != 0 or not np.abs(eliminated).max(initial=0.0) <= growth * np.abs(
+                M[k, size:, size:]).max(initial=0.0):
             fallback.append(k)
             continue
-        sign, logabs = np.linalg.slogdet(M[k, size:, size:] - eliminated)
+        sign, logabs = np.linalg.slogdet(schur)
         out[k, 0] = out[k, 1] + logabs + 1j * np.angle(sign) if (
             np.isfinite(logabs) and sign != 0) else np.nan
     if fallback:
