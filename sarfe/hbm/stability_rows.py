@@ -470,9 +470,13 @@ def _upper_contour(epsilon, X, top, poles):
         depth.append(depth[-1] + max(2.0 * float(np.abs(poles - corner).min(initial=np.inf)),
                                      1e-2 * top))
     depth[-1] = X + epsilon
-    height = [top]                                      # left edge, downwards
+    # left edge, downwards; a pole farther than top/16 from it never shortens a step below top/8
+    margin = top / 16
+    near = poles[(-epsilon - poles.real <= margin) & (poles.imag >= -margin)
+                 & (poles.imag <= top + margin)]
+    height = [top]
     while height[-1] > 0.0:
-        step = float(np.clip(_left_step(height[-1], epsilon, poles), top / 64, top / 8))
+        step = float(np.clip(_left_step(height[-1], epsilon, near), top / 64, top / 8))
         height.append(max(height[-1] - step, 0.0))
     right = X + 1j * top * np.array([0.0, 1.0])
     return np.concatenate([right, np.array(depth[-2::-1]) - epsilon + 1j * top,
