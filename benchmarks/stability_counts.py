@@ -10,8 +10,10 @@ of a sweep, for comparing two sarfe trees on the same orbits (issue 15, session 
 :func:`sarfe.hbm.solve.stability` call (problem, ω, U, AFT forces, options). ``evaluate`` computes
 per point the verdict (``stability``, as the solver does), the count at H and the count at H'
 (with a tree before the shared contour: ``contact_row_count`` and ``stability_trust.count_at``,
-each on its own contour) and the CPU seconds of ``stability``. ``compare`` lists the points where
-verdict, either count or the leading exponent (relative 10⁻⁶) differ, and the total CPU.
+each on its own contour), the det F evaluations of the count's contour (``evaluations``, None
+where no contour was sampled) and the CPU seconds of ``stability``. ``compare`` lists the points
+where verdict, either count or the leading exponent (relative 10⁻⁶) differ, the total CPU and the
+mean evaluations.
 """
 import json
 import os
@@ -50,6 +52,14 @@ def evaluate(points_path, out):
 
     with open(points_path, "rb") as f:
         records = pickle.load(f)
+    sampled = {}
+    winding_counts = rows.winding_counts
+
+    def counted(*args, **kwargs):          # the count's contour: keep its evaluations
+        counts, evaluations = winding_counts(*args, **kwargs)
+        sampled.setdefault("evaluations", evaluations)
+        return counts, evaluations
+
     points = []
     for problem, omega, U, forces, options in records:
         t = time.process_time()
@@ -59,6 +69,8 @@ def evaluate(points_path, out):
         check = trust.check_harmonics(problem.harmonics)
         op = ContactOperator(problem, U, omega, forces)
         args = (problem.model, problem.contacts, omega, problem.harmonics, forces, op)
+        sampled.clear()
+        rows.winding_counts = counted
         if hasattr(rows, "contact_row_counts"):
             _, zeros, coarse = rows.contact_row_counts(*args, tolerance=options.stability_tolerance,
                                                        check_harmonics=check)
@@ -66,9 +78,10 @@ def evaluate(points_path, out):
             zeros = rows.contact_row_count(*args, tolerance=options.stability_tolerance)[1]
             coarse = trust.count_at(problem, omega, U, forces, check,
                                     options.stability_tolerance)[1]
+        rows.winding_counts = winding_counts
         points.append(dict(frequency_hz=float(omega / (2 * np.pi)), stable=r.stable,
                            leading=float(r.leading), note=r.note, zeros=zeros, coarse=coarse,
-                           cpu_s=cpu))
+                           evaluations=sampled.get("evaluations"), cpu_s=cpu))
     with open(out, "w") as f:
         json.dump(points, f, indent=1)
     print(len(points), "points, stability CPU", round(sum(p["cpu_s"] for p in points), 1), "s")
@@ -90,6 +103,12 @@ def compare(before_path, after_path):
                                                  ("stable", "zeros", "coarse", "leading")})
     print(f"{len(before)} points, {differ} differ; stability CPU "
           f"{sum(p['cpu_s'] for p in before):.1f} -> {sum(p['cpu_s'] for p in after):.1f} s")
+    counted = [(p.get("evaluations"), q.get("evaluations")) for p, q in zip(before, after)]
+    counted = [(a, b) for a, b in counted if a is not None and b is not None]
+    if counted:
+        print(f"det F evaluations per counted point ({len(counted)}): "
+              f"{sum(a for a, _ in counted) / len(counted):.1f} -> "
+              f"{sum(b for _, b in counted) / len(counted):.1f}")
     return differ
 
 

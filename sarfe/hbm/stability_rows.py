@@ -40,7 +40,8 @@ det F along its boundary (no pole inside: the poles are the structure's own expo
 of −ε when every mode is damped; X bounds |s| of any exponent, |s| ≤ ‖d‖ + √‖k‖ from
 pᴴT(s)p = 0). F is real for real s, so det F(s̄) = conj det F(s) and the count is the change of
 arg det F along the upper half of the boundary divided by π. The contour is sampled adaptively
-(every step's change of arg below π/3).
+(every step's change of arg below π/3) from nodes placed by the known poles of det F
+(:func:`_upper_contour`).
 
 No zero in Ω: stable, and no exponent is within the uncertain band; the leading exponent reported
 is the least damped exponent of the structure (max Re of μ s² + δ s + 1 = 0; the coupled
