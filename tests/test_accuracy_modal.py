@@ -2,7 +2,8 @@
 (the top 1/20 and 1/5 of the modes left out) and the decay p of an error ∝ m^{−p} fitted from both.
 Closed forms: for a truncation error e(m) = C m^{−p} the probes change by d_i = e(m'_i) − e(m) and
 the extrapolation returns e(m) exactly while 1 ≤ p ≤ 2.5, more than e(m) (never less) for faster
-decays, and p = 1 (the slowest plate-like decay) when the changes do not decay."""
+decays, and p = 1 (the slowest plate-like decay: the earlier single probe, top fifth × 4, which it
+never exceeds) when the changes do not decay."""
 import numpy as np
 import pytest
 
@@ -37,11 +38,19 @@ def test_faster_decay_is_over_reported_never_under(p):
 
 def test_changes_that_do_not_decay_use_the_slowest_decay():
     coarser = [MODES - max(1, int(MODES * q)) for q in MODE_PROBES]
-    # the smaller probe changed more than the larger (a resonance near the cutoff): p = 1
+    # the smaller probe changed more than the larger (a resonance near the cutoff): p = 1 on the
+    # larger probe, the top fifth × m'/(m − m') ≈ 4
     estimate, fitted = modal_extrapolation(MODES, coarser, [2e-4, 1e-4])
     assert fitted == 1.0
-    assert estimate == pytest.approx(2e-4 * coarser[0] / (MODES - coarser[0]))     # m'/(m − m')
-    assert mode_richardson(MODES, coarser[0]) == pytest.approx(coarser[0] / (MODES - coarser[0]))
+    assert estimate == pytest.approx(1e-4 * coarser[1] / (MODES - coarser[1]))     # m'/(m − m')
+    assert mode_richardson(MODES, coarser[1]) == pytest.approx(coarser[1] / (MODES - coarser[1]))
+
+
+@pytest.mark.parametrize("changes", [[1e-4, 1e-3], [1e-4, 2e-4], [3e-4, 1e-4], [1e-9, 1e-3]])
+def test_never_above_the_single_top_fifth_probe(changes):
+    coarser = [MODES - max(1, int(MODES * q)) for q in MODE_PROBES]
+    estimate, _ = modal_extrapolation(MODES, coarser, changes)
+    assert estimate <= changes[1] * mode_richardson(MODES, coarser[1], 1.0) * (1 + 1e-12)
 
 
 def test_one_probe_or_equal_probes_fall_back_to_p_1():

@@ -105,8 +105,8 @@ class ReductionConfig:
     ≤ 0.012 dB(A) against 2 H f_max (1.5 at 5 mm); 0.75 H f_max moves them by 1.5e-3 /
     0.023 dB(A) (harmonics above the cutoff have no modes to live in). The per-point estimate's
     modal part (two probes, decay fitted: sarfe.accuracy.estimates (5)) brackets those changes
-    at every point from 0.75 H f_max up and over-reports at H f_max by ≤ 14× (amplitude) / 17×
-    (dB), resolution floor included (the earlier single probe of the top fifth: 34× / 35×, which
+    at every point from 0.75 H f_max up and over-reports at H f_max by ≤ 12× (amplitude and
+    dB), resolution floor included (the earlier single probe of the top fifth: 34× / 35×, which
     kept the margin at 1.25; benchmarks/results/modal_estimate.md)."""
 
     mode_count: int | None = None
