@@ -13,9 +13,9 @@ Per cutoff c = factor · H · f_max (factors 0.25 … 2.0, f_max = 80 Hz; the de
    finest), of the first-harmonic contact amplitude a₁ (the estimate's measure), of the radiating
    surface's normal displacement harmonics (the response), the ERP level dB / dB(A) and the ERP
    per harmonic (max |ΔL_k| over harmonics within 30 dB of the strongest);
-4. the error estimate's modal-truncation part (sarfe.accuracy.estimates, (4): top fifth of the
-   modes left out, re-solved, × the Richardson factor 4) at the same point, set against the
-   measured change (does it bracket it?);
+4. the error estimate's modal-truncation part (sarfe.accuracy.estimates, (4)–(5): the top 1/20
+   and 1/5 of the modes left out, re-solved, extrapolated with the decay fitted from both) at the
+   same point, set against the measured change (does it bracket it?);
 5. the split: the point's contact forces λ̃ from the smaller basis, the displacement recovered on
    the finest basis, ũ_k = Z_k⁻¹ (f̃_k − Gᵀ λ̃_k) (sarfe.hbm.linear.recover_displacement), compared
    with the finest in the same measures — "only the recovery and ERP need the high modes".
@@ -108,24 +108,19 @@ def compare(case, stage, U, U_ref, s, s_ref, omega):
 
 
 def modal_estimate(stage, nl, solution):
-    """The per-point estimate's modal part (4): (modal_rel, modal_db, seconds) or NaNs."""
-    from sarfe.accuracy.estimates import (_first_harmonic_amplitude, mode_richardson,
-                                          modal_truncation_change)
+    """The per-point estimate's modal part (4)–(5): (modal_rel, modal_db, seconds) or NaNs."""
+    from sarfe.accuracy.estimates import _first_harmonic_amplitude, modal_truncation_estimate
     from sarfe.pipeline.accuracy import accuracy_problem
 
     problem = accuracy_problem(stage, nl)
     clock = time.perf_counter()
     a_ref = np.max(_first_harmonic_amplitude(problem.contacts, solution.displacement),
                    initial=0.0) or None
-    change = modal_truncation_change(solution, problem.model, problem.contacts, problem.excitation,
-                                     problem.modal_dofs, problem.residual_dofs, problem.erp_map,
-                                     problem.erp_areas, None, a_ref)
-    seconds = time.perf_counter() - clock
-    if change is None:
-        return float("nan"), float("nan"), seconds
-    kept = len(problem.modal_dofs)
-    factor = mode_richardson(kept, kept - change[2])
-    return factor * change[0], factor * change[1], seconds
+    modal = modal_truncation_estimate(solution, problem.model, problem.contacts,
+                                      problem.excitation, problem.modal_dofs,
+                                      problem.residual_dofs, problem.erp_map, problem.erp_areas,
+                                      None, a_ref)
+    return modal.amplitude_rel, modal.erp_db, time.perf_counter() - clock
 
 
 def solve_points(nl, frequencies_hz):

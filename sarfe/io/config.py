@@ -99,18 +99,19 @@ class ReductionConfig:
     """reduction (FE cases): mode_count or cutoff_hz (or neither: cutoff from the excitation),
     cutoff_margin × H × f_max, at least min_mode_count modes, static residual vectors.
 
-    cutoff_margin 1.25 (was 1.5): door trim, 12 contact pairs, H = 15, 40–80 Hz, 15, 10 and 5 mm
-    (benchmarks/results/cutoff.md): already the cutoff H f_max changes the contact-row
+    cutoff_margin 1.0 (was 1.25, before that 1.5): door trim, 12 contact pairs, H = 15, 40–80 Hz,
+    15, 10 and 5 mm (benchmarks/results/cutoff.md): the cutoff H f_max changes the contact-row
     first-harmonic amplitudes by ≤ 1.7e-4, every response harmonic by ≤ 3.1e-4 and the ERP by
     ≤ 0.012 dB(A) against 2 H f_max (1.5 at 5 mm); 0.75 H f_max moves them by 1.5e-3 /
-    0.021 dB(A) (harmonics above the cutoff have no modes to live in). 1.25, not 1.0: the
-    per-point estimate's modal part leaves the top fifth of the modes out, which from H f_max
-    probes ≈ 0.8 H f_max and over-reports up to 40× (demo case, 80 Hz: 0.34 dB estimated, 0.008
-    measured; its 'balanced' check then fails); from 1.25 H f_max it probes ≈ H f_max."""
+    0.023 dB(A) (harmonics above the cutoff have no modes to live in). The per-point estimate's
+    modal part (two probes, decay fitted: sarfe.accuracy.estimates (5)) brackets those changes
+    at every point from 0.75 H f_max up and over-reports at H f_max by ≤ 12× (amplitude and
+    dB), resolution floor included (the earlier single probe of the top fifth: 34× / 35×, which
+    kept the margin at 1.25; benchmarks/results/modal_estimate.md)."""
 
     mode_count: int | None = None
     cutoff_hz: float | None = None
-    cutoff_margin: float = 1.25
+    cutoff_margin: float = 1.0
     min_mode_count: int = 10
     residual_vectors: bool = True
 

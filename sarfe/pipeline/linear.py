@@ -97,10 +97,10 @@ def _file_digest(path: Path) -> str:
 
 def default_cutoff_hz(config) -> float:
     """Reduction cutoff [Hz] when none is given: margin · H · f_max (``reduction.cutoff_margin``,
-    1.25 by default: every kept harmonic has the modes up to its frequency, the modes above answer
+    1.0 by default: every kept harmonic has the modes up to its frequency, the modes above answer
     quasi-statically through the residual vectors; measured on the door trim, H = 15, against
-    2 H f_max: at 1.0 already contact amplitudes ≤ 1.7e-4, ERP ≤ 0.012 dB(A) — the 0.25 above it
-    keeps the error estimate's modal part honest: :class:`sarfe.io.config.ReductionConfig`).
+    2 H f_max: contact amplitudes ≤ 1.7e-4, ERP ≤ 0.012 dB(A), and the error estimate's modal part
+    brackets it: :class:`sarfe.io.config.ReductionConfig`).
     ``config``: the case's CaseConfig (or the Case)."""
     config = getattr(config, "config", config)
     return (config.reduction.cutoff_margin * config.solver.harmonics
