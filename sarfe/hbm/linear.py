@@ -338,10 +338,11 @@ def condense(model, gap_map, excitation: np.ndarray, omega: float,
         static_forced, modal_forced = basis.load_projection(forces)
         # G y_k = G K⁻¹ f_k + (GV)(q_k ⊙ Vᵀ f_k): O(n_rows n_modes), y_k itself only on demand
         gy = real_product(static_forced, Gd.T) + real_product(g * modal_forced, gap_modes.T)
-        # Σ_j (G v_j)_r q_kj (G v_j)_s as one real product over the orders and rows
-        Ck = static_compliance[None] + real_product(
-            (gap_modes[None] * g[:, None, :]).reshape(-1, g.shape[1]),
-            gap_modes.T).reshape(k.size, n_rows, n_rows)
+        # Σ_j (G v_j)_r q_kj (G v_j)_s as one real product over the orders and rows per part
+        # (Re q, Im q): the scaled rows are formed real, not as a complex array split again
+        scaled = gap_modes[None] * np.stack([g.real, g.imag])[:, :, None, :]   # (2, m, n_rows, n_modes)
+        parts = (scaled.reshape(-1, g.shape[1]) @ gap_modes.T).reshape(2, k.size, n_rows, n_rows)
+        Ck = static_compliance[None] + (parts[0] + 1j * parts[1])
         factors = dict(modal=ModalCompliance(basis, g, gap_modes, static, static_forced,
                                              modal_forced))
     else:
