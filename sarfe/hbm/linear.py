@@ -221,11 +221,11 @@ class Condensation:
             return out
         out = np.empty(B.shape, dtype=np.result_type(B, float))
         if first:
-            out[:first] = mean @ B[:first]
-        if pairs.shape[0]:
+            np.matmul(mean, B[:first], out=out[:first])
+        if pairs.shape[0]:      # the products written in place (no (P, q) temporary to copy)
             width = pairs.shape[1]
-            out[first:] = (pairs @ B[first:].reshape(pairs.shape[0], width, -1)).reshape(
-                B.shape[0] - first, -1)
+            np.matmul(pairs, B[first:].reshape(pairs.shape[0], width, -1),
+                      out=out[first:].reshape(pairs.shape[0], width, -1))
         return out
 
     def apply_admittance(self, L: np.ndarray) -> np.ndarray:
