@@ -340,9 +340,11 @@ def condense(model, gap_map, excitation: np.ndarray, omega: float,
         gy = real_product(static_forced, Gd.T) + real_product(g * modal_forced, gap_modes.T)
         # Σ_j (G v_j)_r q_kj (G v_j)_s as one real product over the orders and rows per part
         # (Re q, Im q): the scaled rows are formed real, not as a complex array split again
-        scaled = gap_modes[None] * np.stack([g.real, g.imag])[:, :, None, :]   # (2, m, n_rows, n_modes)
-        parts = (scaled.reshape(-1, g.shape[1]) @ gap_modes.T).reshape(2, k.size, n_rows, n_rows)
-        Ck = static_compliance[None] + (parts[0] + 1j * parts[1])
+        # (the same two products as real_product of the complex rows: the same numbers)
+        def part(q):
+            return ((gap_modes[None] * q[:, None, :]).reshape(-1, g.shape[1]) @ gap_modes.T)
+        Ck = static_compliance[None] + (part(g.real) + 1j * part(g.imag)).reshape(
+            k.size, n_rows, n_rows)
         factors = dict(modal=ModalCompliance(basis, g, gap_modes, static, static_forced,
                                              modal_forced))
     else:
