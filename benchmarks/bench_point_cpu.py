@@ -3,6 +3,9 @@
 
     python benchmarks/bench_point_cpu.py CASE.yaml STAGE.pkl TREE_A TREE_B [--runs 2]
     python benchmarks/bench_point_cpu.py --build CASE.yaml STAGE.pkl      (the stage, once)
+    python benchmarks/bench_point_cpu.py          (``make bench``: P1 with workers 1 and stability
+                                                   off, its stage built in a temporary folder,
+                                                   this tree, and $SARFE_BASELINE first if set)
 
 The linear stage (42 s at P1) is built once and pickled (``--build``); each run is a fresh
 process of one tree (``PYTHONPATH=TREE``) that loads it and calls ``solve_case(case,
@@ -21,7 +24,7 @@ import os
 import pathlib
 import subprocess
 import sys
-import time
+import tempfile
 
 HERE = pathlib.Path(__file__).resolve().parent
 NOTES = "## Where the CPU goes (cProfile, hand-written)"
@@ -79,6 +82,25 @@ def build(case, stage):
         pickle.dump(build_linear_model(load_case(case)), f, protocol=5)
 
 
+def default_run():
+    """``make bench`` (no arguments): P1 (cases/door_trim_p1.yaml) in one process with stability
+    off, its linear stage built once in a temporary folder; this tree, after $SARFE_BASELINE."""
+    import yaml
+
+    case = yaml.safe_load((HERE.parent / "cases" / "door_trim_p1.yaml").read_text())
+    case.setdefault("solver", {}).update(workers=1, stability=False)
+    trees = [t for t in (os.environ.get("SARFE_BASELINE"), str(HERE.parent)) if t]
+    with tempfile.TemporaryDirectory() as folder:
+        path = pathlib.Path(folder) / "p1_one_process.yaml"
+        case_text = yaml.safe_dump(case, sort_keys=False)
+        path.write_text(case_text)
+        stage = pathlib.Path(folder) / "stage.pkl"
+        subprocess.run([sys.executable, str(pathlib.Path(__file__).resolve()), "--build",
+                        str(path), str(stage)], check=True,
+                       env=dict(os.environ, PYTHONPATH=str(HERE.parent), OPENBLAS_NUM_THREADS="1"))
+        main([str(path), str(stage), *trees])
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser()
     parser.add_argument("--build", action="store_true")
@@ -95,7 +117,8 @@ def main(argv=None):
     runs = {str(t): [] for t in trees}
     for i in range(args.runs):
         for t in trees:
-            result = run_tree(t, args.case, args.stage, pathlib.Path(f"/tmp/point_cpu_{t.name}_{i}"))
+            with tempfile.TemporaryDirectory() as folder:      # the result files: not kept
+                result = run_tree(t, args.case, args.stage, pathlib.Path(folder) / "out")
             runs[str(t)].append(result)
             print(t.name, i, json.dumps(result), flush=True)
     names = list(STAGES) + ["summary.json", "total after the linear stage"]
@@ -122,4 +145,7 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    main()
+    if pathlib.Path(sys.argv[0]).name == "run_all.py" or len(sys.argv) == 1:
+        default_run()
+    else:
+        main()
