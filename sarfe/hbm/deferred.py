@@ -58,6 +58,12 @@ def deferred_stability(enabled=True, on_job=None):
         _JOBS, _ON_JOB = outer
 
 
+def deferring() -> bool:
+    """True inside a :func:`deferred_stability` block: :func:`defer` will record the job, so the
+    caller's own evaluation needs no contact Jacobian for the stability."""
+    return _JOBS is not None
+
+
 def defer(problem, omega, U, slider, options) -> int | None:
     """Record the stability of a converged point: its job index, or None outside a
     :func:`deferred_stability` block (compute it in place)."""

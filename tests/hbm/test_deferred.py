@@ -53,3 +53,47 @@ def test_outside_a_block_nothing_is_deferred():
         points = continuation(model, contacts, F, 2 * np.pi * 8.0, 2 * np.pi * 8.5, H, N)
     assert jobs is None
     assert all(s.stability_job is None and s.stable is not None for s in points if s.converged)
+
+
+def assert_same_point_fields(a, b):
+    """The fields finalize evaluates for a point — contact forces (harmonics and samples), states,
+    the full residual, the slider's friction passes — identical in place and deferred (a deferred
+    point's evaluation skips the contact Jacobian, which they do not depend on). Both sweeps run
+    after a first one, so both find the model's cached modal basis (sarfe.hbm.modal)."""
+    np.testing.assert_array_equal(b.contact_force, a.contact_force)
+    np.testing.assert_array_equal(b.contact_force_time, a.contact_force_time)
+    np.testing.assert_array_equal(b.contact_state, a.contact_state)
+    assert b.residual_norm == a.residual_norm and b.friction_passes == a.friction_passes
+
+
+def test_deferred_points_have_the_in_place_contact_fields():
+    """Damped impacts (rate-dependent law) over the fold, and a 2-D Jenkins element slipping on an
+    elliptic orbit near resonance: each point of the deferred sweep carries the in-place fields."""
+    from sarfe.hbm.friction import SLIP
+
+    H, N = 3, 128
+    model, contacts, F = chain(H)
+    band = (2 * np.pi * 9.5, 2 * np.pi * 9.9)
+    continuation(model, contacts, F, *band, H, N)
+    in_place = continuation(model, contacts, F, *band, H, N)
+    with deferred_stability():
+        deferred = continuation(model, contacts, F, *band, H, N)
+    assert len(deferred) == len(in_place) > 5
+    for a, b in zip(in_place, deferred):
+        assert_same_point_fields(a, b)
+
+    model = make_linear_model(np.eye(2), 0.02 * np.eye(2), np.diag([1.0, 1.5]))
+    contacts = make_contact_set(sp.csr_matrix(np.eye(2)), ["squeak"], [-1], [[0, 1]], gap=0.0,
+                                normal_stiffness=0.0, tangential_stiffness=1.0,
+                                friction_coefficient=1.0, normal_load=1.0)
+    F = np.zeros((2 * H + 1, 2))
+    F[1, 0], F[2, 1] = 0.5, 0.4
+    band = (0.9, 1.3)
+    continuation(model, contacts, F, *band, H, N)
+    in_place = continuation(model, contacts, F, *band, H, N)
+    with deferred_stability():
+        deferred = continuation(model, contacts, F, *band, H, N)
+    assert len(deferred) == len(in_place) > 5
+    assert any(np.any(s.contact_state == SLIP) for s in in_place)
+    for a, b in zip(in_place, deferred):
+        assert_same_point_fields(a, b)
