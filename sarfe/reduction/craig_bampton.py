@@ -67,6 +67,11 @@ _SLICE_ENTRIES = 8e7
 # (benchmarks/results/linear.md)
 _PARALLEL_MODES_PER_COLUMN = 0.5
 _RUN0_LEAD_PER_COLUMN = 0.2
+# run 0 may go on past its cap by this fraction of it when the modes still missing below the
+# split are that few (at its own rate so far): a shifted run spends ≈ 150 columns (0.3 of the cap)
+# before its window converges, plus a factorization; P1 at 1.0 H f_max (339 modes): 27 modes
+# were missing at the cap of 480, ≈ 70 more columns for run 0 instead of a 264-column shifted run
+_RUN0_EXTENSION = 0.25
 
 
 @dataclass(frozen=True, eq=False)  # array fields: compare explicitly, not with ==
@@ -275,7 +280,7 @@ class _Partial:
 
 
 def _capped_run0(mass_ii, operator, cutoff_hz, progress, max_columns, release_operator=None,
-                 keep_prefix=None, block_size=12, tol=1e-8, seed=0):
+                 keep_prefix=None, block_size=12, tol=1e-8, seed=0, split_plan=None):
     """Run 0 of spectrum slicing: block Lanczos on K_ii⁻¹ M_ii (σ = 0) from a block of
     ``block_size`` columns, stopped at ``max_columns`` columns, with the shifted runs' partial
     re-orthogonalization (:func:`sarfe.reduction.spectrum_slicing.shifted_block_lanczos` at
@@ -288,10 +293,18 @@ def _capped_run0(mass_ii, operator, cutoff_hz, progress, max_columns, release_op
     halfway to the next Ritz value; ``keep_prefix(modes)``, when given, returns what it holds
     instead of the vectors: the sink's handle); None when nothing converged. ``release_operator()``
     is called after the last operator application, before the Ritz vectors are formed.
+
+    ``split_plan()`` (two processes): the other process's split (λ_s, N(λ_s)), or None. At the
+    cap, when the modes still missing below λ_s would take run 0 at most _RUN0_EXTENSION · cap
+    more columns at its own rate so far (converged prefix / columns), run 0 goes on until its
+    converged prefix holds N(λ_s) values ≤ λ_s and one above: those few modes then cost run 0
+    tens of columns instead of a shifted run of ≈ 150 columns before its window converges plus
+    a factorization (the caller certifies the prefix by the count N(λ_s)).
     """
     from sarfe.reduction.spectrum_slicing import shifted_block_lanczos
 
     cutoff_omega2 = (2 * np.pi * cutoff_hz) ** 2
+    extension = {"split": None, "decided": split_plan is None}
 
     def converged_prefix(lam, converged):
         order = np.argsort(lam)
@@ -300,14 +313,33 @@ def _capped_run0(mass_ii, operator, cutoff_hz, progress, max_columns, release_op
         return order, prefix, int(np.count_nonzero(lam <= cutoff_omega2))
 
     def satisfied(lam, converged):
-        _, prefix, wanted = converged_prefix(lam, converged)
+        order, prefix, wanted = converged_prefix(lam, converged)
         if progress is not None:
             progress(min(prefix, wanted), None)
-        return prefix > wanted              # every mode up to the cutoff, and one above it
+        if prefix > wanted:                 # every mode up to the cutoff, and one above it
+            return True
+        if len(lam) < max_columns:
+            return False
+        split = extension["split"]
+        if not extension["decided"]:        # at the cap: go on toward the split?
+            extension["decided"] = True
+            split = split_plan()
+            if split is not None:
+                missing = split[1] - np.count_nonzero(lam[order[:prefix]] <= split[0])
+                if missing > _RUN0_EXTENSION * max_columns * prefix / len(lam):
+                    split = None
+            extension["split"] = split
+        if split is None:
+            return True
+        below = np.count_nonzero(lam[order[:prefix]] <= split[0])
+        return below >= split[1] and prefix > below
 
     stats = {}
+    limit = max_columns if split_plan is None else int((1 + _RUN0_EXTENSION) * max_columns)
     lam, converged, eigenvectors = shifted_block_lanczos(mass_ii, operator, 0.0, satisfied,
-                                                         max_columns, block_size, tol, seed, stats)
+                                                         limit, block_size, tol, seed, stats)
+    if extension["split"] is not None:
+        stats["extended_to_split"] = int(extension["split"][1])
     if release_operator is not None:
         release_operator()
     order, prefix, wanted = converged_prefix(lam, converged)
@@ -469,6 +501,20 @@ def _worker_splits(upper):
         return upper.splits()
     except SlicingFailed:
         return False
+
+
+def _split_plan(upper):
+    """A function returning the worker's split (λ_s, N(λ_s)), or None when it failed placing it
+    (the caller then finds the failure again in :meth:`UpperSlices.plan`)."""
+    from sarfe.reduction.spectrum_slicing import SlicingFailed
+
+    def split_plan():
+        try:
+            return upper.plan()[1:]
+        except SlicingFailed:
+            return None
+
+    return split_plan
 
 
 def _slice(k_ii, m_ii, cutoff_hz, partial, progress, timings, upper, sink):
@@ -655,7 +701,9 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
                     found = _block_lanczos_modes(m_ii, inverse, mode_count, cutoff_hz, progress)
                 else:
                     found = _capped_run0(m_ii, inverse, cutoff_hz, progress, cap, release_factor,
-                                         None if sink is None else sink.put)
+                                         None if sink is None else sink.put,
+                                         split_plan=None if upper is None else
+                                         _split_plan(upper))
                 if isinstance(found, _Partial):
                     held["factor"] = None     # K_ii's factor is not used by the shifted runs
                     found = _slice(k_ii, m_ii, cutoff_hz, found, progress, timings, upper, sink)

@@ -422,10 +422,18 @@ def _sliced_modes(stiffness, mass, cutoff_omega2, found_omega2, found_modes, bou
         total = int(factor.negative_pivots)                     # eigenvalues below the cutoff
         del factor
     top, top_count = (cutoff_omega2, total) if upper is None else (split, split_count)
-    start = ChainStart(0.0, 0, float(boundary), np.asarray(found_omega2, dtype=float),
-                       found_modes)
-    chain = slice_chain(mass, factor_at, start, top, top_count, sink, slice_modes, max_columns,
-                        progress)
+    found_omega2 = np.asarray(found_omega2, dtype=float)
+    covered = int(np.count_nonzero(found_omega2 <= top))
+    if boundary >= top and covered == top_count:
+        # run 0's converged prefix reaches past the top and holds exactly N(top) values below
+        # it (run 0 went on past its cap toward the split): the count certifies them, no shift
+        sink.keep(found_omega2[:covered], sink.prefix(found_modes, covered))
+        chain = {"shifts": [], "columns": [], "negative_pivots": [], "factorizations": 0,
+                 "steps": 0, "mass_products": 0}
+    else:
+        start = ChainStart(0.0, 0, float(boundary), found_omega2, found_modes)
+        chain = slice_chain(mass, factor_at, start, top, top_count, sink, slice_modes,
+                            max_columns, progress)
     record.update(chain, factorizations=record["factorizations"] + chain["factorizations"],
                   modes_below_cutoff=int(total))
     upper_values, upper_modes = np.zeros(0), []
@@ -433,8 +441,12 @@ def _sliced_modes(stiffness, mass, cutoff_omega2, found_omega2, found_modes, bou
         record.update(split=float(split), split_count=int(split_count))
         try:
             waited = time.perf_counter()
+            record["cpu_s"] = time.process_time()        # this process's CPU up to the join
             upper_values, upper_modes, record["upper"] = upper.join()
-            record["join_wait_s"] = time.perf_counter() - waited   # idle here (a clock, not a result)
+            joined = time.perf_counter()
+            record["join_wait_s"] = joined - waited   # idle here (a clock, not a result)
+            # the worker's idle: from its last run's end to this process's join (one clock)
+            record["upper"]["idle_s"] = max(joined - record["upper"].pop("finished_at"), 0.0)
         except SlicingFailed as exc:      # the worker's part, again in this process
             record["upper_failed"] = str(exc)
             start = ChainStart(split, split_count, split, np.zeros(0),
@@ -503,6 +515,7 @@ class UpperSlices:
     size: int
     _total: tuple | None = None
     _plan: tuple | None = None
+    _failed: Exception | None = None
 
     def _receive(self, kind):
         try:
@@ -523,8 +536,14 @@ class UpperSlices:
         return self._total[1]
 
     def plan(self):
+        if self._failed is not None:
+            raise self._failed
         if self._plan is None and self.splits():
-            self._plan = (self._total[0], *self._receive("plan"))
+            try:
+                self._plan = (self._total[0], *self._receive("plan"))
+            except SlicingFailed as exc:
+                self._failed = exc
+                raise
         return self._plan
 
     def join(self):
@@ -609,6 +628,8 @@ def _upper_worker(connection, stiffness, mass, cutoff_omega2, lead, min_total, p
         record = slice_chain(mass, factor_at, start, cutoff_omega2, total, sink, slice_modes,
                              max_columns)
         record["factorizations"] += counting["factorizations"]    # the counts
+        record["cpu_s"] = time.process_time()          # the worker's CPU (a fork starts at 0)
+        record["finished_at"] = time.perf_counter()    # CLOCK_MONOTONIC: one clock for both
         omega2 = sink.values()
         if len(omega2) != total - counted or np.any(np.diff(omega2) < 0):
             raise SlicingFailed(f"{len(omega2)} modes for a count of {total - counted}")

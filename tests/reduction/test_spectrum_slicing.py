@@ -327,3 +327,29 @@ def test_partial_reorthogonalization_equals_full_and_dense(twin):
     np.testing.assert_allclose(phi.T @ m_ii @ phi, np.eye(len(lam)), atol=1e-9)
     cosines = np.abs(np.einsum("ij,ij->j", full_phi, m_ii @ phi))
     np.testing.assert_allclose(cosines, 1.0, atol=1e-10)
+
+
+def test_run0_goes_on_to_a_split_just_above_its_yield(twin, one, capped):
+    """A split a few modes above what run 0 finds at its cap: run 0 goes on past the cap (at most
+    _RUN0_EXTENSION of it) until its converged prefix holds every mode below λ_s, certified by
+    the worker's count N(λ_s) — no shifted run nor factorization in this process — and the
+    modes equal the dense reference. Both processes' CPU and the worker's idle time are recorded."""
+    omega2 = twin[5]
+    positive = omega2[omega2 > 0]
+    yielded = one.timings["slicing"]["run0_modes"]             # run 0's converged prefix at the cap
+    pair = (yielded + 2) // 2                                  # a close pair just above it
+    split = positive[2 * pair] * (1 + 0.5 * STIFFER)
+    slicing = importlib.import_module("sarfe.reduction.spectrum_slicing")
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(slicing, "split_shift",
+                      lambda factor_at, cutoff, total, wanted: (split,
+                                                                int(factor_at(split).negative_pivots)))
+        reduced = reduce(twin, workers=2)
+    record = reduced.timings["slicing"]
+    assert record["split_count"] == np.count_nonzero(omega2 <= split) > yielded
+    assert record["run0_extended_to_split"] == record["split_count"]
+    assert record["shifts"] == [] and record["factorizations"] == 0
+    extension = importlib.import_module("sarfe.reduction.craig_bampton")._RUN0_EXTENSION
+    assert 64 < record["run0_columns"] <= 64 * (1 + extension)
+    assert record["upper"]["cpu_s"] > 0 and record["upper"]["idle_s"] >= 0 and record["cpu_s"] > 0
+    check_against_dense(reduced, twin)
