@@ -566,23 +566,22 @@ def mode_richardson(modes, coarser_modes, decay=1.0) -> float:
 def mode_decay(modes, coarser, changes) -> float:
     """p of (5), fitted from the changes d₁, d₂ of two probes m₁' > m₂' (fewer modes left out
     first): d_i = e (r_i^p − 1), r_i = m/m_i', so d₂/d₁ = (r₂^p − 1)/(r₁^p − 1), increasing in p;
-    solved by bisection and kept in MODE_DECAY (a ratio at or below its p = 1 value — the changes
-    not decaying, or not monotone — gives p = 1, the slowest decay of :func:`mode_richardson`)."""
+    solved by Brent's method and kept in MODE_DECAY (a ratio at or below its p = 1 value — the
+    changes not decaying, or not monotone — gives p = 1, the slowest decay of
+    :func:`mode_richardson`)."""
+    from scipy.optimize import brentq
+
     (m1, m2), (d1, d2) = coarser, changes
     if not (m1 > m2 and d1 > 0 and np.isfinite(d2)):
         return MODE_DECAY[0]
     r1, r2 = modes / m1, modes / m2
-    ratio = (lambda p: (r2 ** p - 1.0) / (r1 ** p - 1.0))
     lo, hi = MODE_DECAY
-    target = d2 / d1
-    if target <= ratio(lo):
+    mismatch = (lambda p: (r2 ** p - 1.0) / (r1 ** p - 1.0) - d2 / d1)
+    if mismatch(lo) >= 0.0:
         return lo
-    if target >= ratio(hi):
+    if mismatch(hi) <= 0.0:
         return hi
-    for _ in range(50):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if ratio(mid) < target else (lo, mid)
-    return lo
+    return float(brentq(mismatch, lo, hi, xtol=1e-13))
 
 
 def modal_extrapolation(modes, coarser, changes) -> tuple[float, float]:
@@ -596,15 +595,10 @@ def modal_extrapolation(modes, coarser, changes) -> tuple[float, float]:
 
 @dataclass(frozen=True)
 class ModalEstimate:
-    """(5) of one solution: amplitude_rel, erp_db [dB] (NaN when no probe converged), the fitted
-    decays p, the probes' raw changes (relative a₁, |ΔdB|) and mode counts m_i', and notes."""
+    """(5) of one solution: amplitude_rel, erp_db [dB] (NaN when no probe converged), notes."""
 
     amplitude_rel: float
     erp_db: float
-    decay_rel: float = float("nan")
-    decay_db: float = float("nan")
-    changes: tuple = ()
-    coarser_modes: tuple = ()
     notes: tuple = ()
 
 
@@ -623,12 +617,11 @@ def modal_truncation_estimate(solution, model, contacts, excitation, modal_dofs,
     if not probes:
         return ModalEstimate(float("nan"), float("nan"), notes=("modal estimate: singular Jacobian",))
     coarser = [kept - p[2] for p in probes]
-    m_rel, p_rel = modal_extrapolation(kept, coarser, [p[0] for p in probes])
-    m_db, p_db = modal_extrapolation(kept, coarser, [p[1] for p in probes])
+    m_rel, _ = modal_extrapolation(kept, coarser, [p[0] for p in probes])
+    m_db, _ = modal_extrapolation(kept, coarser, [p[1] for p in probes])
     notes = (("modal estimate: one probe did not converge (p = 1 on the other)",)
              if len(probes) < len(MODE_PROBES) else ())
-    return ModalEstimate(m_rel, m_db, p_rel, p_db, tuple((p[0], p[1]) for p in probes),
-                         tuple(coarser), notes)
+    return ModalEstimate(m_rel, m_db, notes)
 
 
 def samples_for(harmonics: int, samples_per_period: int) -> int:
