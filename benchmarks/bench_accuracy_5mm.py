@@ -17,7 +17,10 @@ basis' fixed-interface, residual-vector and reduced-system frequencies.
 
 Usage (each stage one process; the truth's stage is large — run it niced in the background):
   python benchmarks/bench_accuracy_5mm.py solve LABEL CUTOFF_HZ [--truth] → /tmp/acc5/LABEL.pkl
+  python benchmarks/bench_accuracy_5mm.py extensions LABEL → the change H = 15 → H' for several H'
   python benchmarks/bench_accuracy_5mm.py report → benchmarks/results/accuracy_5mm.md and .json
+Measured (2026-11-24, shared machine): truth 3840 Hz, 1436 modes, stage 221 s CPU (676 s wall,
+4.5 GB peak); 1.2 kHz 58 s CPU, 1.5 kHz 83 s CPU; solves and estimates a few CPU s per basis.
 """
 from __future__ import annotations
 
@@ -161,6 +164,44 @@ def solve(label, cutoff_hz, truth=False):
         pickle.dump(out, handle)
 
 
+EXTENSIONS = (17, 19, 20, 21, 23, 25, 30)
+
+
+def extension_changes(label, extensions=EXTENSIONS):
+    """The estimate's harmonics change (a₁, dB) of each H = 15 solution on basis ``label`` for H' in
+    ``extensions``, re-solved as the estimate does (:func:`newton_step` from ũ, the climb when
+    it fails) → /tmp/acc5/LABEL_ext.pkl {frequency: [(H', rel, dB), ...]}."""
+    from sarfe.accuracy.estimates import (_change, _first_harmonic_amplitude, newton_correction,
+                                          newton_step, resize_harmonics, samples_for)
+
+    with open(STORE / f"{label}_stage.pkl", "rb") as handle:
+        kept = pickle.load(handle)
+    stage, nl = kept["stage"], kept["nl"]
+    with open(STORE / f"{label}_solutions.pkl", "rb") as handle:
+        solutions = pickle.load(handle)["h15"]
+    out = {}
+    for f, s in zip(FREQUENCIES_HZ, solutions):
+        a_ref = np.max(_first_harmonic_amplitude(nl.contacts, s.displacement))
+        row = []
+        for H_ext in extensions:
+            N = samples_for(H_ext, SAMPLES)
+            U = newton_step(nl.model, nl.contacts, resize_harmonics(nl.excitation, H_ext),
+                            resize_harmonics(s.displacement, H_ext), s.omega, H_ext, N)
+            if U is None:
+                U = newton_correction(nl.model, nl.contacts, nl.excitation, s, H_ext, N)
+            if U is None:
+                row.append((H_ext, float("nan"), float("nan")))
+                continue
+            reached = (U.shape[0] - 1) // 2
+            rel, db = _change(nl.contacts, resize_harmonics(s.displacement, reached), U, s.omega,
+                              stage.erp_map, stage.erp_areas, a_ref)
+            row.append((reached, rel, db))
+        out[f] = row
+    with open(STORE / f"{label}_ext.pkl", "wb") as handle:
+        pickle.dump(out, handle)
+    return out
+
+
 # ------------------------------------------------------------------------------------ report
 def amplitudes(contact):
     """First-harmonic… H-th amplitudes of the contact rows: (H, rows) from (2H+1, rows)."""
@@ -258,15 +299,156 @@ def report(labels=("m100", "m125")):
            "points": point_rows(truth, bases),
            "harmonics": {f"{FREQUENCIES_HZ[i]:g}": harmonic_rows(truth, bases, i)
                          for i in range(len(FREQUENCIES_HZ))}}
+    extensions = {}
+    for label in ("truth", *labels):
+        path = STORE / f"{label}_ext.pkl"
+        if path.exists():
+            with open(path, "rb") as handle:
+                extensions[label] = {f"{f:g}": row for f, row in pickle.load(handle).items()}
+    res["extensions"] = extensions
+    res["conclusion"] = conclusion(res, labels)
     RESULTS.mkdir(exist_ok=True)
     (RESULTS / "accuracy_5mm.json").write_text(json.dumps(res, indent=1, default=float))
+    (RESULTS / "accuracy_5mm.md").write_text(markdown(res, labels))
     return res
+
+
+def conclusion(res, labels):
+    """The findings, with the numbers of this run."""
+    pts = res["points"]
+    true_h = [r["true_h_rel"] for r in pts]
+    lines = ["## Findings", "",
+             f"- True H error of H = 15 (a₁): {min(true_h):.1e} … {max(true_h):.1e}; ERP "
+             f"≤ {max(abs(r['true_h_db']) for r in pts):.3f} dB. True cutoff error: "
+             + "; ".join(f"{label} ≤ {max(r[label]['true_cutoff_rel'] for r in pts):.1e} a₁, "
+                         f"≤ {max(abs(r[label]['true_cutoff_db']) for r in pts):.4f} dB"
+                         for label in labels)
+             + ". The true total error is the H error: at most "
+             f"{100 * max(r[labels[0]]['true_total_rel'] for r in pts):.2f} % at both margins, "
+             "inside the `balanced` 1 %."]
+    for label in labels:
+        ratio = [r[label]["basis_h_rel"] / r["true_h_rel"] for r in pts]
+        est = [r[label]["amplitude_rel"] / r[label]["true_total_rel"] for r in pts]
+        over = [r["frequency_hz"] for r in pts if r[label]["amplitude_rel"] > 1e-2]
+        lines.append(
+            f"- {label}: the basis' own change H = 15 → H' is {min(ratio):.2f} … {max(ratio):.2f}× "
+            f"the true H change; its H' = 30 solution is "
+            f"{min(r[label]['h30_vs_truth_rel'] for r in pts):.1e} … "
+            f"{max(r[label]['h30_vs_truth_rel'] for r in pts):.1e} (a₁) from the truth's. The "
+            f"whole estimate brackets the true total at every point, {min(est):.1f} … "
+            f"{max(est):.1f}× (dB: "
+            f"{min(r[label]['erp_db'] / abs(r[label]['true_total_db']) for r in pts):.1f} … "
+            f"{max(r[label]['erp_db'] / abs(r[label]['true_total_db']) for r in pts):.1f}×); "
+            f"over the 1 % budget at {', '.join(f'{f:g}' for f in over) or 'no point'}"
+            + (" Hz." if over else "."))
+    lines += [
+        "- Why margin 1.0 reads higher: the residual vectors' Ritz frequencies start just above "
+        "the cutoff (1249 Hz on the 1.2 kHz basis, 1607 Hz on the 1.5 kHz one). The first "
+        "harmonics above a basis' top are answered by them and overshoot the truth (60.74 Hz, "
+        "contact amplitude: 1.3–1.8× at k = 19–21 on the 1.2 kHz basis, 1.4–1.6× at k = 25–26 "
+        "on the 1.5 kHz one); higher up they undershoot (0.4–0.8×). At 58–64 Hz the harmonics "
+        "that change a₁ most are k ≈ 19–25 (the truth's change grows from H' = 19 to 25, table "
+        "above): on the 1.5 kHz basis they are below or at its top and its change follows the "
+        "truth's to H' = 25; on the 1.2 kHz basis they sit on the overshoot, and its change "
+        "grows to 1.4–1.6× the truth's. The growth at 1.0 is the basis' error above its top, "
+        "not a larger H error.",
+        "- Limiting H' to the orders the basis resolves (H' = ⌊f_top / f⌋, Richardson "
+        "1/(1 − H/H')) does not help: the true H error comes from k = 21–25 at 60 Hz (truth: "
+        "H' = 19: 3.4e-4, H' = 25: 2.7e-3), above a 1.2 kHz top. On the 1.2 kHz basis that rule "
+        "(H' = 19 at 60–63 Hz, factor 4.75) gives 1.9e-3 at 60 Hz (true 2.27e-3: the harmonics "
+        "part alone misses) and 1.4e-2 … 1.6e-2 at 61.5–63 Hz (today 8.2e-3 … 1.2e-2). The "
+        "estimate is kept; the per-point estimate records the basis' top (`basis_top_hz`) and the "
+        "accuracy check's warning says when the harmonics change reached above it.",
+        "- A harmonics part that measures the H error only needs a basis whose top covers the "
+        "harmonics that matter (here ≈ 1.25 H f_max covered k ≤ 25 at 60 Hz; the accuracy "
+        "search builds its stage at max(margin, 1.5) H f_max for the same reason) — a reduction "
+        "matter — or residual vectors whose Ritz frequencies do not sit just above the cutoff."]
+    return "\n".join(lines)
+
+
+def _band(values, lo, hi):
+    values = np.asarray(values if values is not None else [], dtype=float)
+    return int(np.count_nonzero((values > lo) & (values <= hi)))
+
+
+def markdown(res, labels):
+    bases = res["bases"]
+    lines = [
+        "# P1 at 5 mm: the per-point error estimate against the truth (issue 15, task acc5mm)", "",
+        "Script: benchmarks/bench_accuracy_5mm.py (its docstring says what is solved). P1 "
+        "(cases/door_trim_p1.yaml, 5 mm, H = 15, N = 256) point by point (warm-started steps, "
+        "stability off). Truth basis: Craig–Bampton cutoff "
+        f"{bases['truth']['cutoff_hz']:.0f} Hz (≥ 2 · 30 · 64 Hz). a₁: max over contact rows of "
+        "|Δa₁| / max a₁ (the estimate's amplitude measure); dB: the larger of |ΔL| and |ΔL_A| "
+        "of the ERP summed over harmonics (the estimate's level measure).", "",
+        "## Bases", "",
+        "| basis | cutoff [Hz] | modes | reduced DOFs | residual vectors: Ritz range [Hz] | "
+        "… in 1.2–1.9 kHz | reduced-model modes in 1.2–1.9 kHz | stage CPU s (wall s) |",
+        "|---|---|---|---|---|---|---|---|"]
+    for label in ("truth", *labels):
+        b = bases[label]
+        rv = np.asarray(b["residual_frequencies_hz"], dtype=float)
+        lines.append(f"| {label} | {b['cutoff_hz']:.0f} | {b['modes']} | {b['reduced_dofs']} | "
+                     f"{rv.min():.0f}–{rv.max():.0f} | {_band(rv, 1200, 1900)} | "
+                     f"{_band(b['system_frequencies_hz'], 1200, 1900)} | "
+                     f"{b['stage_cpu_s']:.0f} ({b['stage_wall_s']:.0f}) |")
+    lines += ["", "## Per point: true errors and the estimate", "",
+              "true H: H = 15 against H = 30 (N = 512) on the truth basis. Per basis: cutoff = "
+              "H = 15 on it against H = 15 on the truth basis; basis H = its own change H = 15 → "
+              "H' (the estimate's raw harmonics change); H' vs truth = its H' = 30 solution "
+              "against the truth's; part = Richardson × raw; estimate = the whole "
+              "amplitude_rel / erp_db; ratio = estimate / (H = 15 on it against H = 30 on the "
+              "truth basis).", "",
+              "| f [Hz] | true H a₁ | true H dB | basis | cutoff a₁ | basis H a₁ | H' = 30 vs "
+              "truth a₁ | harmonics part a₁ | estimate a₁ | ratio a₁ | estimate dB | ratio dB |",
+              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in res["points"]:
+        for j, label in enumerate(labels):
+            o = r[label]
+            head = (f"| {r['frequency_hz']:g} | {r['true_h_rel']:.2e} | {abs(r['true_h_db']):.3f} "
+                    if j == 0 else "| | | ")
+            lines.append(
+                head + f"| {label} | {o['true_cutoff_rel']:.1e} | {o['basis_h_rel']:.2e} | "
+                f"{o['h30_vs_truth_rel']:.1e} | {o['harmonics_part_rel']:.2e} | "
+                f"{o['amplitude_rel']:.2e} | {o['amplitude_rel'] / o['true_total_rel']:.1f} | "
+                f"{o['erp_db']:.3f} | {o['erp_db'] / max(abs(o['true_total_db']), 1e-12):.1f} |")
+    lines += ["", "## Per harmonic of the H' = 30 solutions (60.74 Hz, where P1's check is worst)",
+              "", "contact: max over rows of the harmonic's amplitude, basis / truth; ERP: the "
+              "harmonic's ERP proxy, basis against truth [dB].", "",
+              "| k | k f [Hz] | truth contact [m] | " + " | ".join(
+                  f"{label} contact | {label} ERP dB" for label in labels) + " |",
+              "|---|---|---|" + "---|---|" * len(labels)]
+    for row in res["harmonics"]["60.74"][12:]:
+        t = row["truth"]
+        cells = []
+        for label in labels:
+            b = row[label]
+            cells.append(f"{b['contact_m'] / t['contact_m']:.2f} | "
+                         f"{10 * np.log10(b['power'] / t['power']):+.1f}")
+        lines.append(f"| {row['k']} | {row['hz']:.0f} | {t['contact_m']:.2e} | "
+                     + " | ".join(cells) + " |")
+    if res.get("extensions"):
+        lines += ["", "## The harmonics change H = 15 → H' on each basis (a₁)", "",
+                  "As the estimate re-solves it (Newton from the H = 15 solution), H' = "
+                  + ", ".join(str(h) for h in EXTENSIONS) + ".", "",
+                  "| f [Hz] | basis | " + " | ".join(f"H' = {h}" for h in EXTENSIONS) + " |",
+                  "|---|---|" + "---|" * len(EXTENSIONS)]
+        for f in res["frequencies_hz"]:
+            for label, ext in res["extensions"].items():
+                row = ext.get(f"{f:g}")
+                if row:
+                    lines.append(f"| {f:g} | {label} | "
+                                 + " | ".join(f"{rel:.2e}" for _, rel, _ in row) + " |")
+    lines += ["", res.get("conclusion", "")]
+    return "\n".join(lines) + "\n"
 
 
 if __name__ == "__main__":
     command = sys.argv[1]
     if command == "solve":
         solve(sys.argv[2], float(sys.argv[3]), "--truth" in sys.argv)
+    elif command == "extensions":
+        extension_changes(sys.argv[2])
     elif command == "report":
         report()
     else:
