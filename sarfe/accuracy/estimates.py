@@ -170,6 +170,10 @@ class ErrorEstimate:
     displacement_tail / force_tail: (2).
     amplitude_rel, erp_db: RICHARDSON × (harmonics + aliasing part) + modal part (3), (4) (what
     :func:`choose_resolution` compares with the target). seconds: time spent estimating.
+    basis_top_hz: the highest fixed-interface mode of a Craig–Bampton model [Hz] (NaN otherwise):
+    harmonics of the H' re-solve above it are answered by the residual vectors, whose Ritz
+    frequencies sit just above it — there the reduced model's own error enters the harmonics
+    change (:func:`basis_limited_extension`).
     """
 
     harmonics: int
@@ -187,6 +191,7 @@ class ErrorEstimate:
     erp_db: float
     seconds: float = 0.0
     notes: tuple = field(default=())
+    basis_top_hz: float = float("nan")
 
     def as_dict(self) -> dict:
         data = asdict(self)
@@ -751,12 +756,33 @@ class EstimateProblem:
 
 def problem_error_estimate(solution, problem: EstimateProblem, options=None) -> ErrorEstimate:
     """:func:`estimate_errors` of a case's point with H' reaching past the model's highest mode
-    (:func:`reach_harmonics`)."""
+    (:func:`reach_harmonics`); on a Craig–Bampton model (modal_dofs given) the highest kept mode is
+    recorded as ``basis_top_hz``."""
+    from dataclasses import replace
+
     H_ext = reach_harmonics(int(solution.harmonics), float(solution.omega), problem.highest_mode_hz)
-    return estimate_errors(solution, problem.model, problem.contacts, problem.excitation,
-                           erp_map=problem.erp_map, erp_areas=problem.erp_areas,
-                           modal_dofs=problem.modal_dofs, residual_dofs=problem.residual_dofs,
-                           harmonics_extension=H_ext, options=options)
+    estimate = estimate_errors(solution, problem.model, problem.contacts, problem.excitation,
+                               erp_map=problem.erp_map, erp_areas=problem.erp_areas,
+                               modal_dofs=problem.modal_dofs, residual_dofs=problem.residual_dofs,
+                               harmonics_extension=H_ext, options=options)
+    top = problem.highest_mode_hz
+    if problem.modal_dofs is not None and len(problem.modal_dofs) and top is not None \
+            and np.isfinite(top):
+        estimate = replace(estimate, basis_top_hz=float(top))
+    return estimate
+
+
+def basis_limited_extension(estimate: dict, frequency_hz: float) -> bool:
+    """True when the harmonics change of ``estimate`` (an :meth:`ErrorEstimate.as_dict`) reached
+    past the top of its Craig–Bampton basis, H' f > basis_top_hz: the harmonics between the top
+    and H' f are answered by the residual vectors, and the change includes the reduced model's
+    own error there. Measured on P1 at 5 mm (benchmarks/results/accuracy_5mm.md): with the top at
+    H f_max (cutoff_margin 1.0) the first harmonics above it overshoot the truth's contact
+    amplitude 1.3–1.8× (the residual vectors' Ritz frequencies start just above the cutoff) and
+    the change H → 2H is 1.5–1.6× the true one; with the top at 1.25 H f_max, 0.87–1.05×."""
+    top = estimate.get("basis_top_hz", float("nan"))
+    top = float("nan") if top is None else float(top)
+    return bool(np.isfinite(top) and int(estimate["extended_harmonics"]) * frequency_hz > top)
 
 
 def highest_natural_frequency_hz(model):
@@ -914,5 +940,6 @@ def suggest_mode_count(mode_frequencies_hz, max_frequency_hz, harmonics, target=
 __all__ = ["RICHARDSON", "PRESETS", "AccuracyTarget", "parse_accuracy", "ErrorEstimate", "Resolution",
            "resize_harmonics", "spectral_tail", "harmonic_energy", "newton_correction",
            "extended_harmonics", "reach_harmonics", "samples_for", "estimate_errors", "EstimateProblem",
-           "problem_error_estimate", "highest_natural_frequency_hz", "choose_resolution",
+           "problem_error_estimate", "basis_limited_extension", "highest_natural_frequency_hz",
+           "choose_resolution",
            "suggest_mode_count"]

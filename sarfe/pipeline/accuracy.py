@@ -164,7 +164,8 @@ def accuracy_check(solver: SolverConfig, points) -> dict | None:
     (a 5 dB error 60 dB below the headline changes nothing a user reads). The knob to raise is the
     one whose part (Richardson factors included) is largest at the worst point: harmonics →
     solver.harmonics, aliasing → solver.samples_per_period, modal → the reduction cutoff."""
-    from sarfe.accuracy.estimates import RICHARDSON, harmonics_richardson, parse_accuracy
+    from sarfe.accuracy.estimates import (RICHARDSON, basis_limited_extension,
+                                          harmonics_richardson, parse_accuracy)
 
     target = parse_accuracy(solver.accuracy_or_default)
     rated = [p for p in points if p["converged"] and p.get("error_estimate")
@@ -203,6 +204,12 @@ def accuracy_check(solver: SolverConfig, points) -> dict | None:
         warning = (f"accuracy: the error estimate exceeds the '{target.name}' budget at "
                    f"{worst['frequency_hz']:.2f} Hz (amplitude ±{100 * e['amplitude_rel']:.2g} %, "
                    f"ERP ±{abs(e['erp_db']):.2g} dB); mostly from {knob}: raise {KNOBS[knob]}")
+        if knob == "harmonics" and basis_limited_extension(e, worst["frequency_hz"]):
+            warning += (f" (its re-solve at H' = {int(e['extended_harmonics'])} reaches "
+                        f"{int(e['extended_harmonics']) * worst['frequency_hz']:.0f} Hz, above "
+                        f"the reduced basis' top mode at {e['basis_top_hz']:.0f} Hz, where the "
+                        "reduced model's own error enters the change: if a higher "
+                        "reduction.cutoff_margin lowers it, it was the basis')")
     if unknown:     # an estimate whose re-solve did not converge: unknown, said, not hidden
         where = ", ".join(f"{p['frequency_hz']:.2f}" for p in unknown[:3])
         more = f" and {len(unknown) - 3} more" if len(unknown) > 3 else ""
