@@ -779,7 +779,7 @@ def basis_limited_extension(estimate: dict, frequency_hz: float) -> bool:
     own error there. Measured on P1 at 5 mm (benchmarks/results/accuracy_5mm.md): with the top at
     H f_max (cutoff_margin 1.0) the first harmonics above it overshoot the truth's contact
     amplitude 1.3–1.8× (the residual vectors' Ritz frequencies start just above the cutoff) and
-    the change H → 2H is 1.5–1.6× the true one; with the top at 1.25 H f_max, 0.87–1.05×."""
+    the change H → 2H is 1.4–1.6× the true one; with the top at 1.25 H f_max, 0.8–1.5×."""
     top = estimate.get("basis_top_hz", float("nan"))
     top = float("nan") if top is None else float(top)
     return bool(np.isfinite(top) and int(estimate["extended_harmonics"]) * frequency_hz > top)
