@@ -4,7 +4,8 @@ P1 (cases/door_trim_p1.yaml: 5 mm, H = 15, 40–80 Hz) at a few points in 58–6
 point (45 Hz), solved point by point (warm-started steps, stability off):
 
 - truth: H = 15 (N = 256) and H = 30 (N = 512) on one large Craig–Bampton basis (``truth``,
-  cutoff TRUTH_CUTOFF_HZ); the true H error of H = 15 is its change to H = 30 there;
+  cutoff 3840 Hz ≥ 2 · 30 · 64 Hz, given on the command line); the true H error of H = 15 is its
+  change to H = 30 there;
 - the defaults at cutoff_margin 1.0 and 1.25 (cutoff 1.2 / 1.5 kHz = margin · 15 · 80 Hz), H = 15
   with the pipeline's per-point estimate (``stage_error_estimate``: its harmonics, aliasing and
   modal parts), and H' = 30 on the same basis (what the estimate's harmonics part re-solves): the
@@ -15,10 +16,12 @@ displacements G ũ (2H+1, rows) (boundary coordinates: the same rows on every ba
 ERP proxy per harmonic p_k = (kω)² Σ_s a_s |w_{s,k}|² through that basis' own ERP map, plus the
 basis' fixed-interface, residual-vector and reduced-system frequencies.
 
-Usage (each stage one process; the truth's stage is large — run it niced in the background):
+Environment: SARFE_ACC5_MESH_M (default 0.005; 0.015 → results/accuracy_15mm.*), SARFE_ACC5_STORE
+(default /tmp/acc5). Usage (each stage one process; the truth's stage is large — run it niced in the background):
   python benchmarks/bench_accuracy_5mm.py solve LABEL CUTOFF_HZ [--truth] → /tmp/acc5/LABEL.pkl
   python benchmarks/bench_accuracy_5mm.py extensions LABEL → the change H = 15 → H' for several H'
-  python benchmarks/bench_accuracy_5mm.py report → benchmarks/results/accuracy_5mm.md and .json
+  python benchmarks/bench_accuracy_5mm.py report [LABEL ...] → benchmarks/results/accuracy_5mm.md
+  and .json (default labels m100 m125; this run: m100 1200, m110 1320, m125 1500 Hz)
 Measured (2026-11-24, shared machine): truth 3840 Hz, 1436 modes, stage 221 s CPU (676 s wall,
 4.5 GB peak); 1.2 kHz 58 s CPU, 1.5 kHz 83 s CPU; solves and estimates a few CPU s per basis.
 """
@@ -454,6 +457,6 @@ if __name__ == "__main__":
     elif command == "extensions":
         extension_changes(sys.argv[2])
     elif command == "report":
-        report()
+        report(tuple(sys.argv[2:]) or ("m100", "m125"))
     else:
         raise SystemExit(__doc__)
