@@ -328,7 +328,7 @@ def conclusion(res, labels):
                          f"≤ {max(abs(r[label]['true_cutoff_db']) for r in pts):.4f} dB"
                          for label in labels)
              + ". The true total error is the H error: at most "
-             f"{100 * max(r[labels[0]]['true_total_rel'] for r in pts):.2f} % at both margins, "
+             f"{100 * max(r[labels[0]]['true_total_rel'] for r in pts):.2f} % on every basis here, "
              "inside the `balanced` 1 %."]
     for label in labels:
         ratio = [r[label]["basis_h_rel"] / r["true_h_rel"] for r in pts]
