@@ -650,7 +650,8 @@ def contact_row_counts(model, contacts, omega, harmonics, forces, operator=None,
     damping_norm = 0.0 if Jd is None else float(spla.norm(Jd))
     X = exponent_bound(basis, det.gap_modes, omega, H, jacobian_norm, damping_norm)
     top = 0.505 * omega                                   # the strip |Im s| ≤ 1.01 ω/2
-    contour = _upper_contour(epsilon, X, top, shifted_exponents(structure, omega, H))
+    poles = shifted_exponents(structure, omega, H)
+    contour = _upper_contour(epsilon, X, top, poles)
     samples = {}                # log det F at the contour's nodes, for locating ≥ 2 zeros
 
     def sampled(s):
@@ -671,7 +672,7 @@ def contact_row_counts(model, contacts, omega, harmonics, forces, operator=None,
         lead = real_zero(det.log_determinants, -epsilon, X)
         exponents = None if lead is None else np.array([lead])
     else:
-        exponents = leading_zeros(det.log_determinants, samples, zeros, epsilon, top, X)
+        exponents = leading_zeros(det.log_determinants, samples, zeros, epsilon, top, X, poles)
     if exponents is None:
         return None, zeros, coarse_zeros
     lead = float(exponents.real.max())
@@ -679,13 +680,14 @@ def contact_row_counts(model, contacts, omega, harmonics, forces, operator=None,
                    uncertain_band), zeros, coarse_zeros
 
 
-def leading_zeros(log_det, samples, zeros, epsilon, top, X):
+def leading_zeros(log_det, samples, zeros, epsilon, top, X, poles=()):
     """Every zero of det F in the half-strip Ω of the count (``zeros`` ≥ 2 of them), conjugates
     included ((zeros,) complex [1/s]), located from the count's ``samples`` (dict s ↦ log det F)
-    by :func:`sarfe.hbm.stability_zeros.located_zeros`; None when not all are located."""
+    by :func:`sarfe.hbm.stability_zeros.located_zeros` (``poles``: those of det F,
+    :func:`shifted_exponents`); None when not all are located."""
     from .stability_zeros import located_zeros
 
-    found = located_zeros(log_det, samples, zeros, epsilon, top, X)
+    found = located_zeros(log_det, samples, zeros, epsilon, top, X, poles)
     if found is None:
         return None
     return np.concatenate([found, found[found.imag != 0].conj()])

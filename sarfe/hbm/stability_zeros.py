@@ -40,19 +40,25 @@ import numpy as np
 
 BOX_TRIES = 3            # right edges b tried for the box before giving up
 MAX_POWER_SUMS = 8       # zeros located from one set of power sums (Newton identities' degree)
-ROUNDS = 4               # deflation rounds
-MULLER_STEPS = 40        # Muller iterations per start
+ROUNDS = 6               # rounds of starts (deflated by the zeros located before)
+MULLER_STEPS = 25        # Muller iterations per start
 MULLER_TOLERANCE = 1e-10  # |Δs| ≤ tolerance · max(|s|, r) [relative]
 
 
-def located_zeros(log_det, samples, zeros, epsilon, top, X):
+def located_zeros(log_det, samples, zeros, epsilon, top, X, poles=()):
     r"""The zeros of f = det F in Ω with Im s ≥ 0 ((m,) complex [1/s], real ones with Im = 0,
     each standing for itself and its conjugate) when exactly ``zeros`` = n are located, else
     None (module docstring).
 
     log_det: s (n_s,) complex ↦ log f(s) (n_s,) complex (log|f| + i arg f); samples: dict
     s ↦ log f(s) of the count's contour (read and extended: no node is evaluated twice);
-    epsilon, top, X [1/s]: the half-strip Ω of the count."""
+    epsilon, top, X [1/s]: the half-strip Ω of the count; poles: the known poles of f (the
+    structure's exponents shifted by imω, all left of −ε), of which those within top/16 of the
+    box's left edge (the lightly damped ones beside the strip, the poles the count's contour
+    steps around) are divided out of f wherever it is interpolated or iterated on: they lie
+    outside the box, so its zeros are unchanged, and g is smoother there (a pole just left of −ε
+    beside a zero just right of it otherwise throws Muller's parabola off; dividing out all poles
+    of the region instead makes g vary like Π (s − p) over hundreds of them, and Muller stalls)."""
     from .stability_rows import winding_count
 
     values = samples
@@ -82,22 +88,27 @@ def located_zeros(log_det, samples, zeros, epsilon, top, X):
         return None
     nodes, logs = _upper_boundary(values, epsilon, top, b)
     centre, radius = 0.5 * (b - epsilon), float(np.hypot(0.5 * (b + epsilon), top))
+    poles = np.asarray(poles, dtype=complex).ravel()
+    poles = poles[(-epsilon - poles.real <= top / 16) & (np.abs(poles.imag) <= 17 / 16 * top)]
     snap = 1e-9 * radius
-    found = np.zeros(0, complex)
+    found, stalled = np.zeros(0, complex), False
     for _ in range(ROUNDS):
         known = np.concatenate([found, found[found.imag != 0].conj()])
         left = n - known.size
         if left <= 0 or left > MAX_POWER_SUMS:
             break
-        sums = power_sums(nodes, logs, known, centre, radius, left)
-        starts = centre + radius * roots_of_power_sums(sums)
-        starts = np.where(starts.imag < -snap, starts.conj(), starts)
+        if not stalled:           # the roots of the (deflated) power sums
+            sums = power_sums(nodes, logs, known, centre, radius, left, poles)
+            starts = centre + radius * roots_of_power_sums(sums)
+        else:                     # they led to no new zero: start where arg g turns fastest
+            starts = _steepest_steps(nodes, logs, known, left, poles)
 
         def log_g(s, known=known):
             s = np.asarray(s, dtype=complex)
-            return log_f(s) - np.log(s[:, None] - known[None]).sum(axis=1)
+            return log_f(s) - np.log(s[:, None] - known[None]).sum(axis=1) + np.log(
+                s[:, None] - poles[None]).sum(axis=1)
 
-        z, converged = muller(log_g, starts, radius)
+        z, converged = muller(log_g, _distinct(starts, snap), radius, centre=centre)
         z = z[converged]
         z = np.where(np.abs(z.imag) <= snap, z.real + 0j, z)
         z = np.where(z.imag < 0, z.conj(), z)
@@ -105,12 +116,35 @@ def located_zeros(log_det, samples, zeros, epsilon, top, X):
         for w in z[(z.real > -epsilon) & (z.real < b) & (z.imag < top)]:
             if all(abs(w - u) > 1e-6 * radius for u in [*found, *new]):
                 new.append(w)
-        if not new:
+        if not new and stalled:
             break
+        stalled = not new
         found = np.concatenate([found, new])
     if found.size + np.count_nonzero(found.imag != 0) != n:
         return None
     return found
+
+
+def _distinct(starts, snap):
+    """The start points mapped to Im s ≥ 0 (f(s̄) = conj f(s)), without repeats (to ``snap``)."""
+    starts = np.where(starts.imag < -snap, starts.conj(), starts)
+    keep = []
+    for s in starts[np.isfinite(starts)]:
+        if all(abs(s - t) > snap for t in keep):
+            keep.append(s)
+    return np.array(keep, dtype=complex)
+
+
+def _steepest_steps(nodes, logs, known, count, poles=()):
+    """The midpoints of the ``count`` sampled steps along which arg g (g = f Π (s − p) /
+    Π_known (s − z)) turns fastest (|Δarg g| / |Δs|, local maxima along the contour): beside a
+    zero close to the contour — a period-doubling pair near Im s = ω/2 lies just below the top
+    edge — where the power sums, which take log f linear over a step, are least accurate."""
+    rate = np.abs(_principal_steps(nodes, logs, known, poles).imag) / np.abs(np.diff(nodes))
+    padded = np.concatenate([[-np.inf], rate, [-np.inf]])
+    peaks = np.flatnonzero((rate >= padded[:-2]) & (rate >= padded[2:]))
+    steep = peaks[np.argsort(-rate[peaks], kind="stable")[:count]]
+    return 0.5 * (nodes[steep] + nodes[steep + 1])
 
 
 def _upper_boundary(values, epsilon, top, right):
@@ -128,8 +162,9 @@ def _upper_boundary(values, epsilon, top, right):
     return s[order], v[order]
 
 
-def power_sums(nodes, logs, known, centre, radius, count):
-    r"""p_j = Σ_k w_k^j (j = 0 … count) of the zeros of g = f / Π_known (s − z) inside the closed
+def power_sums(nodes, logs, known, centre, radius, count, poles=()):
+    r"""p_j = Σ_k w_k^j (j = 0 … count) of the zeros of g = f Π (s − p) / Π_known (s − z) (the
+    ``poles`` outside the contour: they change nothing but the smoothness) inside the closed
     contour whose upper half is sampled at ``nodes`` (counter-clockwise, (k,) complex) with
     ``logs`` = log f there; w = (s − centre)/radius. Per step log g is taken linear in s, so
     ∫ w^j d log g = Δlog g (w_b^{j+1} − w_a^{j+1}) / ((j+1)(w_b − w_a)); Δarg f between
@@ -137,14 +172,23 @@ def power_sums(nodes, logs, known, centre, radius, count):
     principal log of (s_b − z)/(s_a − z) (exact for a straight step). p_j = Im I_j / π (the
     lower half is the mirror image). Returns (count + 1,) real (p_0 = count when all is well)."""
     w = (nodes - centre) / radius
-    step = np.diff(logs.real) + 1j * np.angle(np.exp(1j * np.diff(logs.imag)))
-    if known.size:
-        step = step - np.log((nodes[1:, None] - known[None]) /
-                             (nodes[:-1, None] - known[None])).sum(axis=1)
+    step = _principal_steps(nodes, logs, known, poles)
     a, b = w[:-1], w[1:]
     j = np.arange(count + 1)[:, None] + 1
     integrals = (step * (b ** j - a ** j) / (j * (b - a))).sum(axis=1)
     return integrals.imag / np.pi
+
+
+def _principal_steps(nodes, logs, known, poles):
+    """Δ log g between neighbouring nodes, g = f Π (s − p) / Π (s − z): Δarg f the principal one
+    (the count's steps turn it by ≤ π/3), Δ log (s − a) the principal log of
+    (s_b − a)/(s_a − a) — exact for a straight step that does not pass through a."""
+    step = np.diff(logs.real) + 1j * np.angle(np.exp(1j * np.diff(logs.imag)))
+    for points, sign in ((np.asarray(known, complex), -1.0), (np.asarray(poles, complex), 1.0)):
+        if points.size:
+            step = step + sign * np.log((nodes[1:, None] - points[None]) /
+                                        (nodes[:-1, None] - points[None])).sum(axis=1)
+    return step
 
 
 def roots_of_power_sums(sums):
@@ -158,7 +202,7 @@ def roots_of_power_sums(sums):
     return np.roots([(-1) ** k * e[k] for k in range(n + 1)])
 
 
-def muller(log_g, starts, scale, tolerance=MULLER_TOLERANCE, steps=MULLER_STEPS):
+def muller(log_g, starts, scale, tolerance=MULLER_TOLERANCE, steps=MULLER_STEPS, centre=0.0):
     r"""Muller's method on g = exp(log_g) from every start at once → (s (m,), converged (m,)).
 
     Per start the parabola through the last three iterates (x₀, x₁, x₂; g scaled by the start's
@@ -166,7 +210,8 @@ def muller(log_g, starts, scale, tolerance=MULLER_TOLERANCE, steps=MULLER_STEPS)
     b = a (x₂ − x₁) + d₂, gives the next iterate x₃ = x₂ − 2 g₂ / (b ± √(b² − 4 g₂ a)) (the sign
     with the larger denominator). The first three iterates are x − 10⁻³ r, x + 10⁻³ i r, x
     (r = ``scale`` [1/s]). Converged when |x₃ − x₂| ≤ ``tolerance``·max(|x₃|, r); a start whose g
-    is not finite stops. One call of log_g per step for all starts still moving."""
+    is not finite, or whose iterate leaves the disc |s − ``centre``| ≤ 3r (a zero there is not
+    one of the box), stops. One call of log_g per step for all starts still moving."""
     x = np.asarray(starts, dtype=complex)
     m = x.size
     h = 1e-3 * scale
@@ -190,7 +235,7 @@ def muller(log_g, starts, scale, tolerance=MULLER_TOLERANCE, steps=MULLER_STEPS)
             root = np.sqrt(b * b - 4.0 * g2 * a)
             denominator = np.where(np.abs(b + root) >= np.abs(b - root), b + root, b - root)
             x3 = x2 - 2.0 * g2 / denominator
-        finite = np.isfinite(x3)
+        finite = np.isfinite(x3) & (np.abs(x3 - centre) <= 3.0 * scale)
         g3 = np.full(index.size, np.nan, complex)
         if finite.any():
             with np.errstate(all="ignore"):
