@@ -33,8 +33,14 @@ integrator verdict counts as truth only where its shooting closed the orbit (per
 and the verdicts at all its step counts agree. Integrator results are
 kept in results/stability_truth.json and reused by reruns (keyed by frequency and steps).
 
+Section "zeros" (``--zeros POINTS.pkl``, session hillzeros): on captured orbits
+(benchmarks/stability_counts.py capture) the points where the count finds two or more exponents
+right of −ε: the default verdict with the zeros located (sarfe/hbm/stability_zeros.py) and its
+CPU, the Ritz hand-over it replaces, and the full nonlinear Hill problem on all reduced DOFs
+started at the located leading exponent. → results/stability_zeros.json.
+
 Run: OPENBLAS_NUM_THREADS=1 python benchmarks/bench_stability.py [--skip-full] [--rows] [--sweep]
-[--truth]
+[--truth] [--zeros POINTS.pkl …]
 """
 import json
 import os
@@ -524,10 +530,117 @@ def write_truth_section(lines):
     path.write_text(head.rstrip("\n") + "\n\n" + "\n".join(lines) + ("\n" + tail if tail else ""))
 
 
+ZEROS_HEADER = "## Two or more zeros right of −ε, located (issue 15 P1, session hillzeros)"
+
+
+def zeros_study(points_paths):
+    """Per captured point (benchmarks/stability_counts.py capture) where the count finds two or
+    more exponents right of −ε: the default verdict (the zeros located,
+    sarfe/hbm/stability_zeros.py) and its CPU, the same with the locator stubbed to fail (the
+    Ritz method of the hand-over, as before), and the full nonlinear Hill problem on all reduced
+    DOFs started at the located leading exponent (refine_exponent: the full method's own secant
+    iteration on T(s); its ARPACK selection, the exponents nearest 0, misses a pair near
+    Im s = ω/2 on P1)."""
+    import pickle
+    import types
+    import scipy.sparse as sp
+    import sarfe.hbm.solve as solve_module
+    import sarfe.hbm.stability_rows as rows_module
+    from sarfe.hbm.aft import jacobian_matrix
+    from sarfe.hbm.linear import dynamic_stiffness_matrix
+    from sarfe.hbm.stability import _hill, refine_exponent
+    from sarfe.hbm.stability_trust import check_harmonics
+
+    records = []
+    for path in points_paths:
+        with open(path, "rb") as f:
+            records += pickle.load(f)
+    points = []
+    for problem, omega, U, forces, options in records:
+        op = ContactOperator(problem, U, omega, forces)
+        _, zeros, _ = rows_module.contact_row_counts(
+            problem.model, problem.contacts, omega, problem.harmonics, forces, op,
+            tolerance=options.stability_tolerance,
+            check_harmonics=check_harmonics(problem.harmonics))
+        if not zeros or zeros < 2:
+            continue
+        ev = types.SimpleNamespace(forces=forces, jacobian=None)
+        labels = {}
+        for name in ("located", "ritz"):
+            original = rows_module.leading_zeros
+            if name == "ritz":
+                rows_module.leading_zeros = lambda *args, **kwargs: None
+            try:
+                t = time.process_time()
+                r = solve_module.stability(problem, omega, U, ev, options)
+                labels[name] = dict(stable=r.stable, leading=r.leading, note=r.note,
+                                    cpu_s=time.process_time() - t, exponents=r.exponents)
+            finally:
+                rows_module.leading_zeros = original
+        lead = labels["located"]["exponents"]
+        lead = lead[np.argmax(lead.real)]
+        lead = lead.conjugate() if lead.imag < 0 else lead
+        H, G = problem.harmonics, problem.contacts.gap_map
+        GG = sp.kron(sp.identity(2 * H + 1), G, format="csr")
+        jacobian = (sp.csr_matrix(dynamic_stiffness_matrix(problem.model, omega, H))
+                    + GG.T @ jacobian_matrix(forces.blocks, G.shape[0], H) @ GG
+                    + op.correction(0.0).real)
+        Mt, Dt = _hill(problem.model, omega, H, contact_damping(problem, forces))
+        t = time.process_time()
+        full, converged = refine_exponent(Mt, Dt, jacobian, op, lead, dense=False)
+        for label in labels.values():
+            label.pop("exponents")
+        points.append(dict(frequency_hz=omega / (2 * np.pi), zeros=zeros,
+                           reduced_dofs=problem.model.dof_count, **labels,
+                           located_exponent=[lead.real, lead.imag],
+                           full_exponent=[full.real, full.imag], full_converged=bool(converged),
+                           full_cpu_s=time.process_time() - t))
+        print(points[-1], flush=True)
+    return {"case": ", ".join(str(p) for p in points_paths),
+            "load_average": os.getloadavg()[0], "points": points}
+
+
+def zeros_lines(res):
+    lines = [ZEROS_HEADER, "",
+             f"Captured orbits {res['case']} (load {res['load_average']:.1f}; CPU seconds per "
+             "point). located: the default (the zeros "
+             "right of −ε located from the count's samples); Ritz: the same with the locator "
+             "stubbed to fail (the hand-over before this session); full: the nonlinear Hill "
+             "problem on all reduced DOFs started at the located leading exponent.", "",
+             "| f [Hz] | reduced DOFs | zeros | located: verdict (leading) | CPU | Ritz: verdict "
+             "(leading) | CPU | located exponent | full exponent (converged) | full CPU |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    for p in res["points"]:
+        a, b = p["located"], p["ritz"]
+        z, w = complex(*p["located_exponent"]), complex(*p["full_exponent"])
+        lines.append(f"| {p['frequency_hz']:.4f} | {p['reduced_dofs']} | {p['zeros']} | {a['stable']} "
+                     f"({a['leading']:.4g}) | {a['cpu_s']:.2f} | {b['stable']} ({b['leading']:.4g}) "
+                     f"| {b['cpu_s']:.2f} | {z:.4f} | {w:.4f} ({p['full_converged']}) | "
+                     f"{p['full_cpu_s']:.0f} |")
+    return lines
+
+
+def write_zeros_section(lines):
+    """Replace (or append at the end) the zeros section of results/stability.md."""
+    path = HERE / "results" / "stability.md"
+    text = path.read_text() if path.exists() else ""
+    head, _, rest = text.partition(ZEROS_HEADER)
+    tail = "## " + rest.split("\n## ", 1)[1] if "\n## " in rest else ""
+    path.write_text(head.rstrip("\n") + "\n\n" + "\n".join(lines) + "\n" + ("\n" + tail if tail else ""))
+
+
 def main():
     if "--compare" in sys.argv:
         i = sys.argv.index("--compare")
         compare_sweeps(sys.argv[i + 1], sys.argv[i + 2])
+        return
+    if "--zeros" in sys.argv:          # --zeros POINTS.pkl … (benchmarks/stability_counts.py capture)
+        res = zeros_study(sys.argv[sys.argv.index("--zeros") + 1:])
+        (HERE / "results").mkdir(exist_ok=True)
+        (HERE / "results" / "stability_zeros.json").write_text(
+            json.dumps(res, indent=1, default=str))
+        write_zeros_section(zeros_lines(res))
+        print("\n".join(zeros_lines(res)))
         return
     for flag, run, name, write, table in (
             ("--sweep", sweep_cost, "stability_sweep.json", write_sweep_section, sweep_lines),

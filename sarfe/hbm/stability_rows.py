@@ -47,9 +47,10 @@ No zero in Ω: stable, and no exponent is within the uncertain band; the leading
 is the least damped exponent of the structure (max Re of μ s² + δ s + 1 = 0; the coupled
 exponents left of −ε are not located). One zero in Ω: it is real (a fold's exponent), located on
 the real axis by the sign of det F, and decides the verdict (:func:`contact_row_stability`). Two
-or more zeros in Ω, a pole near the contour, a model without a modal basis or a contour that does
-not close on a multiple of π: ``None`` — the caller then locates the exponents by the Ritz-basis
-Hill method (:mod:`sarfe.hbm.stability_condensed`). The check of :mod:`sarfe.hbm.stability_trust` (the contact
+or more: all of them are located from the count's samples (:mod:`sarfe.hbm.stability_zeros`) and
+the leading one decides. A pole near the contour, a model without a modal basis, a contour that
+does not close on a multiple of π, or zeros that are not all located: ``None`` — the caller then
+locates the exponents by the Ritz-basis Hill method (:mod:`sarfe.hbm.stability_condensed`). The check of :mod:`sarfe.hbm.stability_trust` (the contact
 coupling cut to H' < H) is counted along the same contour from the same LU
 (:func:`contact_row_counts`, :meth:`ContactRowDeterminant.log_determinants`).
 Measured against the full Hill method in tests/hbm/test_stability_rows.py and
@@ -615,8 +616,10 @@ def contact_row_counts(model, contacts, omega, harmonics, forces, operator=None,
     the middle branch of a fold is unstable here without an eigen-solve. (The Ritz basis of
     :mod:`sarfe.hbm.stability_condensed`, which these points went to before, reported 'stable'
     with a leading exponent near −7 1/s at three points of such a branch of the 12-pair door trim
-    at 46.2 Hz, where det F changes sign at s* ≈ 1.2–3.5 1/s.) Two or more: None (the caller
-    locates them).
+    at 46.2 Hz, where det F changes sign at s* ≈ 1.2–3.5 1/s.) Two or more: every zero in the
+    half-strip is located from the count's samples (:func:`leading_zeros`: Delves–Lyness power
+    sums on a box, Muller's method, deflation) and the leading one decides by the same rule; None
+    (the caller's Ritz method) only where fewer than the counted number are located.
 
     forces: the AFT :class:`ContactForces` of the orbit (all harmonic rows, blocks computed);
     operator: the :class:`ContactOperator` (friction memory) or None. See the module docstring.
@@ -646,9 +649,18 @@ def contact_row_counts(model, contacts, omega, harmonics, forces, operator=None,
     jacobian_norm = 2.0 * float(np.linalg.norm(det.probe_terms, axis=(1, 2)).max())
     damping_norm = 0.0 if Jd is None else float(spla.norm(Jd))
     X = exponent_bound(basis, det.gap_modes, omega, H, jacobian_norm, damping_norm)
-    contour = _upper_contour(epsilon, X, 0.505 * omega,
-                             shifted_exponents(structure, omega, H))
-    counts, _ = winding_counts(lambda s: det.log_determinants(s, coarse=coarse), contour)
+    top = 0.505 * omega                                   # the strip |Im s| ≤ 1.01 ω/2
+    poles = shifted_exponents(structure, omega, H)
+    contour = _upper_contour(epsilon, X, top, poles)
+    samples = {}                # log det F at the contour's nodes, for locating ≥ 2 zeros
+
+    def sampled(s):
+        values = det.log_determinants(s, coarse=coarse)
+        samples.update(zip(np.asarray(s).tolist(),
+                           (values if coarse is None else values[:, 0]).tolist()))
+        return values
+
+    counts, _ = winding_counts(sampled, contour)
     closed = [None if not np.isfinite(c) or abs(c - round(c)) > 0.1 else int(round(c))
               for c in counts]
     zeros, coarse_zeros = closed[0], (closed[1] if coarse is not None else None)
@@ -656,8 +668,26 @@ def contact_row_counts(model, contacts, omega, harmonics, forces, operator=None,
         return None, None, coarse_zeros
     if zeros == 0:
         return stable, 0, coarse_zeros
-    lead = real_zero(det.log_determinants, -epsilon, X) if zeros == 1 else None
-    if lead is None:
+    if zeros == 1:
+        lead = real_zero(det.log_determinants, -epsilon, X)
+        exponents = None if lead is None else np.array([lead])
+    else:
+        exponents = leading_zeros(det.log_determinants, samples, zeros, epsilon, top, X, poles)
+    if exponents is None:
         return None, zeros, coarse_zeros
-    return verdict(lead, np.append(lead, structure), omega, tolerance, uncertain_band), 1, \
-        coarse_zeros
+    lead = float(exponents.real.max())
+    return verdict(lead, np.concatenate([exponents, structure]), omega, tolerance,
+                   uncertain_band), zeros, coarse_zeros
+
+
+def leading_zeros(log_det, samples, zeros, epsilon, top, X, poles=()):
+    """Every zero of det F in the half-strip Ω of the count (``zeros`` ≥ 2 of them), conjugates
+    included ((zeros,) complex [1/s]), located from the count's ``samples`` (dict s ↦ log det F)
+    by :func:`sarfe.hbm.stability_zeros.located_zeros` (``poles``: those of det F,
+    :func:`shifted_exponents`); None when not all are located."""
+    from .stability_zeros import located_zeros
+
+    found = located_zeros(log_det, samples, zeros, epsilon, top, X, poles)
+    if found is None:
+        return None
+    return np.concatenate([found, found[found.imag != 0].conj()])

@@ -29,9 +29,11 @@ lumped damped-impact chain's middle branch kept 'unstable', NLvib 03's too). Mea
 time integrator's monodromy (:func:`sarfe.hbm.stability_check.perturbation_check`) in
 benchmarks/bench_stability.py (``--truth``) and tests/hbm/test_stability_trust.py.
 
-The Ritz method (:mod:`sarfe.hbm.stability_condensed`) still locates the exponents where the count
-at H finds two or more; a model without a modal basis (sparse lumped models, damping not diagonal
-in the modes) keeps the full Hill method up to ``FULL_UP_TO`` Hill rows.
+Where the count at H finds two or more exponents right of −ε they are located from its samples
+(:mod:`sarfe.hbm.stability_zeros`) and checked the same way; the Ritz method
+(:mod:`sarfe.hbm.stability_condensed`) is left for the points where they are not all located; a
+model without a modal basis (sparse lumped models, damping not diagonal in the modes) keeps the
+full Hill method up to ``FULL_UP_TO`` Hill rows.
 """
 from __future__ import annotations
 
