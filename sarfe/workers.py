@@ -18,7 +18,8 @@ process. This module imports nothing from sarfe, so every layer may use it.
 - Ctrl-C: the workers ignore SIGINT; the parent receives it, stops its workers and re-raises.
   The workers write no result file, except the ERP map series (``sarfe.io.outputs.
   write_erp_sweep``: each map its own file, in the run's temporary directory, at the end).
-- ``progress()``: called in the parent once per finished item (in finishing order).
+- ``progress(item)``: called in the parent once per finished item, with that item (in finishing
+  order), so a caller whose items are of different sizes can weigh them.
 
 :func:`worker_count` turns the case's ``solver.workers`` (``auto`` | n) into a process count.
 """
@@ -114,7 +115,7 @@ class PendingMap:
             for i, item in enumerate(items):
                 results[i] = function(item)
                 if progress is not None:
-                    progress()
+                    progress(item)
             return results
         done, pending, pool = set(), self.pending, self.pool
         try:
@@ -128,7 +129,7 @@ class PendingMap:
                         continue
                     done.add(i)
                     if progress is not None:
-                        progress()
+                        progress(items[i])
         except BaseException:                     # Ctrl-C or an item's exception: stop the workers
             self.cancel()
             raise
@@ -138,7 +139,7 @@ class PendingMap:
             if i not in done:
                 results[i] = function(items[i])
                 if progress is not None:
-                    progress()
+                    progress(items[i])
         return results
 
     def cancel(self):

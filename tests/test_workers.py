@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 import os
 import signal
+import time
 from pathlib import Path
 
 import pytest
@@ -68,9 +69,9 @@ def test_items_of_a_killed_worker_are_computed_by_the_parent():
         return x + 100
 
     progress = []
-    result = workers.map_points(dies_in_a_worker, range(6), 2, progress=lambda: progress.append(1))
+    result = workers.map_points(dies_in_a_worker, range(6), 2, progress=progress.append)
     assert result == [x + 100 for x in range(6)]
-    assert len(progress) == 6
+    assert sorted(progress) == list(range(6))       # each item once, the parent's too
 
 
 def test_worker_count_setting():
@@ -272,3 +273,22 @@ def test_an_error_in_a_worker_is_one_error_and_leaves_no_result_folder(tmp_path,
     with pytest.raises(RuntimeError, match="record of point 5 failed"):
         solve_case(_lumped(2), output_dir=target)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_record_progress_counts_each_chunk_by_its_own_points(monkeypatch):
+    """Records go to the workers in chunks of unequal size that finish in any order: the progress
+    callback still ticks once per point, and the records come back in point order."""
+    from sarfe.pipeline import postprocess
+
+    def records(config, stage, nl, points):
+        if points[0][0] == 0:                 # the first chunk finishes last
+            time.sleep(0.3)
+        return [index * 10 for index, _, _ in points]
+
+    monkeypatch.setattr(postprocess, "record_chunks", lambda count: [[0, 1, 2, 3, 4], [5], [6, 7]])
+    monkeypatch.setattr(postprocess, "point_records", records)
+    ticks = []
+    result = point_workers.point_records(None, None, None, list(range(8)), [None] * 8, 2,
+                                         progress=lambda: ticks.append(1))
+    assert result == [i * 10 for i in range(8)]
+    assert len(ticks) == 8

@@ -24,8 +24,6 @@ result is that path's.
 """
 from __future__ import annotations
 
-import functools
-
 from sarfe.hbm.deferred import pending, stability_of, with_stability
 from sarfe.io.config import CaseConfig, SolverConfig
 from sarfe.pipeline.progress import bar as _bar
@@ -111,7 +109,7 @@ def point_work(config: CaseConfig, stage, nl, solutions, jobs, done, first, work
             + (f", Hill stability of the {len(hill)} left" if hill else "")
             + (f" on {workers} processes" if len(tasks) > 1 else ""))
     bar = _bar(progress, what, len(tasks), unit="item")
-    tick = None if bar is None else functools.partial(bar.update, 1)
+    tick = None if bar is None else (lambda item: bar.update(1))
     try:
         results = (map_points(run, first_pool, workers, progress=tick)
                    + map_points(run, second_pool, workers, progress=tick))
@@ -137,7 +135,7 @@ def point_records(config: CaseConfig, stage, nl, solutions, estimates, workers,
                   progress=None) -> list:
     """[(point dict, table row, ErpResult, map fields)] per solution (:func:`sarfe.pipeline.
     postprocess.point_records`, by chunks of points), on ``workers`` processes; ``progress()``
-    once per point (a chunk's when it finishes)."""
+    once per point (a chunk's points when it finishes)."""
     from sarfe.pipeline.postprocess import point_records as records_of, record_chunks
 
     chunks = record_chunks(len(solutions))
@@ -145,13 +143,8 @@ def point_records(config: CaseConfig, stage, nl, solutions, estimates, workers,
     def record(chunk):
         return records_of(config, stage, nl, [(i, solutions[i], estimates[i]) for i in chunk])
 
-    finished = []
-
-    def tick():     # chunks finish in any order: the last one counts what is left
-        finished.append(1)
-        size = len(chunks[0]) if len(finished) < len(chunks) else \
-            len(solutions) - len(chunks[0]) * (len(chunks) - 1)
-        for _ in range(size):
+    def tick(chunk):
+        for _ in chunk:
             progress()
 
     results = map_points(record, chunks, workers, progress=None if progress is None else tick)
