@@ -13,10 +13,12 @@ the transformation u = T q, T = [[I, 0], [Ψ, Φ]], gives K_r = Tᵀ K T and M_r
 
 K_ii is factorized once (``sarfe.fe.linear_solvers.factorize``) and that factor serves Ψ
 (one block solve with n_b right-hand sides) and the shift-invert Lanczos iteration for Φ: by
-default a block Lanczos on K_ii⁻¹ M_ii whose steps are multi-RHS solves; alternatively
-``scipy.sparse.linalg.eigsh`` with sigma = 0 and OPinv = K_ii⁻¹, where for a cutoff frequency the
-modes are found in blocks, each run on the operator deflated of the modes already found,
-(I − Φ Φᵀ M_ii) K_ii⁻¹, until the highest frequency found exceeds the cutoff.
+default a block Lanczos on K_ii⁻¹ M_ii whose steps are multi-RHS solves (one σ = 0 engine,
+:func:`sarfe.reduction.lanczos.shifted_block_lanczos`: uncapped in :func:`_block_lanczos_modes`,
+capped as run 0 of spectrum slicing in :func:`_capped_run0`); alternatively ARPACK
+(:func:`sarfe.reduction.arpack_modes.arpack_modes`: ``eigsh`` with σ = 0, deflated blocks for a
+cutoff). This module holds the partition, the factor, Ψ, the mode search dispatch, the residual
+modes and the projection.
 
 Residual vectors (optional, like Nastran's RESVEC): the modes above the cutoff are missing, and
 their quasi-static share of the interior response to the boundary's inertia loads is not in Ψ.
@@ -195,7 +197,7 @@ def _capped_run0(mass_ii, operator, cutoff_hz, progress, max_columns, release_op
                  keep_prefix=None, block_size=12, tol=1e-8, seed=0, split_plan=None):
     """Run 0 of spectrum slicing: block Lanczos on K_ii⁻¹ M_ii (σ = 0) from a block of
     ``block_size`` columns, stopped at ``max_columns`` columns, with the shifted runs' partial
-    re-orthogonalization (:func:`sarfe.reduction.spectrum_slicing.shifted_block_lanczos` at
+    re-orthogonalization (:func:`sarfe.reduction.lanczos.shifted_block_lanczos` at
     σ = 0: a full M-re-orthogonalization pass only when Simon's estimate of the lost
     orthogonality exceeds 1e-10, one sparse product M·(n, b) per step without it). A Ritz pair
     is converged when ‖A φ − θ φ‖_M ≤ tol·θ, θ = 1/ω², relative to its own θ.
@@ -457,10 +459,10 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
     [Hz] (both given: at most mode_count below the cutoff; neither: only static condensation).
     solver: backend for K_ii (see ``linear_solvers``). progress: optional callable(done, total|None)
     called after each mode block. eigensolver: "block" (default: block shift-invert Lanczos with
-    16-column multi-RHS solves, :func:`_block_lanczos_modes`; 35–40 % less CPU than ARPACK on the
-    door trim, same frequencies to 1e-15; falls back to ARPACK on tiny interiors) or "arpack"
-    (``eigsh`` single-vector shift-invert Lanczos, deflated blocks for a cutoff). free_dofs/total_dof_count: stored for recovery on the original
-    DOF numbering (``free_dofs_system``'s third output).
+    12-column multi-RHS solves, :mod:`sarfe.reduction.lanczos`; 35–40 % less CPU than ARPACK on
+    the door trim, the same frequencies to ~1e-12; falls back to ARPACK on tiny interiors) or
+    "arpack" (:func:`sarfe.reduction.arpack_modes.arpack_modes`). free_dofs/total_dof_count:
+    stored for recovery on the original DOF numbering (``free_dofs_system``'s third output).
     residual_vectors: add residual modes for the boundary inertia loads M_ib + M_ii Ψ (module
     docstring); residual_loads: (n, k) further load columns on the free DOFs whose interior part
     gets residual modes too (e.g. the base-excitation load −M ι); either needs one extra block solve.

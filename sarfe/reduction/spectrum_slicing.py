@@ -44,14 +44,10 @@ column cap would save memory too but costs CPU steeply: each run spends ≈ 150 
 window converges (door trim at 5 mm, cap 240 with windows of 48: 262 s CPU instead of 100 s;
 benchmarks/results/linear.md, P1 memory).
 
-All runs use the M inner product; a Ritz pair is converged when ‖A φ − θ φ‖_M ≤ tol·|θ| (relative
-to its own θ: a value next to the shift, with a huge θ, must not loosen the test for the others).
-Every run (run 0 at σ = 0 too) re-orthogonalizes a new block against the whole stored basis
-only when Simon's recurrence estimates its M-orthogonality to an older block above 1e-10
-(partial re-orthogonalization, :func:`shifted_block_lanczos`): about every second step on the
-door trim, 15–17 % less CPU per run, the same Ritz values to ~1e-14. Blocks of 12 columns: on
-the door trim a window converges in 10 % fewer columns than with 16 for 6 % less CPU (the
-multi-RHS solves cost a little more per column); 24 and 32 took 24 % and 42 % more CPU.
+Every run (run 0 at σ = 0 too) is :func:`sarfe.reduction.lanczos.shifted_block_lanczos`: the M
+inner product, a Ritz pair converged when ‖A φ − θ φ‖_M ≤ tol·|θ| (relative to its own θ: a value
+next to the shift, with a huge θ, must not loosen the test for the others), partial
+re-orthogonalization, blocks of 12 columns (that module's docstring has the measurements).
 """
 from __future__ import annotations
 
