@@ -53,7 +53,7 @@ def m_orthonormal(block, mass, mass_block=None):
 
 
 def shifted_block_lanczos(mass, operator, shift, satisfied, max_columns, block_size=12, tol=1e-8,
-                          seed=0, stats=None, partial=True, capacity=None, scale="own"):
+                          seed=0, stats=None, partial=True, capacity=None):
     r"""Block Lanczos on A = (K − σM)⁻¹ M (``operator(Y)`` = (K − σM)⁻¹ Y, σ = ``shift``) in the
     M inner product; Q (n, m) is stored, M Q only for the last two blocks (the three-term part).
 
@@ -77,8 +77,7 @@ def shifted_block_lanczos(mass, operator, shift, satisfied, max_columns, block_s
     for the three-term part's w; a second one after a full pass).
 
     After each block step ``satisfied(lam, converged)`` gets the Ritz eigenvalues λ = σ + 1/θ
-    (m,) and their convergence flags (residual ≤ tol·|θ|; ``scale="largest"``: ≤ tol·max|θ|, the
-    same bound for every pair) and returns True to stop. Returns (λ (m,), converged (m,),
+    (m,) and their convergence flags (residual ≤ tol·|θ|) and returns True to stop. Returns (λ (m,), converged (m,),
     vectors(selection) → M-normalized eigenvectors (n, k)); stops at ``max_columns`` columns or
     when the Krylov space is exhausted. Q is stored column-major (a block of columns is
     contiguous, which the sparse solvers want) in room for ``capacity`` columns (default
@@ -147,10 +146,7 @@ def shifted_block_lanczos(mass, operator, shift, satisfied, max_columns, block_s
         theta, vectors = np.linalg.eigh(projected)
         theta_max = max(theta_max, np.abs(theta).max(initial=0.0))
         residual = np.linalg.norm(coupling @ vectors[m_old:], axis=0)
-        if scale == "own":
-            converged = residual <= tol * np.abs(theta)     # relative to each Ritz value
-        else:
-            converged = residual <= tol * np.abs(theta).max(initial=0.0)
+        converged = residual <= tol * np.abs(theta)     # relative to each Ritz value
         with np.errstate(divide="ignore"):
             lam = shift + 1.0 / theta
         exhausted = q.shape[1] == 0 or m_new + q.shape[1] > min(max_columns, n - 1)
