@@ -18,8 +18,9 @@ these meshes finds every mode), "uncapped" (_SLICE_COLUMNS = 10⁹: the one unca
 old: _block_lanczos_modes' own loop, new: the wrapper over shifted_block_lanczos), "modes60"
 (mode_count = 60, no cutoff: the uncapped run too).
 
-Usage: python benchmarks/bench_lanczos_unified.py [--old-ref REF] [--repeats 2] [--quick]
-       python benchmarks/bench_lanczos_unified.py --variants   (new tree: block size, test scale)
+Usage: python benchmarks/bench_lanczos_unified.py [--old-ref REF] [--repeats 2] [--only m:p,…]
+       python benchmarks/bench_lanczos_unified.py --variants   (new tree: block size, partial)
+       python benchmarks/bench_lanczos_unified.py --report     (rewrite the .md from the .json)
 """
 from __future__ import annotations
 
@@ -203,6 +204,48 @@ def variants(new, repeats):
     return rows
 
 
+def report(results):
+    """benchmarks/results/lanczos_unified.md from the JSON (old vs new rows, then the variants)."""
+    lines = ["# One σ = 0 block Lanczos: old vs new (benchmarks/bench_lanczos_unified.py)", "",
+             f"Old tree: `{results.get('old_ref', '?')}` (git archive); new: this tree. Fresh "
+             "process per run, one BLAS thread, A B A B; CPU = Craig–Bampton's "
+             "`normal_modes_cpu` (process time of the mode search), median of the runs.", "",
+             "| model | path | n_i | modes old/new | max rel Δf old→new | solves old/new | "
+             "CPU old [s] | CPU new [s] | Δ CPU |", "|---|---|---|---|---|---|---|---|---|"]
+    for key, row in results.get("compare", {}).items():
+        if "erp_dba_old" in row:
+            continue
+        old, new = np.median(row["cpu_old_s"]), np.median(row["cpu_new_s"])
+        diff = row["max_rel_frequency_diff"]
+        lines.append(f"| {row['model']} | {row['path']} | {row['n_interior']} | "
+                     f"{row['modes_old']}/{row['modes_new']} | "
+                     f"{'—' if diff is None else f'{diff:.1e}'} | "
+                     f"{row['applications_old']}/{row['applications_new']} | {old:.3f} "
+                     f"({len(row['cpu_old_s'])}) | {new:.3f} | {100 * (new / old - 1):+.1f} % |")
+    dense = [row for row in results.get("compare", {}).values() if "max_rel_vs_dense_new" in row]
+    for row in dense:
+        lines += ["", f"{row['model']}: every mode ≤ cutoff against the dense reference "
+                      f"(θ of L⁻¹ M_ii L⁻ᵀ): old {row['max_rel_vs_dense_old']:.1e}, new "
+                      f"{row['max_rel_vs_dense_new']:.1e} relative in frequency."]
+    for key, row in results.get("compare", {}).items():
+        if "erp_dba_old" in row:
+            lines += ["", f"{key} (whole `solve_case` of the demo): ERP dB(A) per point old "
+                          f"{[round(v, 9) for v in row['erp_dba_old']]}, new "
+                          f"{[round(v, 9) for v in row['erp_dba_new']]}: max |Δ| = "
+                          f"{row['max_abs_dba_diff']:.1e} dB."]
+    if results.get("variants"):
+        lines += ["", "## Variants of the uncapped σ = 0 run (new tree)", "",
+                  "| model | path | knobs | modes | solves | CPU [s] | max rel Δf vs first |",
+                  "|---|---|---|---|---|---|---|"]
+        for row in results["variants"]:
+            knobs = {k: v for k, v in row.items() if k in ("block_size", "scale", "partial")}
+            lines.append(f"| {row['model']} | {row['path']} | {knobs} | {row['modes']} | "
+                         f"{row['applications']} | {row['cpu_s']:.3f} | "
+                         f"{row['max_rel_vs_first']:.1e} |")
+    lines += [""] + results.get("notes", [])
+    (HERE / "results" / "lanczos_unified.md").write_text("\n".join(lines) + "\n")
+
+
 def main():
     if len(sys.argv) > 1 and sys.argv[1] == "--worker":
         _worker(*sys.argv[2:6])
@@ -212,9 +255,13 @@ def main():
     parser.add_argument("--repeats", type=int, default=2)
     parser.add_argument("--variants", action="store_true")
     parser.add_argument("--only", default=None, help="comma-separated model:path pairs")
+    parser.add_argument("--report", action="store_true", help="only rewrite the .md")
     args = parser.parse_args()
     out = HERE / "results" / "lanczos_unified.json"
     results = json.loads(out.read_text()) if out.exists() else {}
+    if args.report:
+        report(results)
+        return
     if args.variants:
         results["variants"] = variants(str(ROOT), args.repeats)
     else:
@@ -233,6 +280,7 @@ def main():
         for row in compare(old, str(ROOT), plan, args.repeats):
             results["compare"][f"{row['model']}:{row['path']}"] = row
     out.write_text(json.dumps(results, indent=1))
+    report(results)
 
 
 if __name__ == "__main__":
