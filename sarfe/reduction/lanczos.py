@@ -83,13 +83,15 @@ def shifted_block_lanczos(mass, operator, shift, satisfied, max_columns, block_s
     for the three-term part's w; a second one after a full pass).
 
     After each block step ``satisfied(lam, converged)`` gets the Ritz eigenvalues λ = σ + 1/θ
-    (m,) and their convergence flags (residual ≤ tol·|θ|) and returns True to stop. Returns (λ (m,), converged (m,),
-    vectors(selection) → M-normalized eigenvectors (n, k)); stops at ``max_columns`` columns or
-    when the Krylov space is exhausted. Q is stored column-major (a block of columns is
-    contiguous, which the sparse solvers want) in room for ``capacity`` columns (default
-    ``max_columns``), doubled when full, never beyond ``max_columns``: an uncapped run (max_columns
-    = n) must not hold two n × n arrays up front. ``stats`` (a dict, optional) counts "steps",
-    "full_passes" and "mass_products".
+    (m,) and their convergence flags (residual ≤ tol·|θ|) and returns True to stop. Returns
+    (λ (m,), converged (m,), vectors(selection) → M-normalized eigenvectors (n, k)); stops at
+    ``max_columns`` columns or when the Krylov space is exhausted. Q is stored column-major (a
+    block of columns is contiguous, which the sparse solvers want) in room for ``capacity``
+    columns (default ``max_columns``), doubled when full, never beyond ``max_columns``: an
+    uncapped run (max_columns = n) must not hold an n × n array up front. ``stats`` (a dict,
+    optional) counts "steps", "full_passes" and "mass_products".
+    mass: (n, n) sparse M; operator: (n, b) → (n, b); shift σ in λ's units ([rad²/s²] for
+    Craig–Bampton).
     """
     n = mass.shape[0]
     stats = {} if stats is None else stats
