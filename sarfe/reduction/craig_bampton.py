@@ -13,10 +13,12 @@ the transformation u = T q, T = [[I, 0], [Ψ, Φ]], gives K_r = Tᵀ K T and M_r
 
 K_ii is factorized once (``sarfe.fe.linear_solvers.factorize``) and that factor serves Ψ
 (one block solve with n_b right-hand sides) and the shift-invert Lanczos iteration for Φ: by
-default a block Lanczos on K_ii⁻¹ M_ii whose steps are multi-RHS solves; alternatively
-``scipy.sparse.linalg.eigsh`` with sigma = 0 and OPinv = K_ii⁻¹, where for a cutoff frequency the
-modes are found in blocks, each run on the operator deflated of the modes already found,
-(I − Φ Φᵀ M_ii) K_ii⁻¹, until the highest frequency found exceeds the cutoff.
+default a block Lanczos on K_ii⁻¹ M_ii whose steps are multi-RHS solves (one σ = 0 engine,
+:func:`sarfe.reduction.lanczos.shifted_block_lanczos`: uncapped in :func:`_block_lanczos_modes`,
+capped as run 0 of spectrum slicing in :func:`_capped_run0`); alternatively ARPACK
+(:func:`sarfe.reduction.arpack_modes.arpack_modes`: ``eigsh`` with σ = 0, deflated blocks for a
+cutoff). This module holds the partition, the factor, Ψ, the mode search dispatch, the residual
+modes and the projection.
 
 Residual vectors (optional, like Nastran's RESVEC): the modes above the cutoff are missing, and
 their quasi-static share of the interior response to the boundary's inertia loads is not in Ψ.
@@ -44,11 +46,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
-from sarfe.fe.linear_solvers import factorize
+from sarfe.fe.linear_solvers import available_solvers, factorize
+from sarfe.reduction.arpack_modes import arpack_modes
+from sarfe.reduction.lanczos import m_orthonormal, shifted_block_lanczos
+from sarfe.reduction.mode_sinks import FileSink
+from sarfe.reduction.spectrum_slicing import SlicingFailed, sliced_modes, start_upper_slices
 
-_MODE_BLOCK = 24  # fixed-interface modes requested per Lanczos run when searching up to a cutoff
 # a σ = 0 block Lanczos run keeps at most max(_SLICE_COLUMNS, _SLICE_ENTRIES / n) Krylov columns;
 # past that the modes up to the cutoff come from spectrum slicing (Q: 0.79 GB at n = 206k). Run 0
 # finds its modes at half the CPU per mode of a shifted run (door trim at 5 mm: 0.08 against
@@ -177,96 +181,6 @@ def node_dofs(nodes, components=(0, 1, 2), dofs_per_node: int = 6) -> np.ndarray
     return (dofs_per_node * nodes[:, None] + np.asarray(components, dtype=int)[None, :]).ravel()
 
 
-def _fixed_interface_modes(stiffness_ii, mass_ii, operator, mode_count, cutoff_hz, progress, seed=0):
-    """Lowest modes of K_ii φ = ω² M_ii φ via shift-invert (σ = 0) Lanczos, in blocks when cut off.
-
-    operator(y) = K_ii⁻¹ y. Returns ω² (n_m,) ascending and Φ (n_i, n_m) with Φᵀ M_ii Φ = I.
-    """
-    n = mass_ii.shape[0]
-    rng = np.random.default_rng(seed)
-    eigenvalues = np.empty(0)
-    modes = np.empty((n, 0))
-    target = mode_count if mode_count is not None else np.inf
-    cutoff_omega2 = (2 * np.pi * cutoff_hz) ** 2 if cutoff_hz is not None else np.inf
-    while True:
-        want = int(min(target - len(eigenvalues), _MODE_BLOCK if cutoff_hz is not None else target,
-                       n - len(eigenvalues) - 2))
-        if want <= 0:
-            break
-        found = modes
-
-        def deflated(y, found=found):
-            x = operator(y)
-            if found.shape[1]:
-                x = x - found @ (found.T @ (mass_ii @ x))  # project out found modes (M-orthogonal)
-            return x
-
-        opinv = spla.LinearOperator((n, n), matvec=deflated, dtype=float)
-        start = rng.standard_normal(n)
-        if found.shape[1]:
-            start -= found @ (found.T @ (mass_ii @ start))
-        values, vectors = spla.eigsh(stiffness_ii, k=want, M=mass_ii, sigma=0.0, OPinv=opinv, which="LM", v0=start)
-        # with OPinv given, eigsh only uses A for its shape; eigenvalues are λ = σ + 1/ν of OP = OPinv M
-        order = np.argsort(values)
-        values, vectors = values[order], vectors[:, order]
-        scale = np.sqrt(np.einsum("ij,ij->j", vectors, mass_ii @ vectors))
-        eigenvalues = np.concatenate([eigenvalues, values])
-        modes = np.hstack([modes, vectors / scale])
-        if progress is not None:
-            progress(len(eigenvalues), mode_count)
-        if cutoff_hz is None or values[-1] > cutoff_omega2:
-            break
-    order = np.argsort(eigenvalues)
-    eigenvalues, modes = eigenvalues[order], modes[:, order]
-    if cutoff_hz is not None:
-        keep = eigenvalues <= cutoff_omega2
-        if mode_count is not None:
-            keep &= np.arange(len(eigenvalues)) < mode_count
-        eigenvalues, modes = eigenvalues[keep], modes[:, keep]
-    return eigenvalues, modes
-
-
-def _m_orthonormal(block, mass, mass_block=None):
-    """Q, MQ with Qᵀ M Q = I spanning ``block`` (Gram-matrix eigendecomposition, twice; rank-deficient
-    columns dropped). One sparse product M·block (none when ``mass_block`` = M·block is given):
-    the second pass reuses M Q = (M block) T."""
-    mass_block = mass @ block if mass_block is None else mass_block
-    for _ in range(2):
-        gram = block.T @ mass_block
-        values, vectors = np.linalg.eigh(0.5 * (gram + gram.T))
-        keep = values > 1e-12 * max(values.max(initial=0.0), 1e-300)
-        transform = vectors[:, keep] / np.sqrt(values[keep])
-        block, mass_block = (transform.T @ block.T).T, (transform.T @ mass_block.T).T  # column-major
-    return block, mass_block
-
-
-def lanczos_extend(basis, mass_products, w, projected, previous_start):
-    """One block-Lanczos step in the M inner product with full re-orthogonalization.
-
-    ``basis`` Q (n, m) holds the Krylov columns so far (the last block new), ``w`` = A q_block the
-    operator applied to the newest block, ``projected`` T_old (m_old, m_old) = Qᵀ M A Q on the older
-    columns, and ``mass_products(cols, y)`` returns Q[:, cols]ᵀ M y. The three-term part (columns
-    from ``previous_start``: the current and previous block carry the large components of A q)
-    comes first, then ONE full M-orthogonalization pass against all of Q removes the rest (as
-    accurate as two full passes at half their cost). Returns (w − Q C, T_new (m, m)) with C the
-    coefficients Qᵀ M w; T_new is symmetrized. Products written as (Cᵀ Qᵀ)ᵀ keep the column-major
-    layout the sparse solvers want.
-    """
-    m_new, m_old = basis.shape[1], projected.shape[0]
-    coefficients = np.zeros((m_new, w.shape[1]))
-    local = slice(previous_start, m_new)
-    coefficients[local] = mass_products(local, w)
-    w = w - (coefficients[local].T @ basis[:, local].T).T
-    correction = mass_products(slice(0, m_new), w)
-    w = w - (correction.T @ basis.T).T
-    coefficients = coefficients + correction
-    grown = np.zeros((m_new, m_new))
-    grown[:m_old, :m_old] = projected
-    grown[:, m_old:] = coefficients
-    grown[m_old:, :] = coefficients.T
-    return w, 0.5 * (grown + grown.T)
-
-
 @dataclass(frozen=True, eq=False)
 class _Partial:
     """A σ = 0 Lanczos run stopped at its column cap: its converged eigenpairs, all ω² ≤ boundary
@@ -283,7 +197,7 @@ def _capped_run0(mass_ii, operator, cutoff_hz, progress, max_columns, release_op
                  keep_prefix=None, block_size=12, tol=1e-8, seed=0, split_plan=None):
     """Run 0 of spectrum slicing: block Lanczos on K_ii⁻¹ M_ii (σ = 0) from a block of
     ``block_size`` columns, stopped at ``max_columns`` columns, with the shifted runs' partial
-    re-orthogonalization (:func:`sarfe.reduction.spectrum_slicing.shifted_block_lanczos` at
+    re-orthogonalization (:func:`sarfe.reduction.lanczos.shifted_block_lanczos` at
     σ = 0: a full M-re-orthogonalization pass only when Simon's estimate of the lost
     orthogonality exceeds 1e-10, one sparse product M·(n, b) per step without it). A Ritz pair
     is converged when ‖A φ − θ φ‖_M ≤ tol·θ, θ = 1/ω², relative to its own θ.
@@ -301,8 +215,6 @@ def _capped_run0(mass_ii, operator, cutoff_hz, progress, max_columns, release_op
     tens of columns instead of a shifted run of ≈ 150 columns before its window converges plus
     a factorization (the caller certifies the prefix by the count N(λ_s)).
     """
-    from sarfe.reduction.spectrum_slicing import shifted_block_lanczos
-
     cutoff_omega2 = (2 * np.pi * cutoff_hz) ** 2
     extension = {"split": None, "decided": split_plan is None}
 
@@ -354,91 +266,59 @@ def _capped_run0(mass_ii, operator, cutoff_hz, progress, max_columns, release_op
                     boundary, len(lam), stats)
 
 
-def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, block_size=16, tol=1e-8,
-                         seed=0):
-    """Lowest modes of K_ii φ = ω² M_ii φ by block shift-invert Lanczos (σ = 0), full M-reorthogonalization.
+def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, block_size=12,
+                         tol=1e-8, seed=0, stats=None):
+    """Lowest modes of K_ii φ = ω² M_ii φ by one uncapped σ = 0 block Lanczos run on
+    A = K_ii⁻¹ M_ii (:func:`sarfe.reduction.lanczos.shifted_block_lanczos` at σ = 0: ω² = 1/θ,
+    partial M-re-orthogonalization, a Ritz pair converged when ‖A φ − θ φ‖_M ≤ tol·θ).
 
-    Krylov space of A = K_ii⁻¹ M_ii from a block of ``block_size`` columns: every step is ONE
-    multi-RHS solve (cheaper per column than single solves). H = Qᵀ M A Q is projected exactly;
-    its eigenpairs (ν, y) give ω² = 1/ν, φ = Q y, with residual ‖A φ − ν φ‖_M = ‖R y_last‖.
-    Stops when the wanted Ritz pairs have residual < tol·ν (eigenvalue error ~ residual², so 1e-8
-    gives frequencies to ~1e-15; 11 % fewer solves than 1e-10 on the door trim). Returns ω²
-    (ascending), Φ (Φᵀ M Φ = I), or None when the Krylov space fills the interior before that (tiny
-    models). Door trim at 5 mm (206k DOFs, 60 modes, one thread): 10.8 s CPU, down from 17.8 s with
-    two full Gram–Schmidt passes, row-major blocks and a too-small initial store. (A cutoff with
-    many modes caps the σ = 0 run instead: :func:`_capped_run0`, then spectrum slicing.)
+    mass_ii: (n_i, n_i) sparse M_ii [kg]; operator(Y) = K_ii⁻¹ Y (n_i, b); mode_count: modes wanted
+    and/or cutoff_hz [Hz]: every mode up to it. The run stops when its converged prefix (the
+    lowest Ritz values, in order, all converged) holds every mode wanted: mode_count of them, or
+    every mode ≤ cutoff plus one above it (so none below is missing; with both, the first
+    min(mode_count, N(cutoff)) and one more). Eigenvalue error ~ residual², so tol = 1e-8 gives
+    frequencies to ~1e-15. Returns ω² (ascending, [rad²/s²]) and Φ (n_i, n_m), Φᵀ M_ii Φ = I, or
+    None when the Krylov space fills the interior first (tiny models: the caller uses ARPACK).
+    The Krylov store starts at ≈ 5 columns per mode wanted (64 modes' worth for a cutoff alone)
+    and doubles when full, never n_i columns up front. (A cutoff with many modes caps the σ = 0
+    run instead: :func:`_capped_run0`, then spectrum slicing.)
     """
     n = mass_ii.shape[0]
-    rng = np.random.default_rng(seed)
     cutoff_omega2 = (2 * np.pi * cutoff_hz) ** 2 if cutoff_hz is not None else np.inf
     target = mode_count if mode_count is not None else n
-    q, mq = _m_orthonormal(operator(mass_ii @ rng.standard_normal((n, block_size))), mass_ii)
-    # initial Krylov store: from the mode count, or a modest guess for a cutoff (it grows by
-    # doubling below) — never n columns up front, which is two dense n×n arrays
     guess = min(target, n) if mode_count is not None else 64
-    capacity = min(n, max(4 * block_size, 5 * guess + 2 * block_size))  # measured: ~4.8 columns per mode
-    # Q, M Q preallocated column-major: a block of columns is then contiguous, which the sparse
-    # solvers want (no copy per solve)
-    store = np.empty((n, capacity), order="F")
-    mass_store = np.empty((n, capacity), order="F")
-    m_new = q.shape[1]
-    store[:, :m_new] = q
-    mass_store[:, :m_new] = mq
-    projected = np.zeros((0, 0))
-    previous_start = 0  # first column of the block before the current one
-    while True:
-        m_old = projected.shape[0]
-        w = operator(mq)
-        basis, mass_basis = store[:, :m_new], mass_store[:, :m_new]
+    capacity = 5 * guess + 2 * block_size          # measured: ~4.8 columns per mode
 
-        def mass_products(cols, y):
-            return mass_basis[:, cols].T @ y
-
-        # three-term part first (the current and previous block carry the large components of
-        # A q), then ONE full M-orthogonalization pass against all of Q removes the rest: as
-        # accurate as two full passes at half their cost. (Products written as (Cᵀ Qᵀ)ᵀ keep the
-        # column-major layout the solvers want.)
-        w, projected = lanczos_extend(basis, mass_products, w, projected,
-                                      previous_start)
-        previous_start = m_old
-        q, mq = _m_orthonormal(w, mass_ii)
-        coupling = mq.T @ w  # R with w = q R (+ dropped directions)
-        values, vectors = np.linalg.eigh(projected)
-        values, vectors = values[::-1], vectors[:, ::-1]  # largest ν = lowest ω² first
-        residual = np.linalg.norm(coupling @ vectors[m_old:], axis=0)
-        converged = residual <= tol * np.abs(values[0])
-        positive = values > 0
-        omega2 = np.where(positive, 1.0 / np.where(positive, values, 1.0), np.inf)
-        wanted = min(target, m_new)
+    def prefix_and_wanted(lam, converged):
+        """Ascending order of λ (θ ≤ 0, none at σ = 0 but for round-off, last), the converged
+        prefix's length and the number of modes wanted among those found."""
+        order = np.argsort(np.where(lam > 0, lam, np.inf))
+        flags = converged[order]
+        prefix = int(np.argmin(flags)) if not flags.all() else len(flags)
+        wanted = min(target, len(lam))
         if cutoff_hz is not None:
-            wanted = min(wanted, int(np.sum(omega2 <= cutoff_omega2)))
-        leading = int(np.argmin(converged)) if not converged.all() else len(converged)  # converged prefix
+            wanted = min(wanted, int(np.count_nonzero((lam > 0) & (lam <= cutoff_omega2))))
+        done = prefix > wanted if cutoff_hz is not None else prefix >= target
+        return order, prefix, wanted, done
+
+    def satisfied(lam, converged):
+        _, prefix, _, done = prefix_and_wanted(lam, converged)
         if progress is not None:
-            progress(min(leading, target), mode_count)
-        above_cutoff = cutoff_hz is None or (leading > wanted)
-        done = leading >= wanted and above_cutoff and (wanted == target or cutoff_hz is not None)
-        if done or m_new + q.shape[1] > n - 1 or q.shape[1] == 0:
-            break
-        if m_new + q.shape[1] > capacity:
-            capacity = min(n, max(2 * capacity, m_new + q.shape[1]))
-            grown_store = np.empty((n, capacity), order="F")
-            grown_mass = np.empty((n, capacity), order="F")
-            grown_store[:, :m_new] = store[:, :m_new]
-            grown_mass[:, :m_new] = mass_store[:, :m_new]
-            store, mass_store = grown_store, grown_mass
-        store[:, m_new:m_new + q.shape[1]] = q
-        mass_store[:, m_new:m_new + q.shape[1]] = mq
-        m_new += q.shape[1]
+            progress(min(prefix, target), mode_count)
+        return done
+
+    lam, converged, eigenvectors = shifted_block_lanczos(mass_ii, operator, 0.0, satisfied, n,
+                                                         block_size, tol, seed, stats,
+                                                         capacity=capacity)
+    order, _, wanted, done = prefix_and_wanted(lam, converged)
     if not done:
         return None  # Krylov space exhausted before convergence (tiny interior): caller uses ARPACK
-    modes = basis @ vectors[:, :wanted]
-    return omega2[:wanted], modes
+    return lam[order[:wanted]], eigenvectors(order[:wanted])
 
 
 def _two_processes(workers):
     """Whether spectrum slicing may run in two processes: ``workers`` ≥ 2 (None: the usable
     cores) and PARDISO (the worker's inertia counts)."""
-    from sarfe.fe.linear_solvers import available_solvers
     from sarfe.workers import available_cpus
 
     workers = available_cpus() if workers is None else int(workers)
@@ -451,8 +331,6 @@ def _start_upper_slices(k_ii, m_ii, cutoff_hz, cap):
     the upper part of the spectrum while this process factorizes K_ii, forms Ψ and the residual
     statics, runs run 0 and the lower part
     (:func:`sarfe.reduction.spectrum_slicing.start_upper_slices`). None where it cannot start."""
-    from sarfe.reduction.spectrum_slicing import start_upper_slices
-
     try:
         return start_upper_slices(k_ii, m_ii, (2 * np.pi * cutoff_hz) ** 2,
                                   _RUN0_LEAD_PER_COLUMN * cap,
@@ -464,8 +342,6 @@ def _start_upper_slices(k_ii, m_ii, cutoff_hz, cap):
 def _park(*arrays):
     """Write (n, k) arrays (or None) to a temporary file on disk and return a function that reads
     them back, in their memory order, and removes the file (:mod:`sarfe.reduction.mode_sinks`)."""
-    from sarfe.reduction.mode_sinks import FileSink
-
     sink = FileSink(next(a.shape[0] for a in arrays if a is not None))
     try:
         parked = [None if a is None else (sink.put(a), "F" if np.isfortran(a) else "C")
@@ -487,16 +363,12 @@ def _park(*arrays):
 
 def _file_sink(rows):
     """A :class:`sarfe.reduction.mode_sinks.FileSink` for this process's found vectors."""
-    from sarfe.reduction.mode_sinks import FileSink
-
     return FileSink(rows)
 
 
 def _worker_splits(upper):
     """Wait for the worker's count below the cutoff: True when it slices the upper part (else it
     has exited); its split comes later (:meth:`UpperSlices.plan`, after run 0)."""
-    from sarfe.reduction.spectrum_slicing import SlicingFailed
-
     try:
         return upper.splits()
     except SlicingFailed:
@@ -506,8 +378,6 @@ def _worker_splits(upper):
 def _split_plan(upper):
     """A function returning the worker's split (λ_s, N(λ_s)), or None when it failed placing it
     (the caller then finds the failure again in :meth:`UpperSlices.plan`)."""
-    from sarfe.reduction.spectrum_slicing import SlicingFailed
-
     def split_plan():
         try:
             return upper.plan()[1:]
@@ -522,9 +392,6 @@ def _slice(k_ii, m_ii, cutoff_hz, partial, progress, timings, upper, sink):
     part from ``upper``'s worker when given; ``sink``: where the found vectors wait, None: in
     memory): (ω², Φ as column blocks), or None when slicing cannot run (no PARDISO for the
     inertia) or a gap's count was not reached."""
-    from sarfe.fe.linear_solvers import available_solvers
-    from sarfe.reduction.spectrum_slicing import SlicingFailed, sliced_modes
-
     if "pardiso" not in available_solvers():
         if sink is not None:
             sink.remove()
@@ -569,9 +436,9 @@ def residual_modes(stiffness_ii, mass_ii, operator, loads, modes, relative_toler
     if not keep.any():
         return np.empty(0), np.empty((n, 0))
     transform = vectors[:, keep] / np.sqrt(values[keep])
-    basis, mass_basis = _m_orthonormal(static @ transform, mass_ii, mass_static @ transform)
+    basis, mass_basis = m_orthonormal(static @ transform, mass_ii, mass_static @ transform)
     basis = basis - modes @ (modes.T @ mass_basis)  # the clean-up against Φ
-    basis, _ = _m_orthonormal(basis, mass_ii)
+    basis, _ = m_orthonormal(basis, mass_ii)
     if basis.shape[1] == 0:
         return np.empty(0), np.empty((n, 0))
     projected = basis.T @ (stiffness_ii @ basis)
@@ -592,10 +459,10 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
     [Hz] (both given: at most mode_count below the cutoff; neither: only static condensation).
     solver: backend for K_ii (see ``linear_solvers``). progress: optional callable(done, total|None)
     called after each mode block. eigensolver: "block" (default: block shift-invert Lanczos with
-    16-column multi-RHS solves, :func:`_block_lanczos_modes`; 35–40 % less CPU than ARPACK on the
-    door trim, same frequencies to 1e-15; falls back to ARPACK on tiny interiors) or "arpack"
-    (``eigsh`` single-vector shift-invert Lanczos, deflated blocks for a cutoff). free_dofs/total_dof_count: stored for recovery on the original
-    DOF numbering (``free_dofs_system``'s third output).
+    12-column multi-RHS solves, :mod:`sarfe.reduction.lanczos`; 35–40 % less CPU than ARPACK on
+    the door trim, the same frequencies to ~1e-12; falls back to ARPACK on tiny interiors) or
+    "arpack" (:func:`sarfe.reduction.arpack_modes.arpack_modes`). free_dofs/total_dof_count:
+    stored for recovery on the original DOF numbering (``free_dofs_system``'s third output).
     residual_vectors: add residual modes for the boundary inertia loads M_ib + M_ii Ψ (module
     docstring); residual_loads: (n, k) further load columns on the free DOFs whose interior part
     gets residual modes too (e.g. the base-excitation load −M ι); either needs one extra block solve.
@@ -714,7 +581,7 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
                 if found is None and cap is not None:   # slicing impossible: one uncapped run
                     found = _block_lanczos_modes(m_ii, inverse, mode_count, cutoff_hz, progress)
             if found is None:
-                found = _fixed_interface_modes(k_ii, m_ii, inverse, mode_count, cutoff_hz, progress)
+                found = arpack_modes(k_ii, m_ii, inverse, mode_count, cutoff_hz, progress)
                 eigensolver = "arpack"
             omega2, blocks = found
             timings["eigensolver"] = eigensolver

@@ -44,14 +44,10 @@ column cap would save memory too but costs CPU steeply: each run spends ≈ 150 
 window converges (door trim at 5 mm, cap 240 with windows of 48: 262 s CPU instead of 100 s;
 benchmarks/results/linear.md, P1 memory).
 
-All runs use the M inner product; a Ritz pair is converged when ‖A φ − θ φ‖_M ≤ tol·|θ| (relative
-to its own θ: a value next to the shift, with a huge θ, must not loosen the test for the others).
-Every run (run 0 at σ = 0 too) re-orthogonalizes a new block against the whole stored basis
-only when Simon's recurrence estimates its M-orthogonality to an older block above 1e-10
-(partial re-orthogonalization, :func:`shifted_block_lanczos`): about every second step on the
-door trim, 15–17 % less CPU per run, the same Ritz values to ~1e-14. Blocks of 12 columns: on
-the door trim a window converges in 10 % fewer columns than with 16 for 6 % less CPU (the
-multi-RHS solves cost a little more per column); 24 and 32 took 24 % and 42 % more CPU.
+Every run (run 0 at σ = 0 too) is :func:`sarfe.reduction.lanczos.shifted_block_lanczos`: the M
+inner product, a Ritz pair converged when ‖A φ − θ φ‖_M ≤ tol·|θ| (relative to its own θ: a value
+next to the shift, with a huge θ, must not loosen the test for the others), partial
+re-orthogonalization, blocks of 12 columns (that module's docstring has the measurements).
 """
 from __future__ import annotations
 
@@ -63,162 +59,11 @@ import numpy as np
 
 from sarfe.fe.linear_solvers import shifted_factorizer
 from sarfe.reduction.mode_sinks import FileSink, MemorySink
-from sarfe.reduction.craig_bampton import _m_orthonormal
+from sarfe.reduction.lanczos import shifted_block_lanczos
 
 
 class SlicingFailed(RuntimeError):
     """A gap's eigenvalue count was not reached within the column cap (the caller falls back)."""
-
-
-# partial re-orthogonalization: the estimated |Q_jᵀ M q| of the new block against the older ones
-# that triggers a full pass (semi-orthogonality is √ε ≈ 1.5e-8; kept lower so that the Ritz
-# vectors stay M-orthonormal to ~1e-10)
-_ORTHOGONALITY = 1e-10
-_EPS = np.finfo(float).eps
-
-
-def shifted_block_lanczos(mass, operator, shift, satisfied, max_columns, block_size=12, tol=1e-8,
-                          seed=0, stats=None, partial=True):
-    r"""Block Lanczos on A = (K − σM)⁻¹ M (``operator(Y)`` = (K − σM)⁻¹ Y, σ = ``shift``) in the
-    M inner product; Q (n, m) is stored, M Q only for the last two blocks (the three-term part).
-
-    Re-orthogonalization against all of Q (a full pass, n·m·b per step) only when needed
-    (``partial``, Simon's partial re-orthogonalization for blocks): the orthogonality
-    W_{j,k} = Q_jᵀ M Q_k of each older block j to the newest one is estimated by the recurrence
-    that A's M-symmetry gives from the block three-term relation
-    A Q_k = Q_{k−1} B_{k−1}ᵀ + Q_k A_k + Q_{k+1} B_k,
-
-        W_{·,k+1} B_k = T W_{·,k} − W_{·,k} A_k − W_{·,k−1} B_{k−1}ᵀ + O(ε ‖A‖)
-
-    (T the projected matrix, the rounding term taken with the sign that makes it grow; the last
-    two blocks' rows are the three-term part's ε ‖A‖ / σ_min(B_k)); a new block whose estimate
-    max_j ‖W_{j,k+1}‖ exceeds _ORTHOGONALITY gets a full pass (C = Qᵀ M w, w ← w − Q C, its
-    estimate reset to ε; T keeps the three-term part, the pass's older-block coefficients are
-    discarded) before it is stored, so Q stays M-orthonormal to ~1e-10 and the Ritz
-    pairs are those of a fully re-orthogonalized run to round-off (semi-orthogonality suffices,
-    Simon 1984). The estimate tracks the measured Q_jᵀ M q within a factor 2.5 (twin plate); in
-    shift-invert it grows ~1e2–1e3 per step, so about every second step needs the full pass.
-    ``partial=False``: a full pass at every step. A step costs one sparse product M·(n, b) (M w
-    for the three-term part's w; a second one after a full pass).
-
-    After each block step ``satisfied(lam, converged)`` gets the Ritz eigenvalues λ = σ + 1/θ
-    (m,) and their convergence flags (residual ≤ tol·|θ|) and returns True to stop. Returns
-    (λ (m,), converged (m,), vectors(selection) → M-normalized eigenvectors (n, k)); stops at
-    ``max_columns`` columns or when the Krylov space is exhausted. ``stats`` (a dict, optional)
-    counts "steps", "full_passes" and "mass_products".
-    """
-    n = mass.shape[0]
-    stats = {} if stats is None else stats
-    for key in ("steps", "full_passes", "mass_products"):
-        stats.setdefault(key, 0)
-    rng = np.random.default_rng(seed)
-    q, mq = _m_orthonormal(operator(mass @ rng.standard_normal((n, block_size))), mass)
-    stats["mass_products"] += 2
-    store = np.empty((n, max(max_columns, q.shape[1])), order="F")
-    m_new = q.shape[1]
-    store[:, :m_new] = q
-    recent = [mq]                # M Q of the previous and the current block
-    projected = np.zeros((0, 0))
-    previous_start = 0
-    # estimated W_{·,k} = Q_{1..k}ᵀ M Q_k and W_{·,k−1}, and ‖A‖ ≈ max |θ| so far
-    omega, omega_previous = np.eye(m_new), np.zeros((0, 0))
-    theta_max = 0.0
-    while True:
-        m_old = projected.shape[0]
-        basis = store[:, :m_new]
-        mass_recent = recent[0] if len(recent) == 1 else np.hstack(recent)
-        local = slice(previous_start, m_new)
-        w = operator(mq)
-        coefficients = np.zeros((m_new, w.shape[1]))
-        coefficients[local] = mass_recent.T @ w            # the three-term part
-        w = w - (coefficients[local].T @ basis[:, local].T).T
-        mw = mass @ w
-        stats["steps"] += 1
-        stats["mass_products"] += 1
-        projected = _grown(projected, coefficients)
-        full = not partial or previous_start == 0
-        if not full:
-            growth, theta_max, level = _orthogonality_growth(projected, omega, omega_previous,
-                                                             coefficients, m_old, theta_max)
-            full = _lost(growth, w, mw, previous_start)
-        if full:
-            stats["full_passes"] += 1
-            correction = basis.T @ mw                        # C = Qᵀ M w, then a fresh M w
-            w = w - (correction.T @ basis.T).T
-            mw = mass @ w
-            stats["mass_products"] += 1
-            # partial: T keeps the three-term part only; the older blocks' coefficients are
-            # the orthogonality lost since the last pass (up to ~1e-8 once it jumps), and in T
-            # (symmetrized) they made the Ritz vectors' residuals 100× larger (P1: 4e-10
-            # instead of 4e-12); discarded, as in Simon's scheme, they are main's
-            if partial:
-                correction[:previous_start] = 0.0
-            projected = _grown(projected[:m_old, :m_old], coefficients + correction)
-        q, mq = _m_orthonormal(w, mass, mw)
-        coupling = mq.T @ w                                  # B_k: w = Q_{k+1} B_k
-        if full or q.shape[1] != w.shape[1]:
-            next_omega = np.full((m_new, q.shape[1]), _EPS)      # just re-orthogonalized
-        else:
-            next_omega = np.linalg.solve(coupling.T, growth.T).T     # W_{·,k+1} = G B_k⁻¹
-            next_omega[previous_start:] = level / np.linalg.svd(coupling, compute_uv=False).min()
-        omega_previous, omega = omega, np.vstack([next_omega, np.eye(q.shape[1])])
-        previous_start = m_old
-        theta, vectors = np.linalg.eigh(projected)
-        theta_max = max(theta_max, np.abs(theta).max(initial=0.0))
-        residual = np.linalg.norm(coupling @ vectors[m_old:], axis=0)
-        converged = residual <= tol * np.abs(theta)     # relative to each Ritz value
-        with np.errstate(divide="ignore"):
-            lam = shift + 1.0 / theta
-        exhausted = q.shape[1] == 0 or m_new + q.shape[1] > min(max_columns, n - 1)
-        if satisfied(lam, converged) or exhausted:
-            break
-        store[:, m_new:m_new + q.shape[1]] = q
-        recent = [recent[-1], mq]
-        m_new += q.shape[1]
-
-    def eigenvectors(selection):
-        return basis @ vectors[:, selection]
-
-    return lam, converged, eigenvectors
-
-
-def _grown(projected, coefficients):
-    """T (m, m) from T_old (m_old, m_old) and the new block's column C (m, b) = Qᵀ M A q_k,
-    symmetrized."""
-    m_new, m_old = coefficients.shape[0], projected.shape[0]
-    grown = np.zeros((m_new, m_new))
-    grown[:m_old, :m_old] = projected
-    grown[:, m_old:] = coefficients
-    grown[m_old:, :] = coefficients.T
-    return 0.5 * (grown + grown.T)
-
-
-def _orthogonality_growth(projected, omega, omega_previous, coefficients, start, theta_max):
-    """G = W_{·,k+1} B_k (m, b) of :func:`shifted_block_lanczos`'s recurrence, the updated ‖A‖
-    estimate and the orthogonality level the three-term part leaves (ε ‖A‖). ``omega`` (m, b_k)
-    = W_{·,k} (block k's rows the identity), ``omega_previous`` (start, b_{k−1}) = W_{·,k−1};
-    ``start``: the first column of block k; ``coefficients`` (m, b_k): T's new column."""
-    diagonal = coefficients[start:]                         # A_k
-    theta_max = max(theta_max, np.abs(diagonal).max(initial=0.0))
-    growth = projected @ omega - omega @ diagonal
-    b_previous = omega_previous.shape[1]
-    if b_previous:                                           # − W_{·,k−1} B_{k−1}ᵀ
-        growth[:start] -= omega_previous @ coefficients[start - b_previous:start]
-    growth += _EPS * theta_max * np.where(growth < 0, -1.0, 1.0)     # rounding, made to grow
-    return growth, theta_max, _EPS * theta_max
-
-
-def _lost(growth, w, mw, previous_start):
-    """Whether the new block w (n, b) (z = M w) would be more than _ORTHOGONALITY from
-    M-orthogonal to a block older than the last two: max_j ‖W_{j,k+1}‖ = ‖G_j B_k⁻¹‖ with B_k from
-    wᵀ M w = B_kᵀ B_k (row norms do not depend on the rotation the orthonormalization picks);
-    True when w is (nearly) rank-deficient."""
-    gram = w.T @ mw
-    values, vectors = np.linalg.eigh(0.5 * (gram + gram.T))
-    if values.min() <= 1e-20 * max(values.max(), 1e-300):
-        return True
-    estimate = growth[:previous_start] @ (vectors / np.sqrt(values))
-    return bool(np.linalg.norm(estimate, axis=1).max(initial=0.0) > _ORTHOGONALITY)
 
 
 def _place_shift(factor_at, right_edge, known, wanted, top_omega2, total, rate, record):
