@@ -35,14 +35,14 @@ $(VENV)/.installed: pyproject.toml $(LOCK) | system-deps
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
 	$(PY) -m pip install -q --no-deps -r $(LOCK)
-	$(PY) -m pip install -q --no-deps -e '.[dev]'
+	$(PY) -m pip install -q --no-deps -e '.[dev,batch]'
 	touch $@
 
 # Regenerate the lock file from the venv the tests passed with: add a dependency to pyproject.toml,
 # install it (.venv/bin/pip install NAME), run `make test`, then `make lock` writes every installed
 # version (pip freeze, sarfe itself excluded). tests/test_lock_file.py fails while a pyproject
 # dependency has no pin. To move everything to the newest versions:
-# `rm -rf .venv && python3 -m venv .venv && .venv/bin/pip install -e '.[dev]' && make test && make lock`.
+# `rm -rf .venv && python3 -m venv .venv && .venv/bin/pip install -e '.[dev,batch]' && make test && make lock`.
 lock:
 	@test -x $(PY) || { echo "no $(VENV): run 'make setup' (or create it) first" >&2; exit 1; }
 	{ echo "# Exact versions sarfe's tests passed with, installed as they are by 'make setup'"; \

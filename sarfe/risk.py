@@ -23,8 +23,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-__all__ = ["ContactRisk", "linear_risk", "linear_risk_from_contacts", "worst_case_risk",
-           "tangential_peak_to_peak", "risk_rows"]
+__all__ = ["ContactRisk", "linear_risk", "linear_risk_from_contacts", "tangential_peak_to_peak"]
 
 
 @dataclass(frozen=True)
@@ -117,33 +116,3 @@ def linear_risk_from_contacts(contacts, contact_displacement, tolerance, frequen
     t_idx[:, 0] = np.where(t_rows[:, 0] >= 0, t_rows[:, 0], nan_col)
     return linear_risk(padded[:, normal_idx], padded[:, t_idx], contacts.gap, tolerance,
                        names=contacts.names, frequency_hz=frequency_hz)
-
-
-def worst_case_risk(sweep: list[list[ContactRisk]]) -> list[ContactRisk]:
-    """Per contact, the entry of a frequency sweep with the smallest dynamic tolerance.
-
-    ``sweep[j]`` is the list of :func:`linear_risk` at frequency j (same contacts, same order). The
-    tangential peak-to-peak reported is the largest over the sweep (its frequency may differ; the
-    entry's ``frequency_hz`` is that of the smallest dynamic tolerance, or of the largest s_pp for
-    contacts without a normal row).
-    """
-    if not sweep:
-        return []
-    worst = []
-    for per_contact in zip(*sweep):
-        d = np.array([r.dynamic_tolerance_m for r in per_contact])
-        s = np.array([r.tangential_peak_to_peak_m for r in per_contact])
-        if np.all(np.isnan(d)):
-            j = int(np.nanargmax(s)) if not np.all(np.isnan(s)) else 0
-        else:
-            j = int(np.nanargmin(d))
-        s_max = float(np.nanmax(s)) if not np.all(np.isnan(s)) else float("nan")
-        r = per_contact[j]
-        worst.append(ContactRisk(r.name, r.frequency_hz, r.gap_m, r.tolerance_m,
-                                 r.normal_amplitude_m, r.dynamic_tolerance_m, r.rattle_risk, s_max))
-    return worst
-
-
-def risk_rows(risks: list[ContactRisk]) -> list[dict]:
-    """Plain dicts (for summary.json and :func:`sarfe.io.outputs.console_table`)."""
-    return [r.as_dict() for r in risks]

@@ -38,3 +38,7 @@ def test_setup_installs_from_the_lock_file():
     assert "pip install -q --no-deps -r $(LOCK)" in makefile
     assert "LOCK   := constraints.txt" in makefile
     assert "make test" in (ROOT / ".ci" / "run").read_text()
+    # `make test` / `make demo` install sarfe with every extra (the batch tests need `batch`)
+    extras = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["optional-dependencies"]
+    installed = re.search(r"pip install -q --no-deps -e '\.\[([a-z,]+)\]'", makefile)
+    assert installed and set(installed.group(1).split(",")) == set(extras)

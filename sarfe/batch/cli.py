@@ -1,7 +1,8 @@
 """``sarfe batch``: run case files and study files, optionally through a Dask cluster.
 
 Exit codes (as ``sarfe solve`` where they overlap): 0 every variant finished and converged, or
-the gate passed; 2 unusable study/case file (nothing run); 3 no gate asked and some variant did not
+the gate passed; 2 unusable study/case file or a package of the ``batch`` extra missing (nothing
+run); 3 no gate asked and some variant did not
 converge (unless ``--allow-nonconverged``); 4 gate failed (``--fail-above-db``: a variant above the
 level, a non-converged one unless ``--allow-nonconverged``, or a failed one); 5 no gate asked and
 some variants failed with an error (each recorded in the table); 1 internal error.
@@ -9,13 +10,19 @@ some variants failed with an error (each recorded in the table); 1 internal erro
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import sys
 
 EXIT_NOT_CONVERGED = 3  # = sarfe.io.errors.EXIT_NOT_CONVERGED
 EXIT_VARIANTS_FAILED = 5
+# The optional dependencies of ``sarfe batch`` (pyproject extra ``batch``); the solve never imports
+# them. distributed (Dask) only runs the variants in parallel: ``--workers 0`` needs none of it.
+BATCH_EXTRA = "batch"
+TABLE_PACKAGES = ("pandas", "pyarrow")
+CLUSTER_PACKAGES = ("distributed",)
 HELP = "run many cases or a study (grid / list / Monte Carlo variations) in parallel"
 EPILOG = ("exit codes: 0 all variants finished and converged, or the gate passed; 2 bad study or case "
-          "file; 3 some variant did not converge (no gate); 4 gate failed (offending variants listed on "
+          "file or missing batch extra; 3 some variant did not converge (no gate); 4 gate failed (offending variants listed on "
           "stderr); 5 some variants failed with an error (no gate); 1 internal error")
 
 
@@ -44,8 +51,21 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="do not read/write linear stages in <output>/.cache")
 
 
+def missing_packages(workers: int, scheduler: str | None) -> list[str]:
+    """The packages of the ``batch`` extra this run needs and cannot import (Dask only when it runs
+    on workers or a scheduler)."""
+    needed = TABLE_PACKAGES + (CLUSTER_PACKAGES if workers > 0 or scheduler else ())
+    return [name for name in needed if importlib.util.find_spec(name) is None]
+
+
 def run(args: argparse.Namespace) -> int:
     """Handler of ``sarfe batch``; returns the exit code."""
+    missing = missing_packages(args.workers, args.scheduler)
+    if missing:
+        print(f"sarfe batch: needs the optional package{'s' if len(missing) > 1 else ''} "
+              f"{', '.join(missing)}: install them with pip install 'sarfe[{BATCH_EXTRA}]' "
+              f"(from a source tree: pip install -e '.[{BATCH_EXTRA}]')", file=sys.stderr)
+        return 2
     from sarfe.batch.report import GATE_EXIT_CODE, evaluate_gate
     from sarfe.batch.runner import default_output_dir, run_study
     from sarfe.batch.study import StudyError, collect_variants

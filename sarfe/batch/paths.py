@@ -79,14 +79,6 @@ def _parents(data: dict, steps: tuple[Step, ...], path: str) -> list[dict]:
     return nodes
 
 
-def get_path(data: dict, path: str) -> list:
-    """Values at ``path`` (a list: wildcards and name selectors may match several)."""
-    steps = parse_path(path)
-    if steps[-1].selector is not None:
-        return _parents(data, steps, path)
-    return [node[steps[-1].key] for node in _parents(data, steps, path) if steps[-1].key in node]
-
-
 def count_matches(data: dict, path: str) -> int:
     """Number of places ``path`` would be written (0: a selector matches no list item)."""
     steps = parse_path(path)

@@ -23,13 +23,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from .assembly import assemble_pair, element_dofs
 from sarfe.mesh.laminate import rotate_plane_stress
-from .shell import (_BENDING, _DEGREE4_RULE, _MEMBRANE, BLOCK_SIZE, DRILLING_PENALTY,
+from .shell import (_BENDING, _DEGREE4_RULE, _MEMBRANE, DRILLING_PENALTY,
                     _allman_field, _dkt_rotation_field, _to_global, _weighted_gram,
                     consistent_mass, drilling_vector, element_kinematics)
 
-__all__ = ["section_shell_element_matrices", "section_shell_matrices"]
+__all__ = ["section_shell_element_matrices"]
 
 
 def section_shell_element_matrices(points, triangles, membrane, coupling, bending,
@@ -100,27 +99,3 @@ def section_shell_element_matrices(points, triangles, membrane, coupling, bendin
     return (0.5 * (stiffness + stiffness.transpose(0, 2, 1)),
             0.5 * (mass + mass.transpose(0, 2, 1)))
 
-
-def section_shell_matrices(points, triangles, membrane, coupling, bending, material_axis,
-                           mass_per_area, rotary_inertia_per_area,
-                           drilling_penalty=DRILLING_PENALTY, first_moment_per_area=None):
-    """Global K, M CSR (6n, 6n) of section shells; arguments as in
-    :func:`section_shell_element_matrices` (per-triangle arrays)."""
-    points = np.asarray(points, float)
-    triangles = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
-    n_el = triangles.shape[0]
-    if first_moment_per_area is None:
-        first_moment_per_area = np.zeros(n_el)
-    per_element = [np.asarray(v, float) for v in (membrane, coupling, bending, material_axis,
-                                                  mass_per_area, rotary_inertia_per_area)]
-    moment = np.asarray(first_moment_per_area, float)
-    combined = np.empty((n_el, 18, 18), dtype=complex)
-    for start in range(0, n_el, BLOCK_SIZE):
-        block = slice(start, start + BLOCK_SIZE)
-        k_e, m_e = section_shell_element_matrices(points, triangles[block],
-                                                  *[v[block] for v in per_element],
-                                                  drilling_penalty=drilling_penalty,
-                                                  first_moment_per_area=moment[block])
-        combined[block].real = k_e
-        combined[block].imag = m_e
-    return assemble_pair(combined, None, element_dofs(triangles), 6 * points.shape[0])

@@ -34,7 +34,6 @@ import numpy.fft as _fft
 FFT_BACKEND = "numpy"
 
 __all__ = [
-    "coefficient_count",
     "check_harmonics",
     "time_samples",
     "harmonic_coefficients",
@@ -43,11 +42,6 @@ __all__ = [
     "harmonic_orders",
     "FFT_BACKEND",
 ]
-
-
-def coefficient_count(harmonics: int) -> int:
-    """Number of real Fourier coefficients 2H+1 of a signal with H harmonics."""
-    return 2 * int(harmonics) + 1
 
 
 def check_harmonics(harmonics, samples_per_period) -> None:

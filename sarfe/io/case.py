@@ -201,11 +201,6 @@ def _schema_message(error):
     return path, error.message
 
 
-def _relevance(error):
-    # report the first problem in document order, deepest first at equal position
-    return (-len(error.absolute_path),)
-
-
 def validate_schema(data, source=None, lines=None):
     """Raise CaseError for the first schema violation (document order)."""
     lines = lines or {}

@@ -1,7 +1,7 @@
 """Typed configuration of a case: one small frozen dataclass per case section, built ONCE from the
 validated, normalized case (:func:`sarfe.io.case.normalize`) and owning the defaults.
 
-    config = case_config(case)          # cached per Case; CaseConfig(model, damping, reduction,
+    config = case.config                # built once per Case; CaseConfig(model, damping, reduction,
                                         #   contacts, excitation, solver, erp, output)
     config.solver.harmonics, config.solver.continuation.max_step, config.erp.density_kg_m3 ...
 
@@ -296,13 +296,8 @@ def build_config(data: dict) -> CaseConfig:
                             target_dba=out.get("target_dba")))
 
 
-def case_config(case) -> CaseConfig:
-    """The CaseConfig of a normalized Case (``case.config``: built once per Case)."""
-    return case.config
-
-
 __all__ = ["CaseConfig", "ModelConfig", "FeConfig", "MatricesConfig", "DampingConfig",
            "ReductionConfig", "ContactConfig", "ExcitationConfig", "SweepConfig", "SolverConfig",
-           "ContinuationConfig", "ErpConfig", "OutputConfig", "build_config", "case_config",
+           "ContinuationConfig", "ErpConfig", "OutputConfig", "build_config",
            "DEFAULT_ZETA", "DEFAULT_ACCURACY", "CONTINUATION_MAX_STEP",
            "default_samples_per_period"]

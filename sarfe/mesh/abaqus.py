@@ -471,14 +471,6 @@ def _rotation(axis_a, axis_b, angle_deg):
     return np.eye(3) + math.sin(t) * K + (1 - math.cos(t)) * K @ K
 
 
-def _isotropic_section(young, poisson, thickness):
-    """A, B, D (3, 3) of a homogeneous isotropic shell: A = t Q, B = 0, D = t³/12 Q with the
-    plane-stress Q = E/(1−ν²) [[1, ν, 0], [ν, 1, 0], [0, 0, (1−ν)/2]] (engineering γ_xy)."""
-    q = young / (1 - poisson**2) * np.array([[1, poisson, 0], [poisson, 1, 0],
-                                             [0, 0, (1 - poisson) / 2]])
-    return thickness * q, np.zeros((3, 3)), thickness**3 / 12 * q
-
-
 def _build(reader: _Reader) -> DeckModel:
     """Flatten parts and instances into global numbered arrays."""
     placements = ([(reader.model, None)] if not reader.instances else

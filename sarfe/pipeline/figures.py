@@ -86,16 +86,6 @@ def point_figures(config, stage, nl, summary, solutions, erps, directory: Path, 
     return images
 
 
-def surface_maps(config, mesh, point_data, translations, point, directory: Path,
-                 contact_nodes=None) -> dict:
-    """Report renders at the loudest point: the ERP map [dB re 1 pW/m²], the deflection at the
-    phase of largest displacement (exaggerated warp, colour |u| [mm]) and, when contacts move,
-    their relative displacement [mm], named at ``contact_nodes`` {name: mesh node}. Returns
-    {key: PNG path, 'renderer': text}."""
-    return finish_surface_maps(start_surface_maps(config, mesh, point_data, translations, point,
-                                                  directory, contact_nodes))
-
-
 def finish_surface_maps(run) -> dict:
     """{key: PNG path, 'renderer': text} of the renders :func:`start_surface_maps` started."""
     from sarfe.io.outputs.render import finish_render
@@ -109,8 +99,11 @@ def finish_surface_maps(run) -> dict:
 
 def start_surface_maps(config, mesh, point_data, translations, point, directory: Path,
                        contact_nodes=None):
-    """Start the renders of :func:`surface_maps` in their child process and return at once
-    (:func:`sarfe.io.outputs.render.start_render`): the run's other files are written meanwhile."""
+    """Start the report renders at the loudest point in their child process and return at once
+    (:func:`sarfe.io.outputs.render.start_render`): the run's other files are written meanwhile.
+    The renders: the ERP map [dB re 1 pW/m²], the deflection at the phase of largest displacement
+    (exaggerated warp, colour |u| [mm]) and, when contacts move, their relative displacement [mm],
+    named at ``contact_nodes`` {name: mesh node}; :func:`finish_surface_maps` collects them."""
     from sarfe.io.outputs.render import start_render
     from sarfe.io.outputs.vtk import period_samples
 

@@ -4,7 +4,7 @@ import math
 import numpy as np
 import pytest
 
-from sarfe.batch.paths import PathError, get_path, set_path
+from sarfe.batch.paths import PathError, set_path
 from sarfe.batch.study import StudyError, collect_variants, load_study, parameter_sets, read_yaml
 
 from conftest import HERE
@@ -21,8 +21,8 @@ def write(tmp_path, text, name="study.yaml"):
 
 
 def test_paths_index_name_wildcard_and_copy():
-    assert get_path(CASE, "contacts[1].gap_m") == [2e-4]
-    assert get_path(CASE, "contacts[-1].name") == ["pocket_2"]
+    assert set_path(CASE, "contacts[1].gap_m", 3e-4)["contacts"][1]["gap_m"] == 3e-4
+    assert set_path(CASE, "contacts[-1].gap_m", 4e-4)["contacts"][1]["gap_m"] == 4e-4
     out = set_path(CASE, "contacts[name=pocket_2].gap_m", 5e-4)
     assert out["contacts"][1]["gap_m"] == 5e-4 and CASE["contacts"][1]["gap_m"] == 2e-4  # copy
     out = set_path(CASE, "contacts[*].friction_coefficient", 0.4)

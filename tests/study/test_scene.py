@@ -1,11 +1,11 @@
-"""Model only what the scene requires: contact screening/pruning and harmonic content."""
+"""Model only what the scene requires: contact screening/pruning."""
 import warnings
 
 import numpy as np
 import pytest
 
 from sarfe.hbm import SolverOptions, solve_frequency
-from sarfe.study.scene import (CLOSED, NONLINEAR, OPEN, check_pruning, harmonic_content,
+from sarfe.study.scene import (CLOSED, NONLINEAR, OPEN, check_pruning,
                                prune_contacts, screen_contacts, solve_frequency_pruned,
                                subset_contacts)
 from sarfe.study.lumped import lumped_problem
@@ -75,33 +75,6 @@ def test_violated_decision_falls_back():
     assert report["violations"] and report["fallback"]
     assert s.converged and np.abs(s.contact_force_time).max() > 0
     assert check_pruning(strong.contacts, d, s.displacement)  # still violated: it does close
-
-
-def test_harmonic_content_symmetric_response():
-    """A symmetric (zero-mean, odd) nonlinearity: two equal gaps on both sides → no even harmonics."""
-    from scipy import sparse as sp
-
-    from sarfe.hbm.contacts import make_contact_set
-    from sarfe.study.lumped import lumped_problem as lp
-
-    p = lp(1, rattle_dofs=(), harmonics=7, force=10.0)
-    G = sp.csr_matrix(np.array([[1.0], [-1.0]]))
-    contacts = make_contact_set(G, np.array(["rattle", "rattle"], dtype=object), [0, 1],
-                                [[-1, -1], [-1, -1]], [1e-3, 1e-3], [1e5, 1e5])
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        s = solve_frequency(p.model, contacts, p.excitation, 90.0, 7, 256, options=OPTIONS)
-    assert s.converged
-    report = harmonic_content(s, threshold=1e-6)
-    assert report["even_share"] < 1e-20 and report["odd_share"] == pytest.approx(1.0)
-    assert "odd-only" in report["suggestion"]
-    one_sided = lumped_problem(gap=1e-3, harmonics=7)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        s1 = solve_frequency(one_sided.model, one_sided.contacts, one_sided.excitation, 90.0, 7, 256,
-                             options=OPTIONS)
-    r1 = harmonic_content(s1, threshold=1e-2)
-    assert r1["even_share"] > 1e-4 and 1 <= r1["needed_harmonics"] <= 7
 
 
 def test_linear_responses_equal_linearized_guess():
