@@ -5,39 +5,23 @@ Solve the reduced eigenproblem K_r x_j = ω_j² M_r x_j with X ᵀ M_r X = I and
     D_r = M_r X diag(2 ζ_j ω_j) Xᵀ M_r       [N s/m]
 
 so that every mode of the reduced model (boundary DOFs free) has damping ratio ζ_j. Zero-frequency
-(rigid-body) modes get no damping. ``sarfe.fe.damping.modal_damping`` implements the same formula;
-it is used when importable, the local version below is the fallback.
+(rigid-body) modes get no damping. The formula is ``sarfe.fe.damping.modal_damping``'s (fe is below
+reduction): applied here to the reduced matrices.
 """
 from __future__ import annotations
 
 import dataclasses
 
 import numpy as np
-import scipy.linalg as sla
+
+from sarfe.fe.damping import modal_damping
 
 from .craig_bampton import ReducedModel
 
 
 def reduced_modal_damping(mass, stiffness, zeta) -> np.ndarray:
     """D_r (n_r, n_r) from dense M_r [kg], K_r [N/m] and ζ (scalar or (n_r,), ascending modes)."""
-    try:
-        from sarfe.fe.damping import modal_damping
-    except ImportError:
-        return _modal_damping(mass, stiffness, zeta)
     return modal_damping(mass, stiffness, zeta)
-
-
-def _modal_damping(mass, stiffness, zeta):
-    mass = np.asarray(mass, dtype=float)
-    stiffness = np.asarray(stiffness, dtype=float)
-    omega2, modes = sla.eigh(0.5 * (stiffness + stiffness.T), 0.5 * (mass + mass.T))
-    omega = np.sqrt(np.clip(omega2, 0.0, None))
-    zeta = np.broadcast_to(np.asarray(zeta, dtype=float), omega.shape)
-    if np.any(zeta < 0):
-        raise ValueError("damping ratios must be >= 0")
-    weighted = mass @ modes
-    damping = (weighted * (2.0 * zeta * omega)) @ weighted.T
-    return 0.5 * (damping + damping.T)
 
 
 def with_modal_damping(reduced: ReducedModel, zeta) -> ReducedModel:
