@@ -165,8 +165,9 @@ def _in_layout(name: str, top: set, inside: dict) -> bool:
 
 
 def _atomic_temp_of(leaf: str, pattern) -> bool:
+    """``leaf`` is the temporary of an atomic write of a name matching ``pattern``."""
     match = _ATOMIC_TEMP.fullmatch(leaf)
-    return match is not None and match["name"] is not None and pattern.fullmatch(match["name"]) is not None
+    return bool(match and match["name"] and pattern.fullmatch(match["name"]))
 
 
 def _solve_rule(name: str, path: Path) -> bool:
