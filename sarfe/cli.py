@@ -125,10 +125,11 @@ def cmd_verify(args) -> int:
 def output_options(parser) -> None:
     parser.add_argument("--output", "-o", metavar="DIR", default=None,
                         help="result directory (default: output.directory of the case, "
-                        "results/<name>); must be absent, empty or an earlier sarfe result")
+                        "results/<name>); must be absent, empty or an earlier sarfe result holding "
+                        "only what sarfe wrote")
     parser.add_argument("--force", action="store_true",
-                        help="replace an output folder that is not a sarfe result (never the "
-                        "current folder or the case file's folder)")
+                        help="replace an output folder holding files sarfe did not write, "
+                        "deleting them (never the current, home or case file's folder)")
 
 
 def build_parser() -> argparse.ArgumentParser:

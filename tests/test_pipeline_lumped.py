@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from sarfe.cli import main
+from sarfe.io.errors import CaseError
 from sarfe.pipeline import build_linear_model, linear_model_key, load_case, solve_case
 
 M, K, ZETA, F, GAP = 0.5, 2.0e4, 0.03, 2.0, 0.05
@@ -178,8 +179,11 @@ def test_matrix_files_npz_mtx_npy(tmp_path):
 def test_rerun_replaces_results_and_leaves_no_temporary(tmp_path):
     target = tmp_path / "res"
     solve_case(oscillator([20.0]), output_dir=target)
-    (target / "stale.txt").write_text("from an older run")
+    (target / "notes.txt").write_text("the user's")      # not sarfe's: the re-run refuses
+    with pytest.raises(CaseError, match="notes.txt"):
+        solve_case(oscillator([21.0]), output_dir=target)
+    assert (target / "notes.txt").read_text() == "the user's"
+    (target / "notes.txt").unlink()
     solve_case(oscillator([21.0]), output_dir=target)
-    assert not (target / "stale.txt").exists()
     assert json.loads((target / "summary.json").read_text())["points"][0]["frequency_hz"] == 21.0
     assert sorted(p.name for p in tmp_path.iterdir()) == ["res"]

@@ -354,3 +354,138 @@ def test_debris_of_versions_before_the_marker(tmp_path):
         os.utime(folder, (day_ago, day_ago))
     clean_stale(tmp_path, "res")
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["res", new_tmp.name, foreign.name])
+
+
+# ------------------------------------------------------------- a re-run keeps the user's own files
+def fe_case(folder: Path) -> Path:
+    """The rattle rig (FE, generated mesh) coarsened to 2 frequencies: a result with the erp/ and
+    animation/ subfolders in a few seconds."""
+    import yaml
+
+    data = yaml.safe_load((ROOT / "cases" / "rattle_rig.yaml").read_text())
+    data["model"]["fe"]["generator"]["mesh_size_m"] = 0.02
+    data["excitation"].pop("sweep")
+    data["excitation"]["frequency_hz"] = [31.0, 26.0]
+    data["solver"].update(harmonics=3, error_estimate=False, stability=False)
+    data["output"] = {"files": ["summary", "table", "erp_vtu", "animation"]}
+    folder.mkdir()
+    path = folder / "rig.yaml"
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+def test_user_files_in_an_earlier_result_survive_a_rerun(tmp_path, monkeypatch, capsys):
+    """Finding 1 of review8: a note at the top level and one in sarfe's own erp/ folder are
+    refused by solve and validate with the same line (folder untouched, byte for byte); --force
+    replaces the folder and deletes them."""
+    from sarfe.io.result_folder import _solve_rule
+
+    case = fe_case(tmp_path / "case")
+    monkeypatch.chdir(tmp_path)
+    assert run(capsys, "solve", case, "--output", "res", "--quiet")[0] == 0
+    listed = json.loads((Path("res") / MARKER).read_text())["files"]
+    on_disk = sorted(str(p.relative_to("res")) + ("/" if p.is_dir() else "")
+                     for p in Path("res").rglob("*") if p.name != MARKER)
+    assert sorted(listed) == on_disk and {"erp/", "animation/", "summary.json"} <= set(listed)
+    # the documented layout (by which markers without a file list are judged) covers the writer
+    assert all(_solve_rule(name, None) for name in listed)
+    (Path("res") / "notes.txt").write_text("my notes")
+    (Path("res") / "erp" / "notes.txt").write_text("which map is which")
+    before = snapshot(Path("res"))
+    code, out, err = run(capsys, "solve", case, "--output", "res", "--quiet")
+    assert_one_line_error(code, out, err, "res", "'erp/notes.txt', 'notes.txt'",
+                          "did not write", "--force", "delete those files")
+    assert snapshot(Path("res")) == before
+    code, out, err2 = run(capsys, "validate", case, "--output", "res")
+    assert_one_line_error(code, out, err2)
+    assert err2 == err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["case", "res"]   # nothing written
+    assert run(capsys, "solve", case, "--output", "res", "--quiet", "--force")[0] == 0
+    assert not (Path("res") / "notes.txt").exists() and not (Path("res") / "erp" / "notes.txt").exists()
+    assert is_sarfe_result(Path("res"))
+
+
+def test_a_clean_rerun_replaces_and_a_foreign_folder_inside_is_named_once(case, capsys):
+    assert run(capsys, "solve", case, "--output", "res", "--quiet")[0] == 0
+    (Path("res") / "table.txt").write_text("edited")            # sarfe's name: still sarfe's
+    assert run(capsys, "solve", case, "--output", "res", "--quiet")[0] == 0   # clean: replaced
+    assert (Path("res") / "table.txt").read_text() != "edited"
+    assert json.loads((Path("res") / MARKER).read_text())["files"] == ["summary.json", "table.txt"]
+    (Path("res") / "mine").mkdir()
+    for name in ("a.txt", "b.txt"):
+        (Path("res") / "mine" / name).write_text(name)
+    for name in ("z1.txt", "z2.txt", "z3.txt"):
+        (Path("res") / name).write_text(name)
+    before = snapshot(Path("res"))
+    code, out, err = run(capsys, "solve", case, "--output", "res")
+    assert_one_line_error(code, out, err, "'mine/', 'z1.txt', 'z2.txt' and 1 more")
+    assert snapshot(Path("res")) == before
+
+
+def test_a_marker_without_a_file_list_is_judged_by_the_documented_layout(case, capsys):
+    """Results of sarfe versions whose marker had no file list, or no marker at all: sarfe's
+    documented names (erp/erp_NNNN.vtu, animation/deflection_NNN.vtu, …) are replaceable,
+    anything else is foreign."""
+    old = Path("old")
+    (old / "erp").mkdir(parents=True)
+    (old / "animation").mkdir()
+    (old / MARKER).write_text(json.dumps({"sarfe_version": "0.0.9", "kind": "solve", "case": "t"}))
+    for name in ("summary.json", "table.txt", "report.html", "erp/erp.pvd", "erp/erp_0000.vtu",
+                 "erp/erp_0001.vtu", "animation/deflection.pvd", "animation/deflection_000.vtu"):
+        (old / name).write_text("{}")
+    premarker = Path("premarker")
+    premarker.mkdir()
+    (premarker / "summary.json").write_text(json.dumps({"sarfe_version": "0.0.1", "case": "t"}))
+    (premarker / "table.txt").write_text("table")
+    assert is_sarfe_result(old) and is_sarfe_result(premarker)
+    (old / "animation" / "deflection.png").write_text("my screenshot")
+    (premarker / "notes.txt").write_text("mine")
+    for folder, foreign in ((old, "'animation/deflection.png'"), (premarker, "'notes.txt'")):
+        before = snapshot(folder)
+        code, out, err = run(capsys, "solve", case, "--output", folder)
+        assert_one_line_error(code, out, err, foreign, "did not write")
+        assert snapshot(folder) == before
+    (old / "animation" / "deflection.png").unlink()
+    assert run(capsys, "solve", case, "--output", old, "--quiet")[0] == 0
+    assert sorted(p.name for p in old.iterdir()) == sorted([MARKER, "summary.json", "table.txt"])
+
+
+def test_a_file_put_into_the_result_during_the_run_is_kept(tmp_path):
+    target = tmp_path / "res"
+    write_result_folder(target, write_files("old"), marker_info("solve", "t"))
+
+    def write(folder):
+        write_files("new")(folder)
+        (target / "notes.txt").write_text("written while sarfe ran")
+    with pytest.raises(CaseError, match="changed during the run.*notes.txt|notes.txt.*changed during"):
+        write_result_folder(target, write, marker_info("solve", "t"))
+    assert (target / "notes.txt").read_text() == "written while sarfe ran"
+    assert (target / "a.txt").read_text() == "old"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["res"]
+
+
+def test_batch_folder_with_a_user_file_is_refused_and_a_clean_one_resumes(case, capsys):
+    """The batch folder (written in place) and its variant_outputs/<id>/ results follow the same
+    rule; a batch never writes into a solve result."""
+    from sarfe.batch.cli import main as batch_main
+
+    argv = ["--workers", "0", "--write-variant-outputs", "--output", "out", str(case)]
+    assert batch_main(argv) == 0, capsys.readouterr().err
+    (variant,) = list((Path("out") / "variant_outputs").iterdir())
+    assert is_sarfe_result(Path("out")) and is_sarfe_result(variant)
+    assert batch_main(argv) == 0, capsys.readouterr().err                  # resumes there
+    capsys.readouterr()
+    (variant / "mine.txt").write_text("notes")
+    (Path("out") / "notes.txt").write_text("notes")
+    before = snapshot(Path("out"))
+    assert batch_main(argv) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1, err
+    assert f"'notes.txt', 'variant_outputs/{variant.name}/mine.txt'" in err and "--force" in err
+    assert snapshot(Path("out")) == before
+    (variant / "mine.txt").unlink()
+    (Path("out") / "notes.txt").unlink()
+    assert batch_main(argv) == 0, capsys.readouterr().err
+    assert run(capsys, "solve", case, "--output", "res", "--quiet")[0] == 0
+    assert batch_main(["--workers", "0", "--output", "res", str(case)]) == 2
+    assert "not a batch folder" in capsys.readouterr().err
