@@ -45,8 +45,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--retry-failed", action="store_true",
                         help="run variants that failed in an earlier run again")
     parser.add_argument("--force", action="store_true",
-                        help="write into an output folder that is not a sarfe batch folder (never "
-                             "the current folder or one holding an input file)")
+                        help="write into an output folder that is not a sarfe batch folder or holds "
+                             "files the batch did not write (nothing is deleted; never the current "
+                             "folder or one holding an input file)")
     parser.add_argument("--no-cache", action="store_true",
                         help="do not read/write linear stages in <output>/.cache")
 
