@@ -423,6 +423,10 @@ def _normalize_contacts(case, data):
                 raise case.error("only with from_elements", p + ("element_axis",))
             if "between" in contact and contact["between"][0] == "ground":
                 raise case.error("the first group cannot be 'ground'", p + ("between", 0))
+            for j, pair in enumerate(contact.get("pairs", [])):
+                if pair[0] == pair[1]:
+                    raise case.error(f"node {pair[0]} is paired with itself (a pair joins two "
+                                     "different nodes, or a node and 'ground')", p + ("pairs", j))
             contact.setdefault("pairing_tolerance_m", 1e-3)
             contact.setdefault("normal", "auto")
             has_normal = True

@@ -123,6 +123,33 @@ def check_held(case, mesh, fixed_nodes) -> None:
                          f"{members[0]}); add a fixed group on it", ("model", "fe", "fixed"))
 
 
+def check_loads_free(case, mesh, fixed_nodes) -> list:
+    """Every force group of an FE case acts on a free DOF. The force F of a group is split
+    equally over its n nodes (F/n each) and a fixed node's share goes into the support, so a group
+    whose nodes are all held (fixed, or on no triangle) is a CaseError naming it, and a partly
+    held group gets a warning stating the share lost. Returns the warnings (one line each)."""
+    from sarfe.pipeline.linear import resolve_node_group
+
+    used = np.zeros(mesh.n_nodes, bool)
+    used[mesh.triangles.ravel()] = True
+    held = ~used
+    held[np.asarray(fixed_nodes, dtype=int)] = True
+    warnings = []
+    for i, load in enumerate(case.config.excitation.forces):
+        path = ("excitation", "forces", i, "group")
+        nodes = resolve_node_group(case, mesh, load["group"], path)
+        count = int(np.count_nonzero(held[nodes]))
+        if count == len(nodes):
+            raise case.error(f"the force on group {load['group']} acts on no free DOF: all of its "
+                             f"DOFs are fixed ({len(nodes)} node(s) held by model.fe.fixed or on "
+                             "no triangle)", path)
+        if count:
+            warnings.append(f"excitation.forces[{i}]: {count} of the {len(nodes)} nodes of group "
+                            f"{load['group']} are fixed: {100 * count / len(nodes):.3g} % of "
+                            f"force_N = {load['force_N']:g} N goes straight into the supports")
+    return warnings
+
+
 def bending_resolution_hz(points, triangles, thickness, young, poisson, density) -> np.ndarray:
     """Per triangle, the frequency [Hz] whose plate bending wavelength spans
     :data:`ELEMENTS_PER_WAVELENGTH` of its longest edge h:
@@ -229,8 +256,7 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True)
     check_thickness(case, mesh)
     normals = nodal_normals(mesh.points, mesh.triangles)
     paired = {c.name: pair_contact(case, mesh, c.index, normals) for c in config.contacts}
-    for i, f in enumerate(config.excitation.forces):
-        resolve_node_group(case, mesh, f["group"], ("excitation", "forces", i, "group"))
+    load_warnings = check_loads_free(case, mesh, fixed)
     surface = config.erp.surface
     if surface is not None and surface not in mesh.element_groups:
         resolve_node_group(case, mesh, surface, ("erp", "surface"))
@@ -239,8 +265,8 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True)
     check_held(case, mesh, fixed)
     info = {"nodes": mesh.n_nodes, "triangles": mesh.n_triangles,
             "contact_pairs": {name: len(p[0]) for name, p in paired.items()}}
-    return CaseCheck(info, tuple(range_warnings(case, mesh)), output)
+    return CaseCheck(info, tuple(range_warnings(case, mesh)) + tuple(load_warnings), output)
 
 
-__all__ = ["CaseCheck", "check_case", "output_target", "check_element_quality", "check_held", "check_thickness",
+__all__ = ["CaseCheck", "check_case", "check_loads_free", "output_target", "check_element_quality", "check_held", "check_thickness",
            "bending_resolution_hz", "mesh_frequency_limit_hz", "range_warnings", "reduced_model_warnings"]

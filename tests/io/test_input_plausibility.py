@@ -1,0 +1,66 @@
+"""Inputs that are not errors but far outside a plausible model: each gets one warning line (never
+a silent change of the model), and nothing numpy says leaks to stderr (review8 items 4 and 6-7)."""
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from sarfe.io.case import CaseLoader, load_case
+
+ROOT = Path(__file__).resolve().parents[2]
+CASES = ROOT / "cases"
+
+
+def squeak() -> dict:
+    return yaml.load((CASES / "squeak_rig.yaml").read_text(), Loader=CaseLoader)
+
+
+def rig() -> dict:
+    return yaml.load((CASES / "rattle_rig.yaml").read_text(), Loader=CaseLoader)
+
+
+def checked(data, tmp_path):
+    from sarfe.pipeline.checks import check_case
+
+    path = tmp_path / "case.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return check_case(load_case(path), write=False)
+
+
+def test_sweep_plot_of_zero_power_points_raises_no_numpy_warning():
+    """A sweep whose every level is −inf dB (zero radiated power): no jump is found and numpy's
+    'invalid value encountered in subtract' does not reach stderr."""
+    from sarfe.io.outputs.plots import jump_starts
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert not jump_starts(np.full(5, -np.inf)).any()
+        assert jump_starts(np.array([10.0, 10.5, 40.0, 40.2]))[2]
+
+
+def test_force_partly_on_fixed_nodes_warns_with_the_share_lost(tmp_path):
+    """A force on the whole beam (element group part_beam) whose clamp_beam nodes are fixed: F/n
+    per node, so the k clamped of n nodes put k/n of force_N into the supports — a warning
+    stating k, n and k/n (the model is not changed); all nodes fixed is an error."""
+    from sarfe.pipeline.linear import load_case_mesh, resolve_node_group
+
+    data = rig()
+    assert not [w for w in checked(data, tmp_path).warnings if "supports" in w]
+    data["excitation"]["forces"][0]["group"] = "part_beam"
+    found = [w for w in checked(data, tmp_path).warnings if "supports" in w]
+    case = load_case(tmp_path / "case.yaml")
+    mesh = load_case_mesh(case)
+    beam = resolve_node_group(case, mesh, "part_beam", ())
+    clamp = resolve_node_group(case, mesh, "clamp_beam", ())
+    k, n = len(np.intersect1d(beam, clamp)), len(beam)
+    assert 0 < k < n
+    assert found == [f"excitation.forces[0]: {k} of the {n} nodes of group part_beam are fixed: "
+                     f"{100 * k / n:.3g} % of force_N = 0.05 N goes straight into the supports"]
+    data["excitation"]["forces"][0]["group"] = "clamp_beam"
+    with pytest.raises(Exception, match=r"excitation\.forces\[0\]\.group: the force on group "
+                                        "clamp_beam acts on no free DOF"):
+        checked(data, tmp_path)
