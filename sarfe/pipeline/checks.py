@@ -11,7 +11,9 @@ Errors (CaseError, exit 2, one line naming the key or the element):
   * thickness plausibility: 1e-4·L < t < 0.1·L for the model size L (the bounding-box diagonal),
     which catches a thickness given in mm;
   * the structure is held: every connected part of the mesh holds at least one fixed node (else
-    the stiffness has rigid-body modes and the reduction cannot factorize it);
+    the stiffness has rigid-body modes and the reduction cannot factorize it); a matrices model's
+    K plus the springs of the contacts closed at rest is regular (:func:`check_matrices_held`);
+  * every force acts on a free DOF (a force group all fixed is an error, partly fixed a warning);
   * the output folder: absent, empty or a sarfe result, and writable (:mod:`sarfe.io.result_folder`).
 
 Warnings (one line each, printed and written to summary.json ``warnings``) for inputs far outside
@@ -150,6 +152,46 @@ def check_loads_free(case, mesh, fixed_nodes) -> list:
     return warnings
 
 
+HELD_MATRIX_LIMIT = 3000        # DOFs: a dense eigenvalue check above costs more than it finds
+RIGID_TOLERANCE = 1e-10         # eigenvalue ≤ this × the largest: a rigid-body (null-space) mode
+
+
+def check_matrices_held(case) -> None:
+    r"""A ``model.matrices`` model is held at rest, as :func:`check_held` asks of a mesh: the static
+    stiffness with the contacts linearized at u = 0 (their preload state: :func:`sarfe.hbm.pruning.
+    linearized_stiffness`),
+
+        K_0 = K + Gᵀ diag(k) G      (k: the springs of the contacts closed at rest, k_t of the stuck
+                                     tangents; open contacts add nothing),
+
+    must be regular — else the static (0th harmonic) block of the HBM Jacobian is singular at every
+    point. K_0 (n, n) [N/m]; its eigenvalues λ ≤ :data:`RIGID_TOLERANCE`·max λ span the rigid-body
+    modes. CaseError naming model.matrices.stiffness and the null-space size. Models above
+    :data:`HELD_MATRIX_LIMIT` DOFs are not checked (a dense eigenvalue problem)."""
+    from sarfe.hbm.pruning import linearized_stiffness
+    from sarfe.pipeline.linear import build_linear_model
+    from sarfe.pipeline.nonlinear import nonlinear_model
+
+    stage = build_linear_model(case)
+    n = stage.dof_count
+    if n > HELD_MATRIX_LIMIT:
+        return
+    nl = nonlinear_model(case, stage)
+    K0 = linearized_stiffness(nl.model, nl.contacts)[0]
+    K0 = K0.toarray() if hasattr(K0, "toarray") else np.asarray(K0, dtype=float)
+    values, vectors = np.linalg.eigh(0.5 * (K0 + K0.T))
+    rigid = values <= RIGID_TOLERANCE * max(np.abs(values).max(initial=0.0), 1e-300)
+    if rigid.any():
+        count = int(np.count_nonzero(rigid))
+        moving = np.flatnonzero(np.abs(vectors[:, rigid]).max(axis=1) > 1e-6)
+        shown = ", ".join(map(str, moving[:8])) + (" …" if moving.size > 8 else "")
+        raise case.error(f"the structure is not held: the stiffness plus the springs of the "
+                         f"contacts closed at rest is singular ({count} rigid-body mode(s), "
+                         f"null space of size {count} of {n} DOFs; DOF(s) {shown} move freely); "
+                         "add stiffness to ground or a preloaded contact",
+                         ("model", "matrices", "stiffness"))
+
+
 def bending_resolution_hz(points, triangles, thickness, young, poisson, density) -> np.ndarray:
     """Per triangle, the frequency [Hz] whose plate bending wavelength spans
     :data:`ELEMENTS_PER_WAVELENGTH` of its longest edge h:
@@ -231,15 +273,15 @@ def output_target(case, output_dir=None, force=False):
 def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True) -> CaseCheck:
     """All checks of the module docstring. Raises CaseError at the first problem."""
     from sarfe.erp import nodal_normals
-    from sarfe.pipeline.linear import (_build_matrices, _per_triangle, load_case_mesh,
-                                       pair_contact, resolve_node_group)
+    from sarfe.pipeline.linear import (_per_triangle, load_case_mesh, pair_contact,
+                                       resolve_node_group)
 
     case = load_case(case)
     output = output_target(case, output_dir, force) if write else None
     if not mesh_checks:
         return CaseCheck({}, tuple(range_warnings(case)), output)
     if not case.is_fe:
-        _build_matrices(case)
+        check_matrices_held(case)
         return CaseCheck({}, tuple(range_warnings(case)), output)
     config = case.config
     if config.model.fe.is_deck:   # a Nastran/Abaqus deck: its own checks, with ids
@@ -268,5 +310,5 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True)
     return CaseCheck(info, tuple(range_warnings(case, mesh)) + tuple(load_warnings), output)
 
 
-__all__ = ["CaseCheck", "check_case", "check_loads_free", "output_target", "check_element_quality", "check_held", "check_thickness",
+__all__ = ["CaseCheck", "check_case", "check_loads_free", "check_matrices_held", "output_target", "check_element_quality", "check_held", "check_thickness",
            "bending_resolution_hz", "mesh_frequency_limit_hz", "range_warnings", "reduced_model_warnings"]

@@ -278,6 +278,9 @@ CORPUS = [
     ("force-on-clamped-group", rig, setitem(("excitation", "forces", 0, "group"), "clamp_beam"),
      None, None, ["excitation.forces[0].group", "the force on group clamp_beam acts on no free "
                   "DOF: all of its DOFs are fixed"]),
+    ("stiffness-all-zero", lumped, setitem(("model", "matrices", "stiffness"),
+                                           [[0.0] * 3 for _ in range(3)]), None, None,
+     ["model.matrices.stiffness", "not held", "null space of size 2 of 3 DOFs", "DOF(s) 0, 1"]),
     ("tabulated-preload-above-plateau", rig, lambda d: d["contacts"][0].update(
         type="tabulated", curve=[[0, 0], [1e-3, 1.0], [2e-3, 1.0]], preload_N=2.0) or [
         d["contacts"][0].pop(k) for k in ("normal_stiffness_N_m",)], None, None,

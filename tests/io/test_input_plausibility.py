@@ -64,3 +64,26 @@ def test_force_partly_on_fixed_nodes_warns_with_the_share_lost(tmp_path):
     with pytest.raises(Exception, match=r"excitation\.forces\[0\]\.group: the force on group "
                                         "clamp_beam acts on no free DOF"):
         checked(data, tmp_path)
+
+
+def test_matrices_model_held_only_by_closed_contacts(tmp_path):
+    """Two masses, DOF 1 on a ground spring, DOF 0 free except for a contact to DOF 1 (w = u0 − u1).
+    K alone is singular (rank 1). An open rattle gap (g > 0) adds no static spring: not held, null
+    space 1 naming DOF 0. The same contact preloaded is closed at rest: K + k_n (e0 − e1)(e0 − e1)ᵀ
+    is regular, and the case passes."""
+    from sarfe.io.errors import CaseError
+
+    data = {"name": "floating", "model": {"matrices": {"mass": [[1.0, 0.0], [0.0, 1.0]],
+                                                       "stiffness": [[0.0, 0.0], [0.0, 1.0e4]]}},
+            "damping": {"modal_zeta": 0.02},
+            "contacts": [{"name": "c", "type": "rattle", "normal_dof": {"dof": 0, "relative_to": 1},
+                          "gap_m": 1e-4, "normal_stiffness_N_m": 1e5}],
+            "excitation": {"forces": [{"dof": 1, "force_N": 1.0}], "frequency_hz": [20.0]},
+            "solver": {"harmonics": 3, "samples_per_period": 64},
+            "erp": {"dofs": [1], "areas_m2": [0.01]}}
+    with pytest.raises(CaseError, match=r"model\.matrices\.stiffness: the structure is not held.*"
+                                        r"null space of size 1 of 2 DOFs; DOF\(s\) 0 move"):
+        checked(data, tmp_path)
+    del data["contacts"][0]["gap_m"]
+    data["contacts"][0]["preload_N"] = 5.0
+    assert checked(data, tmp_path).warnings == ()
