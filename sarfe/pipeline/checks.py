@@ -247,17 +247,52 @@ def range_warnings(case, mesh=None) -> list:
     return warnings
 
 
+def interior_dof_count(mesh, fixed_nodes, boundary_nodes) -> int:
+    """Interior DOFs of the Craig–Bampton split, as the linear stage makes it: 6 per node on a
+    triangle that is not fixed, minus the 3 translations of each free contact or load node (the
+    boundary). At most this many fixed-interface modes exist."""
+    used = np.zeros(mesh.n_nodes, bool)
+    used[mesh.triangles.ravel()] = True
+    free = used.copy()
+    free[np.asarray(fixed_nodes, dtype=int)] = False
+    boundary = np.unique(np.asarray(boundary_nodes, dtype=int))
+    boundary = boundary[(boundary >= 0) & free[np.maximum(boundary, 0)]]
+    return int(6 * np.count_nonzero(free) - 3 * boundary.size)
+
+
+def mode_count_warnings(case, interior) -> list:
+    """reduction.mode_count above the ``interior`` DOF count: a warning stating the clip."""
+    reduction = case.config.reduction
+    asked = None if reduction is None else reduction.mode_count
+    if asked is None or asked <= interior:
+        return []
+    return [f"reduction.mode_count = {asked} asks more modes than the structure has: its "
+            f"{interior} interior DOFs give at most {interior} fixed-interface modes, so the "
+            f"reduction keeps all it finds ({asked} asked, at most {interior} available; a full "
+            "eigenproblem): lower mode_count or give reduction.cutoff_hz"]
+
+
 def reduced_model_warnings(case, stage) -> list:
-    """Warnings that need the reduced model: H·f_max above its highest fixed-interface mode."""
+    """Warnings that need the reduced model: fewer modes kept than reduction.mode_count asked
+    (unless :func:`mode_count_warnings` said so before the reduction), H·f_max above the highest
+    fixed-interface mode."""
     modes = np.asarray(stage.mode_frequencies_hz)
     reduction = case.config.reduction
-    if stage.kind != "fe" or not modes.size or reduction is None or reduction.mode_count is None:
+    if stage.kind != "fe" or reduction is None or reduction.mode_count is None:
         return []
+    warnings = []
+    asked, kept = reduction.mode_count, int(stage.info.get("modes", modes.size))
+    interior = stage.info.get("free_dofs", 0) - stage.info.get("boundary_dofs", 0)
+    said_before = not case.config.model.fe.is_deck and asked > interior
+    if kept < asked and not said_before:
+        warnings.append(f"reduction.mode_count = {asked}: the reduction kept {kept} modes "
+                        f"({asked} asked, {kept} available from {interior} interior DOFs)")
     top, H = _excitation_top_hz(case), case.config.solver.harmonics
-    if H * top > modes.max():
-        return [f"excitation {top:g} Hz × {H} harmonics = {H * top:.4g} Hz is above the highest "
-                f"kept mode ({modes.max():.4g} Hz, reduction.mode_count = {modes.size})"]
-    return []
+    if modes.size and H * top > modes.max():
+        warnings.append(f"excitation {top:g} Hz × {H} harmonics = {H * top:.4g} Hz is above the "
+                        f"highest kept mode ({modes.max():.4g} Hz, reduction.mode_count = "
+                        f"{modes.size})")
+    return warnings
 
 
 def output_target(case, output_dir=None, force=False):
@@ -307,8 +342,14 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True)
     check_held(case, mesh, fixed)
     info = {"nodes": mesh.n_nodes, "triangles": mesh.n_triangles,
             "contact_pairs": {name: len(p[0]) for name, p in paired.items()}}
-    return CaseCheck(info, tuple(range_warnings(case, mesh)) + tuple(load_warnings), output)
+    load_nodes = [resolve_node_group(case, mesh, f["group"], ("excitation", "forces", i, "group"))
+                  for i, f in enumerate(config.excitation.forces)]
+    interior = interior_dof_count(mesh, fixed, np.concatenate(
+        [np.zeros(0, int)] + [np.concatenate([p[0], p[1]]) for p in paired.values()] + load_nodes))
+    return CaseCheck(info, tuple(range_warnings(case, mesh)) + tuple(load_warnings)
+                     + tuple(mode_count_warnings(case, interior)), output)
 
 
 __all__ = ["CaseCheck", "check_case", "check_loads_free", "check_matrices_held", "output_target", "check_element_quality", "check_held", "check_thickness",
-           "bending_resolution_hz", "mesh_frequency_limit_hz", "range_warnings", "reduced_model_warnings"]
+           "bending_resolution_hz", "mesh_frequency_limit_hz", "range_warnings", "reduced_model_warnings",
+           "interior_dof_count", "mode_count_warnings"]

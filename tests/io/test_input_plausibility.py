@@ -87,3 +87,30 @@ def test_matrices_model_held_only_by_closed_contacts(tmp_path):
     del data["contacts"][0]["gap_m"]
     data["contacts"][0]["preload_N"] = 5.0
     assert checked(data, tmp_path).warnings == ()
+
+
+def test_mode_count_above_the_interior_warns_with_the_clip(tmp_path):
+    """reduction.mode_count = 100000 on the squeak rig: validate states the clip with the interior
+    DOF count, which equals the linear stage's free − boundary DOFs (built with 5 modes); a
+    reduction that kept fewer modes than asked (within the interior) warns after the reduction."""
+    from types import SimpleNamespace
+
+    from sarfe.pipeline.checks import reduced_model_warnings
+    from sarfe.pipeline.linear import build_linear_model
+
+    data = squeak()
+    data["reduction"] = {"mode_count": 5}
+    assert not [w for w in checked(data, tmp_path).warnings if "mode_count" in w]
+    info = build_linear_model(load_case(tmp_path / "case.yaml")).info
+    interior = info["free_dofs"] - info["boundary_dofs"]
+    data["reduction"] = {"mode_count": 100000}
+    found = [w for w in checked(data, tmp_path).warnings if "mode_count" in w]
+    assert len(found) == 1 and f"100000 asked, at most {interior} available" in found[0]
+    stage = SimpleNamespace(kind="fe", mode_frequencies_hz=np.array([1e3, 2e3]),
+                            info={"modes": 2, "free_dofs": 100, "boundary_dofs": 10})
+    assert reduced_model_warnings(load_case(tmp_path / "case.yaml"), stage) == []   # said before
+    data["reduction"] = {"mode_count": 50}
+    checked(data, tmp_path)
+    assert reduced_model_warnings(load_case(tmp_path / "case.yaml"), stage)[0] == (
+        "reduction.mode_count = 50: the reduction kept 2 modes (50 asked, 2 available from 90 "
+        "interior DOFs)")
