@@ -23,7 +23,9 @@ the model's range:
     :data:`ELEMENTS_PER_WAVELENGTH` element edges h, so f_mesh = (2π / (6 h))² √(D / (ρ t)) / 2π
     (median over the triangles);
   * H·f_max above ``reduction.cutoff_hz`` (the harmonics have no modes to live in);
-  * a gap larger than the structure (the contact can never close).
+  * an open gap larger than the structure (the contact can never close), or |gap_m| more than
+    :data:`GAP_RANGE` × the thickest shell or the contact's tolerance_m (:func:`gap_warnings`);
+  * reduction.mode_count above the interior DOFs; a force group partly fixed.
 """
 from __future__ import annotations
 
@@ -222,6 +224,38 @@ def mesh_frequency_limit_hz(case, mesh) -> float:
     return float(np.median(bending_resolution_hz(mesh.points, mesh.triangles, t, E, nu, rho)))
 
 
+GAP_RANGE = 10.0   # |gap_m| above this × the contact's reference length warns
+
+
+def gap_warnings(case, mesh=None) -> list:
+    r"""A ``gap_m`` far from the contact's scale: |g| > :data:`GAP_RANGE` · L with the reference
+    length L = max(thickest shell ``thickness_m`` of an FE model, the contact's ``tolerance_m``)
+    [m] — a gap in mm given as metres (0.5 for 0.5 mm), or an overclosure that presses the parts
+    through each other. Not an error (the model is solved as given); no L (a matrices model with
+    tolerance_m = 0), or an open gap already larger than the structure (:func:`range_warnings`),
+    no warning."""
+    config = case.config
+    fe = config.model.fe.data if case.is_fe else {}
+    thickest = max((float(t) for t in fe.get("thickness_m", {}).values()), default=0.0)
+    size = np.inf if mesh is None else float(np.linalg.norm(np.ptp(mesh.points, axis=0)))
+    warnings = []
+    for i, contact in ((c.index, c.params) for c in config.contacts):
+        gap = contact.get("gap_m")
+        tolerance = float(contact.get("tolerance_m", 0.0))
+        reference = max(thickest, tolerance)
+        if gap is None or reference <= 0.0 or abs(gap) <= GAP_RANGE * reference or gap > size:
+            continue
+        what = (f"the thickest shell, thickness_m = {thickest:g} m" if thickest >= tolerance
+                else f"its tolerance_m = {tolerance:g} m")
+        kind = "an overclosure (the parts pressed" if gap < 0 else "an open gap (the parts"
+        detail = (f"{kind} {abs(gap) * 1e3:.4g} mm into each other)" if gap < 0
+                  else f"{kind} {gap * 1e3:.4g} mm apart)")
+        warnings.append(f"contacts[{i}] ({contact['name']}): gap_m = {gap:g} m is {detail}, "
+                        f"more than {GAP_RANGE:g} × {what}: gap_m is in metres "
+                        "(0.5 mm = 5e-4)")
+    return warnings
+
+
 def range_warnings(case, mesh=None) -> list:
     """One-line warnings for inputs far outside the model's range (module docstring)."""
     warnings = []
@@ -237,9 +271,10 @@ def range_warnings(case, mesh=None) -> list:
         size = float(np.linalg.norm(np.ptp(mesh.points, axis=0)))
         for i, contact in ((c.index, c.params) for c in config.contacts):
             gap = contact.get("gap_m")
-            if gap is not None and abs(gap) > size:
+            if gap is not None and gap > size:
                 warnings.append(f"contacts[{i}] ({contact['name']}): gap_m = {gap:g} m is larger "
                                 f"than the structure ({size:.3g} m): the contact can never close")
+    warnings += gap_warnings(case, mesh)
     cutoff = None if config.reduction is None else config.reduction.cutoff_hz
     if cutoff is not None and H * top > cutoff:
         warnings.append(f"excitation {top:g} Hz × {H} harmonics = {H * top:.4g} Hz is above "
@@ -352,4 +387,4 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True)
 
 __all__ = ["CaseCheck", "check_case", "check_loads_free", "check_matrices_held", "output_target", "check_element_quality", "check_held", "check_thickness",
            "bending_resolution_hz", "mesh_frequency_limit_hz", "range_warnings", "reduced_model_warnings",
-           "interior_dof_count", "mode_count_warnings"]
+           "interior_dof_count", "mode_count_warnings", "gap_warnings"]

@@ -114,3 +114,30 @@ def test_mode_count_above_the_interior_warns_with_the_clip(tmp_path):
     assert reduced_model_warnings(load_case(tmp_path / "case.yaml"), stage)[0] == (
         "reduction.mode_count = 50: the reduction kept 2 modes (50 asked, 2 available from 90 "
         "interior DOFs)")
+
+
+@pytest.mark.parametrize("gap, warned", [(5e-4, False), (-5e-4, False), (0.02, False),
+                                         (0.1, True), (-0.1, True), (-0.5, True)])
+def test_gap_far_above_the_shell_thickness_warns(tmp_path, gap, warned):
+    """Rule: |gap_m| > 10 × max(thickest shell, tolerance_m) warns — on the rattle rig (shells
+    2.5 mm, tolerance 0.1 mm, 0.287 m across) above 25 mm: ±0.1 and −0.5 (an overclosure beyond
+    the structure's size) do, ±0.5 mm and 20 mm do not. The case is not changed."""
+    data = rig()
+    data["contacts"][0]["gap_m"] = gap
+    found = [w for w in checked(data, tmp_path).warnings if "gap_m" in w]
+    assert bool(found) == warned, found
+    if warned:
+        assert found[0].startswith(f"contacts[0] (tip): gap_m = {gap:g} m is ")
+        assert "10 × the thickest shell, thickness_m = 0.0025 m" in found[0]
+        assert ("overclosure" in found[0]) == (gap < 0)
+    assert load_case(tmp_path / "case.yaml").config.contacts[0].params["gap_m"] == gap
+
+
+def test_gap_of_a_matrices_contact_is_judged_by_its_tolerance(tmp_path):
+    """Without shells the reference is tolerance_m: lumped_rattle (2e-5 m) warns above 2e-4 m;
+    its own 1e-4 m does not."""
+    data = yaml.load((CASES / "lumped_rattle.yaml").read_text(), Loader=CaseLoader)
+    assert checked(data, tmp_path).warnings == ()
+    data["contacts"][0]["gap_m"] = 0.01
+    (found,) = checked(data, tmp_path).warnings
+    assert "its tolerance_m = 2e-05 m" in found and "open gap" in found
