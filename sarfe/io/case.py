@@ -218,11 +218,33 @@ def validate_schema(data, source=None, lines=None):
     def order(error):
         return (_line_of(lines, error.absolute_path) or 0, -len(error.absolute_path))
     error = min(errors, key=order)
-    # descend into the most specific sub-error of a combinator
+    # descend into the sub-error of the combinator's branch that fits the value's kind
     while error.context:
-        error = jsonschema.exceptions.best_match(error.context)
+        depth = len(error.absolute_path)
+        fitting = [e for e in error.context if e.validator not in ("type", "enum")
+                   or len(e.absolute_path) > depth]
+        if not fitting:   # no branch fits: name every accepted form
+            path = tuple(error.absolute_path)
+            raise CaseError(f"must be {_accepted_forms(error.context)}, got "
+                            f"{_describe(error.instance)}", path, source, _line_of(lines, path))
+        error = jsonschema.exceptions.best_match(fitting)
     path, message = _schema_message(error)
     raise CaseError(message, path, source, _line_of(lines, path))
+
+
+def _accepted_forms(errors) -> str:
+    """'one of 'fast', 'balanced', 'fine' or a mapping' from the type/enum errors of the branches
+    of a oneOf/anyOf."""
+    forms = []
+    for error in errors:
+        if error.validator == "enum":
+            forms.append(", ".join(map(repr, error.validator_value)))
+        else:
+            types = error.validator_value
+            types = [types] if isinstance(types, str) else types
+            forms.append(" or ".join(_TYPE_NAMES.get(t, t) for t in types))
+    forms = list(dict.fromkeys(forms))
+    return ("one of " if any(e.validator == "enum" for e in errors) else "") + " or ".join(forms)
 
 
 # ------------------------------------------------------------------------ numbers and plausibility
