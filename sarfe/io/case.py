@@ -213,11 +213,33 @@ def validate_schema(data, source=None, lines=None):
     def order(error):
         return (_line_of(lines, error.absolute_path) or 0, -len(error.absolute_path))
     error = min(errors, key=order)
-    # descend into the most specific sub-error of a combinator
+    # descend into the sub-error of the combinator's branch that fits the value's kind
     while error.context:
-        error = jsonschema.exceptions.best_match(error.context)
+        depth = len(error.absolute_path)
+        fitting = [e for e in error.context if e.validator not in ("type", "enum")
+                   or len(e.absolute_path) > depth]
+        if not fitting:   # no branch fits: name every accepted form
+            path = tuple(error.absolute_path)
+            raise CaseError(f"must be {_accepted_forms(error.context)}, got "
+                            f"{_describe(error.instance)}", path, source, _line_of(lines, path))
+        error = jsonschema.exceptions.best_match(fitting)
     path, message = _schema_message(error)
     raise CaseError(message, path, source, _line_of(lines, path))
+
+
+def _accepted_forms(errors) -> str:
+    """'one of 'fast', 'balanced', 'fine' or a mapping' from the type/enum errors of the branches
+    of a oneOf/anyOf."""
+    forms = []
+    for error in errors:
+        if error.validator == "enum":
+            forms.append(", ".join(map(repr, error.validator_value)))
+        else:
+            types = error.validator_value
+            types = [types] if isinstance(types, str) else types
+            forms.append(" or ".join(_TYPE_NAMES.get(t, t) for t in types))
+    forms = list(dict.fromkeys(forms))
+    return ("one of " if any(e.validator == "enum" for e in errors) else "") + " or ".join(forms)
 
 
 # ------------------------------------------------------------------------ numbers and plausibility
@@ -418,6 +440,10 @@ def _normalize_contacts(case, data):
                 raise case.error("only with from_elements", p + ("element_axis",))
             if "between" in contact and contact["between"][0] == "ground":
                 raise case.error("the first group cannot be 'ground'", p + ("between", 0))
+            for j, pair in enumerate(contact.get("pairs", [])):
+                if pair[0] == pair[1]:
+                    raise case.error(f"node {pair[0]} is paired with itself (a pair joins two "
+                                     "different nodes, or a node and 'ground')", p + ("pairs", j))
             contact.setdefault("pairing_tolerance_m", 1e-3)
             contact.setdefault("normal", "auto")
             has_normal = True

@@ -11,7 +11,9 @@ Errors (CaseError, exit 2, one line naming the key or the element):
   * thickness plausibility: 1e-4·L < t < 0.1·L for the model size L (the bounding-box diagonal),
     which catches a thickness given in mm;
   * the structure is held: every connected part of the mesh holds at least one fixed node (else
-    the stiffness has rigid-body modes and the reduction cannot factorize it);
+    the stiffness has rigid-body modes and the reduction cannot factorize it); a matrices model's
+    K plus the springs of the contacts closed at rest is regular (:func:`check_matrices_held`);
+  * every force acts on a free DOF (a force group all fixed is an error, partly fixed a warning);
   * the output folder: absent, empty or a sarfe result, and writable (:mod:`sarfe.io.result_folder`).
 
 Warnings (one line each, printed and written to summary.json ``warnings``) for inputs far outside
@@ -21,7 +23,9 @@ the model's range:
     :data:`ELEMENTS_PER_WAVELENGTH` element edges h, so f_mesh = (2π / (6 h))² √(D / (ρ t)) / 2π
     (median over the triangles);
   * H·f_max above ``reduction.cutoff_hz`` (the harmonics have no modes to live in);
-  * a gap larger than the structure (the contact can never close).
+  * an open gap larger than the structure (the contact can never close), or |gap_m| more than
+    :data:`GAP_RANGE` × the thickest shell or the contact's tolerance_m (:func:`gap_warnings`);
+  * reduction.mode_count above the interior DOFs; a force group partly fixed.
 """
 from __future__ import annotations
 
@@ -123,6 +127,73 @@ def check_held(case, mesh, fixed_nodes) -> None:
                          f"{members[0]}); add a fixed group on it", ("model", "fe", "fixed"))
 
 
+def check_loads_free(case, mesh, fixed_nodes) -> list:
+    """Every force group of an FE case acts on a free DOF. The force F of a group is split
+    equally over its n nodes (F/n each) and a fixed node's share goes into the support, so a group
+    whose nodes are all held (fixed, or on no triangle) is a CaseError naming it, and a partly
+    held group gets a warning stating the share lost. Returns the warnings (one line each)."""
+    from sarfe.pipeline.linear import resolve_node_group
+
+    used = np.zeros(mesh.n_nodes, bool)
+    used[mesh.triangles.ravel()] = True
+    held = ~used
+    held[np.asarray(fixed_nodes, dtype=int)] = True
+    warnings = []
+    for i, load in enumerate(case.config.excitation.forces):
+        path = ("excitation", "forces", i, "group")
+        nodes = resolve_node_group(case, mesh, load["group"], path)
+        count = int(np.count_nonzero(held[nodes]))
+        if count == len(nodes):
+            raise case.error(f"the force on group {load['group']} acts on no free DOF: all of its "
+                             f"DOFs are fixed ({len(nodes)} node(s) held by model.fe.fixed or on "
+                             "no triangle)", path)
+        if count:
+            warnings.append(f"excitation.forces[{i}]: {count} of the {len(nodes)} nodes of group "
+                            f"{load['group']} are fixed: {100 * count / len(nodes):.3g} % of "
+                            f"force_N = {load['force_N']:g} N goes straight into the supports")
+    return warnings
+
+
+HELD_MATRIX_LIMIT = 3000        # DOFs: a dense eigenvalue check above costs more than it finds
+RIGID_TOLERANCE = 1e-10         # eigenvalue ≤ this × the largest: a rigid-body (null-space) mode
+
+
+def check_matrices_held(case) -> None:
+    r"""A ``model.matrices`` model is held at rest, as :func:`check_held` asks of a mesh: the static
+    stiffness with the contacts linearized at u = 0 (their preload state: :func:`sarfe.hbm.pruning.
+    linearized_stiffness`),
+
+        K_0 = K + Gᵀ diag(k) G      (k: the springs of the contacts closed at rest, k_t of the stuck
+                                     tangents; open contacts add nothing),
+
+    must be regular — else the static (0th harmonic) block of the HBM Jacobian is singular at every
+    point. K_0 (n, n) [N/m]; its eigenvalues λ ≤ :data:`RIGID_TOLERANCE`·max λ span the rigid-body
+    modes. CaseError naming model.matrices.stiffness and the null-space size. Models above
+    :data:`HELD_MATRIX_LIMIT` DOFs are not checked (a dense eigenvalue problem)."""
+    from sarfe.hbm.pruning import linearized_stiffness
+    from sarfe.pipeline.linear import build_linear_model
+    from sarfe.pipeline.nonlinear import nonlinear_model
+
+    stage = build_linear_model(case)
+    n = stage.dof_count
+    if n > HELD_MATRIX_LIMIT:
+        return
+    nl = nonlinear_model(case, stage)
+    K0 = linearized_stiffness(nl.model, nl.contacts)[0]
+    K0 = K0.toarray() if hasattr(K0, "toarray") else np.asarray(K0, dtype=float)
+    values, vectors = np.linalg.eigh(0.5 * (K0 + K0.T))
+    rigid = values <= RIGID_TOLERANCE * max(np.abs(values).max(initial=0.0), 1e-300)
+    if rigid.any():
+        count = int(np.count_nonzero(rigid))
+        moving = np.flatnonzero(np.abs(vectors[:, rigid]).max(axis=1) > 1e-6)
+        shown = ", ".join(map(str, moving[:8])) + (" …" if moving.size > 8 else "")
+        raise case.error(f"the structure is not held: the stiffness plus the springs of the "
+                         f"contacts closed at rest is singular ({count} rigid-body mode(s), "
+                         f"null space of size {count} of {n} DOFs; DOF(s) {shown} move freely); "
+                         "add stiffness to ground or a preloaded contact",
+                         ("model", "matrices", "stiffness"))
+
+
 def bending_resolution_hz(points, triangles, thickness, young, poisson, density) -> np.ndarray:
     """Per triangle, the frequency [Hz] whose plate bending wavelength spans
     :data:`ELEMENTS_PER_WAVELENGTH` of its longest edge h:
@@ -153,6 +224,38 @@ def mesh_frequency_limit_hz(case, mesh) -> float:
     return float(np.median(bending_resolution_hz(mesh.points, mesh.triangles, t, E, nu, rho)))
 
 
+GAP_RANGE = 10.0   # |gap_m| above this × the contact's reference length warns
+
+
+def gap_warnings(case, mesh=None) -> list:
+    r"""A ``gap_m`` far from the contact's scale: |g| > :data:`GAP_RANGE` · L with the reference
+    length L = max(thickest shell ``thickness_m`` of an FE model, the contact's ``tolerance_m``)
+    [m] — a gap in mm given as metres (0.5 for 0.5 mm), or an overclosure that presses the parts
+    through each other. Not an error (the model is solved as given); no L (a matrices model with
+    tolerance_m = 0), or an open gap already larger than the structure (:func:`range_warnings`),
+    no warning."""
+    config = case.config
+    fe = config.model.fe.data if case.is_fe else {}
+    thickest = max((float(t) for t in fe.get("thickness_m", {}).values()), default=0.0)
+    size = np.inf if mesh is None else float(np.linalg.norm(np.ptp(mesh.points, axis=0)))
+    warnings = []
+    for i, contact in ((c.index, c.params) for c in config.contacts):
+        gap = contact.get("gap_m")
+        tolerance = float(contact.get("tolerance_m", 0.0))
+        reference = max(thickest, tolerance)
+        if gap is None or reference <= 0.0 or abs(gap) <= GAP_RANGE * reference or gap > size:
+            continue
+        what = (f"the thickest shell, thickness_m = {thickest:g} m" if thickest >= tolerance
+                else f"its tolerance_m = {tolerance:g} m")
+        kind = "an overclosure (the parts pressed" if gap < 0 else "an open gap (the parts"
+        detail = (f"{kind} {abs(gap) * 1e3:.4g} mm into each other)" if gap < 0
+                  else f"{kind} {gap * 1e3:.4g} mm apart)")
+        warnings.append(f"contacts[{i}] ({contact['name']}): gap_m = {gap:g} m is {detail}, "
+                        f"more than {GAP_RANGE:g} × {what}: gap_m is in metres "
+                        "(0.5 mm = 5e-4)")
+    return warnings
+
+
 def range_warnings(case, mesh=None) -> list:
     """One-line warnings for inputs far outside the model's range (module docstring)."""
     warnings = []
@@ -168,9 +271,10 @@ def range_warnings(case, mesh=None) -> list:
         size = float(np.linalg.norm(np.ptp(mesh.points, axis=0)))
         for i, contact in ((c.index, c.params) for c in config.contacts):
             gap = contact.get("gap_m")
-            if gap is not None and abs(gap) > size:
+            if gap is not None and gap > size:
                 warnings.append(f"contacts[{i}] ({contact['name']}): gap_m = {gap:g} m is larger "
                                 f"than the structure ({size:.3g} m): the contact can never close")
+    warnings += gap_warnings(case, mesh)
     cutoff = None if config.reduction is None else config.reduction.cutoff_hz
     if cutoff is not None and H * top > cutoff:
         warnings.append(f"excitation {top:g} Hz × {H} harmonics = {H * top:.4g} Hz is above "
@@ -178,17 +282,52 @@ def range_warnings(case, mesh=None) -> list:
     return warnings
 
 
+def interior_dof_count(mesh, fixed_nodes, boundary_nodes) -> int:
+    """Interior DOFs of the Craig–Bampton split, as the linear stage makes it: 6 per node on a
+    triangle that is not fixed, minus the 3 translations of each free contact or load node (the
+    boundary). At most this many fixed-interface modes exist."""
+    used = np.zeros(mesh.n_nodes, bool)
+    used[mesh.triangles.ravel()] = True
+    free = used.copy()
+    free[np.asarray(fixed_nodes, dtype=int)] = False
+    boundary = np.unique(np.asarray(boundary_nodes, dtype=int))
+    boundary = boundary[(boundary >= 0) & free[np.maximum(boundary, 0)]]
+    return int(6 * np.count_nonzero(free) - 3 * boundary.size)
+
+
+def mode_count_warnings(case, interior) -> list:
+    """reduction.mode_count above the ``interior`` DOF count: a warning stating the clip."""
+    reduction = case.config.reduction
+    asked = None if reduction is None else reduction.mode_count
+    if asked is None or asked <= interior:
+        return []
+    return [f"reduction.mode_count = {asked} asks more modes than the structure has: its "
+            f"{interior} interior DOFs give at most {interior} fixed-interface modes, so the "
+            f"reduction keeps all it finds ({asked} asked, at most {interior} available; a full "
+            "eigenproblem): lower mode_count or give reduction.cutoff_hz"]
+
+
 def reduced_model_warnings(case, stage) -> list:
-    """Warnings that need the reduced model: H·f_max above its highest fixed-interface mode."""
+    """Warnings that need the reduced model: fewer modes kept than reduction.mode_count asked
+    (unless :func:`mode_count_warnings` said so before the reduction), H·f_max above the highest
+    fixed-interface mode."""
     modes = np.asarray(stage.mode_frequencies_hz)
     reduction = case.config.reduction
-    if stage.kind != "fe" or not modes.size or reduction is None or reduction.mode_count is None:
+    if stage.kind != "fe" or reduction is None or reduction.mode_count is None:
         return []
+    warnings = []
+    asked, kept = reduction.mode_count, int(stage.info.get("modes", modes.size))
+    interior = stage.info.get("free_dofs", 0) - stage.info.get("boundary_dofs", 0)
+    said_before = not case.config.model.fe.is_deck and asked > interior
+    if kept < asked and not said_before:
+        warnings.append(f"reduction.mode_count = {asked}: the reduction kept {kept} modes "
+                        f"({asked} asked, {kept} available from {interior} interior DOFs)")
     top, H = _excitation_top_hz(case), case.config.solver.harmonics
-    if H * top > modes.max():
-        return [f"excitation {top:g} Hz × {H} harmonics = {H * top:.4g} Hz is above the highest "
-                f"kept mode ({modes.max():.4g} Hz, reduction.mode_count = {modes.size})"]
-    return []
+    if modes.size and H * top > modes.max():
+        warnings.append(f"excitation {top:g} Hz × {H} harmonics = {H * top:.4g} Hz is above the "
+                        f"highest kept mode ({modes.max():.4g} Hz, reduction.mode_count = "
+                        f"{modes.size})")
+    return warnings
 
 
 def output_target(case, output_dir=None, force=False):
@@ -204,15 +343,15 @@ def output_target(case, output_dir=None, force=False):
 def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True) -> CaseCheck:
     """All checks of the module docstring. Raises CaseError at the first problem."""
     from sarfe.erp import nodal_normals
-    from sarfe.pipeline.linear import (_build_matrices, _per_triangle, load_case_mesh,
-                                       pair_contact, resolve_node_group)
+    from sarfe.pipeline.linear import (_per_triangle, load_case_mesh, pair_contact,
+                                       resolve_node_group)
 
     case = load_case(case)
     output = output_target(case, output_dir, force) if write else None
     if not mesh_checks:
         return CaseCheck({}, tuple(range_warnings(case)), output)
     if not case.is_fe:
-        _build_matrices(case)
+        check_matrices_held(case)
         return CaseCheck({}, tuple(range_warnings(case)), output)
     config = case.config
     if config.model.fe.is_deck:   # a Nastran/Abaqus deck: its own checks, with ids
@@ -229,8 +368,7 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True)
     check_thickness(case, mesh)
     normals = nodal_normals(mesh.points, mesh.triangles)
     paired = {c.name: pair_contact(case, mesh, c.index, normals) for c in config.contacts}
-    for i, f in enumerate(config.excitation.forces):
-        resolve_node_group(case, mesh, f["group"], ("excitation", "forces", i, "group"))
+    load_warnings = check_loads_free(case, mesh, fixed)
     surface = config.erp.surface
     if surface is not None and surface not in mesh.element_groups:
         resolve_node_group(case, mesh, surface, ("erp", "surface"))
@@ -239,8 +377,14 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True)
     check_held(case, mesh, fixed)
     info = {"nodes": mesh.n_nodes, "triangles": mesh.n_triangles,
             "contact_pairs": {name: len(p[0]) for name, p in paired.items()}}
-    return CaseCheck(info, tuple(range_warnings(case, mesh)), output)
+    load_nodes = [resolve_node_group(case, mesh, f["group"], ("excitation", "forces", i, "group"))
+                  for i, f in enumerate(config.excitation.forces)]
+    interior = interior_dof_count(mesh, fixed, np.concatenate(
+        [np.zeros(0, int)] + [np.concatenate([p[0], p[1]]) for p in paired.values()] + load_nodes))
+    return CaseCheck(info, tuple(range_warnings(case, mesh)) + tuple(load_warnings)
+                     + tuple(mode_count_warnings(case, interior)), output)
 
 
-__all__ = ["CaseCheck", "check_case", "output_target", "check_element_quality", "check_held", "check_thickness",
-           "bending_resolution_hz", "mesh_frequency_limit_hz", "range_warnings", "reduced_model_warnings"]
+__all__ = ["CaseCheck", "check_case", "check_loads_free", "check_matrices_held", "output_target", "check_element_quality", "check_held", "check_thickness",
+           "bending_resolution_hz", "mesh_frequency_limit_hz", "range_warnings", "reduced_model_warnings",
+           "interior_dof_count", "mode_count_warnings", "gap_warnings"]

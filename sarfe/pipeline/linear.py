@@ -182,6 +182,15 @@ def _read_matrix(case: Case, key):
     except CaseError as exc:
         raise case.error(exc.message, path_key) from None
     except Exception as exc:  # unreadable file of any kind
+        if "allow_pickle" in str(exc) or "pickled" in str(exc):   # numpy's advice to unpickle
+            with open(path, "rb") as handle:
+                head = handle.read(6)
+            what = ("holds pickled Python objects, which sarfe does not load"
+                    if head.startswith((b"PK", b"\x93NUMPY")) or head[:1] == b"\x80"
+                    else "is not a NumPy .npy/.npz file (no zip or NPY header): corrupt or "
+                         "another format")
+            raise case.error(f"cannot read matrix file {path}: it {what}; save the matrix with "
+                             "numpy.save / numpy.savez or scipy.sparse.save_npz", path_key) from None
         raise case.error(f"cannot read matrix file {path}: {exc}", path_key) from None
     if matrix.ndim != 2 or matrix.shape[0] != matrix.shape[1]:
         raise case.error(f"must be a square matrix, file holds shape {matrix.shape}", path_key)
@@ -257,6 +266,23 @@ def _generate_mesh(name, mesh_size, params):
     return cached_mesh(name, mesh_size, **params)
 
 
+def _check_generator_params(case: Case, gen) -> None:
+    """An unknown key in model.fe.generator.params → CaseError naming it and the valid ones."""
+    import difflib
+
+    from sarfe.mesh.generators import GENERATORS, parameter_names
+
+    if gen["name"] not in GENERATORS:
+        return
+    valid = parameter_names(gen["name"])
+    for key in gen["params"]:
+        if key not in valid:
+            close = difflib.get_close_matches(str(key), valid, n=1)
+            hint = f"did you mean '{close[0]}'? " if close else ""
+            raise case.error(f"unknown parameter of generator {gen['name']} ({hint}valid: "
+                             f"{', '.join(valid)})", ("model", "fe", "generator", "params", key))
+
+
 def load_case_mesh(case: Case):
     """The case's PanelMesh (file or generator), in metres; errors name model.fe.mesh/generator."""
     from sarfe.mesh import load_mesh
@@ -271,6 +297,7 @@ def load_case_mesh(case: Case):
         where = ("model", "fe", "mesh_units")
     else:
         gen = fe["generator"]
+        _check_generator_params(case, gen)
         try:
             mesh = _generate_mesh(gen["name"], gen["mesh_size_m"], gen["params"])
         except ImportError as exc:
@@ -520,12 +547,38 @@ def _reduce(case: Case, reduction, k_ff, m_ff, boundary, free, n_nodes, base_loa
             # a cutoff below the first fixed-interface modes leaves only static condensation
             reduced = reduce(min(reduction.min_mode_count, len(free) - len(boundary) - 1), None)
     except Exception as exc:   # any solver's failure (PARDISO, CHOLMOD, ARPACK): one line
-        raise case.error(f"the structure is not held (singular stiffness: {exc}); check the "
-                         "fixed groups", ("model", "fe", "fixed")) from None
+        raise reduction_error(case, exc, len(free), len(boundary)) from None
     finally:
         if bar is not None:
             bar.close()
     return reduced, cutoff
+
+
+SINGULAR_WORDS = ("singular", "positive definite", "pivot", "pardiso", "cholmod", "not spd")
+
+
+def reduction_error(case: Case, exc: BaseException, free_count: int, boundary_count: int):
+    """A CaseError (one line) saying why the Craig–Bampton reduction failed: a singular K_ii (the
+    factorization's words: singular, not positive definite, zero pivot) → the structure is not
+    held; out of memory, no eigensolver convergence or anything else → that cause, with the
+    model's size, under ``reduction``."""
+    from scipy.sparse.linalg import ArpackError, ArpackNoConvergence
+
+    text = " ".join(str(exc).split()) or type(exc).__name__
+    size = (f"{free_count} free DOFs, {boundary_count} boundary, "
+            f"{free_count - boundary_count} interior")
+    if isinstance(exc, MemoryError):
+        return case.error(f"the Craig–Bampton reduction ran out of memory ({size}): coarsen the "
+                          "mesh, lower reduction.mode_count or reduction.cutoff_hz", ("reduction",))
+    if isinstance(exc, (ArpackNoConvergence, ArpackError)):
+        return case.error(f"the eigensolver of the Craig–Bampton reduction did not converge "
+                          f"({size}): {text}; lower reduction.mode_count or give cutoff_hz",
+                          ("reduction",))
+    if isinstance(exc, np.linalg.LinAlgError) or any(w in text.lower() for w in SINGULAR_WORDS):
+        return case.error(f"the structure is not held (singular stiffness K_ii: {text}); check "
+                          "the fixed groups", ("model", "fe", "fixed"))
+    return case.error(f"the Craig–Bampton reduction failed ({size}): {type(exc).__name__}: "
+                      f"{text}", ("reduction",))
 
 
 def reduced_coordinates(boundary_global, n_nodes):

@@ -191,3 +191,49 @@ def test_case_file_pairs_csv_and_preload(tmp_path):
     del half["contacts"][0]["friction_coefficient"]
     with pytest.raises(CaseError, match="friction_coefficient: missing required key"):
         load_case(half)
+
+
+def test_preload_above_a_plateau_is_an_input_error_and_a_rising_curve_extends_linearly():
+    """A curve ending flat at 1 N cannot carry 2 N: the case names contacts[0].preload_N and its
+    line; the law itself refuses (no 1e300 m deflection). A rising last piece (slope k) carries
+    any force on the docs' linear extension: δ = δ_S + (P − F_S)/k exactly."""
+    import copy
+
+    from sarfe.io.errors import CaseError
+    from sarfe.pipeline import load_case
+
+    plateau = copy.deepcopy(CASE)
+    plateau["contacts"][0]["curve"] = [[0, 0], [1e-3, 1.0], [2e-3, 1.0]]
+    plateau["contacts"][0]["preload_N"] = 2.0
+    with pytest.raises(CaseError, match=r"contacts\[0\]\.preload_N: 2 N is above the curve's "
+                                        r"largest force 1 N"):
+        load_case(plateau)
+    for interpolation in ("linear", "monotone_spline"):
+        flat = table([[0, 0], [1e-3, 1.0], [2e-3, 1.0]], interpolation, force_scale=np.ones(1))
+        with pytest.raises(ValueError, match="above the largest force 1 N"):
+            tabulated.static_deflection(flat, np.array([2.0]))
+        below = tabulated.static_deflection(flat, np.array([0.5]))
+        assert tabulated.curve_force(flat, below[None])[0][0, 0] == pytest.approx(0.5, rel=1e-9)
+    rising = table([[0, 0], [1e-3, 10.0], [2e-3, 30.0]], force_scale=np.ones(1))  # slope 2e4 N/m
+    assert tabulated.static_deflection(rising, np.array([70.0]))[0] == pytest.approx(
+        2e-3 + 40.0 / 2e4, rel=1e-9)
+    silent = copy.deepcopy(CASE)
+    silent["contacts"][0]["curve"] = [[0, 0], [1e-3, 0.0]]
+    with pytest.raises(CaseError, match=r"contacts\[0\]\.curve: all forces are 0"):
+        load_case(silent)
+
+
+@pytest.mark.parametrize("text", [
+    "# pad, measured 2026\ndeflection_m,force_N\n1e-4,2.0\n2e-4,6.0\n4e-4,20.0\n",
+    "deflection_m,force_N  # header\n# comment\n1e-4,2.0\n2e-4,6.0\n\n4e-4,20.0\n",
+    "# only comments, no header\n1e-4,2.0\n2e-4,6.0\n4e-4,20.0\n"])
+def test_curve_file_comments_and_one_header(tmp_path, text):
+    """'#' comments anywhere and one header line (docs/case-file.md) give the same curve as the
+    pairs in the case; a second non-numeric line is an error naming the file's line."""
+    path = tmp_path / "pad.csv"
+    path.write_text(text)
+    points = tabulated.read_curve_file(path)
+    assert np.allclose(points, [[1e-4, 2.0], [2e-4, 6.0], [4e-4, 20.0]], rtol=1e-15)
+    path.write_text(text + "5e-4,abc\n")
+    with pytest.raises(tabulated.LawInputError, match=r"pad.csv line \d+: not two numbers"):
+        tabulated.read_curve_file(path)

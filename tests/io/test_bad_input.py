@@ -271,6 +271,30 @@ CORPUS = [
      ["erp.surface", "roof"]),
     ("unknown-thickness-group", rig, lambda d: d["model"]["fe"]["thickness_m"].pop("part_beam"),
      None, None, ["model.fe.thickness_m", "no listed element group"]),
+    # inputs that used to solve into nonsense (review8)
+    ("pair-with-itself", rig, lambda d: (d["contacts"][0].pop("between"),
+                                         d["contacts"][0].update(pairs=[[5, 5]])), None, None,
+     ["contacts[0].pairs[0]", "node 5 is paired with itself"]),
+    ("force-on-clamped-group", rig, setitem(("excitation", "forces", 0, "group"), "clamp_beam"),
+     None, None, ["excitation.forces[0].group", "the force on group clamp_beam acts on no free "
+                  "DOF: all of its DOFs are fixed"]),
+    ("stiffness-all-zero", lumped, setitem(("model", "matrices", "stiffness"),
+                                           [[0.0] * 3 for _ in range(3)]), None, None,
+     ["model.matrices.stiffness", "not held", "null space of size 2 of 3 DOFs", "DOF(s) 0, 1"]),
+    ("accuracy-negative", lumped, setitem(("solver", "accuracy"), {"erp_db": -1}), None, None,
+     ["solver.accuracy.erp_db", "must be > 0, got -1"]),
+    ("workers-zero", lumped, setitem(("solver", "workers"), 0), None, None,
+     ["solver.workers", "must be >= 1, got 0"]),
+    ("workers-text", lumped, setitem(("solver", "workers"), "many"), None, None,
+     ["solver.workers", "must be one of 'auto' or an integer, got 'many'"]),
+    ("generator-param-typo", squeak, setitem(("model", "fe", "generator", "params"),
+                                             {"plate_sizee": 0.1}), None, None,
+     ["model.fe.generator.params.plate_sizee", "unknown parameter of generator squeak_rig",
+      "did you mean 'plate_size'?", "valid: plate_size"]),
+    ("tabulated-preload-above-plateau", rig, lambda d: d["contacts"][0].update(
+        type="tabulated", curve=[[0, 0], [1e-3, 1.0], [2e-3, 1.0]], preload_N=2.0) or [
+        d["contacts"][0].pop(k) for k in ("normal_stiffness_N_m",)], None, None,
+     ["contacts[0].preload_N", "2 N is above the curve's largest force 1 N"]),
 ]
 
 

@@ -54,6 +54,8 @@ def curve_table(points, interpolation="linear", key="curve"):
         raise LawInputError(key, f"force at zero deflection must be 0, got {f[0]:g}")
     if np.any(np.diff(f) < 0):
         raise LawInputError(key, "forces must not decrease (a monotone curve)")
+    if f[-1] <= 0.0:
+        raise LawInputError(key, "all forces are 0: the curve carries no force")
     coefficients = np.zeros((x.size, 4))
     if interpolation == "monotone_spline" and x.size > 2:
         from scipy.interpolate import PchipInterpolator
@@ -106,19 +108,37 @@ def linearize(p, gap):
 
 
 def static_deflection(p, force):
-    """δ with s·F(δ) = force (bisection on the monotone curve; linear beyond the table)."""
+    """δ with s·F(δ) = force [N] (bisection on the monotone curve; beyond the table the linear
+    extension with the last slope, δ = δ_S + (force − s F_S) / (s F'_S)). A force the curve never
+    reaches (above a plateau: last slope 0) raises ValueError — the case check
+    (:func:`check_preload`) rejects such a preload_N before."""
     force = np.asarray(force, dtype=float)
     breakpoints = np.where(np.isnan(p["curve_breakpoints"]), -np.inf, p["curve_breakpoints"])
     upper = breakpoints.max(axis=-1)
     top, slope = curve_force(p, upper[None])
-    upper = np.where(force > top[0], upper + (force - top[0]) / np.maximum(slope[0], 1e-300),
-                     upper)
+    beyond = force > top[0]
+    if np.any(beyond & (slope[0] <= 0.0)):
+        largest = float(np.max(top[0][beyond & (slope[0] <= 0.0)]))
+        raise ValueError(f"a static force of {float(np.max(force[beyond])):g} N is above the "
+                         f"largest force {largest:g} N of a curve that ends flat")
+    upper = np.where(beyond, upper + (force - top[0]) / np.where(beyond, slope[0], 1.0), upper)
     lower = np.zeros_like(upper)
     for _ in range(80):
         middle = 0.5 * (lower + upper)
         above = curve_force(p, middle[None])[0][0] >= force
         upper, lower = np.where(above, middle, upper), np.where(above, lower, middle)
     return upper
+
+
+def check_preload(table, preload_N):
+    """A preload P [N] the curve cannot carry: P above the largest force F_S of a curve whose
+    linear extension is flat (last slope 0) → LawInputError naming ``preload_N``. A rising last
+    piece carries any P (the docs' linear extension)."""
+    top = float(table["curve_coefficients"][-1, 0])
+    last_slope = float(table["curve_coefficients"][-1, 1])
+    if preload_N > top and last_slope <= 0.0:
+        raise LawInputError("preload_N", f"{preload_N:g} N is above the curve's largest force "
+                            f"{top:g} N (the curve ends flat and cannot carry it)")
 
 
 def prepare(contact, resolve):
@@ -128,19 +148,44 @@ def prepare(contact, resolve):
         raise LawInputError("curve", "give exactly one of curve or curve_file")
     interpolation = contact.get("interpolation", "linear")
     if "curve" in contact:
-        return curve_table(contact["curve"], interpolation)
-    path = resolve(contact["curve_file"])
+        table = curve_table(contact["curve"], interpolation)
+    else:
+        table = curve_table(read_curve_file(resolve(contact["curve_file"])), interpolation,
+                            "curve_file")
+    if isinstance(contact.get("preload_N"), (int, float)):
+        check_preload(table, float(contact["preload_N"]))
+    return table
+
+
+def read_curve_file(path):
+    """(S, 2) pairs of a curve CSV: two comma-separated columns, '#' comment lines anywhere and
+    at most one header line (the first line that is not a comment) → LawInputError naming
+    ``curve_file``."""
     try:
-        points = np.loadtxt(path, delimiter=",", comments="#", ndmin=2)
+        text = path.read_text(errors="replace")
     except OSError:
         raise LawInputError("curve_file", f"file not found: {path}") from None
-    except ValueError:
+    lines = [(number, line.split("#", 1)[0].strip())
+             for number, line in enumerate(text.splitlines(), start=1)]
+    lines = [(number, line) for number, line in lines if line]
+    rows = []
+    for position, (number, line) in enumerate(lines):
+        fields = [field.strip() for field in line.split(",")]
         try:
-            points = np.loadtxt(path, delimiter=",", comments="#", ndmin=2, skiprows=1)
-        except ValueError as error:
-            raise LawInputError("curve_file", f"{path.name}: not two numeric columns "
-                                f"({error})") from None
-    return curve_table(points, interpolation, "curve_file")
+            values = [float(field) for field in fields]
+        except ValueError:
+            if position == 0:
+                continue                    # the header line
+            raise LawInputError("curve_file", f"{path.name} line {number}: not two numbers "
+                                f"({line!r})") from None
+        if len(values) != 2:
+            raise LawInputError("curve_file", f"{path.name} line {number}: {len(values)} "
+                                "columns, expected 2 (deflection_m, force_N)")
+        rows.append(values)
+    if not rows:
+        raise LawInputError("curve_file", f"{path.name}: no data rows (two columns "
+                            "deflection_m, force_N)")
+    return np.array(rows, dtype=float)
 
 
 def check(p):

@@ -78,7 +78,8 @@ def jump_starts(y, factor: float = 5.0, minimum_db: float = 6.0) -> np.ndarray:
     max(``minimum_db``, ``factor`` × the median step) — a point-by-point sweep landing on another
     branch, not a continuous curve, so no line is drawn across it."""
     y = np.asarray(y, dtype=float)
-    step = np.abs(np.diff(y))
+    with np.errstate(invalid="ignore"):      # −inf dB (zero power) − −inf dB: no step (NaN)
+        step = np.abs(np.diff(y))
     out = np.zeros(y.size, dtype=bool)
     finite = step[np.isfinite(step)]
     if finite.size:
