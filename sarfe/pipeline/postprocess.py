@@ -540,11 +540,13 @@ def worst_of(points):
         error_db = estimate.get("erp_db")
         worst = {"index": p["index"], "erp_level_dba": p["erp"]["level_dba"],
                  "erp_level_db": p["erp"]["level_db"], "frequency_hz": p["frequency_hz"],
-                 # the headline's ± and its notes: the point's error bound [dB] (None: not
-                 # estimated), whether it is interpolated between estimated points, and the
-                 # stability verdict (None: not assessed)
+                 # the headline's ± and its notes: the point's error bound [dB] (None: none),
+                 # whether an estimate was made (its re-solve may have failed: bound unknown),
+                 # whether it is interpolated between estimated points, and the stability
+                 # verdict (None: not assessed)
                  "erp_error_db": None if error_db is None or not math.isfinite(error_db)
                  else abs(float(error_db)),
+                 "error_estimated": bool(estimate),
                  "error_interpolated": bool(estimate.get("interpolated", False)),
                  "stable": p.get("stable"),
                  "ranking": contributions.get("ranking", []),

@@ -240,14 +240,15 @@ def headline_notes(worst: dict) -> list[str]:
     """What the headline level of summary.json's ``worst`` does not carry: 'stability not
     assessed' (``stable`` None: the loudest point is the loudest one not found unstable),
     'error interpolated' (its error bound is the larger of two estimated neighbours'),
-    'error not estimated' (no bound at all). Keys absent (older summaries): no note."""
+    'error unknown' (its estimate's re-solve failed), 'error not estimated' (none asked or no
+    contacts). Keys absent (older summaries): no note."""
     notes = []
     if "stable" in worst and worst["stable"] is None:
         notes.append("stability not assessed")
     if worst.get("error_interpolated"):
         notes.append("error interpolated")
     if "erp_error_db" in worst and worst["erp_error_db"] is None:
-        notes.append("error not estimated")
+        notes.append("error unknown" if worst.get("error_estimated") else "error not estimated")
     return notes
 
 
