@@ -66,3 +66,4 @@ def test_report_headline_has_the_bound_and_notes():
     assert "97.0 ± 0.70 dB(A)" in html
     assert "(stability not assessed)" in html and "(error interpolated)" in html
     assert "36 boundary +\n    212 modes + 37 residual vectors" in html
+    assert "<td>0.20</td>" in html and "<td>~0.70</td>" in html      # the all-points table

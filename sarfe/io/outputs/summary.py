@@ -267,7 +267,7 @@ def loudest_lines(worst: dict | None, count: int = 5) -> list[str]:
     excitation = worst.get("excitation")
     if excitation and worst.get("ranking"):
         share = excitation.get("share_a")
-        share = "-" if share is None or not math.isfinite(share) else f"{100 * share:.0f} %"
+        share = "-" if share is None or not math.isfinite(share) else f"{round(100 * share)} %"
         lines.append(f"  (the excitation through the structure without contact forces: "
                      f"{level_text(excitation.get('level_dba'), unit='dB(A)')}, {share})")
     return lines
