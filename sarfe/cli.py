@@ -44,9 +44,11 @@ def cmd_solve(args) -> int:
     if not args.quiet:
         model = summary["model"]
         if model.get("kind") == "fe":
+            residual = model.get("residual_vectors") or 0     # reduced = boundary + modes + these
             print(f"model: {model['nodes']} nodes, {model['free_dofs']} free DOFs → "
                   f"{model['reduced_dofs']} reduced ({model['boundary_dofs']} boundary + "
-                  f"{model['modes']} modes)")
+                  f"{model['modes']} modes"
+                  + (f" + {residual} residual vectors)" if residual else ")"))
         pruning = pruning_line(summary.get("contact_pruning"))
         if pruning:
             print(pruning)

@@ -1,4 +1,5 @@
-"""Shipped cases: every file validates; the FE rigs run end to end (coarse meshes)."""
+"""Shipped cases: every file validates; the FE rigs run end to end (coarse meshes); every shipped
+case converges, exits 0 and meets its own accuracy budget (slow), squeak_rig also a finer model."""
 from __future__ import annotations
 
 import json
@@ -53,15 +54,14 @@ def test_rattle_rig_end_to_end(tmp_path):
                                rtol=1e-6, atol=1e-12)
     assert (tmp_path / "rig" / "response.h5").is_file()
     near, far = summary["points"]
+    assert near["converged"] and far["converged"] and result.exit_code == 0
     tip_near, tip_far = near["contacts"][0], far["contacts"][0]
-    if near["converged"]:
-        assert tip_near["open_fraction"] < 1.0 and tip_near["peak_normal_force_N"] > 0
-        # linear baseline: no contact → the plate hardly moves; with contact it radiates
-        assert near["erp"]["level_db"] > near["linear"]["erp_level_db"] + 40
-        assert near["linear"]["contacts"][0]["rattle_risk"] is True
-    if far["converged"]:
-        assert tip_far["open_fraction"] == 1.0 and tip_far["peak_normal_force_N"] == 0.0
-    assert result.exit_code == (0 if summary["all_converged"] else 3)
+    assert tip_near["open_fraction"] < 1.0 and tip_near["peak_normal_force_N"] > 0
+    # linear baseline: no contact → the plate hardly moves; with contact it radiates
+    assert near["erp"]["level_db"] > near["linear"]["erp_level_db"] + 40
+    assert near["linear"]["contacts"][0]["rattle_risk"] is True
+    # 20 Hz, far below the strip's 31 Hz mode: the tip never reaches the plate
+    assert tip_far["open_fraction"] == 1.0 and tip_far["peak_normal_force_N"] == 0.0
     gap = 0.5e-3
     assert near["linear"]["contacts"][0]["dynamic_tolerance_m"] == pytest.approx(
         gap - 1e-4 - near["linear"]["contacts"][0]["normal_amplitude_m"], rel=1e-3)
@@ -90,14 +90,70 @@ solver: {harmonics: 3, samples_per_period: 64}
     assert f"{X:11.4e}".strip() in out
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize("name", ["door_trim", "squeak_rig", "instrument_panel"])
-def test_shipped_fe_case_runs(name, tmp_path):
-    result = solve_case(load_case(CASES / f"{name}.yaml"), output_dir=tmp_path / name)
-    assert result.exit_code in (0, 3)
+# squeak_rig's A-weighted ERP [dB(A)] at 50, 100, 150 Hz from a converged finer model of the same
+# mesh: H = 48, N = 1024, cutoff margin 2 (32 modes); H = 24 and 48 agree within 0.05 dB
+# (test_squeak_rig_finer_model recomputes it). H = 3, the case's old setting, gave 11.6 / 32.2 / 38.7.
+SQUEAK_RIG_FINE_DBA = (22.03, 37.24, 38.93)
+
+# Shipped cases that miss their 'balanced' budget today, with what was measured (the README's case
+# table says so too); strict: the test fails once a case meets it, so this list stays true.
+BUDGET_MISSED = {
+    "rattle_rig": "H = 10: ±18 dB at 35.2 Hz (a fold end), 30 points without an estimate; H = 20 "
+                  "moves the sweep by 1.3-5 dB (30-34 Hz) and still misses (±2.7 dB at 33.3 Hz)",
+    "rattle_rig_deck": "the rattle rig from its deck: the same sweep and estimate as rattle_rig",
+    "instrument_panel": "estimate ±3 % amplitude at 62 Hz (modal part), a false alarm: a converged "
+                        "model (H = 12, 806 modes) is within 0.06 dB(A) and 0.6 % of H = 3",
+    "lumped_rattle": "H = 7: ±2.9 dB at 51 Hz (0.7-1.3 dB low vs H = 30); H = 16 fits the budget "
+                     "but 3 fold-tip points have no estimate (their re-solve fails, also at H = 30)",
+}
+
+
+def shipped_case_params():
+    return [pytest.param(name, marks=pytest.mark.xfail(strict=True, reason=BUDGET_MISSED[name]))
+            if name in BUDGET_MISSED else name
+            for name in sorted(p.stem for p in CASES.glob("*.yaml"))
+            if name != "door_trim_p1"]            # a benchmark (make bench), not a shipped example
+
+
+def assert_case_delivers(summary, exit_code):
+    """What every shipped case must achieve: all points converged, exit 0, and its own error
+    estimate inside its accuracy budget with no point left unestimated."""
+    assert exit_code == 0 and summary["all_converged"], summary["non_converged_points"]
+    check = summary["accuracy_check"]
+    assert check["met"] is True and not check["unknown_points"], check["warning"]
+
+
+def test_squeak_rig_meets_its_budget_and_a_finer_model(tmp_path):
+    """The shipped squeak rig (H = 23): converged, exit 0, estimate inside 'balanced' (0.5 dB), and
+    each point's dB(A) within its own error bound (and 0.5 dB) of the finer model."""
+    result = solve_case(load_case(CASES / "squeak_rig.yaml"), output_dir=tmp_path / "squeak")
     summary = result.summary
-    assert len(summary["points"]) >= 1
-    assert all(np.isfinite(p["erp"]["power_W"]) for p in summary["points"])
+    assert_case_delivers(summary, result.exit_code)
+    for p, fine in zip(summary["points"], SQUEAK_RIG_FINE_DBA, strict=True):
+        bound = abs(p["error_estimate"]["erp_db"])
+        assert abs(p["erp"]["level_dba"] - fine) <= min(bound + 0.02, 0.5), p["frequency_hz"]
+        assert p["stable"] is True and 0.2 < p["contacts"][0]["slip_fraction"] < 0.8  # stick-slip
+
+
+@pytest.mark.slow
+def test_squeak_rig_finer_model(tmp_path):
+    """SQUEAK_RIG_FINE_DBA is a converged model: H = 48, N = 1024 with twice the cutoff."""
+    data = load_case(CASES / "squeak_rig.yaml").data
+    data["solver"].update(harmonics=48, samples_per_period=1024, stability=False)
+    data["reduction"] = {"cutoff_margin": 2.0}
+    data["output"]["files"] = ["summary"]
+    summary = solve_case(data, output_dir=tmp_path / "fine").summary
+    levels = [p["erp"]["level_dba"] for p in summary["points"]]
+    assert levels == pytest.approx(SQUEAK_RIG_FINE_DBA, abs=0.01)
+    assert max(abs(p["error_estimate"]["erp_db"]) for p in summary["points"]) < 0.2
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", shipped_case_params())
+def test_shipped_case_meets_its_accuracy_budget(name, tmp_path):
+    result = solve_case(load_case(CASES / f"{name}.yaml"), output_dir=tmp_path / name)
+    assert all(np.isfinite(p["erp"]["power_W"]) for p in result.summary["points"])
+    assert_case_delivers(result.summary, result.exit_code)
 
 
 def test_fe_contact_geometry_pairs_ground_and_normal():

@@ -190,7 +190,9 @@ def full_field_every_point(stage, solutions) -> bool:
 def results_table(rows, contact_types=None, max_contacts=6) -> str:
     """Console table of the frequency points: convergence, ERP and, per contact (at most
     ``max_contacts``), the indicator its law declares (max penetration, or the slip fraction of a
-    friction law). ``contact_types``: {name: law name} (default: max penetration)."""
+    friction law: the share of the period in slip, 0…1). The ±dB column is the ERP error bound,
+    "~" marking a bound interpolated between estimated points. ``contact_types``: {name: law
+    name} (default: max penetration)."""
     from sarfe.hbm.laws import table_column
     from sarfe.io.outputs import console_table
 
@@ -208,7 +210,7 @@ def results_table(rows, contact_types=None, max_contacts=6) -> str:
     for name in names[:max_contacts]:
         law = (contact_types or {}).get(name)
         if law is not None and table_column(law) == "slip_fraction":
-            key, header, fmt = f"{name}.slip_fraction", f"{name} slip", ".2f"
+            key, header, fmt = f"{name}.slip_fraction", f"{name} slip fraction", ".2f"
         else:
             key, header, fmt = f"{name}.max_penetration_m", f"{name} pen [mm]", ".3f"
         columns.append(key)
@@ -221,6 +223,11 @@ def results_table(rows, contact_types=None, max_contacts=6) -> str:
         for key in ("erp_db", "erp_dba", "linear_erp_db"):
             if key in row:
                 row[key] = shown_level(row[key])
+    if "erp_error_db" in columns:  # "~": interpolated between estimated points (not estimated)
+        cells = [_error_cell(row) for row in rows]
+        width = max(len(c) for c in cells)
+        for row, cell in zip(shown, cells):
+            row["erp_error_db"] = cell.rjust(width)
     for row in shown:  # penetration in mm for reading
         for name in names:
             key = f"{name}.max_penetration_m"
@@ -230,6 +237,15 @@ def results_table(rows, contact_types=None, max_contacts=6) -> str:
     if len(names) > max_contacts:
         table += f"\n({len(names) - max_contacts} more contacts in summary.json)"
     return table
+
+
+def _error_cell(row) -> str:
+    """Table text of a row's ERP error bound [dB]: '0.24', '~3.06' when the point's estimate is
+    interpolated between estimated points, '-' when there is none."""
+    value = row.get("erp_error_db", float("nan"))
+    if value is None or not math.isfinite(value):
+        return "-"
+    return ("~" if row.get("erp_error_interpolated") else "") + f"{value:.2f}"
 
 
 def replace_directory(temporary: Path, target: Path, force: bool = False):

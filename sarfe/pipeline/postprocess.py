@@ -506,6 +506,7 @@ def with_estimate(point, row, estimate):
     point["error_estimate"] = estimate
     row["erp_error_db"] = (abs(float(estimate["erp_db"])) if estimate and "erp_db" in estimate
                            else float("nan"))
+    row["erp_error_interpolated"] = bool(estimate and estimate.get("interpolated", False))
 
 
 def loudest_point(points) -> int | None:
@@ -535,8 +536,19 @@ def worst_of(points):
         contributions = p.get("contributions") or {}
         excitation = next((s for s in contributions.get("sources", [])
                            if s["name"] == "excitation"), None)
+        estimate = p.get("error_estimate") or {}
+        error_db = estimate.get("erp_db")
         worst = {"index": p["index"], "erp_level_dba": p["erp"]["level_dba"],
                  "erp_level_db": p["erp"]["level_db"], "frequency_hz": p["frequency_hz"],
+                 # the headline's ± and its notes: the point's error bound [dB] (None: none),
+                 # whether an estimate was made (its re-solve may have failed: bound unknown),
+                 # whether it is interpolated between estimated points, and the stability
+                 # verdict (None: not assessed)
+                 "erp_error_db": None if error_db is None or not math.isfinite(error_db)
+                 else abs(float(error_db)),
+                 "error_estimated": bool(estimate),
+                 "error_interpolated": bool(estimate.get("interpolated", False)),
+                 "stable": p.get("stable"),
                  "ranking": contributions.get("ranking", []),
                  "excitation": None if excitation is None else {
                      "level_dba": excitation["level_dba"], "share_a": excitation["share_a"]},

@@ -98,6 +98,13 @@ def result_groups(points, nl) -> dict:
         groups["bands"] = {"band": numbers, "nominal_hz": (np.array([nominal_frequency(b)
                                                                      for b in numbers]), "Hz"),
                            "center_hz": (mid, "Hz"), "lower_hz": (lo, "Hz"), "upper_hz": (hi, "Hz"),
-                           **{k: (v, "dB re 1e-12 W" if "level" in k else "W")
-                              for k, v in table.items()}}
+                           **{k: (v, _band_units(k)) for k, v in table.items()}}
     return groups
+
+
+def _band_units(name: str) -> str:
+    """``units`` attribute of a /bands dataset: '*_level_dba' A-weighted levels, '*_level_db'
+    levels, '*_power_W' / '*_power_a_W' powers."""
+    if name.endswith("_level_dba"):
+        return "dB(A) re 1e-12 W"
+    return "dB re 1e-12 W" if "level" in name else "W"

@@ -130,17 +130,17 @@ def test_deflection_animation_over_one_period(tmp_path):
     for j in (0, 3, 7):
         reader.set_active_time_value(times[j])
         mesh = reader.read()[0]
-        u = mesh.point_data["displacement"]
+        u = mesh.point_data["displacement_m"]
         assert u.shape == (n, 3) and not np.any(np.isnan(u))
         theta = 2 * np.pi * j / 12
         expected = U[0] + U[1] * np.cos(theta) + U[2] * np.sin(theta) \
             + U[3] * np.cos(2 * theta) + U[4] * np.sin(2 * theta)
         np.testing.assert_allclose(u, expected, atol=1e-18)
-        np.testing.assert_allclose(mesh.point_data["displacement_magnitude"],
+        np.testing.assert_allclose(mesh.point_data["displacement_magnitude_m"],
                                    np.linalg.norm(expected, axis=1), atol=1e-18)
         assert "contact_marker" in mesh.point_data
-        assert mesh.point_data.active_vectors_name == "displacement"
-        assert mesh.field_data["phase"][0] == pytest.approx(j / 12)
+        assert mesh.point_data.active_vectors_name == "displacement_m"
+        assert mesh.field_data["phase_rad"][0] == pytest.approx(2 * np.pi * j / 12)
     # without omega the "time" is the period fraction
     pvd2 = write_deflection_animation(tmp_path / "anim2", points, triangles, U, n_frames=4)
     np.testing.assert_allclose(pv.get_reader(str(pvd2)).time_values, [0, 0.25, 0.5, 0.75])

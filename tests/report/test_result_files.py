@@ -26,6 +26,19 @@ def test_response_h5_holds_contributions_dynamics_and_bands(lumped_case, tmp_pat
                                                                             rel=1e-9)
         assert data["bands"]["linear_power_W"][i].sum() == pytest.approx(
             p["linear"]["erp_power_W"], rel=1e-9)
+    # names and units: A-weighted band levels say dB(A); the ERP levels in dB(A) also under names
+    # ending in their unit (the *_a_db names kept for existing scripts, the same data)
+    import h5py
+
+    with h5py.File(tmp_path / "out" / "response.h5", "r") as f:
+        assert f["bands/nonlinear_level_dba"].attrs["units"] == "dB(A) re 1e-12 W"
+        assert f["bands/linear_level_dba"].attrs["units"] == "dB(A) re 1e-12 W"
+        assert f["bands/nonlinear_level_db"].attrs["units"] == "dB re 1e-12 W"
+        assert f["erp/level_total_dba"].attrs["units"] == "dB(A) re 1e-12 W"
+    assert np.array_equal(data["erp"]["level_total_dba"], data["erp"]["level_total_a_db"])
+    assert np.array_equal(data["erp"]["level_dba"], data["erp"]["level_a_db"])
+    assert data["erp"]["level_total_dba"] == pytest.approx(
+        [p["erp"]["level_dba"] for p in summary["points"]])
     d = data["contact_dynamics"]
     assert list(d["contact_names"]) == ["panel_bracket", "seal"]
     assert d["impacts_per_period"].shape == (5, 2)

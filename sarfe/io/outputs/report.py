@@ -5,7 +5,8 @@
 Built from the jinja2 template ``templates/report.html.j2`` (package data) with autoescaping;
 every image is embedded as a base64 PNG data URI and the CSS is inline, so the page needs no
 network and no other file. Sections (those without data are left out): case and model, the
-headline at the loudest point (converged, not unstable, highest dB(A): ``summary["worst"]``),
+headline at the loudest point (converged, not found unstable, highest dB(A): ``summary["worst"]``)
+with its ERP error bound and notes (stability not assessed, error interpolated),
 accuracy estimate, ERP vs frequency with the linear baseline and ``output.target_dba``, the contact
 ranking, third-octave spectrum, contact forces and stick/slip, ERP map (dB) and deflection at the
 loudest point, and the table of all points. Levels of a motionless surface read "-".
@@ -19,7 +20,7 @@ import base64
 import math
 from pathlib import Path
 
-from sarfe.io.outputs.summary import level_text, shown_level
+from sarfe.io.outputs.summary import headline_level, headline_notes, level_text, shown_level
 
 __all__ = ["write_report_html", "render_report_html", "data_uri", "environment"]
 
@@ -118,6 +119,7 @@ def render_report_html(summary: dict, images: dict | None = None, notes: dict | 
     return template.render(
         s=summary, points=points, worst=worst, loudest=loudest, images=images,
         notes=notes or {}, target_dba=output.get("target_dba"),
+        headline_level=headline_level(worst), headline_notes=headline_notes(worst),
         ranking=_ranking_rows(loudest), bands=_band_rows(loudest), estimates=estimates,
         excitation=case_data.get("excitation") or {}, contacts=summary.get("contacts") or [],
         model=summary.get("model") or {}, solver=summary.get("solver") or {})

@@ -36,6 +36,8 @@ convention (``/`` attribute ``fourier_convention``): index 0 = static term u0, 2
     /erp/harmonic_frequencies_hz    (n_f, H) k ω/2π [Hz]
     /erp/power_W, level_db, level_a_db             (n_f, H)   per harmonic [W], [dB re 1 pW], [dB(A)]
     /erp/power_total_W, level_total_db, level_total_a_db  (n_f,)
+    /erp/level_dba, level_total_dba                 the *_a_db datasets again (hard links), named
+                                                    by their unit dB(A)
     /erp/density_total_W_m2         (n_f, n_r) ERP density summed over harmonics [W/m²]
     /erp/density_W_m2               (n_f, H, n_r) per harmonic (only if requested)
     /<group>/<name>                 caller-supplied extra groups (e.g. /linear/... of the linear
@@ -224,6 +226,9 @@ def write_response_h5(
             _put(group, "power_total_W", [e.power_total for e in erp], "W")
             _put(group, "level_total_db", [e.level_total_db for e in erp], "dB re 1e-12 W")
             _put(group, "level_total_a_db", [e.level_total_a_db for e in erp], "dB(A) re 1e-12 W")
+            # the same datasets under names ending in their unit (hard links: one copy of the data;
+            # the *_a_db names stay for existing scripts)
+            group["level_dba"], group["level_total_dba"] = group["level_a_db"], group["level_total_a_db"]
             _put(group, "density_total_W_m2", _stack(erp, "density_total"), "W/m^2")
             if store_erp_density_per_harmonic:
                 _put(group, "density_W_m2", _stack(erp, "density"), "W/m^2")

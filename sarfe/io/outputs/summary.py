@@ -10,7 +10,8 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["to_jsonable", "write_summary_json", "console_table", "pruning_line", "NULL_NOTE",
-           "SILENT_LEVEL_DB", "shown_level", "level_text", "loudest_lines", "stability_line"]
+           "SILENT_LEVEL_DB", "shown_level", "level_text", "headline_level", "headline_notes",
+           "loudest_lines", "stability_line"]
 
 # Levels below this are a motionless surface (round-off: a solve's 1e-19 m noise radiates
 # −180 dB re 1 pW): the console, table.txt and the report show them as "-"; the files keep the value.
@@ -222,6 +223,35 @@ def pruning_line(report: dict | None) -> str | None:
     return f"contacts: {len(linear)} of {len(report['contacts'])} solved linearly ({what})"
 
 
+def headline_level(worst: dict) -> str:
+    """The headline level of summary.json's ``worst`` with its error bound: '97.0 ± 0.24 dB(A)'
+    (``erp_error_db``, the point's ERP error estimate [dB]); '97.0 dB(A)' without an estimate;
+    '-' for no sound."""
+    text = level_text(worst.get("erp_level_dba"))
+    error = worst.get("erp_error_db")
+    if text == "-":
+        return text
+    if error is not None and math.isfinite(error):
+        text += f" ± {error:.2f}"
+    return f"{text} dB(A)"
+
+
+def headline_notes(worst: dict) -> list[str]:
+    """What the headline level of summary.json's ``worst`` does not carry: 'stability not
+    assessed' (``stable`` None: the loudest point is the loudest one not found unstable),
+    'error interpolated' (its error bound is the larger of two estimated neighbours'),
+    'error unknown' (its estimate's re-solve failed), 'error not estimated' (none asked or no
+    contacts). Keys absent (older summaries): no note."""
+    notes = []
+    if "stable" in worst and worst["stable"] is None:
+        notes.append("stability not assessed")
+    if worst.get("error_interpolated"):
+        notes.append("error interpolated")
+    if "erp_error_db" in worst and worst["erp_error_db"] is None:
+        notes.append("error unknown" if worst.get("error_estimated") else "error not estimated")
+    return notes
+
+
 def loudest_lines(worst: dict | None, count: int = 5) -> list[str]:
     """Console lines of summary.json's ``worst``: the headline at the loudest (converged, not
     unstable) point and the first ``count`` lines of its contact ranking."""
@@ -229,14 +259,15 @@ def loudest_lines(worst: dict | None, count: int = 5) -> list[str]:
         return []
     if worst.get("index") is None:
         return [f"loudest point: none ({worst.get('note', 'no converged, not unstable point')})"]
-    lines = [f"loudest point: {level_text(worst.get('erp_level_dba'), unit='dB(A)')} "
+    notes = "".join(f" ({note})" for note in headline_notes(worst))
+    lines = [f"loudest point: {headline_level(worst)} "
              f"({level_text(worst.get('erp_level_db'), unit='dB re 1 pW')}) at "
-             f"{worst['frequency_hz']:.2f} Hz"]
+             f"{worst['frequency_hz']:.2f} Hz{notes}"]
     lines += [f"  {line}" for line in (worst.get("ranking") or [])[:count]]
     excitation = worst.get("excitation")
     if excitation and worst.get("ranking"):
         share = excitation.get("share_a")
-        share = "-" if share is None or not math.isfinite(share) else f"{100 * share:.0f} %"
+        share = "-" if share is None or not math.isfinite(share) else f"{round(100 * share)} %"
         lines.append(f"  (the excitation through the structure without contact forces: "
                      f"{level_text(excitation.get('level_dba'), unit='dB(A)')}, {share})")
     return lines

@@ -402,8 +402,9 @@ def write_deflection_animation(directory, points, triangles, displacement_harmon
     """Operating deflection over one period as a PVD time series that ParaView plays.
 
     Frame j (``<basename>_<jjj>.vtu``) holds u(θ_j) = U0 + Σ_k U_kc cos kθ_j + U_ks sin kθ_j,
-    θ_j = 2πj/n_frames, as the point vector ``displacement`` [m] (apply *Warp By Vector*; the
-    coordinates stay undeformed) and its norm ``displacement_magnitude`` [m]. The PVD time is
+    θ_j = 2πj/n_frames, as the point vector ``displacement_m`` [m] (apply *Warp By Vector*; the
+    coordinates stay undeformed), its norm ``displacement_magnitude_m`` [m] and the field value
+    ``phase_rad`` = θ_j [rad]. The PVD time is
     t_j = θ_j/ω [s] when ``omega`` [rad/s] is given, else the period fraction j/n_frames.
     ``displacement_harmonics`` is (2H+1, n, 3) [m]; ``point_data`` adds constant arrays to every
     frame (e.g. ``contact_marker``). Returns ``<directory>/<basename>.pvd``.
@@ -420,10 +421,10 @@ def write_deflection_animation(directory, points, triangles, displacement_harmon
     for j, u in enumerate(frames):
         name = f"{basename}_{j:03d}.vtu"
         data = dict(point_data or {})
-        data["displacement"] = u
-        data["displacement_magnitude"] = np.linalg.norm(u, axis=1)
-        phase = j / int(n_frames)
-        write_erp_vtu(directory / name, points, triangles, data, active_vectors="displacement",
-                      field_data={"phase": phase})
-        entries.append((2.0 * np.pi * phase / omega if omega else phase, name))
+        data["displacement_m"] = u
+        data["displacement_magnitude_m"] = np.linalg.norm(u, axis=1)
+        phase_rad = 2.0 * np.pi * j / int(n_frames)
+        write_erp_vtu(directory / name, points, triangles, data, active_vectors="displacement_m",
+                      field_data={"phase_rad": phase_rad})
+        entries.append((phase_rad / omega if omega else j / int(n_frames), name))
     return write_pvd(directory / f"{basename}.pvd", entries)
