@@ -221,6 +221,9 @@ def used_nodes(deck) -> np.ndarray:
 #: the model spans the mesh path refuses (sarfe.pipeline.linear.check_mesh), in metres
 SPAN_RANGE_M = (5e-3, 20.0)
 UNITS_KEY = ("model", "fe", "units")
+# upper bounds used only to pick a suggested unit system (never an error): stiffer than
+# diamond or denser than osmium is not a material
+_SUGGEST_MAX_E_PA, _SUGGEST_MAX_RHO_KG_M3 = 1.2e12, 2.3e4
 
 
 def _section_moduli(shells) -> np.ndarray:
@@ -281,9 +284,10 @@ def unit_findings(deck) -> list[tuple]:
 
 
 def suggested_units(deck, units: str):
-    """The unit system (a name of UNIT_SYSTEMS) under which the deck's smallest modulus and
-    density and its span would all be plausible, closest to a typical trim part (median E
-    1e9 Pa, ρ 1e3 kg/m³, L 0.5 m, summed on a log scale); None when no other system passes.
+    """The unit system (a name of UNIT_SYSTEMS) under which the deck's moduli, densities and
+    span would all be plausible (the errors' bounds, and E ≤ 1.2e12 Pa, ρ ≤ 2.3e4 kg/m³),
+    closest to a typical trim part (median E 1e9 Pa, ρ 1e3 kg/m³, L 0.5 m, summed on a log
+    scale); None when no other system passes.
     The deck is in SI as read with ``units``: a value v of dimension (l, m, t) becomes
     v · f_candidate / f_units."""
     from sarfe.io.case import _MIN_E_PA, _MIN_RHO_KG_M3
@@ -297,8 +301,9 @@ def suggested_units(deck, units: str):
                           *[b.density for b in deck.solids.values()]])
     span = float(np.linalg.norm(np.ptp(deck.points, axis=0))) if deck.n_nodes else 0.0
     # (values, dimension, plausible range, typical value)
-    quantities = [(moduli[np.isfinite(moduli) & (moduli > 0)], (-1, 1, -2), (_MIN_E_PA, np.inf), 1e9),
-                  (rho[rho > 0], (-3, 1, 0), (_MIN_RHO_KG_M3, np.inf), 1e3),
+    quantities = [(moduli[np.isfinite(moduli) & (moduli > 0)], (-1, 1, -2),
+                   (_MIN_E_PA, _SUGGEST_MAX_E_PA), 1e9),
+                  (rho[rho > 0], (-3, 1, 0), (_MIN_RHO_KG_M3, _SUGGEST_MAX_RHO_KG_M3), 1e3),
                   (np.array([span]) if span > 0 else np.zeros(0), (1, 0, 0), SPAN_RANGE_M, 0.5)]
     current = UNIT_SYSTEMS[units]
     best, best_score = None, np.inf
