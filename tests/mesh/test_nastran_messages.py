@@ -1,0 +1,58 @@
+"""Nastran deck errors are one short line with the deck's file and line of the card: a CQUAD4 on
+GRIDs the deck does not have names the element and those GRIDs only (pyNastran's own message
+lists every GRID of the deck); a non-numeric field names the GRID and its line, and pyNastran's
+console output (``UserWarning: bad fields``, ``problem adding``) does not reach the user."""
+import warnings
+from pathlib import Path
+
+import pytest
+
+from sarfe.mesh.deck import DeckError
+from sarfe.mesh.nastran import card_line, read_nastran
+
+DECK = Path(__file__).resolve().parents[2] / "meshes" / "rattle_rig_deck.bdf"
+FIRST_QUAD = ("CQUAD4*                1               1             239             214\n"
+              "*                    118              37")
+
+
+def test_card_line_finds_small_large_and_free_fields(tmp_path):
+    text = DECK.read_text()
+    assert card_line(DECK, "CQUAD4", 1) == (str(DECK), 759)
+    assert card_line(DECK, "MAT1", 2) == (str(DECK), 1477)
+    assert card_line(DECK, "MAT1", 3) is None
+    (tmp_path / "part.inc").write_text("GRID,7,,0.,0.,0.\nCQUAD4  11      1       7       8\n")
+    (tmp_path / "main.bdf").write_text("BEGIN BULK\nINCLUDE 'part.inc'\nENDDATA\n")
+    assert card_line(tmp_path / "main.bdf", "GRID", 7) == (str(tmp_path / "part.inc"), 1)
+    assert card_line(tmp_path / "main.bdf", "CQUAD4", 11) == (str(tmp_path / "part.inc"), 2)
+    assert "CQUAD4*                1" in text.splitlines()[758]
+
+
+def test_missing_grids_name_the_element_not_every_grid(tmp_path):
+    deck = tmp_path / "deck.bdf"
+    text = DECK.read_text()
+    assert FIRST_QUAD in text
+    # large field: 16 characters a field
+    deck.write_text(text.replace(FIRST_QUAD, FIRST_QUAD.replace("   239", "999999")
+                                 .replace("   118", "888888")))
+    with pytest.raises(DeckError) as error:
+        read_nastran(deck, units="mm-t-s")
+    message = str(error.value)
+    assert message == f"{deck}:759: CQUAD4 1: GRIDs 888888, 999999 are not in the deck"
+
+
+def test_bad_field_is_one_line_with_its_card_and_no_console_output(tmp_path, capfd):
+    deck = tmp_path / "deck.bdf"
+    lines = DECK.read_text().splitlines(keepends=True)
+    assert lines[6].startswith("GRID*                  1") and lines[7].split() == ["*", "0.0"]
+    lines[7] = lines[7].replace("0.0", "abc")
+    deck.write_text("".join(lines))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with pytest.raises(DeckError) as error:
+            read_nastran(deck, units="mm-t-s")
+    message = str(error.value)
+    assert message.startswith(f"{deck}:7: GRID 1: ") and "'ABC'" in message
+    assert "\n" not in message and len(message) < 400
+    assert not caught
+    out, err = capfd.readouterr()
+    assert out == "" and err == ""
