@@ -162,6 +162,11 @@ def _pynastran_message(error, path: Path) -> str:
     cards += re.findall(r"new_\w+=\s*([A-Z][A-Z0-9]*)\*?\s+(\d+)", text)
     first = re.sub(r"(nids|spoints|epoints|Allowed \w+)=[^=]*?(\]\)?|$)", "", first)
     first = re.sub(r"^\w+Error: '?", "", first.strip()).strip(" .'\"\n")
+    first = re.sub(r"\s+cwd: .*", "", first, flags=re.DOTALL)      # a missing INCLUDE file
+    twice = re.match(r"\w+=\d+\s+old_\w+=\s*(.*?)\s+new_\w+=\s*(.*)", first, re.DOTALL)
+    if twice:   # a duplicate id: both cards, short
+        first = (f"the id is used twice: {' '.join(twice.group(1).split())} and "
+                 f"{' '.join(twice.group(2).split())}")
     where = card_where(path, *cards[0]) if cards else f"cannot read Nastran deck {path}"
     line = " ".join(first.split()) or type(error).__name__
     return f"{where}: {line[:240]}{'…' if len(line) > 240 else ''}"

@@ -56,3 +56,14 @@ def test_bad_field_is_one_line_with_its_card_and_no_console_output(tmp_path, cap
     assert not caught
     out, err = capfd.readouterr()
     assert out == "" and err == ""
+
+
+def test_duplicate_grid_names_both_cards_in_one_line(tmp_path):
+    deck = tmp_path / "deck.bdf"
+    deck.write_text("BEGIN BULK\nGRID,1,,0.,0.,0.\nGRID,2,,1.,0.,0.\nGRID,3,,1.,1.,0.\n"
+                    "GRID,2,,5.,5.,0.\nENDDATA\n")
+    with pytest.raises(DeckError) as error:
+        read_nastran(deck, units="mm-t-s")
+    message = str(error.value)
+    assert message.startswith(f"{deck}:3: GRID 2: the id is used twice: GRID 2 1. ")
+    assert "GRID 2 5. 5." in message and "\n" not in message
