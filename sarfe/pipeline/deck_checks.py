@@ -239,12 +239,28 @@ def _section_moduli(shells) -> np.ndarray:
     return np.fmax(e1, e2)
 
 
+def _section_densities(shells) -> np.ndarray:
+    """(m_t,) density [kg/m³] of each triangle's section from its rotary inertia per area
+    I = ∫ ρ z² dz = ρ t³/12: ρ = 12 I / t³ (a PSHELL's MID1 ρ, without the NSM that ρ t + NSM
+    would mix in; a laminate's through-thickness average for a PCOMP); 0 where t = 0."""
+    t = shells.thickness
+    return np.divide(12.0 * shells.rotary_inertia_per_area, t**3, out=np.zeros_like(t),
+                     where=t > 0)
+
+
+def model_span(deck) -> float:
+    """Bounding-box diagonal L [m] of the GRIDs that elements use (a stray reference GRID of a
+    coordinate system does not count); 0 for no such GRID."""
+    used = used_nodes(deck)
+    return float(np.linalg.norm(np.ptp(deck.points[used], axis=0))) if used.size else 0.0
+
+
 def unit_findings(deck) -> list[tuple]:
     """Values of a deck (in SI after its unit conversion) that no trim part has — the
     plausibility bounds of the case keys (:mod:`sarfe.io.case`, :mod:`sarfe.pipeline.checks`):
 
         E < 1e5 Pa, 0 < ρ < 1 kg/m³ (shell sections, solids, beams),
-        model span L (bounding-box diagonal of the GRIDs) > 20 m or < 5 mm,
+        model span L (:func:`model_span`) > 20 m or < 5 mm,
         shell thickness t > 0.1 L or t < 1e-4 L.
 
     Returns (quantity, table, row, value) per finding, worst first within a quantity:
@@ -255,8 +271,7 @@ def unit_findings(deck) -> list[tuple]:
 
     moduli = [("shell", _section_moduli(deck.shells))]
     t = deck.shells.thickness
-    densities = [("shell", np.divide(deck.shells.mass_per_area, t, out=np.zeros_like(t),
-                                     where=t > 0))]
+    densities = [("shell", _section_densities(deck.shells))]
     for kind, block in deck.solids.items():
         moduli.append((f"solid:{kind}", block.young))
         densities.append((f"solid:{kind}", block.density))
@@ -270,8 +285,7 @@ def unit_findings(deck) -> list[tuple]:
             if rows.size:
                 worst = int(rows[np.argmin(values[rows])])
                 findings.append((quantity, table, worst, float(values[worst])))
-    used = np.unique(deck.shells.triangles) if deck.shells.n_triangles else np.arange(deck.n_nodes)
-    span = float(np.linalg.norm(np.ptp(deck.points[used], axis=0))) if used.size else 0.0
+    span = model_span(deck)
     if span > SPAN_RANGE_M[1] or 0 < span < SPAN_RANGE_M[0]:
         findings.append(("span", "grid", None, span))
     if span > 0 and t.size:
@@ -293,13 +307,11 @@ def suggested_units(deck, units: str):
     from sarfe.io.case import _MIN_E_PA, _MIN_RHO_KG_M3
     from sarfe.mesh.deck import UNIT_SYSTEMS
 
-    t = deck.shells.thickness
     moduli = np.concatenate([_section_moduli(deck.shells), deck.beams.young,
                              *[b.young for b in deck.solids.values()]])
-    rho = np.concatenate([np.divide(deck.shells.mass_per_area, t, out=np.zeros_like(t),
-                                    where=t > 0), deck.beams.density,
+    rho = np.concatenate([_section_densities(deck.shells), deck.beams.density,
                           *[b.density for b in deck.solids.values()]])
-    span = float(np.linalg.norm(np.ptp(deck.points, axis=0))) if deck.n_nodes else 0.0
+    span = model_span(deck)
     # (values, dimension, plausible range, typical value)
     quantities = [(moduli[np.isfinite(moduli) & (moduli > 0)], (-1, 1, -2),
                    (_MIN_E_PA, _SUGGEST_MAX_E_PA), 1e9),
@@ -354,8 +366,7 @@ def check_units(case: Case, deck) -> None:
                          f"implausible for a trim part ({side}); {hint}", UNITS_KEY)
     where = _card_of(path, deck, units, quantity, table, row, value)
     if quantity == "thickness":
-        span = float(np.linalg.norm(np.ptp(deck.points[np.unique(deck.shells.triangles)],
-                                           axis=0)))
+        span = model_span(deck)
         low, high = THICKNESS_RANGE
         rule = (f"above {high:g} of the model size {span:.3g} m" if value > high * span
                 else f"below {low:g} of the model size {span:.3g} m")
