@@ -114,3 +114,10 @@ def test_abaqus_material_in_mpa_read_as_si(tmp_path):
     message = str(error.value)
     assert f"plate.inp:{line}: *MATERIAL, NAME=PP: E = 2000 Pa with units: SI" in message
     assert "set model.fe.units: mm-t-s" in message
+
+
+def test_solve_refuses_the_wrong_units_before_any_assembly(tmp_path):
+    from sarfe.pipeline import build_linear_model
+
+    with pytest.raises(CaseError, match=r"model\.fe\.units: .*MAT1 1: E = 2200 Pa"):
+        build_linear_model(shipped_case(tmp_path, units="SI"))

@@ -67,3 +67,14 @@ def test_duplicate_grid_names_both_cards_in_one_line(tmp_path):
     message = str(error.value)
     assert message.startswith(f"{deck}:3: GRID 2: the id is used twice: GRID 2 1. ")
     assert "GRID 2 5. 5." in message and "\n" not in message
+
+
+def test_many_missing_grids_are_cut_to_a_few(tmp_path):
+    """An RBE2 on 7 GRIDs the deck lacks: five ids, then the count."""
+    deck = tmp_path / "deck.bdf"
+    deck.write_text("BEGIN BULK\nGRID,1,,0.,0.,0.\n"
+                    "RBE2,5,1,123456,11,12,13,14,15,\n,16,17\nENDDATA\n")
+    with pytest.raises(DeckError) as error:
+        read_nastran(deck)
+    assert str(error.value) == (f"{deck}:3: RBE2 5: GRIDs 11, 12, 13, 14, 15, … (7 in all) "
+                                "are not in the deck")
