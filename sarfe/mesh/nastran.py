@@ -114,7 +114,8 @@ def _load_bdf(path: Path):
                 model.read_bdf(os.fspath(path), xref=False, punch=not has_bulk,
                                encoding="latin-1")
             _check_node_references(model, path)
-            model.cross_reference()
+            model.cross_reference()          # what read_bdf(xref=True) does after reading
+            model._xref = True
     except DeckError:
         raise
     except Exception as error:
@@ -141,10 +142,11 @@ def _check_node_references(model, path: Path) -> None:
               ("rigid", model.rigid_elements))
     for kind, table in tables:
         for eid, card in sorted(table.items()):
-            if kind == "rigid":
-                ids = list(card.independent_nodes) + list(card.dependent_nodes)
-            else:
-                ids = list(card.node_ids)
+            try:
+                ids = (list(card.independent_nodes) + list(card.dependent_nodes)
+                       if kind == "rigid" else list(card.node_ids))
+            except (AttributeError, TypeError):   # a card without node lists: pyNastran checks it
+                continue
             missing = sorted({int(n) for n in ids if n not in (None, 0) and n not in known})
             if missing:
                 raise DeckError(f"{card_where(path, card.type, eid)}: GRID"
