@@ -100,6 +100,7 @@ def _load_bdf(path: Path):
     upper = text.upper()
     has_bulk = "BEGIN BULK" in upper
     has_control = has_bulk and "CEND" in upper.split("BEGIN BULK")[0]
+    _check_includes(path)     # pyNastran would dump a pyNastran_crash.bdf into the folder
     model = BDF(debug=None)
     model.log.level = "error"
     cwd = os.getcwd()
@@ -123,6 +124,28 @@ def _load_bdf(path: Path):
     finally:
         os.chdir(cwd)
     return model
+
+
+_INCLUDE = re.compile(r"^\s*INCLUDE\s+'?([^'\s]+)", re.IGNORECASE)
+
+
+def _check_includes(path: Path, root: Path | None = None, seen=()) -> None:
+    """DeckError "deck.bdf:7: INCLUDE 'x.inc': file not found" for the first INCLUDE (in the
+    deck or the files it includes) that names no file, relative to the including file or to
+    the deck's folder (where pyNastran looks)."""
+    root = path if root is None else root
+    if path in seen:
+        return
+    with open(path, errors="replace") as handle:
+        for number, text in enumerate(handle, start=1):
+            include = _INCLUDE.match(text)
+            if include:
+                name = include.group(1)
+                found = [p for p in (path.parent / name, root.parent / name) if p.is_file()]
+                if not found:
+                    raise DeckError(f"{path}:{number}: INCLUDE '{name}': file not found "
+                                    f"({path.parent / name})")
+                _check_includes(found[0], root, seen + (path,))
 
 
 _SHOWN_IDS = 5   # ids listed in a message before "…"
@@ -179,7 +202,6 @@ def card_line(path, card: str, ident) -> tuple[str, int] | None:
     in the deck or a file it INCLUDEs, in free (comma), small or large (``CARD*``) field
     format; None when not found. A plain scan for error messages, not a parser."""
     card, ident = str(card).upper(), str(int(ident))
-    pattern = re.compile(r"^\s*INCLUDE\s+'?([^'\s]+)", re.IGNORECASE)
     seen = []
 
     def scan(file: Path):
@@ -197,7 +219,7 @@ def card_line(path, card: str, ident) -> tuple[str, int] | None:
                 name = fields[0].strip().upper().rstrip("*")
                 if name == card and len(fields) > 1 and fields[1].strip() == ident:
                     return str(file), number
-                include = pattern.match(text)
+                include = _INCLUDE.match(text)
                 if include:
                     found = scan(file.parent / include.group(1))
                     if found:

@@ -20,11 +20,14 @@ def test_card_line_finds_small_large_and_free_fields(tmp_path):
     assert card_line(DECK, "CQUAD4", 1) == (str(DECK), 759)
     assert card_line(DECK, "MAT1", 2) == (str(DECK), 1477)
     assert card_line(DECK, "MAT1", 3) is None
-    (tmp_path / "part.inc").write_text("GRID,7,,0.,0.,0.\nCQUAD4  11      1       7       8\n")
+    (tmp_path / "part.inc").write_text("GRID,7,,0.,0.,0.\nCQUAD4  11      1       7       8       9       10\n")
     (tmp_path / "main.bdf").write_text("BEGIN BULK\nINCLUDE 'part.inc'\nENDDATA\n")
     assert card_line(tmp_path / "main.bdf", "GRID", 7) == (str(tmp_path / "part.inc"), 1)
     assert card_line(tmp_path / "main.bdf", "CQUAD4", 11) == (str(tmp_path / "part.inc"), 2)
     assert "CQUAD4*                1" in text.splitlines()[758]
+    # read through the INCLUDE, the error names the included file's line
+    with pytest.raises(DeckError, match=r"part\.inc:2: CQUAD4 11: GRIDs 8, 9, 10 are not in the deck$"):
+        read_nastran(tmp_path / "main.bdf")
 
 
 def test_missing_grids_name_the_element_not_every_grid(tmp_path):
@@ -78,3 +81,18 @@ def test_many_missing_grids_are_cut_to_a_few(tmp_path):
         read_nastran(deck)
     assert str(error.value) == (f"{deck}:3: RBE2 5: GRIDs 11, 12, 13, 14, 15, … (7 in all) "
                                 "are not in the deck")
+
+
+def test_missing_include_names_its_line_and_leaves_no_crash_file(tmp_path, monkeypatch):
+    """pyNastran writes pyNastran_crash.bdf into the working folder on a missing INCLUDE; the
+    file is checked first, so nothing is written and the line is named."""
+    work = tmp_path / "work"
+    work.mkdir()
+    monkeypatch.chdir(work)
+    deck = tmp_path / "deck.bdf"
+    deck.write_text("SOL 103\nCEND\nBEGIN BULK\nINCLUDE 'nothere/bulk.inc'\nENDDATA\n")
+    with pytest.raises(DeckError) as error:
+        read_nastran(deck)
+    assert str(error.value).startswith(f"{deck}:4: INCLUDE 'nothere/bulk.inc': file not found")
+    assert list(work.iterdir()) == [] and sorted(p.name for p in tmp_path.iterdir()) == [
+        "deck.bdf", "work"]
