@@ -711,3 +711,20 @@ def read_abaqus(path, ignore_cards=()) -> DeckModel:
         if isinstance(exc, DeckError):
             raise
         raise DeckError(f"{path}: {exc}") from None
+
+
+def section_values(path) -> list[tuple[str, str, float]]:
+    """(where, quantity, value in the file's units) of each material's E ('E') and ρ ('rho')
+    and each shell section's thickness ('thickness'), for messages that name the keyword line:
+    ("plate.inp:47: *MATERIAL, NAME=PP", "E", 2.0e3)."""
+    reader = _Reader(Path(path))
+    reader.label_base = 1
+    reader.run()
+    values = []
+    for name, material in reader.materials.items():
+        values += [(f"{material['where']}, NAME={name}", key, float(material[key]))
+                   for key in ("E", "rho") if key in material]
+    for scope in [reader.model, reader.assembly, *reader.parts.values()]:
+        values += [(where, "thickness", float(thickness)) for _, _, thickness, where in scope.sections]
+    return values
+

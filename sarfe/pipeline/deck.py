@@ -2,6 +2,8 @@ r"""The deck path of the linear stage: an engineer's Nastran / Abaqus deck as it
 
     deck file ──read (pyNastran / sarfe.mesh.abaqus), to SI──▶ DeckModel
       ├─ unsupported cards: an error unless named in ``ignore_cards`` (then recorded)
+      ├─ units: the deck's own E, ρ, span and thickness in SI held against the bounds of the
+      │  case keys (an error on model.fe.units naming the card and the system it looks like)
       ├─ YAML overrides of a group's material / thickness (the deck's own by default)
       ├─ CBUSH/CELAS named by a contact's ``from_elements`` leave the linear model (their
       │  dashpots B stay as parallel dampers; rotational K and GE refused)
@@ -26,8 +28,9 @@ import fnmatch
 import numpy as np
 
 from sarfe.io.case import Case
-from sarfe.pipeline.deck_checks import (card_key, check_quality, free_rigid_motions, has_mass,
-                                        ignored_mass, joined_pairs, support_mask, used_nodes)
+from sarfe.pipeline.deck_checks import (card_key, check_quality, check_units, free_rigid_motions,
+                                        has_mass, ignored_mass, joined_pairs, support_mask,
+                                        used_nodes)
 
 DECK_KEY = ("model", "fe", "deck")
 
@@ -347,6 +350,7 @@ def prepare_deck(case: Case) -> PreparedDeck:
     if deck.shells.n_triangles == 0:
         raise case.error("the deck has no shell elements (the ERP surface is made of shells)",
                          DECK_KEY)
+    check_units(case, deck)          # the deck's own values, before any YAML override
     mesh = deck_panel_mesh(case, deck)
     deck = apply_overrides(case, deck, mesh)
     deck, element_contacts, contact_warnings = springs_to_contacts(case, deck)

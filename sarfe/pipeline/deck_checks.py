@@ -215,3 +215,202 @@ def has_mass(deck) -> bool:
 def used_nodes(deck) -> np.ndarray:
     _, _, used = connected_parts(deck)
     return np.flatnonzero(used)
+
+
+# ------------------------------------------------------------------------------------- units
+#: the model spans the mesh path refuses (sarfe.pipeline.linear.check_mesh), in metres
+SPAN_RANGE_M = (5e-3, 20.0)
+UNITS_KEY = ("model", "fe", "units")
+# upper bounds used only to pick a suggested unit system (never an error): stiffer than
+# diamond or denser than osmium is not a material
+_SUGGEST_MAX_E_PA, _SUGGEST_MAX_RHO_KG_M3 = 1.2e12, 2.3e4
+
+
+def _section_moduli(shells) -> np.ndarray:
+    """(m_t,) largest in-plane modulus [Pa] of each triangle's section, from its membrane
+    stiffness A = t Q: E₁ = (A₁₁ − A₁₂²/A₂₂)/t, E₂ = (A₂₂ − A₁₂²/A₁₁)/t (exactly E for a
+    MAT1, E₁₁/E₂₂ for a MAT8, laminate averages for a PCOMP)."""
+    a = shells.membrane
+    t = np.where(shells.thickness > 0, shells.thickness, np.nan)
+    a11, a22, a12 = a[:, 0, 0], a[:, 1, 1], a[:, 0, 1]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        e1 = (a11 - a12**2 / np.where(a22 != 0, a22, np.inf)) / t
+        e2 = (a22 - a12**2 / np.where(a11 != 0, a11, np.inf)) / t
+    return np.fmax(e1, e2)
+
+
+def _section_densities(shells) -> np.ndarray:
+    """(m_t,) density [kg/m³] of each triangle's section from its rotary inertia per area
+    I = ∫ ρ z² dz = ρ t³/12: ρ = 12 I / t³ (a PSHELL's MID1 ρ, without the NSM that ρ t + NSM
+    would mix in; a laminate's through-thickness average for a PCOMP); 0 where t = 0."""
+    t = shells.thickness
+    return np.divide(12.0 * shells.rotary_inertia_per_area, t**3, out=np.zeros_like(t),
+                     where=t > 0)
+
+
+def model_span(deck) -> float:
+    """Bounding-box diagonal L [m] of the GRIDs that elements use (a stray reference GRID of a
+    coordinate system does not count); 0 for no such GRID."""
+    used = used_nodes(deck)
+    return float(np.linalg.norm(np.ptp(deck.points[used], axis=0))) if used.size else 0.0
+
+
+def unit_findings(deck) -> list[tuple]:
+    """Values of a deck (in SI after its unit conversion) that no trim part has — the
+    plausibility bounds of the case keys (:mod:`sarfe.io.case`, :mod:`sarfe.pipeline.checks`):
+
+        E < 1e5 Pa, 0 < ρ < 1 kg/m³ (shell sections, solids, beams),
+        model span L (:func:`model_span`) > 20 m or < 5 mm,
+        shell thickness t > 0.1 L or t < 1e-4 L.
+
+    Returns (quantity, table, row, value) per finding, worst first within a quantity:
+    quantity 'E' [Pa], 'rho' [kg/m³], 'span' [m], 'thickness' [m]; table 'shell' (row = a
+    triangle), 'solid:<cell type>' or 'beam' (row = an element row), 'grid' (row = None)."""
+    from sarfe.io.case import _MIN_E_PA, _MIN_RHO_KG_M3
+    from sarfe.pipeline.checks import THICKNESS_RANGE
+
+    moduli = [("shell", _section_moduli(deck.shells))]
+    t = deck.shells.thickness
+    densities = [("shell", _section_densities(deck.shells))]
+    for kind, block in deck.solids.items():
+        moduli.append((f"solid:{kind}", block.young))
+        densities.append((f"solid:{kind}", block.density))
+    moduli.append(("beam", deck.beams.young))
+    densities.append(("beam", deck.beams.density))
+    findings = []
+    for quantity, tables, bad in (("E", moduli, lambda v: v < _MIN_E_PA),
+                                  ("rho", densities, lambda v: (v > 0) & (v < _MIN_RHO_KG_M3))):
+        for table, values in tables:
+            rows = np.flatnonzero(bad(np.nan_to_num(values, nan=np.inf)))
+            if rows.size:
+                worst = int(rows[np.argmin(values[rows])])
+                findings.append((quantity, table, worst, float(values[worst])))
+    span = model_span(deck)
+    if span > SPAN_RANGE_M[1] or 0 < span < SPAN_RANGE_M[0]:
+        findings.append(("span", "grid", None, span))
+    if span > 0 and t.size:
+        low, high = THICKNESS_RANGE
+        for rows in (np.flatnonzero(t > high * span), np.flatnonzero((t > 0) & (t < low * span))):
+            if rows.size:
+                worst = int(rows[np.argmax(np.abs(np.log(t[rows] / span)))])
+                findings.append(("thickness", "shell", worst, float(t[worst])))
+    return findings
+
+
+def suggested_units(deck, units: str):
+    """The unit system (a name of UNIT_SYSTEMS) under which the deck's moduli, densities and
+    span would all be plausible (the errors' bounds, and E ≤ 1.2e12 Pa, ρ ≤ 2.3e4 kg/m³),
+    closest to a typical trim part (median E 1e9 Pa, ρ 1e3 kg/m³, L 0.5 m, summed on a log
+    scale); None when no other system passes.
+    The deck is in SI as read with ``units``: a value v of dimension (l, m, t) becomes
+    v · f_candidate / f_units."""
+    from sarfe.io.case import _MIN_E_PA, _MIN_RHO_KG_M3
+    from sarfe.mesh.deck import UNIT_SYSTEMS
+
+    moduli = np.concatenate([_section_moduli(deck.shells), deck.beams.young,
+                             *[b.young for b in deck.solids.values()]])
+    rho = np.concatenate([_section_densities(deck.shells), deck.beams.density,
+                          *[b.density for b in deck.solids.values()]])
+    span = model_span(deck)
+    # (values, dimension, plausible range, typical value)
+    quantities = [(moduli[np.isfinite(moduli) & (moduli > 0)], (-1, 1, -2),
+                   (_MIN_E_PA, _SUGGEST_MAX_E_PA), 1e9),
+                  (rho[rho > 0], (-3, 1, 0), (_MIN_RHO_KG_M3, _SUGGEST_MAX_RHO_KG_M3), 1e3),
+                  (np.array([span]) if span > 0 else np.zeros(0), (1, 0, 0), SPAN_RANGE_M, 0.5)]
+    current = UNIT_SYSTEMS[units]
+    best, best_score = None, np.inf
+    for name, system in UNIT_SYSTEMS.items():
+        if system.factor(1) == current.factor(1) and system.factor(0, 1) == current.factor(0, 1) \
+                and system.factor(0, 0, 1) == current.factor(0, 0, 1):
+            continue                      # the same system (or an alias of it, m-kg-s = SI)
+        score, plausible = 0.0, True
+        for values, dim, (low, high), typical in quantities:
+            if not values.size:
+                continue
+            scaled = values * system.factor(*dim) / current.factor(*dim)
+            plausible &= bool(low <= scaled.min() and scaled.max() <= high)
+            score += abs(np.log10(np.median(scaled) / typical))
+        if plausible and score < best_score:
+            best, best_score = name, score
+    return best
+
+
+_RULES = {"E": "E < 1e5 Pa", "rho": "ρ < 1 kg/m³"}
+_SYMBOL = {"E": ("E", "Pa"), "rho": ("ρ", "kg/m³")}
+_DIMENSION = {"E": (-1, 1, -2), "rho": (-3, 1, 0), "thickness": (1, 0, 0)}
+
+
+def check_units(case: Case, deck) -> None:
+    """One-line CaseError on ``model.fe.units`` for the first implausible value of the deck in
+    SI (:func:`unit_findings`), naming the deck card (file:line: MAT1 1, PSHELL 1, …), the
+    value, the rule and, when one fits, the unit system the deck looks like:
+
+        deck.bdf:1473: MAT1 1: E = 2200 Pa with units: SI — implausible for a trim part
+        (E < 1e5 Pa); the deck looks like mm-t-s: set model.fe.units: mm-t-s
+    """
+    findings = unit_findings(deck)
+    if not findings:
+        return
+    from sarfe.pipeline.checks import THICKNESS_RANGE
+
+    fe = case.config.model.fe.data
+    units, path = fe["units"], case.resolve(fe["deck"])
+    quantity, table, row, value = findings[0]
+    suggestion = suggested_units(deck, units)
+    hint = (f"the deck looks like {suggestion}: set model.fe.units: {suggestion}" if suggestion
+            else "check model.fe.units and the deck's unit system")
+    if quantity == "span":
+        side = f"> {SPAN_RANGE_M[1]:g} m" if value > SPAN_RANGE_M[1] else \
+            f"< {SPAN_RANGE_M[0] * 1e3:g} mm"
+        raise case.error(f"{path}: the GRIDs span {value:.3g} m with units: {units} — "
+                         f"implausible for a trim part ({side}); {hint}", UNITS_KEY)
+    where = _card_of(path, deck, units, quantity, table, row, value)
+    if quantity == "thickness":
+        span = model_span(deck)
+        low, high = THICKNESS_RANGE
+        rule = (f"above {high:g} of the model size {span:.3g} m" if value > high * span
+                else f"below {low:g} of the model size {span:.3g} m")
+        raise case.error(f"{where}: thickness {value:.3g} m with units: {units} — {rule}: the "
+                         "thickness and the GRIDs look like different length units", UNITS_KEY)
+    symbol, unit = _SYMBOL[quantity]
+    raise case.error(f"{where}: {symbol} = {value:.4g} {unit} with units: {units} — implausible "
+                     f"for a trim part ({_RULES[quantity]}); {hint}", UNITS_KEY)
+
+
+def _card_of(path, deck, units, quantity, table, row, value) -> str:
+    """'file:line: CARD id' of the value found: the material (E, ρ) or property (thickness)
+    card of a Nastran deck; the *MATERIAL / *SHELL SECTION line of an Abaqus file whose value
+    in SI equals it; else the element."""
+    if table == "shell":
+        element = int(deck.shells.triangle_element[row])
+        eid, pid = int(deck.shells.element_ids[element]), int(deck.shells.property_ids[element])
+    elif table == "beam":
+        eid, pid = int(deck.beams.element_ids[row]), int(deck.beams.property_ids[row])
+    else:
+        block = deck.solids[table.split(":", 1)[1]]
+        eid, pid = int(block.element_ids[row]), int(block.property_ids[row])
+    if path.suffix.lower() == ".inp":
+        from sarfe.mesh.abaqus import section_values
+        from sarfe.mesh.deck import UNIT_SYSTEMS
+
+        scale = UNIT_SYSTEMS[units].factor(*_DIMENSION[quantity])
+        for where, key, raw in section_values(path):
+            if key == quantity and np.isclose(raw * scale, value, rtol=1e-6):
+                return where
+        return f"{path}: element {eid}"
+    from sarfe.mesh.nastran import _load_bdf, card_where
+
+    model = _load_bdf(path)
+    if table == "beam" and pid == 0:    # CONROD: the material is on the element
+        card = model.elements.get(eid)
+    else:
+        card = model.properties.get(pid)
+    if card is None:
+        return card_where(path, str(deck.beams.card[row]) if table == "beam" else "element", eid)
+    if quantity == "thickness" or card.type == "PCOMP":
+        return card_where(path, card.type, pid)
+    mid = getattr(card, "mid1", None) or getattr(card, "mid", None)
+    material = model.materials.get(int(mid)) if mid else None
+    if material is None:
+        return card_where(path, card.type, getattr(card, "pid", eid))
+    return card_where(path, material.type, int(mid))
