@@ -261,7 +261,10 @@ def check_finite(data, source=None, lines=None, path=()):
 # Bounds outside which a value is a unit mistake rather than a material or a load; each message
 # says which unit the key is in.
 AUDIBLE_LIMIT_HZ = 20e3
-_MIN_E_PA, _MIN_RHO_KG_M3, _MAX_MESH_SIZE_M = 1e5, 1.0, 1.0
+# unit plausibility bounds, shared by the case keys, mesh files and decks (sarfe.pipeline.deck_checks):
+# below them a value in SI is almost surely in another unit system
+MIN_E_PA, MIN_RHO_KG_M3, _MAX_MESH_SIZE_M = 1e5, 1.0, 1.0
+SPAN_RANGE_M = (5e-3, 20.0)       # a trim part's overall size [m]
 
 
 def _check_plausible(case, data):
@@ -289,10 +292,10 @@ def _check_plausible(case, data):
         return
     for name, material in fe.get("materials", {}).items():
         p = ("model", "fe", "materials", name)
-        if material["E_Pa"] < _MIN_E_PA:
+        if material["E_Pa"] < MIN_E_PA:
             raise case.error(f"{material['E_Pa']:g} Pa is far too soft for a panel material — "
                              "given in MPa or GPa? E_Pa is in pascals (steel 2.1e+11)", p + ("E_Pa",))
-        if material["rho_kg_m3"] < _MIN_RHO_KG_M3:
+        if material["rho_kg_m3"] < MIN_RHO_KG_M3:
             raise case.error(f"{material['rho_kg_m3']:g} kg/m³ is lighter than air — given in t/mm³ "
                              "or g/cm³? rho_kg_m3 is in kg/m³ (steel 7850)", p + ("rho_kg_m3",))
     generator = fe.get("generator")

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from sarfe.io.case import Case
+from sarfe.io.case import MIN_E_PA, MIN_RHO_KG_M3, SPAN_RANGE_M, Case
 
 DECK_KEY = ("model", "fe", "deck")
 
@@ -219,7 +219,6 @@ def used_nodes(deck) -> np.ndarray:
 
 # ------------------------------------------------------------------------------------- units
 #: the model spans the mesh path refuses (sarfe.pipeline.linear.check_mesh), in metres
-SPAN_RANGE_M = (5e-3, 20.0)
 UNITS_KEY = ("model", "fe", "units")
 # upper bounds used only to pick a suggested unit system (never an error): stiffer than
 # diamond or denser than osmium is not a material
@@ -266,7 +265,6 @@ def unit_findings(deck) -> list[tuple]:
     Returns (quantity, table, row, value) per finding, worst first within a quantity:
     quantity 'E' [Pa], 'rho' [kg/m³], 'span' [m], 'thickness' [m]; table 'shell' (row = a
     triangle), 'solid:<cell type>' or 'beam' (row = an element row), 'grid' (row = None)."""
-    from sarfe.io.case import _MIN_E_PA, _MIN_RHO_KG_M3
     from sarfe.pipeline.checks import THICKNESS_RANGE
 
     moduli = [("shell", _section_moduli(deck.shells))]
@@ -278,8 +276,8 @@ def unit_findings(deck) -> list[tuple]:
     moduli.append(("beam", deck.beams.young))
     densities.append(("beam", deck.beams.density))
     findings = []
-    for quantity, tables, bad in (("E", moduli, lambda v: v < _MIN_E_PA),
-                                  ("rho", densities, lambda v: (v > 0) & (v < _MIN_RHO_KG_M3))):
+    for quantity, tables, bad in (("E", moduli, lambda v: v < MIN_E_PA),
+                                  ("rho", densities, lambda v: (v > 0) & (v < MIN_RHO_KG_M3))):
         for table, values in tables:
             rows = np.flatnonzero(bad(np.nan_to_num(values, nan=np.inf)))
             if rows.size:
@@ -304,7 +302,6 @@ def suggested_units(deck, units: str):
     scale); None when no other system passes.
     The deck is in SI as read with ``units``: a value v of dimension (l, m, t) becomes
     v · f_candidate / f_units."""
-    from sarfe.io.case import _MIN_E_PA, _MIN_RHO_KG_M3
     from sarfe.mesh.deck import UNIT_SYSTEMS
 
     moduli = np.concatenate([_section_moduli(deck.shells), deck.beams.young,
@@ -314,8 +311,8 @@ def suggested_units(deck, units: str):
     span = model_span(deck)
     # (values, dimension, plausible range, typical value)
     quantities = [(moduli[np.isfinite(moduli) & (moduli > 0)], (-1, 1, -2),
-                   (_MIN_E_PA, _SUGGEST_MAX_E_PA), 1e9),
-                  (rho[rho > 0], (-3, 1, 0), (_MIN_RHO_KG_M3, _SUGGEST_MAX_RHO_KG_M3), 1e3),
+                   (MIN_E_PA, _SUGGEST_MAX_E_PA), 1e9),
+                  (rho[rho > 0], (-3, 1, 0), (MIN_RHO_KG_M3, _SUGGEST_MAX_RHO_KG_M3), 1e3),
                   (np.array([span]) if span > 0 else np.zeros(0), (1, 0, 0), SPAN_RANGE_M, 0.5)]
     current = UNIT_SYSTEMS[units]
     best, best_score = None, np.inf

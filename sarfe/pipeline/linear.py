@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 import scipy.sparse as sp
 
-from sarfe.io.case import Case, load_case
+from sarfe.io.case import SPAN_RANGE_M, Case, load_case
 from sarfe.io.errors import CaseError
 
 
@@ -312,10 +312,10 @@ def load_case_mesh(case: Case):
     if mesh.n_triangles == 0:
         raise case.error("the mesh has no shell triangles", where[:3])
     extent = float(np.linalg.norm(np.ptp(mesh.points, axis=0)))
-    if extent > 20.0:
+    if extent > SPAN_RANGE_M[1]:
         raise case.error(f"the mesh spans {extent:.3g} m — are its coordinates in mm? "
                          "(set mesh_units: mm)", where)
-    if extent < 5e-3:
+    if extent < SPAN_RANGE_M[0]:
         raise case.error(f"the mesh spans only {extent:.3g} m — are its coordinates in metres "
                          "while mesh_units says mm?", where)
     return mesh

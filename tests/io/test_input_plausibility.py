@@ -106,7 +106,7 @@ def test_mode_count_above_the_interior_warns_with_the_clip(tmp_path):
     data["reduction"] = {"mode_count": 100000}
     found = [w for w in checked(data, tmp_path).warnings if "mode_count" in w]
     assert len(found) == 1 and f"100000 asked, at most {interior} available" in found[0]
-    stage = SimpleNamespace(kind="fe", mode_frequencies_hz=np.array([1e3, 2e3]),
+    stage = SimpleNamespace(kind="fe", mode_frequencies_hz=np.array([1e3, 1e4]),   # above H·f_max
                             info={"modes": 2, "free_dofs": 100, "boundary_dofs": 10})
     assert reduced_model_warnings(load_case(tmp_path / "case.yaml"), stage) == []   # said before
     data["reduction"] = {"mode_count": 50}
