@@ -127,21 +127,19 @@ def check_held(case, mesh, fixed_nodes) -> None:
                          f"{members[0]}); add a fixed group on it", ("model", "fe", "fixed"))
 
 
-def check_loads_free(case, mesh, fixed_nodes) -> list:
-    """Every force group of an FE case acts on a free DOF. The force F of a group is split
-    equally over its n nodes (F/n each) and a fixed node's share goes into the support, so a group
-    whose nodes are all held (fixed, or on no triangle) is a CaseError naming it, and a partly
-    held group gets a warning stating the share lost. Returns the warnings (one line each)."""
-    from sarfe.pipeline.linear import resolve_node_group
-
+def check_loads_free(case, mesh, fixed_nodes, load_nodes) -> list:
+    """Every force group of an FE case acts on a free DOF (``load_nodes``: the nodes of each
+    ``excitation.forces`` group, in order). The force F of a group is split equally over its n
+    nodes (F/n each) and a fixed node's share goes into the support, so a group whose nodes are
+    all held (fixed, or on no triangle) is a CaseError naming it, and a partly held group gets a
+    warning stating the share lost. Returns the warnings (one line each)."""
     used = np.zeros(mesh.n_nodes, bool)
     used[mesh.triangles.ravel()] = True
     held = ~used
     held[np.asarray(fixed_nodes, dtype=int)] = True
     warnings = []
-    for i, load in enumerate(case.config.excitation.forces):
+    for i, (load, nodes) in enumerate(zip(case.config.excitation.forces, load_nodes)):
         path = ("excitation", "forces", i, "group")
-        nodes = resolve_node_group(case, mesh, load["group"], path)
         count = int(np.count_nonzero(held[nodes]))
         if count == len(nodes):
             raise case.error(f"the force on group {load['group']} acts on no free DOF: all of its "
@@ -368,7 +366,9 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True)
     check_thickness(case, mesh)
     normals = nodal_normals(mesh.points, mesh.triangles)
     paired = {c.name: pair_contact(case, mesh, c.index, normals) for c in config.contacts}
-    load_warnings = check_loads_free(case, mesh, fixed)
+    load_nodes = [resolve_node_group(case, mesh, f["group"], ("excitation", "forces", i, "group"))
+                  for i, f in enumerate(config.excitation.forces)]
+    load_warnings = check_loads_free(case, mesh, fixed, load_nodes)
     surface = config.erp.surface
     if surface is not None and surface not in mesh.element_groups:
         resolve_node_group(case, mesh, surface, ("erp", "surface"))
@@ -377,8 +377,6 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True)
     check_held(case, mesh, fixed)
     info = {"nodes": mesh.n_nodes, "triangles": mesh.n_triangles,
             "contact_pairs": {name: len(p[0]) for name, p in paired.items()}}
-    load_nodes = [resolve_node_group(case, mesh, f["group"], ("excitation", "forces", i, "group"))
-                  for i, f in enumerate(config.excitation.forces)]
     interior = interior_dof_count(mesh, fixed, np.concatenate(
         [np.zeros(0, int)] + [np.concatenate([p[0], p[1]]) for p in paired.values()] + load_nodes))
     return CaseCheck(info, tuple(range_warnings(case, mesh)) + tuple(load_warnings)

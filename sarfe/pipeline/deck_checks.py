@@ -218,7 +218,6 @@ def used_nodes(deck) -> np.ndarray:
 
 
 # ------------------------------------------------------------------------------------- units
-#: the model spans the mesh path refuses (sarfe.pipeline.linear.check_mesh), in metres
 UNITS_KEY = ("model", "fe", "units")
 # upper bounds used only to pick a suggested unit system (never an error): stiffer than
 # diamond or denser than osmium is not a material
