@@ -24,6 +24,7 @@ import numpy as np
 
 from .gmsh_model import assemble_mesh, gmsh_session, mesh_from_gmsh, split_quads
 from .mesh import PanelMesh
+from .nastran import bulk_fields
 
 LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "in": 0.0254}
 
@@ -94,10 +95,7 @@ def _refuse_model_cards(path: Path, fmt: str):
                 if not in_bulk or not head or head.startswith(("$", "+", "*")) or text[:1] in " \t+*":
                     continue
                 if head == "GRID":
-                    fields = (text.split(",") if "," in text else
-                              [text[:8]] + [text[8 + 16 * k:24 + 16 * k] for k in range(4)]
-                              if text[:8].strip().endswith("*") else
-                              [text[8 * k:8 * k + 8] for k in range(9)])
+                    fields = bulk_fields(text)
                     cp = fields[2].strip() if len(fields) > 2 else ""
                     if cp not in ("", "0"):
                         raise MeshError(f"{path}:{number}: GRID in coordinate system CP={cp}: the "

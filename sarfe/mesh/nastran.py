@@ -47,7 +47,7 @@ from .deck import (BeamElements, DeckError, DeckModel, InterpolationElements, Po
 from .nastran_sections import isotropic, shells
 from .nastran_sets import component_mask, loads, sets, supports
 
-__all__ = ["read_nastran", "nastran_deck", "card_line", "card_where", "CONTROL_CARDS",
+__all__ = ["read_nastran", "nastran_deck", "bulk_fields", "card_line", "card_where", "CONTROL_CARDS",
            "MODELLED_CARDS"]
 
 #: cards sarfe turns into the model
@@ -197,6 +197,16 @@ def _pynastran_message(error, path: Path) -> str:
     return f"{where}: {line[:240]}{'…' if len(line) > 240 else ''}"
 
 
+def bulk_fields(text: str) -> list[str]:
+    """The fields of one bulk-data line, unstripped: free format (comma-separated), large
+    (``CARD*``: the name, then 16-character fields) or small (8-character fields)."""
+    if "," in text:
+        return text.split(",")
+    if text[:8].strip().endswith("*"):
+        return [text[:8]] + [text[8 + 16 * k:24 + 16 * k] for k in range(4)]
+    return [text[8 * k:8 * k + 8] for k in range(9)]
+
+
 def card_line(path, card: str, ident) -> tuple[str, int] | None:
     """(file, line number) of the bulk-data card ``card`` with id ``ident`` (its first field)
     in the deck or a file it INCLUDEs, in free (comma), small or large (``CARD*``) field
@@ -210,12 +220,7 @@ def card_line(path, card: str, ident) -> tuple[str, int] | None:
         seen.append(file)
         with open(file, errors="replace") as handle:
             for number, text in enumerate(handle, start=1):
-                if "," in text[:10]:
-                    fields = text.split(",")[:2]
-                elif text[:8].rstrip().endswith("*"):
-                    fields = [text[:8], text[8:24]]
-                else:
-                    fields = [text[:8], text[8:16]]
+                fields = bulk_fields(text)
                 name = fields[0].strip().upper().rstrip("*")
                 if name == card and len(fields) > 1 and fields[1].strip() == ident:
                     return str(file), number
