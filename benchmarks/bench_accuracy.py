@@ -55,7 +55,7 @@ def load_problem(name):
     from sarfe.accuracy.estimates import resize_harmonics
 
     if name.startswith("lumped_chain"):
-        from sarfe.study.lumped import lumped_problem
+        from sarfe.tradeoff.lumped import lumped_problem
 
         p = lumped_problem(3, rattle_dofs=(0, 2), gap=1e-3, penalty_ratio=10.0, zeta=0.02,
                            force=10.0, squeak_dofs=(1,), harmonics=40)
@@ -189,7 +189,7 @@ def cost_scaling(quick=False):
     chains with a rattle contact on every mass: vs H (8 contacts) and vs n_c (H = 5, N = 128)."""
     from sarfe.hbm import SolverOptions, solve_frequency
     from sarfe.accuracy.estimates import resize_harmonics
-    from sarfe.study.lumped import lumped_problem
+    from sarfe.tradeoff.lumped import lumped_problem
 
     options = SolverOptions(stability=False)
     omega = 2 * np.pi * 14.0
@@ -257,7 +257,7 @@ CUTOFF_FACTOR = 3.0     # reference reduction cutoff / the case's (at the case's
 
 
 def shipped_case(name, frequencies_hz, harmonics, samples_per_period, cutoff_hz=None):
-    """Case (sarfe.io.case.Case) of cases/<name>.yaml at the given frequencies, H, N (FE: cutoff)."""
+    """Case (sarfe.case.read.Case) of cases/<name>.yaml at the given frequencies, H, N (FE: cutoff)."""
     from sarfe.pipeline import load_case
 
     data = load_case(ROOT / "cases" / f"{name}.yaml").data
@@ -274,7 +274,7 @@ def shipped_case(name, frequencies_hz, harmonics, samples_per_period, cutoff_hz=
 def solve_setting(case):
     """(stage, nl, solutions) of a case: sarfe's linear stage, nonlinear model and stepped points."""
     from sarfe.pipeline import build_linear_model, nonlinear_model
-    from sarfe.pipeline.points import solve_points
+    from sarfe.pipeline.solve.points import solve_points
 
     stage = build_linear_model(case)
     nl = nonlinear_model(case, stage)
@@ -339,7 +339,7 @@ def true_errors(stage, solution, ref_stage, ref):
 def shipped_solutions(name, spec):
     """Solutions of one shipped case at its own, coarser and reference settings (picklable dict)."""
     from sarfe.pipeline import load_case
-    from sarfe.pipeline.linear import default_cutoff_hz
+    from sarfe.pipeline.model.linear_stage import default_cutoff_hz
 
     base = load_case(ROOT / "cases" / f"{name}.yaml")
     H0, N0 = base.data["solver"]["harmonics"], base.data["solver"]["samples_per_period"]
@@ -369,7 +369,7 @@ def shipped_solutions(name, spec):
 
 def shipped_table(solved):
     """Rows: case, f, setting, estimate (the pipeline's stage_error_estimate), true error."""
-    from sarfe.pipeline.accuracy import stage_error_estimate
+    from sarfe.pipeline.solve.case_accuracy import stage_error_estimate
 
     rows = []
     ref = solved["reference"]

@@ -52,7 +52,7 @@ MESH_M = float(os.environ.get("SARFE_ACC5_MESH_M", "0.005"))
 def p1_case(cutoff_hz, mesh_m=MESH_M):
     """P1 at the listed points with an explicit cutoff (the default rule would take f_max from the
     list, not 80 Hz), H = 15, stability and estimate off (the estimate is called here)."""
-    from sarfe.io.case import load_case
+    from sarfe.case.read import load_case
 
     data = load_case(ROOT / "cases" / "door_trim_p1.yaml").data
     data.pop("case_data", None)
@@ -122,7 +122,7 @@ def system_frequencies_hz(nl):
 
 def solve(label, cutoff_hz, truth=False):
     from sarfe.pipeline import build_linear_model, nonlinear_model
-    from sarfe.pipeline.accuracy import stage_error_estimate
+    from sarfe.pipeline.solve.case_accuracy import stage_error_estimate
 
     STORE.mkdir(parents=True, exist_ok=True)
     case = p1_case(cutoff_hz)

@@ -40,7 +40,7 @@ CUTOFF_AT_H = (5, 10, 20, 40)       # cutoff = 1.5 · H · f (the search's rule 
 
 
 def door_case(solver, reduction=None):
-    from sarfe.io.case import load_case
+    from sarfe.case.read import load_case
 
     data = load_case(ROOT / "cases" / "door_trim.yaml").data
     data.pop("case_data", None)
@@ -61,9 +61,9 @@ def cutoff_study():
     """Rows per (cutoff, H): dBA, dB, iterations, seconds, converged (module docstring, 1)."""
     from sarfe.accuracy.estimates import resize_harmonics
     from sarfe.hbm import SolverOptions, solve_frequency
-    from sarfe.io.case import load_case
+    from sarfe.case.read import load_case
     from sarfe.pipeline import build_linear_model, nonlinear_model
-    from sarfe.pipeline.postprocess import _erp
+    from sarfe.pipeline.post.records import _erp
 
     omega = 2 * np.pi * F_HZ
     options = SolverOptions(stability=False)
@@ -247,7 +247,7 @@ def main():
     # the whole-process runs first: a child forked from a grown parent reports its RSS in ru_maxrss
     res["balanced"] = balanced()
     # (a run with reduction.cutoff_margin 1.0 is now the same run: the search keeps
-    # max(cutoff_margin, 1.5) · H · f_max, sarfe.pipeline.accuracy.rule_cutoff_hz)
+    # max(cutoff_margin, 1.5) · H · f_max, sarfe.pipeline.solve.case_accuracy.rule_cutoff_hz)
     res["cutoffs"] = cutoff_study()
     res["wall_s"] = time.perf_counter() - t0
     write(res)

@@ -17,7 +17,7 @@ Per cutoff c = factor · H · f_max (factors 0.25 … 2.0, f_max = 80 Hz; the de
    and 1/5 of the modes left out, re-solved, extrapolated with the decay fitted from both) at the
    same point, set against the measured change (does it bracket it?);
 5. the split: the point's contact forces λ̃ from the smaller basis, the displacement recovered on
-   the finest basis, ũ_k = Z_k⁻¹ (f̃_k − Gᵀ λ̃_k) (sarfe.hbm.linear.recover_displacement), compared
+   the finest basis, ũ_k = Z_k⁻¹ (f̃_k − Gᵀ λ̃_k) (sarfe.hbm.dynamic_stiffness.recover_displacement), compared
    with the finest in the same measures — "only the recovery and ERP need the high modes".
 
 Usage: python benchmarks/bench_cutoff.py [mesh_mm[:factor,factor,...] ...] (default 10 with all
@@ -47,7 +47,7 @@ BAND_DB = 30.0      # per-harmonic ERP compared where within this of the stronge
 
 
 def door_case(mesh_m, factor):
-    from sarfe.io.case import load_case
+    from sarfe.case.read import load_case
 
     data = load_case(ROOT / "cases" / "door_trim_p1.yaml").data
     data.pop("case_data", None)
@@ -80,7 +80,7 @@ def first_harmonic_rel(R, R_ref):
 
 
 def erp_of(case, stage, U, omega):
-    from sarfe.pipeline.postprocess import _erp
+    from sarfe.pipeline.post.records import _erp
 
     erp, W = _erp(case.config.erp, stage, U, omega)
     return erp, W
@@ -110,7 +110,7 @@ def compare(case, stage, U, U_ref, s, s_ref, omega):
 def modal_estimate(stage, nl, solution):
     """The per-point estimate's modal part (4)–(5): (modal_rel, modal_db, seconds) or NaNs."""
     from sarfe.accuracy.estimates import _first_harmonic_amplitude, modal_truncation_estimate
-    from sarfe.pipeline.accuracy import accuracy_problem
+    from sarfe.pipeline.solve.case_accuracy import accuracy_problem
 
     problem = accuracy_problem(stage, nl)
     clock = time.perf_counter()
@@ -145,7 +145,7 @@ def solve_points(nl, frequencies_hz):
 
 
 def study(mesh_m, factors=FACTORS):
-    from sarfe.hbm.linear import condense, recover_displacement
+    from sarfe.hbm.dynamic_stiffness import condense, recover_displacement
     from sarfe.pipeline import build_linear_model, nonlinear_model
 
     stages = {}

@@ -93,7 +93,7 @@ def write_msh(path: pathlib.Path):
 _NASTRAN = """
 import resource, time, json, sys
 start = time.perf_counter()
-from sarfe.mesh.nastran import read_nastran
+from sarfe.mesh.formats.nastran import read_nastran
 from sarfe.fe.deck_assembly import assemble_deck
 deck = read_nastran(sys.argv[1])
 read = time.perf_counter() - start

@@ -1,6 +1,6 @@
 """Linear stage of the door trim through the deck path against the generator path.
 
-The door trim at 10 mm is written as a Nastran deck in mm-t-s (sarfe.mesh.nastran_writer: CQUAD4 /
+The door trim at 10 mm is written as a Nastran deck in mm-t-s (sarfe.mesh.formats.nastran_writer: CQUAD4 /
 CTRIA3, PSHELL, MAT1, rigid clips as RBE2 + stiff CBUSH + CONM2, SPC1, SET1). Each path runs in a
 fresh Python process (peak memory ru_maxrss is that path's alone): the generator case (mesh from the
 cache, shell K, M, Craig–Bampton) and the deck case (pyNastran read, checks, deck assembly,
@@ -61,7 +61,7 @@ def main(argv=None):
         return
     from sarfe.mesh.cache import cached_mesh
     import test_pipeline_deck_door as door
-    from sarfe.mesh.nastran_writer import ShellProperty, write_panel_deck
+    from sarfe.mesh.formats.nastran_writer import ShellProperty, write_panel_deck
 
     directory = tempfile.mkdtemp(prefix="bench_deck_")
     mesh = cached_mesh("door_trim", args.size)

@@ -118,7 +118,7 @@ P4_FREQUENCIES = [60.0, 67.0, 80.0]   # f_max 80 Hz: the P1 cutoff (1.5 · H · 
 
 def p1_case(mesh_m=None, frequencies=None, harmonics=None, spots=None):
     """cases/door_trim_p1.yaml as data (read as sarfe reads it), optionally changed."""
-    from sarfe.io.case import read_yaml
+    from sarfe.case.read import read_yaml
 
     case = read_yaml(P1_CASE)[0]
     gen = case["model"]["fe"]["generator"]
@@ -258,7 +258,7 @@ def audible():
 def hbm_vs_time():
     from sarfe.hbm.time_integration import integrate_time
     from sarfe.pipeline import build_linear_model, load_case, nonlinear_model
-    from sarfe.pipeline.points import solve_point, solver_options
+    from sarfe.pipeline.solve.points import solve_point, solver_options
 
     case = load_case(ROOT / "cases" / "rattle_rig.yaml")
     stage = build_linear_model(case, progress=False)

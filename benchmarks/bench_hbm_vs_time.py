@@ -27,7 +27,7 @@ the fine step with Richardson extrapolation (2 × step) is the reference when th
 orbit is within ``confirm``/2 of it; otherwise the point is excluded. Points whose reference orbit
 never touches a contact are linear: HBM gives the exact solution there and no check is run.
 
-HBM as a user runs it: the pipeline's per-frequency path (``sarfe.pipeline.points.solve_point``,
+HBM as a user runs it: the pipeline's per-frequency path (``sarfe.pipeline.solve.points.solve_point``,
 each point warm-started from the previous converged one, the case's solver settings), over a
 scan of (H, N); timed without stability (``bare``), and the chosen setting again with the default
 Hill stability and with ``stability_method='condensed'``. The pseudo-arclength sweep
@@ -156,7 +156,7 @@ class Metrics:
 
     def level(self, U, omega):
         """(total ERP level [dB], A-weighted [dB(A)])."""
-        from sarfe.pipeline.postprocess import _erp
+        from sarfe.pipeline.post.records import _erp
 
         result = _erp(self.erp_config, self.stage, U, omega)[0]
         return float(result.level_total_db), float(result.level_total_a_db)
@@ -270,7 +270,7 @@ def reference_point(cfg, nlr, metrics, omega, s, previous_U, settle, options):
 
 # ------------------------------------------------------------------------------ methods
 def hbm_sweep(case, nl, freqs, H, N, stability, method="auto"):
-    from sarfe.pipeline.points import solve_point, solver_options, TIME_INTEGRATION
+    from sarfe.pipeline.solve.points import solve_point, solver_options, TIME_INTEGRATION
 
     options, _ = solver_options(case.config.solver)
     options = dataclasses.replace(options, stability=stability, stability_method=method)
@@ -286,7 +286,7 @@ def hbm_sweep(case, nl, freqs, H, N, stability, method="auto"):
 
 def hbm_continuation(case, nl, band, H, N):
     from sarfe.hbm import continuation
-    from sarfe.pipeline.points import solver_options
+    from sarfe.pipeline.solve.points import solver_options
 
     options, cont = solver_options(case.config.solver)
     cont = dataclasses.replace(cont, solver=dataclasses.replace(options, stability=False))

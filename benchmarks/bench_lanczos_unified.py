@@ -51,8 +51,8 @@ def _worker(tree, model, path_kind, variant):
     """In a fresh process: build the model's linear stage with ``tree``'s sarfe; print JSON."""
     sys.path.insert(0, tree)
     cb = importlib.import_module("sarfe.reduction.craig_bampton")
-    from sarfe.io.case import load_case, read_yaml
-    from sarfe.pipeline.linear import build_linear_model
+    from sarfe.case.read import load_case, read_yaml
+    from sarfe.pipeline.model.linear_stage import build_linear_model
 
     captured = {}
     craig_bampton = cb.craig_bampton

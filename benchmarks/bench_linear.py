@@ -208,7 +208,7 @@ def run_p1():
     spectrum-slicing record and the frequencies."""
     import threading
 
-    from sarfe.pipeline.linear import build_linear_model
+    from sarfe.pipeline.model.linear_stage import build_linear_model
 
     peak = {"rss": 0.0, "pss": 0.0, "pss_self": 0.0, "files": 0.0, "files_max": 0.0}
     stop = threading.Event()
@@ -247,7 +247,7 @@ def p1_lines(p1, memory=None):
     """linear.md's section on the P1 linear stage (one core vs two; rows 3+ carry a ``note``) and,
     with ``memory`` (linear.json "p1_memory"), what is alive at the two-process peak."""
     lines = ["", f"## P1 linear stage (issue 15): door trim 5 mm, cutoff {p1[0]['cutoff_hz'] / 1e3:.2f} kHz, one core vs two", "",
-             "`sarfe.pipeline.linear.build_linear_model(cases/door_trim_p1.yaml)` in a fresh process "
+             "`sarfe.pipeline.model.linear_stage.build_linear_model(cases/door_trim_p1.yaml)` in a fresh process "
              "(mesh from the cache), pinned to one core with taskset or free on two; MKL/OpenBLAS one "
              "thread per process. CPU = this process + the slicing worker. Peak memory of the process "
              "tree sampled every 0.1 s: RSS summed (counts pages shared by the two processes twice) "

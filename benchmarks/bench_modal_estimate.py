@@ -40,7 +40,7 @@ DEMO_HZ = (40.0, 52.0, 67.0, 80.0)
 def probes(stage, nl, solution):
     """Raw change of each probe: {fraction: {rel, db, removed, m, probe_hz, s}}."""
     from sarfe.accuracy.estimates import _first_harmonic_amplitude, modal_truncation_change
-    from sarfe.pipeline.accuracy import accuracy_problem
+    from sarfe.pipeline.solve.case_accuracy import accuracy_problem
 
     problem = accuracy_problem(stage, nl)
     a_ref = np.max(_first_harmonic_amplitude(problem.contacts, solution.displacement),
@@ -84,7 +84,7 @@ def p1_points(mm, factors=(1.0, 0.75)):
 def demo_points():
     import bench_cutoff as bc
     from sarfe.hbm import SolverOptions, solve_frequency
-    from sarfe.io.case import load_case
+    from sarfe.case.read import load_case
     from sarfe.pipeline import build_linear_model, nonlinear_model
 
     solved = {}

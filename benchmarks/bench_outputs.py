@@ -95,8 +95,8 @@ def child(points, repeats, workdir):
 
     import sarfe
     from sarfe.erp import equivalent_radiated_power, nodal_areas
-    from sarfe.io import outputs
-    from sarfe.io.outputs.vtk import contact_point_values
+    from sarfe import results as outputs
+    from sarfe.results.vtk import contact_point_values
     from sarfe.mesh.cache import cached_mesh
 
     mesh = cached_mesh("door_trim", 0.005, rattle_spots=8, squeak_spots=4)
@@ -201,7 +201,7 @@ def whole_case(points) -> dict:
 def whole_child(case_path, out):
     """Solve the case, timing ``write_outputs`` (wall, CPU of this process and of its waited
     children); prints one JSON line."""
-    import sarfe.pipeline.solve as solve
+    import sarfe.pipeline.run as solve
     from sarfe.pipeline import load_case, solve_case
 
     write_outputs, record = solve.write_outputs, {}
@@ -288,9 +288,9 @@ def compare_results(a, b) -> dict:
 def records_child(case_path, out):
     """Solve ``case_path`` with ``solver.workers: 1`` timing the point records and the writers
     (CPU of this process: with one worker everything runs here); prints one JSON line."""
-    import sarfe.io.outputs as io_outputs
-    import sarfe.pipeline.solve as solve
-    from sarfe.io.case import read_yaml
+    import sarfe.results as io_outputs
+    import sarfe.pipeline.run as solve
+    from sarfe.case.read import read_yaml
     from sarfe.pipeline import load_case, solve_case
 
     record = {}

@@ -145,11 +145,11 @@ def chain_point_cost(pairs, harmonics, points=5, repeat=3):
 
 def condensation_paths(directory, mesh_size=0.010):
     """Section 3 of the module docstring."""
-    import sarfe.hbm.linear as linear
+    import sarfe.hbm.dynamic_stiffness as linear
     from sarfe.hbm.modal import modal_basis
     from sarfe.pipeline import load_case
-    from sarfe.pipeline.linear import build_linear_model
-    from sarfe.pipeline.nonlinear import nonlinear_model
+    from sarfe.pipeline.model.linear_stage import build_linear_model
+    from sarfe.pipeline.model.nonlinear_model import nonlinear_model
 
     case = load_case(door_case(mesh_size, directory))
     nl = nonlinear_model(case, build_linear_model(case))
@@ -194,14 +194,14 @@ def condensation_paths(directory, mesh_size=0.010):
 def door_sweep_cost(directory, mesh_size=0.015, harmonics=15, points=20):
     """Section 4 of the module docstring."""
     from sarfe.hbm.residual import Problem, full_residual
-    from sarfe.hbm.stability_condensed import condensed_stability
-    from sarfe.hbm.stability_contacts import ContactOperator
-    from sarfe.hbm.stability_rows import contact_row_stability
-    from sarfe.io.case import read_yaml
+    from sarfe.hbm.stability.condensed import condensed_stability
+    from sarfe.hbm.stability.contact_terms import ContactOperator
+    from sarfe.hbm.stability.rows import contact_row_stability
+    from sarfe.case.read import read_yaml
     from sarfe.pipeline import load_case
-    from sarfe.pipeline.linear import build_linear_model
-    from sarfe.pipeline.nonlinear import nonlinear_model
-    from sarfe.pipeline.solve import solve_case
+    from sarfe.pipeline.model.linear_stage import build_linear_model
+    from sarfe.pipeline.model.nonlinear_model import nonlinear_model
+    from sarfe.pipeline.run import solve_case
 
     data = read_yaml(door_case(mesh_size, directory))[0]
     data["excitation"].pop("frequency_hz")

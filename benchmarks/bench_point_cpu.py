@@ -29,7 +29,7 @@ import tempfile
 HERE = pathlib.Path(__file__).resolve().parent
 NOTES = "## Where the CPU goes (cProfile, hand-written)"
 
-STAGES = {        # stage name: (module, function) wrapped in sarfe.pipeline.solve's namespace
+STAGES = {        # stage name: (module, function) wrapped in sarfe.pipeline.run's namespace
     "sweep": "solve_points_pruned",
     "error estimates": "error_estimates",
     "point records": "point_records",
@@ -38,8 +38,8 @@ STAGES = {        # stage name: (module, function) wrapped in sarfe.pipeline.sol
 
 CHILD = r"""
 import json, pickle, sys, time
-import sarfe.pipeline.solve as S
-import sarfe.io.outputs as O
+import sarfe.pipeline.run as S
+import sarfe.results as O
 cpu = {}
 def timed(name, f):
     def run(*a, **k):
@@ -75,8 +75,8 @@ def run_tree(tree, case, stage, output):
 def build(case, stage):
     import pickle
 
-    from sarfe.io.case import load_case
-    from sarfe.pipeline.linear import build_linear_model
+    from sarfe.case.read import load_case
+    from sarfe.pipeline.model.linear_stage import build_linear_model
 
     with open(stage, "wb") as f:
         pickle.dump(build_linear_model(load_case(case)), f, protocol=5)

@@ -79,9 +79,9 @@ def without_stability(case):
 
 def hbm_cpu(case, stage, prune, repeats):
     """Best-of-``repeats`` CPU time [s] of the frequency points alone (screening, HBM, check and
-    restore: :func:`sarfe.pipeline.pruning.solve_points_pruned`)."""
-    from sarfe.pipeline.nonlinear import nonlinear_model
-    from sarfe.pipeline.pruning import solve_points_pruned
+    restore: :func:`sarfe.pipeline.solve.pruned_points.solve_points_pruned`)."""
+    from sarfe.pipeline.model.nonlinear_model import nonlinear_model
+    from sarfe.pipeline.solve.pruned_points import solve_points_pruned
 
     data = copy.deepcopy(case.data)
     data["solver"]["prune_contacts"] = prune
@@ -128,7 +128,7 @@ def compare(case, stage=None, repeats=0):
 
 
 def door_trim_p1(mesh_m):
-    from sarfe.io.case import read_yaml
+    from sarfe.case.read import read_yaml
 
     data = read_yaml(CASES / "door_trim_p1.yaml")[0]
     data["model"]["fe"]["generator"]["mesh_size_m"] = mesh_m
@@ -153,8 +153,8 @@ def screen_row(case, repeats=3):
     import scipy.sparse as sp
 
     import sarfe.hbm.pruning as pruning
-    from sarfe.pipeline.nonlinear import nonlinear_model
-    from sarfe.pipeline.pruning import pruning_options, screening_frequencies
+    from sarfe.pipeline.model.nonlinear_model import nonlinear_model
+    from sarfe.pipeline.solve.pruned_points import pruning_options, screening_frequencies
 
     start = time.perf_counter()
     with warnings.catch_warnings():

@@ -4,28 +4,28 @@
 Door trim (cases/door_trim.yaml) at a 10 mm mesh, H = 5, N = 64, points at 40/52/67/80/95 Hz solved
 without stability; then per point (a) the frozen full Hill problem as main had it (ARPACK
 shift-invert for the exponents nearest 0 of the 2(2H+1)n-order matrix) and (b) the condensed
-method (:mod:`sarfe.hbm.stability_condensed`: Hill on a bounded Ritz basis). Verdicts and leading exponents side by side. Also the squeak rig (H = 3, N = 128):
+method (:mod:`sarfe.hbm.stability.condensed`: Hill on a bounded Ritz basis). Verdicts and leading exponents side by side. Also the squeak rig (H = 3, N = 128):
 full (with the friction-memory refinement) vs condensed.
 
 Section "contact rows" (``--rows``, issue 15 P1): the contact-row count
-(:mod:`sarfe.hbm.stability_rows`, the default above 3000 Hill rows) per point of the P1 door trim
+(:mod:`sarfe.hbm.stability.rows`, the default above 3000 Hill rows) per point of the P1 door trim
 (cases/door_trim_p1.yaml: 12 pairs, H = 15) at a 15 mm mesh, 60 → 65 Hz, continuation step 0.04:
 the sweep solved without stability, then per point the count's CPU time, its det F evaluations
 and the LU order (2H+1)|R|; the verdict of every point. → results/stability_rows.json.
 
 Section "sweep" (``--sweep``, issue 15 P1, session hilltrack): the whole P1 sweep at 15 mm
 (cases/door_trim_p1.yaml, 40 → 80 Hz, its own continuation: ≈ 206 points) solved with the default
-options, Hill stability deferred (:mod:`sarfe.hbm.deferred`) and then computed per point in this
+options, Hill stability deferred (:mod:`sarfe.hbm.stability.deferred`) and then computed per point in this
 process as the workers compute it (``stability_of``): per point the CPU time, the det F
 evaluations of the count (contour) and of the real-zero search, the path (zeros counted, Ritz
 hand-over), verdict and leading exponent. → results/stability_sweep.json (its verdicts are what
 a before/after comparison checks: ``--compare OLD.json NEW.json``).
 
 Section "truth" (``--truth``, session hilltrust): the verdicts against the time integrator's
-monodromy (:func:`sarfe.hbm.stability_check.perturbation_check`) over the whole sweep of
+monodromy (:func:`sarfe.hbm.stability.perturbation.perturbation_check`) over the whole sweep of
 cases/rattle_rig.yaml (H = 10, N = 256, defaults): per point the full Hill method, the contact-row
 count at H alone and the default (``auto``: the count checked at ⌊3H/4⌋,
-:mod:`sarfe.hbm.stability_trust`) with their CPU times; the integrator at 1024 steps per period on
+:mod:`sarfe.hbm.stability.trust`) with their CPU times; the integrator at 1024 steps per period on
 every point where full and count differ plus every 6th other one, at 2048 steps where its
 verdict disagrees with the count or the default label (and where an earlier run left one), and
 at 4096 where both disagree with the default label. An
@@ -35,7 +35,7 @@ kept in results/stability_truth.json and reused by reruns (keyed by frequency an
 
 Section "zeros" (``--zeros POINTS.pkl``, session hillzeros): on captured orbits
 (benchmarks/stability_counts.py capture) the points where the count finds two or more exponents
-right of −ε: the default verdict with the zeros located (sarfe/hbm/stability_zeros.py) and its
+right of −ε: the default verdict with the zeros located (sarfe/hbm/stability/zeros.py) and its
 CPU, the Ritz hand-over it replaces, and the full nonlinear Hill problem on all reduced DOFs
 started at the located leading exponent. → results/stability_zeros.json.
 
@@ -57,11 +57,11 @@ import yaml  # noqa: E402
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 from sarfe.hbm.residual import Problem, full_residual  # noqa: E402
 from sarfe.hbm.solve import contact_damping  # noqa: E402
-from sarfe.hbm.stability import hill_stability  # noqa: E402
-from sarfe.hbm.stability_condensed import condensed_stability  # noqa: E402
-from sarfe.hbm.stability_contacts import ContactOperator  # noqa: E402
+from sarfe.hbm.stability.hill import hill_stability  # noqa: E402
+from sarfe.hbm.stability.condensed import condensed_stability  # noqa: E402
+from sarfe.hbm.stability.contact_terms import ContactOperator  # noqa: E402
 from sarfe.pipeline import build_linear_model, load_case, nonlinear_model  # noqa: E402
-from sarfe.pipeline.points import solve_point, solver_options  # noqa: E402
+from sarfe.pipeline.solve.points import solve_point, solver_options  # noqa: E402
 
 HERE = pathlib.Path(__file__).resolve().parent
 ROOT = HERE.parent
@@ -127,10 +127,10 @@ def compare(label, path, frequencies, full=True, **settings):
 
 def rows_cost(path="cases/door_trim_p1.yaml", mesh=0.015, band=(60.0, 65.0)):
     """Per point of a P1 sweep: CPU s of contact_row_stability, det F evaluations, LU order."""
-    import sarfe.hbm.stability_rows as rows_module
+    import sarfe.hbm.stability.rows as rows_module
     from sarfe.hbm import continuation
     from sarfe.hbm.modal import cached_modal_basis
-    from sarfe.pipeline.points import solver_options
+    from sarfe.pipeline.solve.points import solver_options
 
     case = case_at(path, mesh, sweep={"start_hz": band[0], "end_hz": band[1]},
                    solver={"continuation": {"initial_step": 0.04, "max_step": 0.04}})
@@ -177,9 +177,9 @@ def sweep_cost(path="cases/door_trim_p1.yaml", mesh=0.015):
     """Per point of the whole P1 sweep at ``mesh``: the deferred Hill stability computed serially,
     with its det F evaluations by phase (module docstring)."""
     import sarfe.hbm.solve as solve_module
-    import sarfe.hbm.stability_rows as rows_module
-    from sarfe.hbm.deferred import deferred_stability, pending, stability_of
-    from sarfe.pipeline.pruning import solve_points_pruned
+    import sarfe.hbm.stability.rows as rows_module
+    from sarfe.hbm.stability.deferred import deferred_stability, pending, stability_of
+    from sarfe.pipeline.solve.pruned_points import solve_points_pruned
 
     case = case_at(path, mesh, solver={"stability": True})
     nl = nonlinear_model(case, build_linear_model(case, progress=False))
@@ -339,9 +339,9 @@ TRUTH_PERIODICITY = 1e-3     # shooting residual above which the integrator's ve
 def truth_study(path="cases/rattle_rig.yaml", every=6):
     """The rattle rig's sweep with the default options (stability deferred), then per point the
     labels of three stability paths and, on the selected points, the integrator's verdict."""
-    from sarfe.hbm.deferred import deferred_stability, stability_of
-    from sarfe.hbm.stability_check import perturbation_check
-    from sarfe.pipeline.pruning import solve_points_pruned
+    from sarfe.hbm.stability.deferred import deferred_stability, stability_of
+    from sarfe.hbm.stability.perturbation import perturbation_check
+    from sarfe.pipeline.solve.pruned_points import solve_points_pruned
     from dataclasses import replace
 
     case = case_at(path, solver={"stability": True})
@@ -412,8 +412,8 @@ def truth_study_nlvib03():
     integrator at 1024 and 2048 steps per period on every point (2 DOFs: cheap)."""
     from dataclasses import replace
     from sarfe.hbm import ContinuationOptions, continuation
-    from sarfe.hbm.deferred import deferred_stability, stability_of
-    from sarfe.hbm.stability_check import perturbation_check
+    from sarfe.hbm.stability.deferred import deferred_stability, stability_of
+    from sarfe.hbm.stability.perturbation import perturbation_check
     import sarfe.hbm.solve as trust     # (its bound name 'checked' is patched)
     sys.path.insert(0, str(ROOT))
     from tests.hbm.test_solver import H03, N03, example03
@@ -470,7 +470,7 @@ def truth_lines(res):
              f"row(s), {len(pts)} points (load average {res['load_average']:.1f} at the end). "
              "full: the Hill eigenproblem on all reduced DOFs (2n smallest |Im s| + the strip); "
              "count: the contact-row count at H (Ritz method where it finds ≥ 2 zeros), no check; "
-             "auto: the default — the count checked at ⌊3H/4⌋ (sarfe/hbm/stability_trust.py). "
+             "auto: the default — the count checked at ⌊3H/4⌋ (sarfe/hbm/stability/trust.py). "
              "TI: the integrator's monodromy (perturbation_check) at 1024 steps per period, "
              "2048 where it disagrees with count or auto (or cached), 4096 where both disagree "
              "with auto; 'n.c.': "
@@ -536,7 +536,7 @@ ZEROS_HEADER = "## Two or more zeros right of −ε, located (issue 15 P1, sessi
 def zeros_study(points_paths):
     """Per captured point (benchmarks/stability_counts.py capture) where the count finds two or
     more exponents right of −ε: the default verdict (the zeros located,
-    sarfe/hbm/stability_zeros.py) and its CPU, the same with the locator stubbed to fail (the
+    sarfe/hbm/stability/zeros.py) and its CPU, the same with the locator stubbed to fail (the
     Ritz method of the hand-over, as before), and the full nonlinear Hill problem on all reduced
     DOFs started at the located leading exponent (refine_exponent: the full method's own secant
     iteration on T(s); its ARPACK selection, the exponents nearest 0, misses a pair near
@@ -545,11 +545,11 @@ def zeros_study(points_paths):
     import types
     import scipy.sparse as sp
     import sarfe.hbm.solve as solve_module
-    import sarfe.hbm.stability_rows as rows_module
+    import sarfe.hbm.stability.rows as rows_module
     from sarfe.hbm.aft import jacobian_matrix
-    from sarfe.hbm.linear import dynamic_stiffness_matrix
-    from sarfe.hbm.stability import _hill, refine_exponent
-    from sarfe.hbm.stability_trust import check_harmonics
+    from sarfe.hbm.dynamic_stiffness import dynamic_stiffness_matrix
+    from sarfe.hbm.stability.hill import _hill, refine_exponent
+    from sarfe.hbm.stability.trust import check_harmonics
 
     records = []
     for path in points_paths:
@@ -667,7 +667,7 @@ def main():
              "plus the friction-memory refinement of the leading exponents). "
              "Condensed: the same Hill problem on a Ritz basis of the averaged linearization's modes "
              "up to 2(H+1)ω (10 … 40) + the contacts' static responses, friction memory included "
-             "(sarfe/hbm/stability_condensed.py).", ""]
+             "(sarfe/hbm/stability/condensed.py).", ""]
     for res in results:
         lines += [f"## {res['case']}: {res['reduced_dofs']} reduced DOFs, {res['contact_rows']} "
                   f"contact rows, H = {res['H']}, N = {res['N']}", "",

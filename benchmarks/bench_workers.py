@@ -37,7 +37,7 @@ def one_run(case_path, workers, band, out):
     import threading
 
     sys.path.insert(0, str(ROOT))
-    from sarfe.io.case import load_case, read_yaml
+    from sarfe.case.read import load_case, read_yaml
     from sarfe.pipeline import solve_case
 
     data = read_yaml(case_path)[0]

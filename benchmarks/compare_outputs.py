@@ -35,7 +35,9 @@ import sys
 import numpy as np
 
 SKIP_KEYS = {"timings_s", "created_utc", "sarfe_version", "case_file",
-             "seconds"}       # (error_estimate.seconds: the estimate's own wall time)
+             "seconds",       # (error_estimate.seconds: the estimate's own wall time)
+             "workers"}       # how the run was scheduled (processes, points finished during
+                              # the sweep): depends on the machine's load, not a result
 ABSOLUTE_KEYS = {"superposition_error"}     # round-off quantities: |a − b| ≤ rtol
 SKIP_ATTRS = {"created_utc", "sarfe_version"}
 

@@ -28,7 +28,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 def capture(case_path, out):
     import sarfe.hbm.solve as solve_module
     from sarfe.pipeline import load_case
-    from sarfe.pipeline.solve import solve_case
+    from sarfe.pipeline.run import solve_case
 
     records, original = [], solve_module.stability
 
@@ -46,9 +46,9 @@ def capture(case_path, out):
 def evaluate(points_path, out):
     import numpy as np
     import sarfe.hbm.solve as solve_module
-    import sarfe.hbm.stability_rows as rows
-    import sarfe.hbm.stability_trust as trust
-    from sarfe.hbm.stability_contacts import ContactOperator
+    import sarfe.hbm.stability.rows as rows
+    import sarfe.hbm.stability.trust as trust
+    from sarfe.hbm.stability.contact_terms import ContactOperator
 
     with open(points_path, "rb") as f:
         records = pickle.load(f)

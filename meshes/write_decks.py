@@ -2,9 +2,9 @@
 
     meshes/rattle_rig_deck.bdf   rattle rig, 10 mm, default parameters (cases/rattle_rig_deck.yaml)
 
-The deck is the generator's model as an engineer's deck (sarfe.mesh.nastran_writer): CQUAD4 /
+The deck is the generator's model as an engineer's deck (sarfe.mesh.formats.nastran_writer): CQUAD4 /
 CTRIA3, PSHELL + MAT1 per part, SPC1 on the clamped edges, SET1 for the contact and load nodes,
-in mm-t-s. `tests/test_pipeline_deck_rig.py` checks that the file equals a fresh write and that
+in mm-t-s. `tests/pipeline/model/test_deck_rig.py` checks that the file equals a fresh write and that
 the deck case solves to the generator case's ERP.
 
 Usage:  python meshes/write_decks.py
@@ -14,7 +14,7 @@ from __future__ import annotations
 import pathlib
 
 from sarfe.mesh.generators import rattle_rig
-from sarfe.mesh.nastran_writer import ShellProperty, write_panel_deck
+from sarfe.mesh.formats.nastran_writer import ShellProperty, write_panel_deck
 
 HERE = pathlib.Path(__file__).resolve().parent
 ABS = (2.2e9, 0.37, 1050.0)

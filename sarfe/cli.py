@@ -3,7 +3,7 @@
 Exit codes: 0 success; 2 a problem in the case file (one line on stderr naming the key, no
 traceback unless ``--debug``); 3 the run finished but some frequency point did not converge (see
 summary.json ``non_converged_points``); 1 an unexpected internal error; 130 interrupted.
-Subcommands from ``sarfe.study.cli`` / ``sarfe.batch.cli`` (a ``register(subparsers)`` function) are
+Subcommands from ``sarfe.tradeoff.cli`` / ``sarfe.batch.cli`` (a ``register(subparsers)`` function) are
 added when those modules exist.
 """
 from __future__ import annotations
@@ -15,9 +15,9 @@ import time
 import traceback
 
 from sarfe import __version__
-from sarfe.io.errors import EXIT_CASE_ERROR, EXIT_NOT_CONVERGED, CaseError
+from sarfe.case.errors import EXIT_CASE_ERROR, EXIT_NOT_CONVERGED, CaseError
 
-EXTENSION_MODULES = ("sarfe.study.cli", "sarfe.batch.cli")
+EXTENSION_MODULES = ("sarfe.tradeoff.cli", "sarfe.batch.cli")
 
 
 def _say(args, text):
@@ -30,9 +30,9 @@ def _warn(line):
 
 
 def cmd_solve(args) -> int:
-    from sarfe.io.outputs.summary import loudest_lines, pruning_line, stability_line
+    from sarfe.results.summary import loudest_lines, pruning_line, stability_line
     from sarfe.pipeline import load_case, results_table, solve_case
-    from sarfe.pipeline.checks import output_target
+    from sarfe.pipeline.checks.case_checks import output_target
 
     case = load_case(args.case)
     output_target(case, args.output, args.force)   # before any work (solve_case checks it all)
@@ -71,9 +71,9 @@ def cmd_solve(args) -> int:
 
 
 def cmd_validate(args) -> int:
-    """Every check `solve` makes before the heavy work (sarfe.pipeline.checks); warnings on stderr."""
+    """Every check `solve` makes before the heavy work (sarfe.pipeline.checks.case_checks); warnings on stderr."""
     from sarfe.pipeline import load_case
-    from sarfe.pipeline.checks import check_case
+    from sarfe.pipeline.checks.case_checks import check_case
 
     case = load_case(args.case)
     checked = check_case(case, output_dir=args.output, force=args.force)
@@ -98,11 +98,11 @@ def cmd_validate(args) -> int:
 def cmd_verify(args) -> int:
     """Time integration of one point against the harmonic balance: every harmonic up to H, contact
     and largest-DOF amplitudes, ERP total and dB(A), and the stability verdict (a perturbation of
-    the HBM orbit decays or grows), each with its tolerance (:mod:`sarfe.pipeline.verify`)."""
+    the HBM orbit decays or grows), each with its tolerance (:mod:`sarfe.pipeline.solve.verify`)."""
     import numpy as np
 
     from sarfe.pipeline import build_linear_model, load_case, nonlinear_model
-    from sarfe.pipeline.verify import format_rows, verify_point
+    from sarfe.pipeline.solve.verify import format_rows, verify_point
 
     if not args.frequency_hz > 0:
         raise CaseError(f"--frequency-hz must be > 0, got {args.frequency_hz}", source=args.case)

@@ -1,14 +1,15 @@
 """Layers point one way: a lower layer of sarfe never imports a higher one (issue 12).
 
-Order: lazy (package exports on first use), workers (process pool, imports no sarfe) < mesh < fe < reduction < hbm < erp (risk) < io, accuracy < pipeline < study, batch, cli. Every module's
+Order: util, linalg < mesh < fe < reduction < hbm < erp < accuracy, case, results < pipeline < tradeoff, batch, cli. Every module's
 imports — module level and inside functions — are read with ``ast`` (relative imports resolved).
 """
 import ast
 from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parents[1] / "sarfe"
-LAYERS = {"lazy": 0, "workers": 0, "mesh": 0, "fe": 1, "reduction": 2, "hbm": 3, "erp": 4, "risk": 4, "io": 5,
-          "accuracy": 5, "pipeline": 6, "study": 7, "batch": 7, "cli": 7, "__main__": 7}
+LAYERS = {"util": 0, "linalg": 0, "mesh": 0, "fe": 1, "reduction": 2, "hbm": 3, "erp": 4,
+          "accuracy": 5, "case": 5, "results": 5, "pipeline": 6, "tradeoff": 7, "batch": 7,
+          "cli": 7, "__main__": 7}
 
 
 def _imports(path):
@@ -55,7 +56,7 @@ def test_every_part_has_a_layer():
 
 
 def test_import_reader_sees_relative_and_local_imports(tmp_path):
-    assert "laws" not in LAYERS and "hbm" in _imports(PACKAGE / "pipeline" / "nonlinear.py")
+    assert "laws" not in LAYERS and "hbm" in _imports(PACKAGE / "pipeline" / "model" / "nonlinear_model.py")
     assert _imports(PACKAGE / "hbm" / "aft.py") == {"hbm"}
 
 
@@ -65,7 +66,7 @@ def test_no_upward_imports():
 
 
 def test_fe_does_not_import_reduction():
-    """fe's modal analysis factorizes K − σM with sarfe.fe.linear_solvers (moved below fe)."""
+    """fe's modal analysis factorizes K − σM with sarfe.linalg (moved below fe)."""
     bad = [v for v in _violations() if v[:2] == ("fe", "reduction")]
     assert not bad, "\n".join(f"{s} imports {t}: {f}" for s, t, f in bad)
 

@@ -1,6 +1,6 @@
 """A run imports only what its case needs (issue 13, performance): starting ``sarfe`` and reading
 a case load none of the heavy libraries; a solve that writes no figure, report or HDF5 file never
-imports matplotlib, jinja2 or h5py (they load on first use, :mod:`sarfe.lazy`)."""
+imports matplotlib, jinja2 or h5py (they load on first use, :mod:`sarfe.util.lazy`)."""
 import json
 import subprocess
 import sys

@@ -18,15 +18,15 @@ import time
 START = time.process_time()          # CPU of the interpreter start-up so far
 
 STAGES = {   # reported name: (module, function), inclusive of what it calls
-    "sweep (continuation, all points)": ("sarfe.pipeline.pruning", "solve_points_pruned"),
+    "sweep (continuation, all points)": ("sarfe.pipeline.solve.pruned_points", "solve_points_pruned"),
     "  of which Hill stability": ("sarfe.hbm.solve", "stability"),
-    "error estimates": ("sarfe.pipeline.postprocess", "error_estimates"),
-    "point records (ERP, baseline, contributions)": ("sarfe.pipeline.postprocess", "point_record"),
-    "figures (incl. matplotlib import)": ("sarfe.pipeline.figures", "point_figures"),
-    "report.html": ("sarfe.io.outputs.report", "write_report_html"),
-    "response.h5 (incl. h5py import)": ("sarfe.io.outputs.response_h5", "write_response_h5"),
-    "summary.json": ("sarfe.io.outputs.summary", "write_summary_json"),
-    "solve_case (all stages)": ("sarfe.pipeline.solve", "solve_case"),
+    "error estimates": ("sarfe.pipeline.post.records", "error_estimates"),
+    "point records (ERP, baseline, contributions)": ("sarfe.pipeline.post.records", "point_record"),
+    "figures (incl. matplotlib import)": ("sarfe.pipeline.write.figures", "point_figures"),
+    "report.html": ("sarfe.results.report", "write_report_html"),
+    "response.h5 (incl. h5py import)": ("sarfe.results.response_h5", "write_response_h5"),
+    "summary.json": ("sarfe.results.summary", "write_summary_json"),
+    "solve_case (all stages)": ("sarfe.pipeline.run", "solve_case"),
 }
 
 
@@ -35,7 +35,7 @@ def main(argv):
     clock = time.process_time()
     import sarfe.cli as cli
     import sarfe.pipeline                                          # noqa: F401
-    import sarfe.pipeline.checks                                   # noqa: F401
+    import sarfe.pipeline.checks.case_checks                                   # noqa: F401
     seconds["imports"] = time.process_time() - clock
 
     def timed(name, function):

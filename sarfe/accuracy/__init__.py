@@ -3,9 +3,9 @@ case layer (plain arrays in, numbers out).
 
 Modules: estimates (a-posteriori error estimates of one solution, the adaptive choice of H, N at
 one frequency, the mode-count rule), resolve (a sweep's accuracy target → H, N, mode count).
-Exports load on first use (:mod:`sarfe.lazy`).
+Exports load on first use (:mod:`sarfe.util.lazy`).
 """
-from sarfe.lazy import lazy_exports
+from sarfe.util.lazy import lazy_exports
 
 _EXPORTS = {name: ".estimates" for name in (
     "PRESETS", "AccuracyTarget", "ErrorEstimate", "EstimateProblem", "Resolution",

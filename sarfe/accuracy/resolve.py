@@ -18,7 +18,7 @@ r"""Accuracy of a whole sweep as an input: a target (``fast | balanced | fine | 
    budget. H is capped at the audible band: H·f ≤ ``audible_top_hz`` (5 kHz; harmonics above it
    carry little of the A-weighted ERP) and ``max_harmonics``.
 4. N at the chosen H: N → 2N (warm start) until RICHARDSON × the change is within the other half.
-5. Craig–Bampton cutoff (FE; the case layer, :func:`sarfe.pipeline.accuracy.case_resolution`):
+5. Craig–Bampton cutoff (FE; the case layer, :func:`sarfe.pipeline.solve.case_accuracy.case_resolution`):
    max(cutoff_margin, LADDER_FACTOR) · H · f_max with the chosen H (1.5 H f_max: modes up to the
    ladder's next rung, which the search judges H by; the reduction's own default is 1.25 H f_max),
    set explicitly; the search is repeated on that stage when it needs more modes than the one
@@ -33,7 +33,7 @@ it the A-weighting (−50 dB and falling) turns the weighted level into a measur
 harmonic alone.
 
 Works on plain arrays (:class:`sarfe.accuracy.estimates.EstimateProblem`); the case layer builds
-them (:mod:`sarfe.pipeline.accuracy`) and applies the result with :func:`apply_resolution`.
+them (:mod:`sarfe.pipeline.solve.case_accuracy`) and applies the result with :func:`apply_resolution`.
 """
 from __future__ import annotations
 
@@ -45,7 +45,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .estimates import (RICHARDSON, EstimateProblem, _change, _erp_proxy, harmonics_richardson,
+from sarfe.accuracy.estimates import (RICHARDSON, EstimateProblem, _change, _erp_proxy, harmonics_richardson,
                         parse_accuracy, resize_harmonics, spectral_tail)
 
 AUDIBLE_TOP_HZ = 5000.0   # A-weighted ERP of impacts: harmonics in 0.5–5 kHz (issue 15)

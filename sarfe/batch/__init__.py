@@ -1,16 +1,16 @@
 """Batch runs: many cases or a study's variants, the linear part once per linear model, via Dask.
 
 ``run_study(study_or_cases, workers=2, scheduler=None, output_dir=None) -> pandas.DataFrame``
-(``sarfe.batch.runner``); study files and variants: ``sarfe.batch.study``; parameter paths:
+(``sarfe.batch.runner``); study files and variants: ``sarfe.batch.variants``; parameter paths:
 ``sarfe.batch.paths``; resumable on-disk state: ``sarfe.batch.store``; statistics, plots and the CI
-gate: ``sarfe.batch.report``; the ``sarfe batch`` subcommand: ``sarfe.batch.cli``. Exports load on
-first use (:mod:`sarfe.lazy`: pandas and dask only when a batch runs).
+gate: ``sarfe.batch.batch_report``; the ``sarfe batch`` subcommand: ``sarfe.batch.cli``. Exports load on
+first use (:mod:`sarfe.util.lazy`: pandas and dask only when a batch runs).
 """
-from sarfe.lazy import lazy_exports
+from sarfe.util.lazy import lazy_exports
 
-_EXPORTS = {"GATE_EXIT_CODE": ".report", "evaluate_gate": ".report", "run_study": ".runner",
-            "StudyError": ".study", "Variant": ".study", "collect_variants": ".study",
-            "load_study": ".study"}
+_EXPORTS = {"GATE_EXIT_CODE": ".batch_report", "evaluate_gate": ".batch_report", "run_study": ".runner",
+            "StudyError": ".variants", "Variant": ".variants", "collect_variants": ".variants",
+            "load_study": ".variants"}
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
 __all__ = ["run_study", "load_study", "collect_variants", "evaluate_gate", "Variant", "StudyError",
            "GATE_EXIT_CODE"]

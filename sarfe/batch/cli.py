@@ -13,7 +13,7 @@ import argparse
 import importlib.util
 import sys
 
-EXIT_NOT_CONVERGED = 3  # = sarfe.io.errors.EXIT_NOT_CONVERGED
+EXIT_NOT_CONVERGED = 3  # = sarfe.case.errors.EXIT_NOT_CONVERGED
 EXIT_VARIANTS_FAILED = 5
 # The optional dependencies of ``sarfe batch`` (pyproject extra ``batch``); the solve never imports
 # them. distributed (Dask) only runs the variants in parallel: ``--workers 0`` needs none of it.
@@ -67,9 +67,9 @@ def run(args: argparse.Namespace) -> int:
               f"{', '.join(missing)}: install them with pip install 'sarfe[{BATCH_EXTRA}]' "
               f"(from a source tree: pip install -e '.[{BATCH_EXTRA}]')", file=sys.stderr)
         return 2
-    from sarfe.batch.report import GATE_EXIT_CODE, evaluate_gate
+    from sarfe.batch.batch_report import GATE_EXIT_CODE, evaluate_gate
     from sarfe.batch.runner import default_output_dir, run_study
-    from sarfe.batch.study import StudyError, collect_variants
+    from sarfe.batch.variants import StudyError, collect_variants
 
     if args.workers < 0:
         print("sarfe batch: --workers must be >= 0", file=sys.stderr)
@@ -100,7 +100,7 @@ def run(args: argparse.Namespace) -> int:
 
 def _case_error_types() -> tuple:
     try:
-        from sarfe.io.errors import CaseError
+        from sarfe.case.errors import CaseError
     except ImportError:
         return ()
     return (CaseError,)

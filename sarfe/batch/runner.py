@@ -1,14 +1,14 @@
 """Run a batch of variants: the linear part once per distinct linear model, then every variant.
 
 Flow (``run_study``):
-  1. expand studies/case files into variants (``sarfe.batch.study``), skip ids already finished in
+  1. expand studies/case files into variants (``sarfe.batch.variants``), skip ids already finished in
      ``<output>/variants`` (resume);
   2. ``load_case`` every remaining variant and group by ``linear_model_key(case)`` — a variant whose
      case is rejected is recorded as failed right away;
   3. per group build the ``LinearStage`` once (on a worker, or read ``<output>/.cache/<key>.npz``),
      ``client.scatter(stage, broadcast=True)`` it and submit the group's variants with it;
   4. write each finished variant's record at once (``sarfe.batch.store``), then merge the table and
-     write summary and plots (``sarfe.batch.report``).
+     write summary and plots (``sarfe.batch.batch_report``).
 
 Workers: ``workers=0`` runs in this process without Dask; ``workers=N`` starts a loopback
 ``LocalCluster`` (processes, one thread each, no dashboard); ``scheduler=ADDRESS`` or ``client=``
@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 import pandas as pd
 
 from sarfe.batch import store
-from sarfe.batch.study import StudyError, Variant, collect_variants
+from sarfe.batch.variants import StudyError, Variant, collect_variants
 
 PIPELINE = "sarfe.pipeline"
 _BLAS_ENV = {name: "1" for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")}
@@ -266,8 +266,8 @@ def default_output_dir(variants: list[Variant]) -> pathlib.Path:
 
 
 def claim_output(output, study_or_cases, variants, force=False) -> pathlib.Path:
-    """Check the batch folder (module ``sarfe.io.result_folder``) and mark it as sarfe's."""
-    from sarfe.io.result_folder import check_output_folder, claim_folder, marker_info
+    """Check the batch folder (module ``sarfe.results.folder``) and mark it as sarfe's."""
+    from sarfe.results.folder import check_output_folder, claim_folder, marker_info
 
     inputs = study_or_cases if isinstance(study_or_cases, (list, tuple)) else [study_or_cases]
     protected = [item for item in inputs if isinstance(item, (str, os.PathLike))]
@@ -292,7 +292,7 @@ def run_study(study_or_cases, workers: int = 2, scheduler: str | None = None, ou
     ``output_dir``: default ``results/<study name>``. Finished variants found there are not run
     again (failed ones are, with ``retry_failed``). ``pipeline``: module providing ``load_case``,
     ``linear_model_key``, ``build_linear_model``, ``solve_case`` (tests pass a stand-in).
-    The output folder follows the rules of :mod:`sarfe.io.result_folder`: absent, empty or a
+    The output folder follows the rules of :mod:`sarfe.results.folder`: absent, empty or a
     sarfe batch folder (marker ``.sarfe-result``), never the current folder or one holding an input
     file; anything else is a CaseError before any work unless ``force``.
 
@@ -300,7 +300,7 @@ def run_study(study_or_cases, workers: int = 2, scheduler: str | None = None, ou
     ``table.attrs['summary']`` = the dict written to ``summary.json``. Raises ``StudyError`` for an
     unusable study/case file before anything is run.
     """
-    from sarfe.batch import report
+    from sarfe.batch import batch_report as report
 
     start = time.perf_counter()
     variants = collect_variants(study_or_cases)

@@ -4,7 +4,7 @@
     <output>/.cache/<key>.npz       linear stages keyed by ``linear_model_key`` (reused on re-runs;
                                     arrays + manifest + content hash, no pickle: ``stage_file``)
     <output>/results.csv|.parquet   merged table, one row per variant x frequency point
-    <output>/summary.json, *.png    statistics and plots (``sarfe.batch.report``)
+    <output>/summary.json, *.png    statistics and plots (``sarfe.batch.batch_report``)
 
 A killed run loses only the variants in flight: everything in ``variants/`` is complete, and a
 re-run skips those ids.
@@ -20,7 +20,7 @@ import tempfile
 import numpy as np
 import pandas as pd
 
-from sarfe.batch.study import Variant, canonical_json
+from sarfe.batch.variants import Variant, canonical_json
 
 # Table columns that describe the variant; the varied inputs and CaseResult.rows keys follow.
 VARIANT_COLUMNS = ["variant_index", "variant_id", "source", "status", "error", "exit_code"]

@@ -2,7 +2,7 @@ r"""Partial ERP of the sources of a surface velocity field, and their coherent s
 
 The structure is linear apart from the contact forces, so per harmonic k the radiating-surface
 normal velocity is a sum over sources s (the excitation and one term per contact, see
-:mod:`sarfe.pipeline.contributions`):
+:mod:`sarfe.pipeline.post.contribution_records`):
 
     v_k,i = Σ_s v_s,k,i                                                    [m/s], complex
 
@@ -128,7 +128,7 @@ def contributions_from_gram(names, gram, omega: float, has_total: bool = True,
     P_s,k = κ Γ_k,ss, Q_s,k = κ Re Σ_b≤S Γ_k,sb, P_k = κ Σ_a,b≤S Γ_k,ab, superposition error
     √(Σ_k Γ_k,dd / Σ_k Γ_k,tt) (NaN without a total). The Gram matrices may come from the nodal
     velocities or from a reduced quadratic form Γ_k = (kω)² X_kᴴ Q X_k (X reduced coordinates,
-    Q = Nᵀ diag(A) N, :mod:`sarfe.pipeline.contributions`): the results are the same.
+    Q = Nᵀ diag(A) N, :mod:`sarfe.pipeline.post.contribution_records`): the results are the same.
     """
     gram = np.asarray(gram, dtype=complex)
     S = len(names)

@@ -5,10 +5,10 @@ node) for the trim panels, a scikit-fem quadratic solid for chunky parts and ref
 checks, support DOF sets and linear damping.
 """
 
-from .assembly import assemble, assemble_pair, element_dofs, fixed_dofs, free_dofs
-from .damping import modal_damping, rayleigh_damping
-from .modes import natural_frequencies
-from .shell import local_frames, shell_element_matrices, shell_matrices
+from sarfe.fe.assembly import assemble, assemble_pair, element_dofs, fixed_dofs, free_dofs
+from sarfe.fe.damping import modal_damping, rayleigh_damping
+from sarfe.fe.modes import natural_frequencies
+from sarfe.fe.shell import local_frames, shell_element_matrices, shell_matrices
 
 __all__ = [
     "shell_matrices",

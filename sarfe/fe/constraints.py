@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from .line_elements import rigid_arm
+from sarfe.fe.line_elements import rigid_arm
 
 __all__ = ["constraint_matrix"]
 

@@ -15,7 +15,7 @@ Steps (global DOF g = 6·node + c, c = 0..5 = [ux, uy, uz, rx, ry, rz], global a
 Spring damping is returned beside K: ``structural_damping`` = Σ GE_e K_e (hysteretic, to be
 multiplied by i) and ``viscous_damping`` = Σ B_e, both on the kept DOFs. The HBM model carries
 only the viscous part (its D enters S_k as i kω D, and the time integration as D u̇): a case whose
-deck keeps a hysteretic GE is refused (:mod:`sarfe.pipeline.deck`); with PARAM,W4 the Nastran
+deck keeps a hysteretic GE is refused (:mod:`sarfe.pipeline.model.deck_model`); with PARAM,W4 the Nastran
 reader has already moved GE into B = GE·K/W4, equal to i·GE·K at ω = W4.
 """
 from __future__ import annotations
@@ -25,13 +25,13 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from sarfe.mesh.deck import DeckError, DeckModel
+from sarfe.mesh.formats.deck import DeckError, DeckModel
 
-from .constraints import constraint_matrix
-from .line_elements import beam_matrices, point_mass_matrices, spring_matrices
-from .shell import DRILLING_PENALTY
-from .shell_section import section_shell_element_matrices
-from .solid_cells import DegenerateCellError, solid_cell_matrices
+from sarfe.fe.constraints import constraint_matrix
+from sarfe.fe.line_elements import beam_matrices, point_mass_matrices, spring_matrices
+from sarfe.fe.shell import DRILLING_PENALTY
+from sarfe.fe.shell_section import section_shell_element_matrices
+from sarfe.fe.solid_cells import DegenerateCellError, solid_cell_matrices
 
 __all__ = ["DeckSystem", "assemble_deck", "support_dofs", "load_vector", "lumped_mass",
            "global_matrices", "mass_properties"]

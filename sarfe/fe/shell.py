@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .assembly import assemble_pair, element_dofs
+from sarfe.fe.assembly import assemble_pair, element_dofs
 
 __all__ = [
     "shell_matrices",

@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 from sarfe.mesh.laminate import rotate_plane_stress
-from .shell import (_BENDING, _DEGREE4_RULE, _MEMBRANE, DRILLING_PENALTY,
+from sarfe.fe.shell import (_BENDING, _DEGREE4_RULE, _MEMBRANE, DRILLING_PENALTY,
                     _allman_field, _dkt_rotation_field, _to_global, _weighted_gram,
                     consistent_mass, drilling_vector, element_kinematics)
 

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .assembly import assemble
+from sarfe.fe.assembly import assemble
 
 __all__ = ["solid_basis", "solid_matrices", "lame_parameters"]
 

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .solid import lame_parameters
+from sarfe.fe.solid import lame_parameters
 
 __all__ = ["solid_cell_matrices", "shape_functions", "DegenerateCellError"]
 

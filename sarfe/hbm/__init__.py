@@ -19,12 +19,12 @@ Example (NLvib example 03)::
     branch = continuation(model, contacts, force, 0.5, 0.8, H, N)  # through the folds
     peak = max(s.amplitude(1) for s in branch)                     # ≈ 0.9374 at Ω ≈ 0.751
 """
-from .contacts import ContactSet, make_contact_set
-from .continuation import continuation
-from .model import LinearModel, make_linear_model
-from .solution import ContinuationOptions, HarmonicSolution, SolverOptions
-from .solve import solve_frequency
-from .stability import floquet_exponents, hill_stability
+from sarfe.hbm.contacts import ContactSet, make_contact_set
+from sarfe.hbm.continuation import continuation
+from sarfe.hbm.model import LinearModel, make_linear_model
+from sarfe.hbm.solution import ContinuationOptions, HarmonicSolution, SolverOptions
+from sarfe.hbm.solve import solve_frequency
+from sarfe.hbm.stability.hill import floquet_exponents, hill_stability
 
 __all__ = [
     "LinearModel", "make_linear_model", "ContactSet", "make_contact_set", "SolverOptions",

@@ -31,8 +31,8 @@ from functools import lru_cache
 import numpy as np
 import scipy.sparse as sp
 
-from . import harmonics as hm
-from . import laws
+from sarfe.hbm import harmonics as hm
+from sarfe.hbm import laws
 
 
 @lru_cache(maxsize=32)

@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from . import laws
+from sarfe.hbm import laws
 
 
 @dataclass(frozen=True)

@@ -48,11 +48,11 @@ from dataclasses import replace
 import numpy as np
 import scipy.sparse as sp
 
-from .harmonic_set import expand_rows, harmonic_set_orders
-from .newton import SingularJacobian, newton, solve_linear
-from .residual import Evaluation, kept_rows
-from .solution import ContinuationOptions
-from .solve import (_check_omega, _solve, finalize, initial_slider, linearized_guess,
+from sarfe.hbm.harmonic_set import expand_rows, harmonic_set_orders
+from sarfe.hbm.newton import SingularJacobian, newton, solve_linear
+from sarfe.hbm.residual import Evaluation, kept_rows
+from sarfe.hbm.solution import ContinuationOptions
+from sarfe.hbm.solve import (_check_omega, _solve, finalize, initial_slider, linearized_guess,
                     make_evaluator, make_problem, slider_acceptor, solve_auto, wants_condensation)
 
 REPORT_DISTANCE = 1e-4   # scaled arclength below which a new point replaces the last one reported

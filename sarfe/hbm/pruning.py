@@ -1,5 +1,5 @@
 r"""Contact screening and pruning (engine): contacts that never switch are solved linearly.
-The pipeline (:mod:`sarfe.pipeline.pruning`) and the studies (:mod:`sarfe.study.scene`) use it.
+The pipeline (:mod:`sarfe.pipeline.solve.pruned_points`) and the studies (:mod:`sarfe.hbm.pruning`) use it.
 
 Contact screening (a cheap linear pass). At every ω of a grid over the sweep, the response of the
 linear model with each contact linearized at u = 0 (what :func:`sarfe.hbm.solve.linearized_guess`
@@ -21,7 +21,7 @@ as a Woodbury update, no solve of model size per ω). With the gap g and a margi
 Because the other contacts' nonlinear response can drive a screened contact, :func:`check_pruning`
 re-checks every decision on the nonlinear solution (w of the dropped contacts is still G u); a
 violated decision means: solve again with the full set (:func:`solve_frequency_pruned` does that
-for one ω; :mod:`sarfe.pipeline.pruning` for the points or the sweep of a case in ``sarfe solve``).
+for one ω; :mod:`sarfe.pipeline.solve.pruned_points` for the points or the sweep of a case in ``sarfe solve``).
 :func:`restore_solution` re-expresses a pruned solution with all contacts, keeping the solver's own
 forces of the kept ones.
 """
@@ -137,7 +137,7 @@ def _modal_row_responses(basis, contacts, excitation, omegas):
     r"""(r̃ (n_ω, 2h+1, n_rows) [m], bad (n_ω,) bool): the linearized model's response at the rows
     of G from the modal basis of the model (no solve of model size per ω; h: the excitation's
     highest order), ``bad`` where some Z_k(ω) is singular. See :func:`contact_row_responses`."""
-    from sarfe.hbm.linear import from_complex, to_complex
+    from sarfe.hbm.dynamic_stiffness import from_complex, to_complex
     from sarfe.hbm.modal import real_product
     from sarfe.hbm.solve import linearized_rows
 
@@ -397,7 +397,7 @@ def restore_solution(solution, model, contacts, excitation, decisions):
 
     from sarfe.hbm.harmonics import time_samples
     from sarfe.hbm.laws import linearization
-    from sarfe.hbm.linear import apply_dynamic_stiffness
+    from sarfe.hbm.dynamic_stiffness import apply_dynamic_stiffness
 
     U = np.asarray(solution.displacement, dtype=float)
     F = np.asarray(excitation, dtype=float)

@@ -5,7 +5,7 @@ Full (all kept DOFs, unknowns x = ũ.ravel(), (2H+1) n of them):
     R(ũ, ω) = S(ω) ũ + f̃_nl(ũ) − f̃_e,      f̃_nl = Gᵀ λ̃(G ũ)   (per harmonic)
     ∂R/∂ũ = S(ω) + (I⊗G)ᵀ ∂λ̃/∂r̃ (I⊗G)      (sparse),    ∂R/∂ω = (∂S/∂ω) ũ + (I⊗G)ᵀ ∂λ̃/∂ω
 
-Condensed (unknowns x = r̃.ravel(), (2H+1) n_rows of them, see :mod:`sarfe.hbm.linear`):
+Condensed (unknowns x = r̃.ravel(), (2H+1) n_rows of them, see :mod:`sarfe.hbm.dynamic_stiffness`):
 
     R_c(r̃, ω) = r̃ − r̃_lin(ω) + C(ω) λ̃(r̃),    ∂R_c/∂r̃ = I + C ∂λ̃/∂r̃ (dense),
     ∂R_c/∂ω = G Z⁻¹ Z' ũ(r̃) + C ∂λ̃/∂ω
@@ -25,9 +25,9 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from .aft import ContactForces, contact_forces, jacobian_matrix
-from .harmonic_set import coefficient_rows, expand_rows
-from .linear import (apply_dynamic_stiffness, apply_dynamic_stiffness_derivative,
+from sarfe.hbm.aft import ContactForces, contact_forces, jacobian_matrix
+from sarfe.hbm.harmonic_set import coefficient_rows, expand_rows
+from sarfe.hbm.dynamic_stiffness import (apply_dynamic_stiffness, apply_dynamic_stiffness_derivative,
                      condensed_omega_derivative, dynamic_stiffness_matrix, modal_omega_derivative,
                      recover_displacement)
 
@@ -132,7 +132,7 @@ def condensed_residual(problem: Problem, condensation, x, slider_start=None,
     the condensation must then hold the same orders). Reference ‖r̃_lin‖.
 
     C is block diagonal over the harmonics, so C ∂λ̃/∂r̃ is formed block row by block row
-    (:meth:`sarfe.hbm.linear.Condensation.apply_compliance`: O(P n_rows · P) instead of O(P³)).
+    (:meth:`sarfe.hbm.dynamic_stiffness.Condensation.apply_compliance`: O(P n_rows · P) instead of O(P³)).
     ``omega_derivative`` False (Newton at a fixed ω): ∂R_c/∂ω is not formed (None)."""
     n_rows = problem.contacts.row_count
     rows = kept_rows(problem)

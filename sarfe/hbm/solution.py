@@ -27,12 +27,12 @@ class SolverOptions:
         G S_k⁻¹ Gᵀ (Newton on the contact rows only). 'auto' condenses when that system is smaller
         than the full one and at most ``max_condensed_size`` unknowns.
     stability: compute Hill stability of the converged solution.
-    stability_method: 'full' (the Hill eigenproblem on all DOFs, :mod:`sarfe.hbm.stability`),
-        'condensed' (Hill on a bounded Ritz basis, :mod:`sarfe.hbm.stability_condensed`),
+    stability_method: 'full' (the Hill eigenproblem on all DOFs, :mod:`sarfe.hbm.stability.hill`),
+        'condensed' (Hill on a bounded Ritz basis, :mod:`sarfe.hbm.stability.condensed`),
         'contact_rows' (the exponents right of the axis counted on the contact rows,
-        :mod:`sarfe.hbm.stability_rows`; the Ritz method where two or more are found; the verdict
+        :mod:`sarfe.hbm.stability.rows`; the Ritz method where two or more are found; the verdict
         None where the count with the contact coupling at ⌊3H/4⌋ disagrees,
-        :mod:`sarfe.hbm.stability_trust`) or 'auto': contact_rows for a model with contacts and a
+        :mod:`sarfe.hbm.stability.trust`) or 'auto': contact_rows for a model with contacts and a
         modal basis, else full up to 3000 Hill rows 2(2H+1)n.
     friction_tolerance, friction_pass_cap: 2-D slider march, stop when the slider state repeats to
         friction_tolerance × (max |q| + max ρ), at most friction_pass_cap periods.
@@ -78,7 +78,7 @@ class ContinuationOptions:
     band takes 105 points with 6 / 10 and 116 with 4 / 5, so 6 / 10 stay (the shipped cases and
     the continuation tests pass with either; rattle rig 367 → 363 points, complete either way).
     The defaults are those of a library call; ``sarfe solve`` always passes the case's
-    ``solver.continuation`` (defaults in :class:`sarfe.io.config.ContinuationConfig`, max_step 0.1).
+    ``solver.continuation`` (defaults in :class:`sarfe.case.config.ContinuationConfig`, max_step 0.1).
     """
 
     initial_step: float = 0.02
@@ -112,7 +112,7 @@ class HarmonicSolution:
     method: how the point was obtained — 'harmonic balance' (the Newton solve), 'linear' (exact
     solution without nonlinear contacts) or 'time integration' (the stand-in for a point whose
     engine call raised: iterations = periods integrated, residual_norm = periodicity error).
-    stability_job: while the Hill stability is deferred (:mod:`sarfe.hbm.deferred`), the index of
+    stability_job: while the Hill stability is deferred (:mod:`sarfe.hbm.stability.deferred`), the index of
     its recorded job (``stable`` None until filled in); None otherwise.
     """
 

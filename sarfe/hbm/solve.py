@@ -9,10 +9,10 @@ Steps of :func:`solve_frequency`:
    (k_n·s, k_t·s, s stepped from s₀ ≤ 10⁻⁴ to 1 in log s) and then the excitation level (f̃_e·s,
    s stepped 0 → 1), each with adaptive steps warm-started by the previous one and capped at
    ``max_homotopy_iterations`` Newton iterations; ``iterations`` counts all of them;
-3. Newton on the contact rows only (dynamic compliance condensation, :mod:`sarfe.hbm.linear`) when
+3. Newton on the contact rows only (dynamic compliance condensation, :mod:`sarfe.hbm.dynamic_stiffness`) when
    that system is smaller, else — or when some S_k(ω) is singular — on all DOFs (sparse LU);
 4. recovery of all DOFs, the residual of the full equation of motion relative to ‖f̃_e‖, Hill
-   stability (:mod:`sarfe.hbm.stability`).
+   stability (:mod:`sarfe.hbm.stability.hill`).
 
 Harmonic sets (:mod:`sarfe.hbm.harmonic_set`): with ``harmonic_set`` = 'odd' or a list of orders,
 Newton's unknowns and equations are the kept coefficient rows only (dropped rows held at zero);
@@ -29,22 +29,22 @@ from dataclasses import replace
 import numpy as np
 import scipy.sparse as sp
 
-from . import laws
-from .aft import default_slider_start, jacobian_matrix
-from .harmonic_set import (AUTO_CANDIDATE, coefficient_rows, dropped_content, expand_rows,
+from sarfe.hbm import laws
+from sarfe.hbm.aft import default_slider_start, jacobian_matrix
+from sarfe.hbm.harmonic_set import (AUTO_CANDIDATE, coefficient_rows, dropped_content, expand_rows,
                            harmonic_set_orders)
-from .harmonics import check_harmonics, derivative_matrix, time_samples
-from .linear import condense, dynamic_stiffness_matrix, recover_displacement
-from .newton import SingularJacobian, newton, solve_linear
-from .deferred import defer, deferring
-from .residual import Problem, condensed_residual, full_residual, kept_rows
-from .solution import HarmonicSolution, SolverOptions
-from .stability import hill_stability
-from .stability_condensed import condensed_stability
-from .stability_contacts import ContactOperator
-from .stability_rows import contact_row_counts
-from .stability_trust import auto_method, checked
-from .stability_trust import check_harmonics as checked_harmonics
+from sarfe.hbm.harmonics import check_harmonics, derivative_matrix, time_samples
+from sarfe.hbm.dynamic_stiffness import condense, dynamic_stiffness_matrix, recover_displacement
+from sarfe.hbm.newton import SingularJacobian, newton, solve_linear
+from sarfe.hbm.stability.deferred import defer, deferring
+from sarfe.hbm.residual import Problem, condensed_residual, full_residual, kept_rows
+from sarfe.hbm.solution import HarmonicSolution, SolverOptions
+from sarfe.hbm.stability.hill import hill_stability
+from sarfe.hbm.stability.condensed import condensed_stability
+from sarfe.hbm.stability.contact_terms import ContactOperator
+from sarfe.hbm.stability.rows import contact_row_counts
+from sarfe.hbm.stability.trust import auto_method, checked
+from sarfe.hbm.stability.trust import check_harmonics as checked_harmonics
 
 CHORD_STEPS = True       # fixed-ω Newton reuses its LU while it contracts (sarfe.hbm.newton)
 
@@ -263,7 +263,7 @@ def harmonic_set_label(problem) -> str:
 
 def contact_damping(problem, forces):
     """(I⊗G)ᵀ E diag(∂λ/∂ṙ) Φ (I⊗G) (sparse) of the rate-dependent laws, or None: the velocity
-    terms of the contact forces in Hill's damping matrix (:mod:`sarfe.hbm.stability`)."""
+    terms of the contact forces in Hill's damping matrix (:mod:`sarfe.hbm.stability.hill`)."""
     if not forces.damping_blocks:
         return None
     G, H = problem.contacts.gap_map, problem.harmonics
@@ -273,8 +273,8 @@ def contact_damping(problem, forces):
 
 def stability_method(problem, options) -> str:
     """'full' | 'condensed' | 'contact_rows' (see :class:`SolverOptions`): 'auto' is the contact-row
-    count (:mod:`sarfe.hbm.stability_rows`) for every model with contacts and a modal basis, else
-    the full Hill method up to 3000 Hill rows (:func:`sarfe.hbm.stability_trust.auto_method`)."""
+    count (:mod:`sarfe.hbm.stability.rows`) for every model with contacts and a modal basis, else
+    the full Hill method up to 3000 Hill rows (:func:`sarfe.hbm.stability.trust.auto_method`)."""
     method = options.stability_method
     return auto_method(problem) if method == "auto" else method
 
@@ -315,14 +315,14 @@ def kept_residual_norm(problem, ev) -> float:
 
 def finalize(problem, omega, U, converged, reason, iterations, slider, options) -> HarmonicSolution:
     """Residual on all DOFs and all harmonic rows, contact fields, Hill stability → HarmonicSolution
-    (inside a :func:`sarfe.hbm.deferred.deferred_stability` block the stability is recorded as a
+    (inside a :func:`sarfe.hbm.stability.deferred.deferred_stability` block the stability is recorded as a
     job, ``stability_job``, and computed later).
 
     residual_norm: the kept rows; dropped_content: η of the dropped rows (for the full set: of the
     rows outside the odd set, what 'auto' would drop)."""
     full = replace(problem, harmonic_orders=None)
     # the contact Jacobian only for a stability computed here: not for a point that did not
-    # converge, nor for one whose stability is deferred (:func:`sarfe.hbm.deferred.stability_of`
+    # converge, nor for one whose stability is deferred (:func:`sarfe.hbm.stability.deferred.stability_of`
     # evaluates it again; the forces, states and residual do not depend on it: 2.8 instead of
     # 4.6 ms a point at P1)
     in_place = options.stability and converged and not deferring()
@@ -344,7 +344,7 @@ def finalize(problem, omega, U, converged, reason, iterations, slider, options) 
         reason = f"full residual {residual:.3g} above full_tolerance {options.full_tolerance:g}"
     stable, exponent, note, job = None, float("nan"), "", None
     if converged and options.stability:
-        job = defer(full, omega, U, slider, options)    # recorded for later (sarfe.hbm.deferred)
+        job = defer(full, omega, U, slider, options)    # recorded for later (sarfe.hbm.stability.deferred)
         if job is None:
             result = stability(full, omega, U, ev, options)
             stable, exponent, note = result.stable, result.leading, result.note

@@ -42,8 +42,8 @@ import scipy.linalg as la
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from . import laws
-from .harmonics import harmonic_coefficients, time_samples
+from sarfe.hbm import laws
+from sarfe.hbm.harmonics import harmonic_coefficients, time_samples
 
 __all__ = ["TimeResponse", "integrate_time", "integrate_transient", "linear_harmonic_response",
            "period_work", "section_spread"]
@@ -624,7 +624,7 @@ def period_work(displacement_harmonics, excitation, damping, contact_displacemen
     returns (input ∮ f_eᵀ u̇ dt, viscous ∮ u̇ᵀ D u̇ dt, contact ∮ λ ṙ dt per row (n_rows,)) [J].
     Periodic balance: input = viscous + Σ contact (penalty rows give 0, friction rows dissipate).
     """
-    from .harmonics import derivative_matrix
+    from sarfe.hbm.harmonics import derivative_matrix
 
     U = np.asarray(displacement_harmonics, dtype=float)
     H = (U.shape[0] - 1) // 2

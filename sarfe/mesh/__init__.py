@@ -3,7 +3,7 @@
 `PanelMesh` (frozen, SI) and `load_mesh(path, length_unit)`; parametric gmsh geometries live in
 `sarfe.mesh.generators.<rattle_rig|squeak_rig|door_trim|instrument_panel>.generate(...)`.
 """
-from .geometry import (
+from sarfe.mesh.geometry import (
     contact_frames,
     connected_components,
     facet_normals,
@@ -13,8 +13,8 @@ from .geometry import (
     orphan_nodes,
     triangle_areas,
 )
-from .io import LENGTH_UNITS, MeshError, load_mesh
-from .mesh import GroupError, PanelMesh
+from sarfe.mesh.io import LENGTH_UNITS, MeshError, load_mesh
+from sarfe.mesh.mesh import GroupError, PanelMesh
 
 __all__ = [
     "PanelMesh", "GroupError", "MeshError", "load_mesh", "LENGTH_UNITS",

@@ -25,9 +25,9 @@ import secrets
 import time
 from pathlib import Path
 
-from .generators import GENERATORS
-from .io import load_mesh
-from .mesh import PanelMesh
+from sarfe.mesh.generators import GENERATORS
+from sarfe.mesh.io import load_mesh
+from sarfe.mesh.mesh import PanelMesh
 
 CACHE_VERSION = 1  # bump when a generator's geometry changes
 _TEMPORARY = re.compile(r"^\..+\.tmp-(?P<pid>\d+)-[0-9a-f]+(\.msh|\.sha256)$")

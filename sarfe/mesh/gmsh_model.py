@@ -13,7 +13,7 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from .mesh import PanelMesh
+from sarfe.mesh.mesh import PanelMesh
 
 _LOCK = threading.RLock()
 _COUNTER = itertools.count()

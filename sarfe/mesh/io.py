@@ -7,7 +7,7 @@
 * A Nastran/Abaqus file holding anything meshio would drop (springs, masses, rigid elements,
   midside nodes, GRID coordinate systems, parts and instances, supports, loads …) is refused
   with a MeshError naming the cards: such a file is read as a deck (``model.fe.deck``,
-  :mod:`sarfe.pipeline.deck`) with its own properties.
+  :mod:`sarfe.pipeline.model.deck_model`) with its own properties.
 * Abaqus ``.inp`` through meshio: ``*NSET`` → node groups, ``*ELSET`` → element groups
   (element sets of non-shell elements keep only their nodes as a node group).
 
@@ -22,9 +22,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .gmsh_model import assemble_mesh, gmsh_session, mesh_from_gmsh, split_quads
-from .mesh import PanelMesh
-from .nastran import bulk_fields
+from sarfe.mesh.gmsh_model import assemble_mesh, gmsh_session, mesh_from_gmsh, split_quads
+from sarfe.mesh.mesh import PanelMesh
+from sarfe.mesh.formats.nastran import bulk_fields
 
 LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "in": 0.0254}
 

@@ -10,18 +10,18 @@ outputs (result files, console table), solve (solve_case).
     build_linear_model(case, progress=False) -> LinearStage picklable reduced model + maps
     solve_case(case, linear_stage=None, output_dir=None, progress=False) -> CaseResult
 """
-from sarfe.io.case import Case, load_case
-from sarfe.io.errors import EXIT_CASE_ERROR, EXIT_NOT_CONVERGED, CaseError
-from sarfe.pipeline.linear import (
+from sarfe.case.read import Case, load_case
+from sarfe.case.errors import EXIT_CASE_ERROR, EXIT_NOT_CONVERGED, CaseError
+from sarfe.pipeline.model.linear_stage import (
     ContactGeometry,
     LinearStage,
     build_linear_model,
     check_mesh,
     linear_model_key,
 )
-from sarfe.pipeline.nonlinear import nonlinear_model
-from sarfe.pipeline.outputs import results_table
-from sarfe.pipeline.solve import CaseResult, solve_case
+from sarfe.pipeline.model.nonlinear_model import nonlinear_model
+from sarfe.pipeline.write.result_files import results_table
+from sarfe.pipeline.run import CaseResult, solve_case
 
 __all__ = ["Case", "CaseError", "CaseResult", "ContactGeometry", "LinearStage", "load_case",
            "linear_model_key", "build_linear_model", "check_mesh", "solve_case",

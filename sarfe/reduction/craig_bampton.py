@@ -11,7 +11,7 @@ the transformation u = T q, T = [[I, 0], [Ψ, Φ]], gives K_r = Tᵀ K T and M_r
     K_r = [[K_bb + K_bi Ψ, 0], [0, Ω²]]
     M_r = [[M_bb + M_bi Ψ + Ψᵀ M_ib + Ψᵀ M_ii Ψ, (M_bi + Ψᵀ M_ii) Φ], [sym, I]]
 
-K_ii is factorized once (``sarfe.fe.linear_solvers.factorize``) and that factor serves Ψ
+K_ii is factorized once (``sarfe.linalg.factorize``) and that factor serves Ψ
 (one block solve with n_b right-hand sides) and the shift-invert Lanczos iteration for Φ: by
 default a block Lanczos on K_ii⁻¹ M_ii whose steps are multi-RHS solves (one σ = 0 engine,
 :func:`sarfe.reduction.lanczos.shifted_block_lanczos`: uncapped in :func:`_block_lanczos_modes`,
@@ -47,7 +47,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from sarfe.fe.linear_solvers import available_solvers, factorize
+from sarfe.linalg import available_solvers, factorize
 from sarfe.reduction.arpack_modes import arpack_modes
 from sarfe.reduction.lanczos import m_orthonormal, shifted_block_lanczos
 from sarfe.reduction.mode_sinks import FileSink
@@ -319,7 +319,7 @@ def _block_lanczos_modes(mass_ii, operator, mode_count, cutoff_hz, progress, blo
 def _two_processes(workers):
     """Whether spectrum slicing may run in two processes: ``workers`` ≥ 2 (None: the usable
     cores) and PARDISO (the worker's inertia counts)."""
-    from sarfe.workers import available_cpus
+    from sarfe.util.workers import available_cpus
 
     workers = available_cpus() if workers is None else int(workers)
     return workers >= 2 and "pardiso" in available_solvers()

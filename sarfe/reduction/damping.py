@@ -16,7 +16,7 @@ import numpy as np
 
 from sarfe.fe.damping import modal_damping
 
-from .craig_bampton import ReducedModel
+from sarfe.reduction.craig_bampton import ReducedModel
 
 
 def reduced_modal_damping(mass, stiffness, zeta) -> np.ndarray:

@@ -22,7 +22,7 @@ Run 0 is the caller's σ = 0 block Lanczos stopped at its column cap; its conver
 next Ritz value enter here as (eigenvalues, modes, boundary).
 
 Every shift's K − σM has the same sparsity pattern: PARDISO's ordering and symbolic analysis run
-once (:func:`sarfe.fe.linear_solvers.shifted_factorizer`), each shift only its numerical LDLᵀ.
+once (:func:`sarfe.linalg.shifted_factorizer`), each shift only its numerical LDLᵀ.
 
 Two processes (two usable cores): a chain of runs needs nothing from another chain but a
 certified count at its bottom, so the spectrum is split at a shift λ_s chosen by count. A worker
@@ -57,7 +57,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sarfe.fe.linear_solvers import shifted_factorizer
+from sarfe.linalg import shifted_factorizer
 from sarfe.reduction.mode_sinks import FileSink, MemorySink
 from sarfe.reduction.lanczos import shifted_block_lanczos
 

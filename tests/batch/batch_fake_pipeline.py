@@ -14,7 +14,7 @@ import time
 from dataclasses import dataclass
 
 try:
-    from sarfe.io.errors import CaseError
+    from sarfe.case.errors import CaseError
 except ImportError:  # case layer not there yet
     class CaseError(Exception):
         pass

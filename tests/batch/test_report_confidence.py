@@ -3,7 +3,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from sarfe.batch.report import (dkw_epsilon, quantile_band, rattle_probability, wilson_interval,
+from sarfe.batch.batch_report import (dkw_epsilon, quantile_band, rattle_probability, wilson_interval,
                                 write_report)
 
 

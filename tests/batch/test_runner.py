@@ -192,7 +192,7 @@ def test_existing_scheduler_by_address(tmp_path, fake_log, dask_client):
 def test_cluster_failures_are_run_again_but_variant_failures_are_not(tmp_path, fake_log):
     from sarfe.batch.runner import failed_record
     from sarfe.batch.store import write_record
-    from sarfe.batch.study import collect_variants
+    from sarfe.batch.variants import collect_variants
 
     path = study(tmp_path, "  grid: {'contacts[0].gap_m': [1.0e-4, 2.0e-4, 3.0e-4]}\n")
     first, second, third = collect_variants(path)

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from sarfe.batch.paths import PathError, set_path
-from sarfe.batch.study import StudyError, collect_variants, load_study, parameter_sets, read_yaml
+from sarfe.batch.variants import StudyError, collect_variants, load_study, parameter_sets, read_yaml
 
 from conftest import HERE
 

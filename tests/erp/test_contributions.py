@@ -1,5 +1,5 @@
 """Contribution of each contact to the radiated power: the structure is linear apart from the
-contact forces, so ũ_k = Z_k⁻¹ f̃_k − Σ_c Z_k⁻¹ G_cᵀ λ̃_k,c exactly (sarfe.pipeline.contributions),
+contact forces, so ũ_k = Z_k⁻¹ f̃_k − Σ_c Z_k⁻¹ G_cᵀ λ̃_k,c exactly (sarfe.pipeline.post.contribution_records),
 and the coherent shares of the sources add up to the total ERP (sarfe.erp.contributions)."""
 from types import SimpleNamespace
 
@@ -9,11 +9,11 @@ import pytest
 from sarfe.erp.contributions import erp_contributions, ranking_lines
 from sarfe.hbm import SolverOptions, solve_frequency
 from sarfe.hbm.contacts import make_contact_set
-from sarfe.hbm.linear import to_complex
+from sarfe.hbm.dynamic_stiffness import to_complex
 from sarfe.hbm.model import make_linear_model
-from sarfe.pipeline.contact_dynamics import contact_dynamics
-from sarfe.io.config import ErpConfig
-from sarfe.pipeline.contributions import point_contributions, source_displacements
+from sarfe.pipeline.post.contact_dynamics import contact_dynamics
+from sarfe.case.config import ErpConfig
+from sarfe.pipeline.post.contribution_records import point_contributions, source_displacements
 
 H, N = 9, 256
 ERP = {"rho_kg_m3": 1.204, "c_m_s": 343.2, "radiation_loss_factor": 1.0,
@@ -21,7 +21,7 @@ ERP = {"rho_kg_m3": 1.204, "c_m_s": 343.2, "radiation_loss_factor": 1.0,
 
 
 def _case_stage_nl(model, contacts, F, groups, erp_map, areas):
-    case = ErpConfig(**ERP)            # the case's erp section (sarfe.io.config)
+    case = ErpConfig(**ERP)            # the case's erp section (sarfe.case.config)
     stage = SimpleNamespace(erp_map=np.asarray(erp_map, dtype=float), erp_areas=np.asarray(areas))
     nl = SimpleNamespace(model=model, contacts=contacts, excitation=F, groups=groups)
     return case, stage, nl
@@ -68,7 +68,7 @@ def test_partial_responses_sum_to_the_total_velocity_field(chain_solution):
     assert result.names == ("excitation", "stop", "clip")
     assert result.superposition_error < 1e-10
     # independently of the shares: Σ partial displacements = the solved ũ_k, DOF by DOF
-    from sarfe.hbm.linear import condense
+    from sarfe.hbm.dynamic_stiffness import condense
 
     cond = condense(model, contacts.gap_map, F, s.omega, orders=np.arange(1, H + 1))
     member = np.eye(2)
@@ -171,8 +171,8 @@ def test_reduced_quadratic_form_equals_the_nodal_erp_sums(chain_solution):
     definition, sarfe.erp.contributions.erp_contributions) to 1e-10 relative, on a radiating
     surface of 40 nodes seeing all three DOFs through a random map N."""
     from sarfe.erp.contributions import normal_velocity
-    from sarfe.hbm.linear import condense
-    from sarfe.pipeline.contributions import contact_rows
+    from sarfe.hbm.dynamic_stiffness import condense
+    from sarfe.pipeline.post.contribution_records import contact_rows
 
     model, contacts, F, groups, s = chain_solution
     rng = np.random.default_rng(7)
@@ -196,8 +196,8 @@ def test_linear_baseline_by_the_condensation_equals_the_assembled_solve(chain_so
     """The linear baseline through the point's condensation (Woodbury on the contact rows) equals
     the direct solve of (K + Gᵀ diag(k) G − ω² M + iω D) Û = F̂ with the preloaded 'clip' as its
     spring and the open 'stop' removed, to 1e-10 relative."""
-    from sarfe.pipeline.contributions import point_condensation
-    from sarfe.pipeline.postprocess import baseline_response
+    from sarfe.pipeline.post.contribution_records import point_condensation
+    from sarfe.pipeline.post.records import baseline_response
 
     model, contacts, F, groups, s = chain_solution
     nl = SimpleNamespace(model=model, contacts=contacts, excitation=F, groups=groups,

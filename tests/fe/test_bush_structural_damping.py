@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from sarfe.fe.deck_assembly import assemble_deck, support_dofs
-from sarfe.mesh.nastran import read_nastran
+from sarfe.mesh.formats.nastran import read_nastran
 
 K_N_M, MASS_KG, GE, FORCE_N = 4.0e5, 2.5, 0.06, 3.0
 OMEGA_N = np.sqrt(K_N_M / MASS_KG)

@@ -8,8 +8,8 @@ import pytest
 import scipy.linalg as la
 
 from sarfe.fe.deck_assembly import (assemble_deck, global_matrices, load_vector, support_dofs)
-from sarfe.mesh.deck import DeckError
-from sarfe.mesh.nastran import read_nastran
+from sarfe.mesh.formats.deck import DeckError
+from sarfe.mesh.formats.nastran import read_nastran
 
 DECKS = Path(__file__).resolve().parents[2].parent / "shared" / "decks"
 needs_decks = pytest.mark.skipif(not (DECKS / "REFERENCE.json").is_file(),
@@ -321,7 +321,7 @@ def test_units_give_the_same_frequencies(tmp_path):
 def _hex20_plate(lx, ly, thickness, counts, young, poisson, density):
     """A DeckModel of a plate of hex20 cells (counts = cells along x, y, z)."""
     from sarfe.fe.solid_cells import _HEX_CORNERS, _HEX_EDGES
-    from sarfe.mesh.deck import DeckModel, SolidElements
+    from sarfe.mesh.formats.deck import DeckModel, SolidElements
 
     nx, ny, nz = counts
     grid = np.arange((2 * nx + 1) * (2 * ny + 1) * (2 * nz + 1)).reshape(2 * nx + 1, 2 * ny + 1, -1)
@@ -346,7 +346,7 @@ def _hex20_plate(lx, ly, thickness, counts, young, poisson, density):
 
 def _shell_plate(lx, ly, thickness, counts, young, poisson, density):
     from sarfe.mesh.laminate import isotropic_plane_stress
-    from sarfe.mesh.deck import DeckModel, ShellElements
+    from sarfe.mesh.formats.deck import DeckModel, ShellElements
 
     nx, ny = counts
     x, y = np.meshgrid(np.linspace(0, lx, nx + 1), np.linspace(0, ly, ny + 1), indexing="ij")
@@ -523,7 +523,7 @@ def test_point_masses_and_offsets_equal_pynastran_mass_properties(tmp_path):
     from pyNastran.bdf.mesh_utils.mass_properties import mass_properties as pyn_mass
 
     from sarfe.fe.deck_assembly import mass_properties
-    from sarfe.mesh.nastran import _load_bdf
+    from sarfe.mesh.formats.nastran import _load_bdf
 
     path = _write(tmp_path, _free_plate_with_rigid_elements() + """
 CORD2R,4,,0.1,0.,0.,0.1,0.,1.

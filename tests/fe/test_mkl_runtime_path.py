@@ -4,7 +4,7 @@ import pathlib
 
 import pytest
 
-from sarfe.fe import linear_solvers
+from sarfe import linalg as linear_solvers
 
 
 def test_mkl_runtime_found_from_metadata_or_left_to_pypardiso(monkeypatch):

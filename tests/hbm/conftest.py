@@ -8,7 +8,7 @@ def squeak_rig():
     """cases/squeak_rig.yaml's nonlinear model and its points at 50 and 150 Hz (H = 3, N = 128:
     the case's old setting, which these tests were written for; the case itself now runs H = 23)."""
     from sarfe.pipeline import build_linear_model, load_case, nonlinear_model
-    from sarfe.pipeline.points import solve_point, solver_options
+    from sarfe.pipeline.solve.points import solve_point, solver_options
     data = load_case("cases/squeak_rig.yaml").data
     data["solver"].update(harmonics=3, samples_per_period=128)
     case = load_case(data)

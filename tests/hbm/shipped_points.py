@@ -9,7 +9,7 @@ def shipped_case_points(name, max_harmonics=5, count=5):
     to the 2H+1 rows of H (at the case's own H the solver rejected it and no point converged)."""
     from dataclasses import replace
     from sarfe.pipeline import build_linear_model, load_case, nonlinear_model
-    from sarfe.pipeline.points import solve_point, solver_options
+    from sarfe.pipeline.solve.points import solve_point, solver_options
 
     case = load_case(f"cases/{name}.yaml")
     nl = nonlinear_model(case, build_linear_model(case, progress=False))
@@ -36,8 +36,8 @@ def full_hill(model, contacts, F, s):
     are compared with) → (StabilityResult, the point's Evaluation, its ContactOperator)."""
     from sarfe.hbm.residual import Problem, full_residual
     from sarfe.hbm.solve import contact_damping
-    from sarfe.hbm.stability import hill_stability
-    from sarfe.hbm.stability_contacts import ContactOperator
+    from sarfe.hbm.stability.hill import hill_stability
+    from sarfe.hbm.stability.contact_terms import ContactOperator
 
     problem = Problem(model, contacts, F, s.harmonics, s.samples_per_period)
     ev = full_residual(problem, s.displacement.ravel(), s.omega)

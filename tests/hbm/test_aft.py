@@ -6,7 +6,7 @@ import scipy.sparse as sp
 from sarfe.hbm import harmonics as hm
 from sarfe.hbm.aft import contact_forces, jacobian_matrix, pointwise_jacobian
 from sarfe.hbm.contacts import make_contact_set
-from sarfe.hbm.friction import compose_clamps, jenkins_periodic_1d, slider_update
+from sarfe.hbm.laws.jenkins import compose_clamps, jenkins_periodic_1d, slider_update
 
 
 def single_row_contact(kind, gap=0.0, k_n=1.0, k_t=0.0, mu=0.0, n0=0.0, normal=True):

@@ -12,7 +12,7 @@ import scipy.sparse as sp
 
 from sarfe.hbm.contacts import make_contact_set
 from sarfe.hbm.continuation import continuation
-from sarfe.hbm.friction import SLIP, STICK
+from sarfe.hbm.laws.jenkins import SLIP, STICK
 from sarfe.hbm.model import make_linear_model
 from sarfe.hbm.solution import ContinuationOptions, SolverOptions
 from sarfe.hbm.solve import solve_frequency

@@ -9,7 +9,7 @@ import sarfe.hbm.solve as solve_module
 from sarfe.hbm import (ContinuationOptions, SolverOptions, continuation, make_contact_set,
                        make_linear_model, solve_frequency)
 from sarfe.hbm.harmonic_set import coefficient_rows, dropped_content, harmonic_set_orders
-from sarfe.hbm.linear import condense
+from sarfe.hbm.dynamic_stiffness import condense
 from sarfe.hbm.residual import condensed_residual, full_residual
 from sarfe.hbm.solve import make_problem
 

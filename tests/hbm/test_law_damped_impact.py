@@ -125,7 +125,7 @@ def test_hbm_matches_time_integration_and_hill_says_stable():
 
 def test_omega_derivative_of_the_residual_full_and_condensed():
     """∂R/∂ω includes (I⊗G)ᵀ ∂λ̃/∂ω (full) and C ∂λ̃/∂ω (condensed): central differences."""
-    from sarfe.hbm.linear import condense
+    from sarfe.hbm.dynamic_stiffness import condense
     from sarfe.hbm.residual import condensed_residual, full_residual
     from sarfe.hbm.solve import make_problem
 
@@ -190,7 +190,7 @@ def test_case_file_keys_and_effective_mass_from_the_model():
     the result equals the ContactSet built by hand with that mass."""
     import copy
 
-    from sarfe.io.errors import CaseError
+    from sarfe.case.errors import CaseError
     from sarfe.pipeline import build_linear_model, load_case, nonlinear_model
 
     case = load_case(MATRICES_CASE)

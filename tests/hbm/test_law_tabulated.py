@@ -166,7 +166,7 @@ def test_case_file_pairs_csv_and_preload(tmp_path):
     overclosure from the curve: F(−g − C λ) = 6 N with the static compliance C = 1/2e4."""
     import copy
 
-    from sarfe.io.errors import CaseError
+    from sarfe.case.errors import CaseError
     from sarfe.pipeline import build_linear_model, load_case, nonlinear_model
 
     case = load_case(CASE)
@@ -199,7 +199,7 @@ def test_preload_above_a_plateau_is_an_input_error_and_a_rising_curve_extends_li
     any force on the docs' linear extension: δ = δ_S + (P − F_S)/k exactly."""
     import copy
 
-    from sarfe.io.errors import CaseError
+    from sarfe.case.errors import CaseError
     from sarfe.pipeline import load_case
 
     plateau = copy.deepcopy(CASE)

@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-import sarfe.hbm.linear as linear
+import sarfe.hbm.dynamic_stiffness as linear
 from sarfe.hbm import (ContinuationOptions, SolverOptions, continuation, make_contact_set,
                        make_linear_model, solve_frequency)
-from sarfe.hbm.linear import (condense, condensed_omega_derivative, modal_omega_derivative,
+from sarfe.hbm.dynamic_stiffness import (condense, condensed_omega_derivative, modal_omega_derivative,
                               recover_displacement)
 from sarfe.hbm.harmonic_set import coefficient_rows
 from sarfe.hbm.modal import cached_modal_basis, modal_basis
@@ -143,7 +143,7 @@ def test_single_dof_closed_form():
 def test_dynamic_stiffness_matrix_reuses_its_pattern():
     """S(ω) from the cached Kronecker parts acts like the harmonic-by-harmonic product S(ω) ũ
     (cos rows K u_c − k²ω² M u_c + kω D u_s, sin rows … − kω D u_c) at several ω."""
-    from sarfe.hbm.linear import apply_dynamic_stiffness, dynamic_stiffness_matrix
+    from sarfe.hbm.dynamic_stiffness import apply_dynamic_stiffness, dynamic_stiffness_matrix
 
     for model in (chain(damping="dashpot"), chain(damping="rayleigh")):
         U = np.random.default_rng(2).normal(size=(2 * H + 1, model.dof_count))

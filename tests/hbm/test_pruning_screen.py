@@ -10,7 +10,7 @@ import sarfe.hbm.modal as modal
 import sarfe.hbm.pruning as pruning
 from sarfe.hbm import make_contact_set, make_linear_model
 from sarfe.hbm.pruning import contact_row_responses, screen_contacts
-from sarfe.study.lumped import lumped_problem
+from sarfe.tradeoff.lumped import lumped_problem
 
 
 def direct_rows(model, contacts, excitation, omegas):

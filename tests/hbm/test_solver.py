@@ -66,7 +66,7 @@ def test_example03_three_solutions_at_070_middle_unstable(sweep03):
     assert low < mid - 0.1 and mid < high - 0.1
     assert [s.stable for s in found[:2]] == [True, False]
     # the upper branch: stable, or (default stability) not resolved at H = 21 — the count with the
-    # contact coupling at 15 harmonics finds a real exponent there (sarfe/hbm/stability_trust.py)
+    # contact coupling at 15 harmonics finds a real exponent there (sarfe/hbm/stability/trust.py)
     assert found[2].stable is True or "not resolved in H" in found[2].stability_note
     assert found[1].floquet_exponent > 0 > found[0].floquet_exponent
 
@@ -288,7 +288,7 @@ def test_hill_sparse_shift_invert_matches_dense():
     """The sparse shift-invert path of the Hill problem keeps the same exponents as the dense one."""
     from sarfe.hbm.residual import full_residual
     from sarfe.hbm.solve import make_problem
-    from sarfe.hbm.stability import floquet_exponents
+    from sarfe.hbm.stability.hill import floquet_exponents
 
     model, contacts, F = example03()
     s = solve_frequency(model, contacts, F, 0.7, H03, 256)

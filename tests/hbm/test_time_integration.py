@@ -5,7 +5,7 @@ import scipy.sparse as sp
 
 import sarfe.hbm.time_integration as ti
 from sarfe.hbm.contacts import make_contact_set
-from sarfe.hbm.friction import SLIP, STICK
+from sarfe.hbm.laws.jenkins import SLIP, STICK
 from sarfe.hbm.model import make_linear_model
 from sarfe.hbm.time_integration import integrate_time, linear_harmonic_response
 from state_checks import assert_states_equal_away_from_ties

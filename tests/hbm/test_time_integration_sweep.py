@@ -4,7 +4,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from sarfe.hbm.contacts import make_contact_set
-from sarfe.hbm.friction import SLIP
+from sarfe.hbm.laws.jenkins import SLIP
 from sarfe.hbm.model import make_linear_model
 from sarfe.hbm.time_integration import integrate_time, section_spread
 

@@ -1,11 +1,11 @@
-"""The Abaqus reader (sarfe.mesh.abaqus) on small files that use every supported keyword,
+"""The Abaqus reader (sarfe.mesh.formats.abaqus) on small files that use every supported keyword,
 including the cases meshio crashes on (repeated *NODE, sets of sets, repeated ELSET=) or reads
 silently wrong (*Instance offsets dropped, S8R midside nodes dropped, sections ignored)."""
 import numpy as np
 import pytest
 
-from sarfe.mesh.abaqus import read_abaqus
-from sarfe.mesh.deck import DeckError, to_si
+from sarfe.mesh.formats.abaqus import read_abaqus
+from sarfe.mesh.formats.deck import DeckError, to_si
 
 E, NU, RHO, T = 2.0e3, 0.3, 1.0e-9, 2.0           # mm-t-s: MPa, t/mm³, mm
 

@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sarfe.mesh.deck import DeckError, to_si
-from sarfe.mesh.nastran import nastran_deck, read_nastran
+from sarfe.mesh.formats.deck import DeckError, to_si
+from sarfe.mesh.formats.nastran import nastran_deck, read_nastran
 
 DECKS = Path(__file__).resolve().parents[2].parent / "shared" / "decks"
 needs_decks = pytest.mark.skipif(not (DECKS / "REFERENCE.json").is_file(),
@@ -20,7 +20,7 @@ DECK_FILES = ["a101x.dat", "plate.bdf", "plate_py.dat", "mode_solid_shell_bar.bd
 
 
 def _pynastran_model(path):
-    from sarfe.mesh.nastran import _load_bdf
+    from sarfe.mesh.formats.nastran import _load_bdf
 
     return _load_bdf(Path(path))
 

@@ -285,7 +285,7 @@ def test_spectrum_slicing_finds_every_mode_below_the_cutoff(plate, monkeypatch):
     cutoff is found (to 1e-9), the modes are M-orthonormal and diagonalize K_ii."""
     import importlib
 
-    from sarfe.fe.linear_solvers import available_solvers
+    from sarfe.linalg import available_solvers
 
     if "pardiso" not in available_solvers():
         pytest.skip("spectrum slicing needs PARDISO's inertia")

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from sarfe.fe.linear_solvers import factorize
+from sarfe.linalg import factorize
 from sarfe.reduction import craig_bampton
 from sarfe.reduction.lanczos import m_orthonormal, shifted_block_lanczos
 

@@ -14,7 +14,7 @@ import pytest
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from sarfe.fe.linear_solvers import available_solvers, shifted_factorizer
+from sarfe.linalg import available_solvers, shifted_factorizer
 from sarfe.reduction import craig_bampton, free_dof_positions, node_dofs
 
 STIFFER = 1e-3    # relative spacing of the close pairs
@@ -137,7 +137,7 @@ def test_one_worker_gives_the_same_reduced_model(twin, one, two):
 def test_falls_back_to_one_process(twin, one, capped, monkeypatch):
     """workers=None on one usable core, or where fork is not available: one process, same modes."""
     slicing = importlib.import_module("sarfe.reduction.spectrum_slicing")
-    monkeypatch.setattr(importlib.import_module("sarfe.workers"), "available_cpus", lambda: 1)
+    monkeypatch.setattr(importlib.import_module("sarfe.util.workers"), "available_cpus", lambda: 1)
     single_core = reduce(twin, workers=None)
     assert "upper" not in single_core.timings["slicing"]
     np.testing.assert_allclose(single_core.mode_frequencies_hz, one.mode_frequencies_hz, rtol=1e-12)

@@ -10,7 +10,7 @@ from importlib import import_module
 
 import numpy as np
 
-from .contract import ContactLaw, LawInputError, Linearization, NormalForce, Parameter
+from sarfe.hbm.laws.contract import ContactLaw, LawInputError, Linearization, NormalForce, Parameter
 
 LAWS = {}
 

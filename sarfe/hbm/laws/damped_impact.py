@@ -29,8 +29,8 @@ from functools import lru_cache
 
 import numpy as np
 
-from .contract import ContactLaw, LawInputError, Linearization, NormalForce, Parameter
-from .rattle import NORMAL_STIFFNESS
+from sarfe.hbm.laws.contract import ContactLaw, LawInputError, Linearization, NormalForce, Parameter
+from sarfe.hbm.laws.rattle import NORMAL_STIFFNESS
 
 PARAMETERS = (
     NORMAL_STIFFNESS,

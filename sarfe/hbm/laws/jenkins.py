@@ -48,8 +48,8 @@ from functools import lru_cache
 
 import numpy as np
 
-from .. import harmonics as hm
-from .contract import Parameter
+from sarfe.hbm import harmonics as hm
+from sarfe.hbm.laws.contract import Parameter
 
 PARAMETERS = (
     Parameter("tangential_stiffness", "tangential_stiffness_N_m", "N/m",
@@ -280,7 +280,7 @@ def _march_2d(q, rho, drho_dw, k_t, start, H, N, jacobian, tolerance, pass_cap, 
     fixed w_0).
     Returns (λ_t (N, n, 2), state (N, n), w_start (n, 2), passes, J (n, 3P, 3P) or None).
     """
-    from . import jenkins_march as march    # numba is imported (and the kernels loaded) on first use
+    from sarfe.hbm.laws import jenkins_march as march    # numba is imported (and the kernels loaded) on first use
     n = q.shape[1]
     P = kept_rows.size                                       # local harmonic rows (kept set)
     scale = np.abs(q).max() + rho.max() + 1e-300

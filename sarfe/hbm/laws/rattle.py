@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .contract import ContactLaw, Linearization, NormalForce, Parameter
+from sarfe.hbm.laws.contract import ContactLaw, Linearization, NormalForce, Parameter
 
 NORMAL_STIFFNESS = Parameter("normal_stiffness", "normal_stiffness_N_m", "N/m",
                              "normal penalty stiffness k_n", minimum=0.0, exclusive=True,

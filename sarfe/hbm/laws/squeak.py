@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import jenkins
-from .contract import ContactLaw, NormalForce, Parameter
-from .rattle import NORMAL_STIFFNESS, penalty_force, penalty_linearization
+from sarfe.hbm.laws import jenkins
+from sarfe.hbm.laws.contract import ContactLaw, NormalForce, Parameter
+from sarfe.hbm.laws.rattle import NORMAL_STIFFNESS, penalty_force, penalty_linearization
 
 NORMAL_LOAD = Parameter("normal_load", None, "N",
                         "constant normal force N0 (case: preload_N of a contact without a normal "

@@ -20,8 +20,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import jenkins
-from .contract import ContactLaw, LawInputError, Linearization, NormalForce, Parameter
+from sarfe.hbm.laws import jenkins
+from sarfe.hbm.laws.contract import ContactLaw, LawInputError, Linearization, NormalForce, Parameter
 
 FRICTION = tuple(Parameter(p.name, p.key, p.unit, p.description + " (optional friction part)",
                            minimum=p.minimum, exclusive=p.exclusive, required=True, split=p.split,

@@ -5,8 +5,8 @@ import os
 
 import numpy as np
 
-from ..gmsh_model import mesh_from_gmsh
-from ..mesh import PanelMesh
+from sarfe.mesh.gmsh_model import mesh_from_gmsh
+from sarfe.mesh.mesh import PanelMesh
 
 
 def set_mesh_size(gmsh, mesh_size: float) -> None:

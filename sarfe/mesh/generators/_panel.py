@@ -14,9 +14,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..gmsh_model import gmsh_session
-from ..mesh import PanelMesh
-from ._gmsh import add_group, finish, set_mesh_size
+from sarfe.mesh.gmsh_model import gmsh_session
+from sarfe.mesh.mesh import PanelMesh
+from sarfe.mesh.generators._gmsh import add_group, finish, set_mesh_size
 
 _LIFT = 3e-3  # rib/boss strips start this far in front of the skin, the sliver is cut away
 

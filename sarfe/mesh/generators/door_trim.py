@@ -21,8 +21,8 @@ interact only through the contact pairs.  Node count ≈ 29k at 5 mm, ≈ 7.5k a
 """
 from __future__ import annotations
 
-from ..mesh import PanelMesh
-from ._panel import AttachedPart, PanelSpec, build
+from sarfe.mesh.mesh import PanelMesh
+from sarfe.mesh.generators._panel import AttachedPart, PanelSpec, build
 
 
 # contact spots on the pocket flange in the unscaled plan (1.0 × 0.6 m; scaled by length, width),

@@ -16,8 +16,8 @@ through the contact pairs.
 """
 from __future__ import annotations
 
-from ..mesh import PanelMesh
-from ._panel import AttachedPart, PanelSpec, build
+from sarfe.mesh.mesh import PanelMesh
+from sarfe.mesh.generators._panel import AttachedPart, PanelSpec, build
 
 
 def spec(length: float = 1.2, width: float = 0.4, crown_x: float = 0.04, crown_y: float = 0.05,

@@ -13,9 +13,9 @@ Suggested properties (for the case file): beam steel 1.5 mm, plate ABS 2.5 mm.
 """
 from __future__ import annotations
 
-from ...mesh.gmsh_model import gmsh_session
-from ..mesh import PanelMesh
-from ._gmsh import add_group, add_rig_clamps, embed_points, finish, set_mesh_size
+from sarfe.mesh.gmsh_model import gmsh_session
+from sarfe.mesh.mesh import PanelMesh
+from sarfe.mesh.generators._gmsh import add_group, add_rig_clamps, embed_points, finish, set_mesh_size
 
 DEFAULTS = dict(plate_size=0.15, beam_length=0.2, beam_width=0.02, gap=0.5e-3,
                 tip_x=0.03, tip_y=0.02, striker_inset=0.005, excite_fraction=0.75)

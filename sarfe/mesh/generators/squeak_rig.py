@@ -17,9 +17,9 @@ from __future__ import annotations
 
 import math
 
-from ...mesh.gmsh_model import gmsh_session
-from ..mesh import PanelMesh
-from ._gmsh import add_group, add_rig_clamps, embed_points, finish, refine_ball, set_mesh_size
+from sarfe.mesh.gmsh_model import gmsh_session
+from sarfe.mesh.mesh import PanelMesh
+from sarfe.mesh.generators._gmsh import add_group, add_rig_clamps, embed_points, finish, refine_ball, set_mesh_size
 
 
 def generate(mesh_size: float = 0.005, path=None, plate_size: float = 0.1,

@@ -1,0 +1,1 @@
+"""The case file: YAML reading with line numbers, schema, normalisation, typed configuration."""

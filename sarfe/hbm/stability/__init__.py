@@ -1,0 +1,1 @@
+"""Stability of periodic solutions: Hill's method, contact-row counts, checks."""

@@ -1,0 +1,1 @@
+"""Engineers' model files: Nastran bulk data (pyNastran) and Abaqus input decks."""

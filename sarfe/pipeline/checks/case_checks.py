@@ -1,0 +1,388 @@
+r"""Everything ``sarfe solve`` checks before the heavy work, in one place, so that a case that
+passes ``sarfe validate`` does not fail on its input later.
+
+    check_case(case, output_dir=None, force=False, write=True) -> CaseCheck
+
+Errors (CaseError, exit 2, one line naming the key or the element):
+  * the case file itself (schema, non-finite numbers, signs, units: :func:`sarfe.case.read.load_case`);
+  * the mesh: readable, groups present, contacts pair (as :func:`sarfe.pipeline.model.linear_stage.check_mesh`);
+  * element quality: zero-area triangles, duplicate triangles (same node set), coincident nodes
+    that neither an element nor a contact pair joins (a crack) — :mod:`sarfe.mesh.quality`;
+  * thickness plausibility: 1e-4·L < t < 0.1·L for the model size L (the bounding-box diagonal),
+    which catches a thickness given in mm;
+  * the structure is held: every connected part of the mesh holds at least one fixed node (else
+    the stiffness has rigid-body modes and the reduction cannot factorize it); a matrices model's
+    K plus the springs of the contacts closed at rest is regular (:func:`check_matrices_held`);
+  * every force acts on a free DOF (a force group all fixed is an error, partly fixed a warning);
+  * the output folder: absent, empty or a sarfe result, and writable (:mod:`sarfe.results.folder`).
+
+Warnings (one line each, printed and written to summary.json ``warnings``) for inputs far outside
+the model's range:
+  * H·f_max above the highest frequency the mesh resolves: a bending wave of a plate,
+    λ = 2π / k with k⁴ = ω² ρ t / D and D = E t³ / (12 (1 − ν²)), needs about
+    :data:`ELEMENTS_PER_WAVELENGTH` element edges h, so f_mesh = (2π / (6 h))² √(D / (ρ t)) / 2π
+    (median over the triangles);
+  * H·f_max above ``reduction.cutoff_hz`` (the harmonics have no modes to live in);
+  * an open gap larger than the structure (the contact can never close), or |gap_m| more than
+    :data:`GAP_RANGE` × the thickest shell or the contact's tolerance_m (:func:`gap_warnings`);
+  * reduction.mode_count above the interior DOFs; a force group partly fixed.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from sarfe.case.read import load_case
+
+ELEMENTS_PER_WAVELENGTH = 6
+COINCIDENT_TOLERANCE = 1e-7      # × model size: nodes closer than this are at the same place
+DEGENERATE_TOLERANCE = 1e-8      # area ≤ this × (longest edge)²: a zero-area triangle
+THICKNESS_RANGE = (1e-4, 0.1)    # thickness / model size
+
+
+@dataclass(frozen=True)
+class CaseCheck:
+    """What :func:`check_case` found: ``info`` for the validate line (nodes, triangles, contact
+    pairs), ``warnings`` (one-line strings), ``output`` (the checked result folder or None)."""
+
+    info: dict = field(default_factory=dict)
+    warnings: tuple = ()
+    output: object = None
+
+
+def _excitation_top_hz(case) -> float:
+    return case.config.excitation.max_frequency_hz
+
+
+def _where(mesh, triangle) -> str:
+    x, y, z = mesh.points[mesh.triangles[triangle]].mean(axis=0)
+    return f"at ({x:.4g}, {y:.4g}, {z:.4g}) m"
+
+
+def check_element_quality(case, mesh, joined=()) -> None:
+    """Zero-area and duplicate triangles, unjoined coincident nodes → CaseError naming them."""
+    from sarfe.mesh.quality import coincident_nodes, degenerate_elements, duplicate_elements
+
+    where = ("model", "fe", "mesh") if case.config.model.fe.source == "mesh" else ("model", "fe",
+                                                                                  "generator")
+    ids = np.arange(mesh.n_triangles)
+    bad = degenerate_elements(mesh.points, mesh.triangles, ids, DEGENERATE_TOLERANCE)
+    if bad:
+        first = bad[0]
+        raise case.error(f"{len(bad)} zero-area triangle(s): triangle {first} (nodes "
+                         f"{', '.join(map(str, mesh.triangles[first]))}) {_where(mesh, first)}"
+                         f"{'' if len(bad) == 1 else ', ' + ', '.join(map(str, bad[1:6]))}"
+                         f"{' …' if len(bad) > 6 else ''}", where)
+    twins = duplicate_elements(mesh.triangles, ids)
+    if twins:
+        kept, repeated = twins[0]
+        raise case.error(f"{len(twins)} duplicate triangle(s) (same nodes, counted twice): "
+                         f"triangle {repeated} repeats triangle {kept} (nodes "
+                         f"{', '.join(map(str, mesh.triangles[kept]))}) {_where(mesh, kept)}", where)
+    size = float(np.linalg.norm(np.ptp(mesh.points, axis=0)))
+    used = np.zeros(mesh.n_nodes, bool)
+    used[mesh.triangles.ravel()] = True
+    nodes = np.flatnonzero(used)
+    pairs = coincident_nodes(mesh.points[nodes], nodes, COINCIDENT_TOLERANCE * size,
+                             joined=[(np.searchsorted(nodes, a), np.searchsorted(nodes, b))
+                                     for a, b in joined if used[a] and b >= 0 and used[b]])
+    if pairs:
+        a, b = pairs[0]
+        x, y, z = mesh.points[a]
+        raise case.error(f"{len(pairs)} pair(s) of coincident nodes that no element or contact "
+                         f"joins (a crack): nodes {a} and {b} at ({x:.4g}, {y:.4g}, {z:.4g}) m; "
+                         "merge them or pair them in a contact", where)
+
+
+def check_thickness(case, mesh) -> None:
+    size = float(np.linalg.norm(np.ptp(mesh.points, axis=0)))
+    low, high = THICKNESS_RANGE
+    for name, t in case.config.model.fe.data["thickness_m"].items():
+        path = ("model", "fe", "thickness_m", name)
+        if t > high * size:
+            raise case.error(f"thickness {t:g} m is not small against the model size {size:.3g} m "
+                             "— given in mm? thickness_m is in metres", path)
+        if t < low * size:
+            raise case.error(f"thickness {t:g} m is implausibly thin for a model of {size:.3g} m "
+                             "— thickness_m is in metres (2.5 mm = 2.5e-3)", path)
+
+
+def check_held(case, mesh, fixed_nodes) -> None:
+    """Every connected part of the shell mesh holds a fixed node (no rigid-body motion left)."""
+    from sarfe.mesh import connected_components
+
+    count, labels = connected_components(mesh.n_nodes, mesh.triangles)
+    held = np.zeros(count, bool)
+    labels_fixed = labels[fixed_nodes]
+    held[labels_fixed[labels_fixed >= 0]] = True
+    if not held.all():
+        free = np.flatnonzero(~held)
+        part = free[0]
+        members = np.flatnonzero(labels == part)
+        x, y, z = mesh.points[members].mean(axis=0)
+        raise case.error(f"the structure is not held: {len(free)} of {count} connected part(s) "
+                         f"have no fixed node and can move as a rigid body (part of "
+                         f"{len(members)} nodes around ({x:.4g}, {y:.4g}, {z:.4g}) m, e.g. node "
+                         f"{members[0]}); add a fixed group on it", ("model", "fe", "fixed"))
+
+
+def check_loads_free(case, mesh, fixed_nodes, load_nodes) -> list:
+    """Every force group of an FE case acts on a free DOF (``load_nodes``: the nodes of each
+    ``excitation.forces`` group, in order). The force F of a group is split equally over its n
+    nodes (F/n each) and a fixed node's share goes into the support, so a group whose nodes are
+    all held (fixed, or on no triangle) is a CaseError naming it, and a partly held group gets a
+    warning stating the share lost. Returns the warnings (one line each)."""
+    used = np.zeros(mesh.n_nodes, bool)
+    used[mesh.triangles.ravel()] = True
+    held = ~used
+    held[np.asarray(fixed_nodes, dtype=int)] = True
+    warnings = []
+    for i, (load, nodes) in enumerate(zip(case.config.excitation.forces, load_nodes)):
+        path = ("excitation", "forces", i, "group")
+        count = int(np.count_nonzero(held[nodes]))
+        if count == len(nodes):
+            raise case.error(f"the force on group {load['group']} acts on no free DOF: all of its "
+                             f"DOFs are fixed ({len(nodes)} node(s) held by model.fe.fixed or on "
+                             "no triangle)", path)
+        if count:
+            warnings.append(f"excitation.forces[{i}]: {count} of the {len(nodes)} nodes of group "
+                            f"{load['group']} are fixed: {100 * count / len(nodes):.3g} % of "
+                            f"force_N = {load['force_N']:g} N goes straight into the supports")
+    return warnings
+
+
+HELD_MATRIX_LIMIT = 3000        # DOFs: a dense eigenvalue check above costs more than it finds
+RIGID_TOLERANCE = 1e-10         # eigenvalue ≤ this × the largest: a rigid-body (null-space) mode
+
+
+def check_matrices_held(case) -> None:
+    r"""A ``model.matrices`` model is held at rest, as :func:`check_held` asks of a mesh: the static
+    stiffness with the contacts linearized at u = 0 (their preload state: :func:`sarfe.hbm.pruning.
+    linearized_stiffness`),
+
+        K_0 = K + Gᵀ diag(k) G      (k: the springs of the contacts closed at rest, k_t of the stuck
+                                     tangents; open contacts add nothing),
+
+    must be regular — else the static (0th harmonic) block of the HBM Jacobian is singular at every
+    point. K_0 (n, n) [N/m]; its eigenvalues λ ≤ :data:`RIGID_TOLERANCE`·max λ span the rigid-body
+    modes. CaseError naming model.matrices.stiffness and the null-space size. Models above
+    :data:`HELD_MATRIX_LIMIT` DOFs are not checked (a dense eigenvalue problem)."""
+    from sarfe.hbm.pruning import linearized_stiffness
+    from sarfe.pipeline.model.linear_stage import build_linear_model
+    from sarfe.pipeline.model.nonlinear_model import nonlinear_model
+
+    stage = build_linear_model(case)
+    n = stage.dof_count
+    if n > HELD_MATRIX_LIMIT:
+        return
+    nl = nonlinear_model(case, stage)
+    K0 = linearized_stiffness(nl.model, nl.contacts)[0]
+    K0 = K0.toarray() if hasattr(K0, "toarray") else np.asarray(K0, dtype=float)
+    values, vectors = np.linalg.eigh(0.5 * (K0 + K0.T))
+    rigid = values <= RIGID_TOLERANCE * max(np.abs(values).max(initial=0.0), 1e-300)
+    if rigid.any():
+        count = int(np.count_nonzero(rigid))
+        moving = np.flatnonzero(np.abs(vectors[:, rigid]).max(axis=1) > 1e-6)
+        shown = ", ".join(map(str, moving[:8])) + (" …" if moving.size > 8 else "")
+        raise case.error(f"the structure is not held: the stiffness plus the springs of the "
+                         f"contacts closed at rest is singular ({count} rigid-body mode(s), "
+                         f"null space of size {count} of {n} DOFs; DOF(s) {shown} move freely); "
+                         "add stiffness to ground or a preloaded contact",
+                         ("model", "matrices", "stiffness"))
+
+
+def bending_resolution_hz(points, triangles, thickness, young, poisson, density) -> np.ndarray:
+    """Per triangle, the frequency [Hz] whose plate bending wavelength spans
+    :data:`ELEMENTS_PER_WAVELENGTH` of its longest edge h:
+
+        k = 2π / (6 h),  f = k² √(D / (ρ t)) / 2π,  D = E t³ / (12 (1 − ν²))
+
+    points (n, 3) [m]; triangles (n_e, 3); thickness [m], young [Pa], poisson, density [kg/m³]
+    scalars or (n_e,) per triangle. Returns (n_e,)."""
+    corners = np.asarray(points, dtype=float)[np.asarray(triangles)]
+    h = np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=2).max(axis=1)
+    t = np.asarray(thickness, dtype=float)
+    bending = np.asarray(young, dtype=float) * t ** 3 / (12 * (1 - np.asarray(poisson) ** 2))
+    k = 2 * np.pi / (ELEMENTS_PER_WAVELENGTH * h)
+    return k ** 2 * np.sqrt(bending / (np.asarray(density, dtype=float) * t)) / (2 * np.pi)
+
+
+def mesh_frequency_limit_hz(case, mesh) -> float:
+    """Highest frequency [Hz] the case's mesh resolves: the median over its triangles of
+    :func:`bending_resolution_hz` with each triangle's material and thickness."""
+    from sarfe.pipeline.model.linear_stage import _per_triangle
+
+    fe = case.config.model.fe.data
+    materials, thickness = list(fe["materials"].values()), list(fe["thickness_m"].values())
+    m = _per_triangle(case, mesh, fe["materials"], "materials")
+    t = np.asarray(thickness, dtype=float)[_per_triangle(case, mesh, fe["thickness_m"],
+                                                          "thickness_m")]
+    E, nu, rho = (np.array([mat[k] for mat in materials])[m] for k in ("E_Pa", "nu", "rho_kg_m3"))
+    return float(np.median(bending_resolution_hz(mesh.points, mesh.triangles, t, E, nu, rho)))
+
+
+GAP_RANGE = 10.0   # |gap_m| above this × the contact's reference length warns
+
+
+def gap_warnings(case, mesh=None) -> list:
+    r"""A ``gap_m`` far from the contact's scale: |g| > :data:`GAP_RANGE` · L with the reference
+    length L = max(thickest shell ``thickness_m`` of an FE model, the contact's ``tolerance_m``)
+    [m] — a gap in mm given as metres (0.5 for 0.5 mm), or an overclosure that presses the parts
+    through each other. Not an error (the model is solved as given); no L (a matrices model with
+    tolerance_m = 0), or an open gap already larger than the structure (:func:`range_warnings`),
+    no warning."""
+    config = case.config
+    fe = config.model.fe.data if case.is_fe else {}
+    thickest = max((float(t) for t in fe.get("thickness_m", {}).values()), default=0.0)
+    size = np.inf if mesh is None else float(np.linalg.norm(np.ptp(mesh.points, axis=0)))
+    warnings = []
+    for i, contact in ((c.index, c.params) for c in config.contacts):
+        gap = contact.get("gap_m")
+        tolerance = float(contact.get("tolerance_m", 0.0))
+        reference = max(thickest, tolerance)
+        if gap is None or reference <= 0.0 or abs(gap) <= GAP_RANGE * reference or gap > size:
+            continue
+        what = (f"the thickest shell, thickness_m = {thickest:g} m" if thickest >= tolerance
+                else f"its tolerance_m = {tolerance:g} m")
+        kind = "an overclosure (the parts pressed" if gap < 0 else "an open gap (the parts"
+        detail = (f"{kind} {abs(gap) * 1e3:.4g} mm into each other)" if gap < 0
+                  else f"{kind} {gap * 1e3:.4g} mm apart)")
+        warnings.append(f"contacts[{i}] ({contact['name']}): gap_m = {gap:g} m is {detail}, "
+                        f"more than {GAP_RANGE:g} × {what}: gap_m is in metres "
+                        "(0.5 mm = 5e-4)")
+    return warnings
+
+
+def range_warnings(case, mesh=None) -> list:
+    """One-line warnings for inputs far outside the model's range (module docstring)."""
+    warnings = []
+    config = case.config
+    top = _excitation_top_hz(case)
+    H = config.solver.harmonics
+    if mesh is not None:
+        limit = mesh_frequency_limit_hz(case, mesh)
+        if H * top > limit:
+            warnings.append(f"excitation {top:g} Hz × {H} harmonics = {H * top:.4g} Hz is above the "
+                            f"~{limit:.4g} Hz the mesh resolves ({ELEMENTS_PER_WAVELENGTH} elements "
+                            "per bending wavelength): refine the mesh or lower the harmonics")
+        size = float(np.linalg.norm(np.ptp(mesh.points, axis=0)))
+        for i, contact in ((c.index, c.params) for c in config.contacts):
+            gap = contact.get("gap_m")
+            if gap is not None and gap > size:
+                warnings.append(f"contacts[{i}] ({contact['name']}): gap_m = {gap:g} m is larger "
+                                f"than the structure ({size:.3g} m): the contact can never close")
+    warnings += gap_warnings(case, mesh)
+    cutoff = None if config.reduction is None else config.reduction.cutoff_hz
+    if cutoff is not None and H * top > cutoff:
+        warnings.append(f"excitation {top:g} Hz × {H} harmonics = {H * top:.4g} Hz is above "
+                        f"reduction.cutoff_hz = {cutoff:g} Hz: the higher harmonics have no modes")
+    return warnings
+
+
+def interior_dof_count(mesh, fixed_nodes, boundary_nodes) -> int:
+    """Interior DOFs of the Craig–Bampton split, as the linear stage makes it: 6 per node on a
+    triangle that is not fixed, minus the 3 translations of each free contact or load node (the
+    boundary). At most this many fixed-interface modes exist."""
+    used = np.zeros(mesh.n_nodes, bool)
+    used[mesh.triangles.ravel()] = True
+    free = used.copy()
+    free[np.asarray(fixed_nodes, dtype=int)] = False
+    boundary = np.unique(np.asarray(boundary_nodes, dtype=int))
+    boundary = boundary[(boundary >= 0) & free[np.maximum(boundary, 0)]]
+    return int(6 * np.count_nonzero(free) - 3 * boundary.size)
+
+
+def mode_count_warnings(case, interior) -> list:
+    """reduction.mode_count above the ``interior`` DOF count: a warning stating the clip."""
+    reduction = case.config.reduction
+    asked = None if reduction is None else reduction.mode_count
+    if asked is None or asked <= interior:
+        return []
+    return [f"reduction.mode_count = {asked} asks more modes than the structure has: its "
+            f"{interior} interior DOFs give at most {interior} fixed-interface modes, so the "
+            f"reduction keeps all it finds ({asked} asked, at most {interior} available; a full "
+            "eigenproblem): lower mode_count or give reduction.cutoff_hz"]
+
+
+def reduced_model_warnings(case, stage) -> list:
+    """Warnings that need the reduced model: fewer modes kept than reduction.mode_count asked
+    (unless :func:`mode_count_warnings` said so before the reduction), H·f_max above the highest
+    fixed-interface mode."""
+    modes = np.asarray(stage.mode_frequencies_hz)
+    reduction = case.config.reduction
+    if stage.kind != "fe" or reduction is None or reduction.mode_count is None:
+        return []
+    warnings = []
+    asked, kept = reduction.mode_count, int(stage.info.get("modes", modes.size))
+    interior = stage.info.get("free_dofs", 0) - stage.info.get("boundary_dofs", 0)
+    said_before = not case.config.model.fe.is_deck and asked > interior
+    if kept < asked and not said_before:
+        warnings.append(f"reduction.mode_count = {asked}: the reduction kept {kept} modes "
+                        f"({asked} asked, {kept} available from {interior} interior DOFs)")
+    top, H = _excitation_top_hz(case), case.config.solver.harmonics
+    if modes.size and H * top > modes.max():
+        warnings.append(f"excitation {top:g} Hz × {H} harmonics = {H * top:.4g} Hz is above the "
+                        f"highest kept mode ({modes.max():.4g} Hz, reduction.mode_count = "
+                        f"{modes.size})")
+    return warnings
+
+
+def output_target(case, output_dir=None, force=False):
+    """The checked result folder of a case (``output_dir`` or ``output.directory``): absent, empty
+    or a previous sarfe result (or anything but the current/case folder with ``force``), and
+    writable — else CaseError, before any work (rules: :mod:`sarfe.results.folder`)."""
+    from sarfe.results.folder import check_output_folder
+
+    target = output_dir if output_dir is not None else case.config.output.directory
+    return check_output_folder(target, force=force, protected=[case.source])
+
+
+def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True) -> CaseCheck:
+    """All checks of the module docstring. Raises CaseError at the first problem."""
+    from sarfe.erp import nodal_normals
+    from sarfe.pipeline.model.linear_stage import (_per_triangle, load_case_mesh, pair_contact,
+                                       resolve_node_group)
+
+    case = load_case(case)
+    output = output_target(case, output_dir, force) if write else None
+    if not mesh_checks:
+        return CaseCheck({}, tuple(range_warnings(case)), output)
+    if not case.is_fe:
+        check_matrices_held(case)
+        return CaseCheck({}, tuple(range_warnings(case)), output)
+    config = case.config
+    if config.model.fe.is_deck:   # a Nastran/Abaqus deck: its own checks, with ids
+        from sarfe.pipeline.model.deck_model import check_deck
+        info = check_deck(case)
+        return CaseCheck(info, tuple(range_warnings(case)) + tuple(info.pop("warnings")), output)
+    mesh = load_case_mesh(case)
+    fe = config.model.fe.data
+    fixed = np.unique(np.concatenate([
+        resolve_node_group(case, mesh, g, ("model", "fe", "fixed", i), allow_elements=False)
+        for i, g in enumerate(fe["fixed"])]))
+    _per_triangle(case, mesh, fe["materials"], "materials")
+    _per_triangle(case, mesh, fe["thickness_m"], "thickness_m")
+    check_thickness(case, mesh)
+    normals = nodal_normals(mesh.points, mesh.triangles)
+    paired = {c.name: pair_contact(case, mesh, c.index, normals) for c in config.contacts}
+    load_nodes = [resolve_node_group(case, mesh, f["group"], ("excitation", "forces", i, "group"))
+                  for i, f in enumerate(config.excitation.forces)]
+    load_warnings = check_loads_free(case, mesh, fixed, load_nodes)
+    surface = config.erp.surface
+    if surface is not None and surface not in mesh.element_groups:
+        resolve_node_group(case, mesh, surface, ("erp", "surface"))
+    joined = [(int(a), int(b)) for p in paired.values() for a, b in zip(p[0], p[1])]
+    check_element_quality(case, mesh, joined)
+    check_held(case, mesh, fixed)
+    info = {"nodes": mesh.n_nodes, "triangles": mesh.n_triangles,
+            "contact_pairs": {name: len(p[0]) for name, p in paired.items()}}
+    interior = interior_dof_count(mesh, fixed, np.concatenate(
+        [np.zeros(0, int)] + [np.concatenate([p[0], p[1]]) for p in paired.values()] + load_nodes))
+    return CaseCheck(info, tuple(range_warnings(case, mesh)) + tuple(load_warnings)
+                     + tuple(mode_count_warnings(case, interior)), output)
+
+
+__all__ = ["CaseCheck", "check_case", "check_loads_free", "check_matrices_held", "output_target", "check_element_quality", "check_held", "check_thickness",
+           "bending_resolution_hz", "mesh_frequency_limit_hz", "range_warnings", "reduced_model_warnings",
+           "interior_dof_count", "mode_count_warnings", "gap_warnings"]

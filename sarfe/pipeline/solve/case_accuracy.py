@@ -1,0 +1,227 @@
+"""A case's point and sweep in the terms of :mod:`sarfe.accuracy`: the estimate problem of a linear
+stage and nonlinear model (plain arrays), the per-point error estimate and a case's accuracy target
+→ H, N and mode count (:func:`resolve_case_accuracy`)."""
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+
+from sarfe.accuracy.estimates import (EstimateProblem, highest_natural_frequency_hz,
+                                      problem_error_estimate)
+from sarfe.accuracy.resolve import resolve_accuracy
+from sarfe.case.config import ExcitationConfig, SolverConfig
+
+
+def stage_modal_coordinates(stage):
+    """(fixed-interface modes, residual modes) of an FE stage's reduced coordinates (after the
+    Craig–Bampton boundary DOFs, each in increasing frequency); (None, None) for matrices."""
+    if stage.kind != "fe":
+        return None, None
+    first = int(stage.info.get("boundary_dofs", 0))
+    modes = int(stage.info.get("modes", stage.dof_count - first))
+    return np.arange(first, first + modes), np.arange(first + modes, stage.dof_count)
+
+
+def accuracy_problem(stage, nl) -> EstimateProblem:
+    """The :class:`EstimateProblem` of a case: ``nl`` (:func:`sarfe.pipeline.nonlinear_model`) on
+    the linear ``stage``, its ERP map and areas, the Craig–Bampton modal coordinates of FE stages
+    and the highest natural frequency (FE: the highest kept mode; matrices: of M, K)."""
+    modal, residual = stage_modal_coordinates(stage)
+    if stage.kind == "fe":
+        highest = float(np.max(stage.mode_frequencies_hz, initial=0.0)) or None
+    else:
+        highest = highest_natural_frequency_hz(nl.model)
+    return EstimateProblem(nl.model, nl.contacts, nl.excitation, stage.erp_map, stage.erp_areas,
+                           modal, residual, highest)
+
+
+def stage_error_estimate(solution, stage, nl):
+    """:func:`sarfe.accuracy.estimates.problem_error_estimate` of a case's point."""
+    return problem_error_estimate(solution, accuracy_problem(stage, nl))
+
+
+def sweep_grid_hz(excitation: ExcitationConfig, points=8) -> np.ndarray:
+    """[Hz]: the listed frequencies, or ``points`` evenly spaced over the sweep."""
+    if excitation.frequency_hz is not None:
+        return np.atleast_1d(np.asarray(excitation.frequency_hz, dtype=float))
+    return np.linspace(excitation.sweep.start_hz, excitation.sweep.end_hz, int(points))
+
+
+def rule_cutoff_hz(case, harmonics) -> float | None:
+    """The accuracy search's cutoff at H: m · H · f_max [Hz] with m = max(cutoff_margin,
+    LADDER_FACTOR) (1.5 by default, above the reduction's own 1.25), for an FE case whose reduction
+    gives neither cutoff_hz nor mode_count; None otherwise (a matrices model, or the user's
+    reduction, which the accuracy search keeps).
+
+    Why more than the reduction's H f_max: the search judges H by the change to the next rung of
+    its ladder, H' ≈ LADDER_FACTOR · H, so its stage keeps modes up to H' f_max; on a stage whose
+    rung harmonics have no modes (answered quasi-statically) the ladder climbs irregularly (door
+    trim, 10 mm, 67 Hz: on a 335 Hz stage to H = 27, then a 610-mode stage, 126 s against 75 s
+    with 1.5; benchmarks/results/audible.md). The sweep reuses the search's last stage."""
+    reduction = case.data.get("reduction") or {}
+    if not case.is_fe or "cutoff_hz" in reduction or "mode_count" in reduction:
+        return None
+    return float(search_margin(case) * int(harmonics) * case.config.excitation.max_frequency_hz)
+
+
+def search_margin(case) -> float:
+    """m of :func:`rule_cutoff_hz`: max(reduction.cutoff_margin, LADDER_FACTOR)."""
+    from sarfe.accuracy.resolve import LADDER_FACTOR
+
+    return float(max(case.config.reduction.cutoff_margin, LADDER_FACTOR))
+
+
+def _with_cutoff(case, cutoff_hz):
+    """The case with reduction.cutoff_hz set (unchanged for None)."""
+    from sarfe.case.read import load_case
+
+    if cutoff_hz is None:
+        return case
+    data = copy.deepcopy(case.data)
+    data.setdefault("reduction", {})["cutoff_hz"] = float(cutoff_hz)
+    return load_case(data, base_dir=case.base_dir)
+
+
+def case_resolution(case, target, points=8, start_harmonics=3, start_samples=64,
+                    max_harmonics=64, max_samples=8192, max_points_tuned=3, max_rebuilds=2):
+    """A case's accuracy target → (report, linear stage): :func:`sarfe.accuracy.resolve_accuracy`
+    over ``points`` frequencies of the case (screened at ``start_harmonics``, then an H ladder at
+    the loudest point), with the case's Newton tolerance and no stability.
+
+    FE cases whose reduction gives neither cutoff_hz nor mode_count: the Craig–Bampton cutoff is
+    the search's rule with the chosen H, c(H) = max(cutoff_margin, 1.5) · H · f_max
+    (:func:`rule_cutoff_hz`: modes up to the ladder's next rung; reported as ``cutoff_hz`` and set
+    explicitly by :func:`sarfe.accuracy.resolve.apply_resolution`).
+    The ladder's changes are only trusted on a stage whose modes cover them: a stage with too few
+    modes answers the high harmonics quasi-statically, and its ladder stops too early or climbs
+    too far (door trim: from a 335 Hz stage, H = 27; from 502 Hz, H = 8; benchmarks/results/
+    audible.md). So the search runs first on the stage of the case's H, c(H_case); while the
+    chosen H needs c(H) above the stage's cutoff, the stage of c(H) is built and the search is
+    repeated on it from ``start_harmonics`` at the tuned frequencies (at most ``max_rebuilds``
+    times). The last stage is returned: the sweep reuses it (same key as the chosen case)."""
+    from sarfe.hbm import SolverOptions
+    from sarfe.case.read import load_case
+    from sarfe.pipeline.model.linear_stage import build_linear_model
+    from sarfe.pipeline.model.nonlinear_model import nonlinear_model
+
+    case = load_case(case)
+    solver = case.config.solver
+    options = SolverOptions(tolerance=solver.tolerance, max_iterations=solver.max_iterations,
+                            stability=False)
+    limits = dict(max_harmonics=max_harmonics, max_samples=max_samples, options=options,
+                  start_harmonics=start_harmonics, start_samples=start_samples)
+    cutoff = rule_cutoff_hz(case, solver.harmonics)
+    grid = sweep_grid_hz(case.config.excitation, points)
+    history, seconds, stages, stage_seconds = [], 0.0, [], []
+    for attempt in range(max_rebuilds + 1):
+        searched = _with_cutoff(case, cutoff)
+        stage = build_linear_model(searched)
+        stages.append(stage.info.get("modes"))
+        stage_seconds.append(float(stage.timings.get("linear_stage_s", 0.0)))
+        report = resolve_accuracy(accuracy_problem(stage, nonlinear_model(searched, stage)),
+                                  target, grid, solver.harmonics, solver.samples_per_period,
+                                  max_points_tuned=max_points_tuned if attempt == 0 else len(grid),
+                                  **limits)
+        history += report["history"]
+        seconds += report["seconds"]
+        if attempt == 0 and report["tuned_hz"]:
+            grid = np.asarray(report["tuned_hz"])
+        need = rule_cutoff_hz(case, report["harmonics"])
+        if cutoff is None or need <= cutoff or not report["tuned_hz"]:
+            break
+        cutoff = need
+    report.update(history=history, seconds=seconds, search_stage_modes=stages,
+                  search_stage_seconds=stage_seconds, cutoff_hz=cutoff)
+    report["text"] += (f"\n  searched on {len(stages)} linear stage(s) (modes: "
+                       f"{', '.join(str(m) for m in stages)})" + (
+                           "" if cutoff is None else
+                           f"; reduction cutoff {cutoff:.0f} Hz (≥ {need:.0f} Hz = "
+                           f"{search_margin(case):g} H f_max at H = {report['harmonics']})"))
+    return report, stage
+
+
+def resolve_case_accuracy(case, target, points=8, start_harmonics=3, start_samples=64,
+                          max_harmonics=64, max_samples=8192, max_points_tuned=3) -> dict:
+    """The report of :func:`case_resolution` (the report dict of
+    :func:`sarfe.accuracy.resolve_accuracy` with the search's stages and cutoff)."""
+    return case_resolution(case, target, points, start_harmonics, start_samples, max_harmonics,
+                           max_samples, max_points_tuned)[0]
+
+
+RELEVANT_DB = 30.0     # points quieter than the loudest by more than this do not count (dB(A))
+
+KNOBS = {"harmonics": "solver.harmonics", "aliasing": "solver.samples_per_period",
+         "modal": "reduction.cutoff_hz (or mode_count)"}
+
+
+def accuracy_check(solver: SolverConfig, points) -> dict | None:
+    """The run's error estimates against its accuracy budget (``solver.accuracy``, default
+    'balanced': 1 % first-harmonic amplitude, 0.5 dB ERP) → {'met', 'target', 'point',
+    'frequency_hz', 'amplitude_rel', 'erp_db', 'knob', 'warning'} or None without estimates.
+
+    Counted: converged points with an estimate whose ERP is within RELEVANT_DB of the loudest
+    (a 5 dB error 60 dB below the headline changes nothing a user reads). The knob to raise is the
+    one whose part (Richardson factors included) is largest at the worst point: harmonics →
+    solver.harmonics, aliasing → solver.samples_per_period, modal → the reduction cutoff."""
+    from sarfe.accuracy.estimates import (RICHARDSON, basis_limited_extension,
+                                          harmonics_richardson, parse_accuracy)
+
+    target = parse_accuracy(solver.accuracy_or_default)
+    rated = [p for p in points if p["converged"] and p.get("error_estimate")
+             and "failed" not in p["error_estimate"]]
+    if not rated:
+        return None
+    loudest = max((p["erp"]["level_dba"] for p in rated if np.isfinite(p["erp"]["level_dba"])),
+                  default=float("nan"))
+    if np.isfinite(loudest):
+        rated = [p for p in rated if not p["erp"]["level_dba"] < loudest - RELEVANT_DB] or rated
+    budget = target.amplitude_budget()
+
+    def badness(p):
+        e = p["error_estimate"]
+        ratios = [np.nan_to_num(e["amplitude_rel"], posinf=np.inf) / budget]
+        if target.erp_db is not None:
+            ratios.append(np.nan_to_num(abs(e["erp_db"]), posinf=np.inf) / target.erp_db)
+        return max(ratios)
+
+    unknown = [p for p in rated if not np.isfinite(badness(p))]
+    rated = [p for p in rated if np.isfinite(badness(p))] or rated
+    worst = max(rated, key=badness)
+    e = worst["error_estimate"]
+    met = bool(badness(worst) <= 1.0)
+    factor = harmonics_richardson(int(e["harmonics"]), int(e["extended_harmonics"]))
+    parts = {"harmonics": factor * np.nan_to_num(e["harmonics_rel"]),
+             "aliasing": RICHARDSON * np.nan_to_num(e["aliasing_rel"]),
+             "modal": np.nan_to_num(e["modal_rel"])}
+    parts_db = {"harmonics": factor * abs(np.nan_to_num(e["harmonics_db"])),
+                "aliasing": RICHARDSON * abs(np.nan_to_num(e["aliasing_db"])),
+                "modal": abs(np.nan_to_num(e["modal_db"]))}
+    share = {k: max(parts[k] / budget, parts_db[k] / (target.erp_db or 1e300)) for k in parts}
+    knob = max(share, key=share.get)
+    warning = None
+    if not met:
+        warning = (f"accuracy: the error estimate exceeds the '{target.name}' budget at "
+                   f"{worst['frequency_hz']:.2f} Hz (amplitude ±{100 * e['amplitude_rel']:.2g} %, "
+                   f"ERP ±{abs(e['erp_db']):.2g} dB); mostly from {knob}: raise {KNOBS[knob]}")
+        if knob == "harmonics" and basis_limited_extension(e, worst["frequency_hz"]):
+            warning += (f" (its re-solve at H' = {int(e['extended_harmonics'])} reaches "
+                        f"{int(e['extended_harmonics']) * worst['frequency_hz']:.0f} Hz, above "
+                        f"the reduced basis' top mode at {e['basis_top_hz']:.0f} Hz, where the "
+                        "reduced model's own error enters the change: if a higher "
+                        "reduction.cutoff_margin lowers it, it was the basis')")
+    if unknown:     # an estimate whose re-solve did not converge: unknown, said, not hidden
+        where = ", ".join(f"{p['frequency_hz']:.2f}" for p in unknown[:3])
+        more = f" and {len(unknown) - 3} more" if len(unknown) > 3 else ""
+        met = False
+        warning = (warning + "; " if warning else "accuracy: ") + (
+            f"no error estimate at {where}{more} Hz (its re-solve at more harmonics or samples "
+            "did not converge)")
+    return {"met": bool(met), "target": target.name, "point": worst["index"],
+            "unknown_points": [p["index"] for p in unknown],
+            "frequency_hz": worst["frequency_hz"], "amplitude_rel": float(e["amplitude_rel"]),
+            "erp_db": float(e["erp_db"]), "knob": KNOBS[knob], "warning": warning}
+
+
+__all__ = ["accuracy_check", "stage_modal_coordinates", "accuracy_problem", "stage_error_estimate", "sweep_grid_hz",
+           "resolve_case_accuracy", "case_resolution", "rule_cutoff_hz", "search_margin"]

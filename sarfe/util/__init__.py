@@ -1,0 +1,1 @@
+"""Utilities below every layer: lazy package exports, the process pool, progress lines."""
