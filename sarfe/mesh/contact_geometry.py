@@ -15,13 +15,13 @@ A contact is defined by what is physical, not by mesh nodes:
 * the gap is between the surfaces, not the mid-surfaces (:func:`surface_gap`).
 
 A mesh's nodal normal (area-weighted over the 1-ring) leans with the mesh at poles of revolved
-surfaces (a node ringed by 5–7 irregular facets): on the squeak rig's pad 0.5–4.2°. The patch
-normal integrates the facet normals against a smooth kernel of a radius in metres,
-
-    N(c) = Σ_e n_e ∫_e k(|x − c|/R) dA,   k(s) = (1 − s²)² (s < 1), 0 otherwise,   n = N/|N|,
-
-which for a surface of revolution centred on its axis is the axis up to the faceting error
-(measured < 0.02° on the rig's cap, tests/mesh/test_contact_geometry.py).
+surfaces (a node ringed by 5–7 irregular facets): on the squeak rig's pad 1.1–4.2° at mesh sizes
+12–4 mm. A kernel average of the facet normals still leans (0.1–0.8° at R = 3 mm: the flat facets
+cut under the curved surface, each tilted its own way), so :func:`patch_normals` fits a quadric
+through the patch's nodes, which lie on the true surface, and takes its normal at the centre:
+within 0.05° of the pad's axis on all those meshes (tests/mesh/test_contact_geometry.py).
+:func:`facet_normal_spread_deg` reports how much the facet normals in a patch disagree (0 on a
+flat plate, the half dihedral angle at a fold or ridge) for a caller's warning.
 """
 from __future__ import annotations
 
@@ -267,7 +267,7 @@ def patch_normals(centres, points, triangles, radius_m, reference=None, iteratio
     used = np.unique(t)
     tree = cKDTree(p[used])
     nearest, _ = tree.query(c, k=min(min_nodes, len(used)))
-    support = np.maximum(float(radius_m), 1.25 * np.atleast_2d(nearest)[:, -1])
+    support = np.maximum(float(radius_m), 1.25 * np.reshape(nearest, (len(c), -1))[:, -1])
     normal = facet_average_normals(c, p, t, support, reference)
     owner, local_node = _candidate_pairs(tree, c, support)
     node = used[local_node]

@@ -7,7 +7,12 @@ import pytest
 import scipy.sparse as sp
 
 from sarfe.fe import fixed_dofs, free_dofs, natural_frequencies, shell_matrices
-from sarfe.fe.coupling import contact_operator, face_offsets, point_weights
+from sarfe.fe.coupling import (
+    contact_operator,
+    face_offsets,
+    point_rotation_weights,
+    point_weights,
+)
 from sarfe.fe.linear_solvers import factorize
 from sarfe.fe.reference_meshes import boundary_nodes, gmsh_rectangle_triangles
 from sarfe.mesh import facet_normals
@@ -25,13 +30,44 @@ def one_triangle_points(m):
 
 @pytest.mark.parametrize("bending", ["cubic", "linear"])
 def test_rigid_motion_moves_the_offset_point_rigidly(bending):
-    """u_i = a + ω × x_i, θ_i = ω  ⇒  u_p = a + ω × (x_p + z n) for any point and offset."""
+    """u_i = a + ω × x_i, θ_i = ω  ⇒  θ_p = ω and u_p = a + ω × (x_p + z n_s) for any point,
+    offset and offset direction n_s (the facet normal n by default)."""
     corners, normal, bary, z = one_triangle_points(60)
-    weights = point_weights(corners, [[0, 1, 2]], np.zeros(60, int), bary, z, bending)
     a, omega = RNG.normal(size=3), RNG.normal(size=3)
     u = np.concatenate([np.r_[a + np.cross(omega, x), omega] for x in corners])
+    element = np.zeros(60, int)
+    weights = point_weights(corners, [[0, 1, 2]], element, bary, z, bending=bending)
     exact = a + np.cross(omega, bary @ corners + z[:, None] * normal)
     np.testing.assert_allclose((weights @ u).reshape(-1, 3), exact, atol=1e-13)
+    tilted = normal + RNG.normal(scale=0.3, size=(60, 3))
+    tilted /= np.linalg.norm(tilted, axis=1, keepdims=True)
+    weights = point_weights(corners, [[0, 1, 2]], element, bary, z, tilted, bending=bending)
+    exact = a + np.cross(omega, bary @ corners + z[:, None] * tilted)
+    np.testing.assert_allclose((weights @ u).reshape(-1, 3), exact, atol=1e-13)
+    rotation = point_rotation_weights(corners, [[0, 1, 2]], element, bary, bending=bending)
+    np.testing.assert_allclose((rotation @ u).reshape(-1, 3), np.tile(omega, (60, 1)),
+                               atol=1e-13)
+
+
+def test_a_point_at_a_node_does_not_depend_on_the_triangle_chosen():
+    """At a vertex (L = e_i) the point is the node: u_p = u_i + θ_i × z n_s whichever of the
+    node's triangles holds it (the pad's pole, where the facets lean by degrees)."""
+    points, triangles = gmsh_rectangle_triangles(0.05, 0.04, 0.01)
+    points = points + np.column_stack([np.zeros((len(points), 2)),
+                                       RNG.normal(scale=2e-3, size=len(points))])   # curved
+    node = np.argmin(np.linalg.norm(points[:, :2] - [0.025, 0.02], axis=1))
+    holding = np.flatnonzero(np.any(triangles == node, axis=1))
+    slot = np.argmax(triangles[holding] == node, axis=1)
+    bary = np.eye(3)[slot]
+    direction = np.array([0.1, -0.2, 1.0]) / np.linalg.norm([0.1, -0.2, 1.0])
+    weights = point_weights(points, triangles, holding, bary, 1.25e-3, direction).toarray()
+    expected = np.zeros((3, 6 * len(points)))
+    expected[:, 6 * node:6 * node + 3] = np.eye(3)
+    expected[:, 6 * node + 3:6 * node + 6] = -np.array(
+        [[0, -direction[2], direction[1]], [direction[2], 0, -direction[0]],
+         [-direction[1], direction[0], 0]]) * 1.25e-3
+    for p in range(len(holding)):
+        np.testing.assert_allclose(weights[3 * p:3 * p + 3], expected, atol=1e-15)
 
 
 def test_cubic_interpolation_is_exact_for_a_quadratic_deflection():
