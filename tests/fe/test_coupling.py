@@ -146,13 +146,13 @@ def point_response(size):
     compliance = normal_rows @ factor.solve(normal_rows.T)
     _, modes = natural_frequencies(k, m, 1, fixed, return_modes=True)
     mode = modes[free, 0] * np.sign(mid[2] @ modes[free, 0])
-    nearest = np.argmin(np.linalg.norm(points[:, None] - POINTS[0], axis=2), axis=0)[0]
-    node_row = np.zeros(k.shape[0])
-    node_row[6 * nearest + 2] = 1.0
-    node_row = node_row[free]
+    nearest = np.argmin(np.linalg.norm(points[:, None] - POINTS, axis=2), axis=0)
+    node_rows = np.zeros((2, k.shape[0]))
+    node_rows[[0, 1], 6 * nearest + 2] = 1.0
+    node_rows = node_rows[:, free]
     return dict(direct=compliance[0, 0], transfer=compliance[0, 1], mode_normal=mid[2] @ mode,
-                mode_tangential=upper[0] @ mode,
-                node=node_row @ factor.solve(node_row),
+                mode_tangential=upper[0] @ mode, both=np.diag(compliance),
+                node=np.diag(node_rows @ factor.solve(node_rows.T)),
                 clearance=np.min(np.linalg.norm(points - POINTS[0], axis=1)))
 
 
@@ -162,8 +162,9 @@ def responses():
 
 
 def test_point_contact_is_mesh_independent_within_1_percent(responses):
-    """Measured vs the 1.5 mm mesh: 5 / 4 / 3 mm within 0.61 / 0.47 / 0.25 % (direct), ≤ 0.4 %
-    (transfer), ≤ 0.4 % (first mode normal, and tangential on the face: −(t/2) ∂φ/∂x)."""
+    """Measured vs the 1.5 mm mesh, 5 / 4 / 3 mm: direct compliance +0.53 / +0.33 / +0.19 %
+    (+0.61 / +0.47 / +0.25 % at the second point), transfer +0.38 / +0.26 / +0.13 %, first mode
+    normal +0.37 / +0.22 / +0.11 %, tangential on the face (−(t/2) ∂φ/∂x) +0.24 / +0.16 / +0.06 %."""
     reference = responses[0.0015]
     for size in (0.005, 0.004, 0.003):
         r = responses[size]
@@ -175,9 +176,10 @@ def test_point_contact_is_mesh_independent_within_1_percent(responses):
 
 
 def test_node_pairing_is_what_moved_with_the_mesh(responses):
-    """Today's contact at the nearest node: its compliance swings by several % between the
-    meshes (the node sits 0.8–2 mm from the point) — the test above has teeth."""
+    """Today's contact at the nearest node: its compliance swings between the meshes (the node
+    sits 0.7–2 mm from the point; measured 2.3 % and 15.4 % peak to peak at the two points),
+    the point's by < 0.5 % — the test above has teeth."""
     node = np.array([responses[s]["node"] for s in (0.005, 0.004, 0.003)])
-    point = np.array([responses[s]["direct"] for s in (0.005, 0.004, 0.003)])
-    assert np.ptp(node) / node.mean() > 0.02
-    assert np.ptp(point) / point.mean() < 0.01
+    point = np.array([responses[s]["both"] for s in (0.005, 0.004, 0.003)])
+    assert np.max(np.ptp(node, axis=0) / node.mean(axis=0)) > 0.05
+    assert np.max(np.ptp(point, axis=0) / point.mean(axis=0)) < 0.01
