@@ -12,7 +12,7 @@ Input: harmonic frequencies f_k [Hz] and SPL L_k [dB re 20 µPa] at the occupant
    ch. 4 and 6.2): a tone is just masked when its level equals the background's level in the
    critical band around it plus the masking index a_v,
 
-       T_m,n = L_CB,n + a_v(f_n),   a_v(f) = −2 − 2.05 atan(f / 4 kHz) − 0.75 atan((f / 1.6 kHz)²) dB,
+       T_m,n = L_CB,n + a_v(f_n),  a_v(f) = −2 − 2.05 atan(f/4 kHz) − 0.75 atan((f/1.6 kHz)²) dB,
 
    L_CB,n = 10 lg ∫ b(f) df over [f_n − Δf_G/2, f_n + Δf_G/2], b(f) the background's power
    density (band power spread evenly over its band), with the critical bandwidth

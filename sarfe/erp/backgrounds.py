@@ -121,7 +121,8 @@ def load_background(name_or_path) -> BackgroundSpectrum:
             raise BackgroundFileError(f"{where}: level {fields[1]} dB must be finite")
         band = _band_of(frequency)
         if band is None:
-            raise BackgroundFileError(f"{where}: {frequency:g} Hz is not a third-octave band centre")
+            raise BackgroundFileError(f"{where}: {frequency:g} Hz is not a third-octave band "
+                                      "centre")
         if band in bands:
             raise BackgroundFileError(f"{where}: band {frequency:g} Hz is listed twice")
         bands.append(band)

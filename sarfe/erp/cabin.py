@@ -16,8 +16,9 @@ constant beyond the first and last). For the ERP of a harmonic response each har
 own P_k and f_k (harmonics are incoherent in power over a period), so L_p,k follows per harmonic,
 ``occupant_spl_db(erp.power, erp.frequencies_hz)``, and per third-octave band from the band
 powers of :func:`sarfe.erp.bands.third_octave_levels`, ``occupant_spl_db(bands.power_W,
-bands.center_hz)`` (ᾱ at the band centre; with a flat ᾱ both agree exactly). The Sabine reverberation time T = 24 ln 10 · V / (c S ᾱ) is reported as
-a plausibility check of the chosen absorption (measured cabin values are 0.04–0.1 s).
+bands.center_hz)`` (ᾱ at the band centre; with a flat ᾱ both agree exactly).
+The Sabine reverberation time T = 24 ln 10 · V / (c S ᾱ) is reported as a plausibility check of
+the chosen absorption (the source below measured 58 ms at 1 kHz).
 
 Default passenger-car cabin (:data:`PASSENGER_CAR`, every value stated with its source):
 

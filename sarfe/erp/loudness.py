@@ -234,12 +234,13 @@ def band_filter_gain(frequency_hz, band_numbers=BAND_NUMBERS, order: int = 3) ->
     r"""Power gain |H_n(f)|² of third-octave analyser filters: Butterworth band-passes of the
     given prototype order around each exact centre f_m,n = 1000·10^(n/10) Hz,
 
-        |H_n(f)|² = 1 / (1 + Ω^(2·order)),   Ω = (f/f_m − f_m/f) / (G^(1/6) − G^(−1/6)),  G = 10^0.3,
+        |H_n(f)|² = 1 / (1 + Ω^(2·order)),  Ω = (f/f_m − f_m/f) / (G^(1/6) − G^(−1/6)),
 
-    so the −3 dB points are the IEC 61260-1 band edges. Order 3 (6th-order band-pass, the usual
-    IEC 61260 class-1 realisation) is the filter bank of the ISO 532-1 reference program; with it
-    the pure-tone test signals of ISO 532-1 Annex B.3 are reproduced within 2.3 %
-    (tests/erp/test_loudness.py). frequency_hz (H,) [Hz] > 0 → (n_bands, H).
+    with G = 10^0.3, so the −3 dB points are the IEC 61260-1 band edges. Order 3 (a 6th-order
+    band-pass, a common IEC 61260 class-1 realisation) stands in for the analyser behind the
+    standard's reference values: with it the pure-tone test signals of ISO 532-1 Annex B.3 are
+    reproduced within 2.3 % (tests/erp/test_loudness.py). frequency_hz (H,) [Hz] > 0 →
+    (n_bands, H).
     """
     f = np.asarray(frequency_hz, dtype=float)[None, :]
     centre = 1000.0 * 10.0 ** (np.asarray(band_numbers, dtype=float)[:, None] / 10.0)
@@ -256,7 +257,7 @@ def line_spectrum_band_levels_db(frequencies_hz, levels_db, filter_order: int | 
 
         L_n = 10 lg Σ_k 10^(L_k/10) · g_n(f_k),
 
-    with g_n = |H_n|² of :func:`band_filter_gain` (``filter_order``, as an analyser measures it,
+    with g_n = |H_n|² of :func:`band_filter_gain` (``filter_order``: as an analyser measures it,
     the input ISO 532-1 expects) or, for ``filter_order=None``, the ideal band g_n = 1 for
     f_k ∈ [f_lo,n, f_hi,n) and 0 elsewhere (each line's power in its own band, exactly).
     Returns (28,), −inf for a band without power.

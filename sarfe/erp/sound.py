@@ -55,7 +55,7 @@ _CHUNK_SAMPLES = 8192
 
 @dataclass(frozen=True)
 class WavCalibration:
-    """How a WAV file's samples map to pressure: p = (sample / full-scale sample) · full_scale_pa."""
+    """How a WAV file's samples map to pressure: p = s / s_full · full_scale_pa."""
 
     full_scale_pa: float     # pressure [Pa] at digital full scale
     sample_rate_hz: int
@@ -195,7 +195,8 @@ def read_wav(path):
         raise ValueError(f"{path}: not a RIFF WAVE file")
     position, fmt, data, comment = 12, None, None, b""
     while position + 8 <= len(raw):
-        tag, size = raw[position:position + 4], struct.unpack("<I", raw[position + 4:position + 8])[0]
+        tag = raw[position:position + 4]
+        size = struct.unpack("<I", raw[position + 4:position + 8])[0]
         body = raw[position + 8:position + 8 + size]
         if tag == b"fmt ":
             fmt = struct.unpack("<HHIIHH", body[:16])

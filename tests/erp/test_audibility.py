@@ -125,7 +125,8 @@ def test_user_background_with_few_bands_and_exact_centres(tmp_path):
     path.write_text("# measured somewhere\n1000 45.0\n501.19 50\n16000 20\n")
     spectrum = load_background(path)
     levels = spectrum.iso_band_levels_db()
-    assert levels[BAND_CENTRES_HZ == 500.0][0] == 50.0 and levels[BAND_CENTRES_HZ == 1000.0][0] == 45
+    assert levels[BAND_CENTRES_HZ == 500.0][0] == 50.0
+    assert levels[BAND_CENTRES_HZ == 1000.0][0] == 45.0
     assert np.isneginf(levels[BAND_CENTRES_HZ == 100.0][0])
     assert spectrum.source == "measured somewhere" and spectrum.band.tolist() == [-3, 0, 12]
     with pytest.raises(BackgroundFileError, match="no such background"):
