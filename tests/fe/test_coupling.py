@@ -13,7 +13,7 @@ from sarfe.fe.coupling import (
     point_rotation_weights,
     point_weights,
 )
-from sarfe.fe.linear_solvers import factorize
+from sarfe.linalg import factorize
 from sarfe.fe.reference_meshes import boundary_nodes, gmsh_rectangle_triangles
 from sarfe.mesh import facet_normals
 from sarfe.mesh.contact_geometry import frames_from_normals, project_to_surface

@@ -8,7 +8,7 @@ import pytest
 
 from sarfe.fe import fixed_dofs, free_dofs, shell_matrices
 from sarfe.fe.coupling import face_offsets, point_weights
-from sarfe.fe.linear_solvers import factorize
+from sarfe.linalg import factorize
 from sarfe.fe.reference_meshes import boundary_nodes, gmsh_rectangle_triangles, rectangle_triangles
 from sarfe.mesh import facet_normals
 from sarfe.mesh.contact_geometry import project_to_surface
