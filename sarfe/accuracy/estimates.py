@@ -1,5 +1,4 @@
-r"""Accuracy as an input: cheap a-posteriori error estimates of a harmonic-balance solution and an
-adaptive choice of H (harmonics), N (AFT samples per period) and the fixed-interface mode count.
+r"""Accuracy as an input: cheap a-posteriori error estimates of a harmonic-balance solution.
 
 A solution ũ (2H+1, n) at ω solves R_{H,N}(ũ) = S(ω) ũ + f̃_nl^{(N)}(ũ) − f̃_e = 0. Embedded in a richer
 discretization (H', N') it leaves a residual R_{H',N'}(ũ) ≠ 0; Newton iterations of the richer problem
@@ -169,7 +168,7 @@ class ErrorEstimate:
     N → 2N (1); modal_rel / modal_db: two probes of the top modes removed, extrapolated (4, 5);
     displacement_tail / force_tail: (2).
     amplitude_rel, erp_db: RICHARDSON × (harmonics + aliasing part) + modal part (3), (4) (what
-    :func:`choose_resolution` compares with the target). seconds: time spent estimating.
+    the run's accuracy check compares with the target). seconds: time spent estimating.
     basis_top_hz: the highest fixed-interface mode of a Craig–Bampton model [Hz] (NaN otherwise):
     harmonics of the H' re-solve above it are answered by the residual vectors, whose Ritz
     frequencies sit just above it — there the reduced model's own error enters the harmonics
@@ -721,21 +720,6 @@ def estimate_errors(solution, model, contacts, excitation, *, erp_map=None, erp_
         seconds=time.perf_counter() - clock, notes=tuple(notes))
 
 
-# ---------------------------------------------------------------------------- adaptive choice
-@dataclass(frozen=True)
-class Resolution:
-    """Result of :func:`choose_resolution`: the final solution, its H, N, estimate and the history
-    (one dict per round: H, N, converged, iterations, estimate, seconds); met: target reached."""
-
-    solution: object
-    harmonics: int
-    samples_per_period: int
-    estimate: ErrorEstimate
-    met: bool
-    reason: str
-    history: list
-
-
 @dataclass(frozen=True)
 class EstimateProblem:
     """What :func:`problem_error_estimate` needs of a case's point, as plain arrays: the problem
@@ -796,150 +780,13 @@ def highest_natural_frequency_hz(model):
     return float(np.sqrt(max(values.max(initial=0.0), 0.0)) / (2 * np.pi))
 
 
-def choose_resolution(target, model, contacts, excitation, omega, *, harmonics=3,
-                      samples_per_period=64, max_harmonics=64, max_samples=8192, max_rounds=12,
-                      erp_map=None, erp_areas=None, modal_dofs=None, residual_dofs=None,
-                      options=None, initial=None) -> Resolution:
-    """Adaptive H, N at one ω [rad/s] until the estimates meet ``target`` (see :func:`parse_accuracy`).
-
-    Loop: solve (warm-started from the previous round, cold with the engine's homotopy if that
-    fails, and once more with 2N if it still fails); while the truncation estimate H → H' exceeds
-    half the budget, H ← H' (N doubled to keep N/H ≥ its starting ratio and N ≥ 4H+1); else while
-    the aliasing estimate N → 2N exceeds half the budget, N ← 2N. Stops at max_harmonics / max_samples / max_rounds (met=False, reason says why)
-    or when a solve does not converge. excitation f̃_e (2H_e+1, n) [N] (any H_e; resized).
-    """
-    from sarfe.hbm.solve import solve_frequency
-
-    import warnings
-
-    target = parse_accuracy(target)
-    H, N = int(harmonics), samples_for(int(harmonics), int(samples_per_period))
-    ratio = max(4.0, N / H)                 # keep N/H ≥ the starting ratio as H grows
-    history, previous = [], initial
-    solved = []
-    solution = estimate = None
-    reason = f"round cap {max_rounds} reached"
-    met = False
-    retried = False
-    for _ in range(max_rounds):
-        clock = time.perf_counter()
-        guess = None if previous is None else resize_harmonics(
-            getattr(previous, "displacement", previous), H)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            F = resize_harmonics(excitation, H)
-            solution = solve_frequency(model, contacts, F, omega, H, N, initial=guess,
-                                       options=options)
-            if not solution.converged and guess is not None:     # cold start (engine homotopy)
-                cold = solve_frequency(model, contacts, F, omega, H, N, options=options)
-                solution = cold if cold.converged else solution
-        estimate = estimate_errors(solution, model, contacts, resize_harmonics(excitation, H),
-                                   erp_map=erp_map, erp_areas=erp_areas, modal_dofs=modal_dofs,
-                                   residual_dofs=residual_dofs,
-                                   options=options)
-        history.append({"harmonics": H, "samples_per_period": N,
-                        "converged": bool(solution.converged), "iterations": int(solution.iterations),
-                        "estimate": estimate.as_dict(), "seconds": time.perf_counter() - clock})
-        if not solution.converged:
-            if not retried and 2 * N <= max_samples:           # aliasing can stall Newton: once 2N
-                retried, N = True, 2 * N
-                continue
-            reason = f"not converged at H={H}, N={N}: {solution.reason}"
-            break
-        previous = solution
-        solved.append((H, N, solution, estimate))
-        earlier = _smallest_sufficient(target, solved, contacts, omega, erp_map, erp_areas)
-        if earlier is not None:      # an earlier (smaller) H, N is within the budget of this one
-            H_e, N_e, solution, estimate = earlier
-            met, reason = True, (f"target met at H = {H_e}, N = {N_e}: its change to H = {H}, "
-                                 f"N = {N} plus that one's estimate")
-            return Resolution(solution, H_e, N_e, estimate, met, reason, history)
-        h_ok = target.met_by(RICHARDSON * _finite(estimate.harmonics_rel),
-                             RICHARDSON * abs(_finite(estimate.harmonics_db)), 0.5)
-        a_ok = target.met_by(RICHARDSON * _finite(estimate.aliasing_rel),
-                             RICHARDSON * abs(_finite(estimate.aliasing_db)), 0.5)
-        if h_ok and a_ok:
-            met, reason = True, "target met"
-            break
-        if not h_ok:
-            if H >= max_harmonics:
-                reason = f"harmonics cap {max_harmonics} reached"
-                break
-            H = min(max_harmonics, estimate.extended_harmonics)
-            N = min(max(max_samples, 4 * H + 1), _at_least(N, max(4 * H + 1, ratio * H)))
-        else:
-            if 2 * N > max_samples:
-                reason = f"samples cap {max_samples} reached"
-                break
-            N *= 2
-    return Resolution(solution, H if solution is None else int(solution.harmonics),
-                      N if solution is None else int(solution.samples_per_period), estimate, met,
-                      reason, history)
-
-
-def _smallest_sufficient(target, solved, contacts, omega, erp_map, erp_areas):
-    """(H, N, solution, estimate) of the smallest earlier round whose measured change to the latest
-    round plus the latest one's own estimate (e(H_j) ≤ ‖ũ_j − ũ_k‖ + e(H_k)) meets half the
-    budget, or None. On impacts an estimate is not monotone in H (a raise can move the active set
-    and the estimate with it): measured against a finer solution the earlier rounds need no
-    estimate of their own, and the climb does not over-resolve."""
-    if len(solved) < 2:
-        return None
-    H_k, N_k, s_k, e_k = solved[-1]
-    if not (np.isfinite(e_k.amplitude_rel) and np.isfinite(e_k.erp_db)):
-        return None
-    U_k = np.asarray(s_k.displacement)
-    for H_j, N_j, s_j, e_j in sorted(solved[:-1], key=lambda r: (r[0], r[1])):
-        rel, db = _change(contacts, resize_harmonics(s_j.displacement, H_k), U_k, omega, erp_map,
-                          erp_areas)
-        bound_rel, bound_db = rel + e_k.amplitude_rel, abs(db) + abs(e_k.erp_db)
-        if np.isfinite(bound_rel) and np.isfinite(bound_db) and target.met_by(bound_rel,
-                                                                               bound_db, 0.5):
-            from dataclasses import replace
-            estimate = replace(e_j, amplitude_rel=float(bound_rel), erp_db=float(bound_db),
-                               notes=e_j.notes + (f"bounded by the change to H = {H_k}, N = {N_k} "
-                                                  "plus that solution's estimate",))
-            return H_j, N_j, s_j, estimate
-    return None
-
-
 def _at_least(N, need):
     while N < need:
         N *= 2
     return int(N)
 
 
-def _finite(x):
-    """NaN (a part not computed) → 0; an unknown part (inf) stays inf."""
-    return 0.0 if np.isnan(x) else float(x)
-
-
-def suggest_mode_count(mode_frequencies_hz, max_frequency_hz, harmonics, target=None,
-                       modal_rel=None, current=None) -> dict:
-    """Fixed-interface mode count for an excited band up to H·f_max.
-
-    Rule: keep the modes below c·H·f_max with c = 1.5 (fast), 2 (balanced), 3 (fine) — a mode at
-    f_j answers a harmonic at f < f_j quasi-statically with relative error ≈ (f/f_j)², so c = 1.5
-    leaves ≈ 45 %, c = 3 ≈ 11 % of the highest harmonic's (small) dynamic amplification. When a
-    ``modal_rel`` estimate above the target is given, the current count is doubled.
-    Returns {'mode_count', 'cutoff_hz', 'reason'}.
-    """
-    target = parse_accuracy(target or "balanced")
-    budget = target.amplitude_budget()
-    factor = 1.5 if budget >= 5e-2 else (2.0 if budget >= 1e-2 else 3.0)
-    cutoff = factor * harmonics * max_frequency_hz
-    f = np.asarray(mode_frequencies_hz, dtype=float)
-    count = int(np.count_nonzero(f <= cutoff)) if f.size else 0
-    reason = f"modes below {factor:g} H f_max = {cutoff:.0f} Hz"
-    if modal_rel is not None and np.isfinite(modal_rel) and modal_rel > 0.5 * budget and current:
-        count = max(count, 2 * int(current))
-        reason += f"; modal estimate {modal_rel:.2g} above half the budget: doubled"
-    return {"mode_count": count, "cutoff_hz": cutoff, "reason": reason}
-
-
-__all__ = ["RICHARDSON", "PRESETS", "AccuracyTarget", "parse_accuracy", "ErrorEstimate", "Resolution",
+__all__ = ["RICHARDSON", "PRESETS", "AccuracyTarget", "parse_accuracy", "ErrorEstimate",
            "resize_harmonics", "spectral_tail", "harmonic_energy", "newton_correction",
            "extended_harmonics", "reach_harmonics", "samples_for", "estimate_errors", "EstimateProblem",
-           "problem_error_estimate", "basis_limited_extension", "highest_natural_frequency_hz",
-           "choose_resolution",
-           "suggest_mode_count"]
+           "problem_error_estimate", "basis_limited_extension", "highest_natural_frequency_hz"]
