@@ -53,7 +53,7 @@ def amplitude_error(contacts, U, U_ref):
 def load_problem(name):
     """(label, model, contacts, excitation (2·40+1, n), erp_map, erp_areas, modal_dofs, frequencies)."""
     from sarfe.pipeline import build_linear_model, load_case, nonlinear_model
-    from sarfe.accuracy.estimates import resize_harmonics
+    from sarfe.accuracy.measures import resize_harmonics
 
     if name.startswith("lumped_chain"):
         from sarfe.tradeoff.lumped import lumped_problem
@@ -78,7 +78,7 @@ def load_problem(name):
 
 def reference(prob, omega, H=40, N=4096, initial=None):
     from sarfe.hbm import SolverOptions, solve_frequency
-    from sarfe.accuracy.estimates import resize_harmonics
+    from sarfe.accuracy.measures import resize_harmonics
 
     return solve_frequency(prob["model"], prob["contacts"], resize_harmonics(prob["excitation"], H),
                            omega, H, N, initial=None if initial is None else
@@ -89,7 +89,7 @@ def nonlinear_points(prob, count=2):
     """Frequencies where a stepped HBM sweep (H = 5, N = 128, warm starts) converges with an active
     contact (force > 0), each with its H = 40, N = 4096 reference (started from it)."""
     from sarfe.hbm import SolverOptions, solve_frequency
-    from sarfe.accuracy.estimates import resize_harmonics
+    from sarfe.accuracy.measures import resize_harmonics
 
     found, previous = [], None
     F = resize_harmonics(prob["excitation"], 5)
@@ -113,7 +113,8 @@ def nonlinear_points(prob, count=2):
 
 # ------------------------------------------------------------------------------------ part 1
 def hbm_vs_time(prob, f, ref, targets=(1e-2, 1e-3), max_steps=4096):
-    from sarfe.accuracy.estimates import EstimateProblem, resize_harmonics
+    from sarfe.accuracy.estimate import EstimateProblem
+    from sarfe.accuracy.measures import resize_harmonics
     from sarfe.accuracy.resolve import resolve_accuracy
     from sarfe.hbm import SolverOptions, solve_frequency
     from sarfe.hbm.time_integration import integrate_time
@@ -167,7 +168,7 @@ def hbm_smallest_sufficient(prob, omega, ref, target):
     least 64) whose cold-start solve meets the target against the reference; the cost of that solve
     only."""
     from sarfe.hbm import SolverOptions, solve_frequency
-    from sarfe.accuracy.estimates import resize_harmonics
+    from sarfe.accuracy.measures import resize_harmonics
 
     for H in HARMONIC_LADDER:
         N = max(64, 16 * H)
@@ -194,7 +195,7 @@ def cost_scaling(quick=False):
     """Seconds per Newton iteration (warm solve from 0.8 × the converged solution, best of 2) of
     chains with a rattle contact on every mass: vs H (8 contacts) and vs n_c (H = 5, N = 128)."""
     from sarfe.hbm import SolverOptions, solve_frequency
-    from sarfe.accuracy.estimates import resize_harmonics
+    from sarfe.accuracy.measures import resize_harmonics
     from sarfe.tradeoff.lumped import lumped_problem
 
     options = SolverOptions(stability=False)
@@ -293,7 +294,7 @@ def raise_harmonics(nl, solution, harmonics, samples_per_period):
     N/2 (impacts converge on some paths only); when none converges the climb ends there
     ((None, None) when the first step fails)."""
     from sarfe.hbm import SolverOptions, solve_frequency
-    from sarfe.accuracy.estimates import resize_harmonics
+    from sarfe.accuracy.measures import resize_harmonics
 
     options = SolverOptions(stability=False, max_iterations=100)
     H, previous, chain = int(solution.harmonics), solution, []
@@ -324,7 +325,7 @@ def true_errors(stage, solution, ref_stage, ref):
     """(relative first-harmonic amplitude error at the contact rows, the larger ERP level error of
     dB and dB(A) [dB]) of
     ``solution`` against ``ref`` (each with its own stage's ERP map: the models may differ)."""
-    from sarfe.accuracy.estimates import _erp_proxy
+    from sarfe.accuracy.measures import erp_proxy
 
     def amplitudes(s):
         R = np.asarray(s.contact_displacement)
@@ -334,9 +335,9 @@ def true_errors(stage, solution, ref_stage, ref):
     rel = float(np.max(np.abs(a - b)) / max(b.max(), 1e-300))
     levels = []
     for weighted in (False, True):   # the estimate bounds the larger of the dB and dB(A) errors
-        p = _erp_proxy(solution.displacement, solution.omega, stage.erp_map, stage.erp_areas,
+        p = erp_proxy(solution.displacement, solution.omega, stage.erp_map, stage.erp_areas,
                        weighted)
-        q = _erp_proxy(ref.displacement, ref.omega, ref_stage.erp_map, ref_stage.erp_areas,
+        q = erp_proxy(ref.displacement, ref.omega, ref_stage.erp_map, ref_stage.erp_areas,
                        weighted)
         levels.append(float(abs(10 * np.log10(p / q))) if p > 0 and q > 0 else float("nan"))
     return rel, max(levels)
@@ -480,7 +481,7 @@ def shipped_markdown(rows):
              "ratio = estimate / true (≥ 1: bracketed). ref H: the highest H the reference reached "
              "(raised ×1.25 a step); floor: its amplitude / ERP change over that last step. "
              "* = the case's own H, N. Parts: raw changes H → H', N → 2N and the modal part (4) "
-             "(sarfe/accuracy/estimates.py).", "",
+             "(sarfe/accuracy/estimate.py).", "",
              "| case | f [Hz] | H, N | modes + RV | amp. estimate | amp. true | ratio | "
              "ERP est. [dB] | ERP true [dB] | ratio | H, N, modal parts (amp.) | ref H, floor | "
              "bracketed |", "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]

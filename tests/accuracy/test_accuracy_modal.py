@@ -1,4 +1,4 @@
-"""The modal part of the per-point error estimate, (4)–(5) of sarfe.accuracy.estimates: two probes
+"""The modal part of the per-point error estimate, (4)–(5) of sarfe.accuracy.modal_truncation: two probes
 (the top 1/20 and 1/5 of the modes left out) and the decay p of an error ∝ m^{−p} fitted from both.
 Closed forms: for a truncation error e(m) = C m^{−p} the probes change by d_i = e(m'_i) − e(m) and
 the extrapolation returns e(m) exactly while 1 ≤ p ≤ 2.5, more than e(m) (never less) for faster
@@ -7,8 +7,8 @@ never exceeds) when the changes do not decay."""
 import numpy as np
 import pytest
 
-from sarfe.accuracy.estimates import (MODE_DECAY, MODE_PROBES, mode_decay, mode_richardson,
-                                      modal_extrapolation)
+from sarfe.accuracy.modal_truncation import (MODE_DECAY, MODE_PROBES, mode_decay,
+                                             mode_richardson, modal_extrapolation)
 
 MODES = 317          # door trim, 15 mm, cutoff H f_max (benchmarks/results/cutoff.md)
 

@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 from sarfe.hbm import SolverOptions, solve_frequency
-from sarfe.accuracy.estimates import (AccuracyTarget, estimate_errors, harmonic_energy,
-                                      parse_accuracy, resize_harmonics, spectral_tail)
+from sarfe.accuracy.estimate import estimate_errors
+from sarfe.accuracy.measures import harmonic_energy, resize_harmonics, spectral_tail
+from sarfe.accuracy.target import AccuracyTarget, parse_accuracy
 from sarfe.tradeoff.lumped import lumped_problem
 
 OPTIONS = SolverOptions(stability=False)
@@ -125,14 +126,14 @@ def _raise_to(nl, solution, H, N):
 def _true_errors(stage, s, ref_stage, ref):
     """(max |Δa₁| / max a₁ over the contact rows, the larger of |ΔL_ERP| and |ΔL_ERP,A| [dB]);
     each with its own ERP map."""
-    from sarfe.accuracy.estimates import _erp_proxy
+    from sarfe.accuracy.measures import erp_proxy
 
     a = np.hypot(*np.asarray(s.contact_displacement)[1:3])
     b = np.hypot(*np.asarray(ref.contact_displacement)[1:3])
     db = []
     for weighted in (False, True):      # the estimate bounds the larger of dB and dB(A)
-        p = _erp_proxy(s.displacement, s.omega, stage.erp_map, stage.erp_areas, weighted)
-        q = _erp_proxy(ref.displacement, ref.omega, ref_stage.erp_map, ref_stage.erp_areas,
+        p = erp_proxy(s.displacement, s.omega, stage.erp_map, stage.erp_areas, weighted)
+        q = erp_proxy(ref.displacement, ref.omega, ref_stage.erp_map, ref_stage.erp_areas,
                        weighted)
         db.append(abs(10 * np.log10(p / q)))
     return float(np.max(np.abs(a - b)) / b.max()), float(max(db))
@@ -186,7 +187,7 @@ def test_coarser_model_is_the_reduction_with_fewer_modes():
     12 and 10 modes, 67 Hz)."""
     from sarfe.pipeline import build_linear_model, load_case, nonlinear_model
     from sarfe.pipeline.solve.points import solve_points
-    from sarfe.accuracy.estimates import modal_truncation_change
+    from sarfe.accuracy.modal_truncation import modal_truncation_change
     from sarfe.pipeline.solve.case_accuracy import stage_modal_coordinates
 
     def solved(mode_count):
