@@ -2,9 +2,10 @@
 
 1. HBM vs the built-in time integrator at equal accuracy (1 % and 0.1 % first-harmonic amplitude at
    the contacts, against a fine HBM reference checked by time integration): wall-time ratio.
-   HBM: :func:`sarfe.accuracy.estimates.choose_resolution` from H = 2, N = 32 (cold, the cost of the
-   whole adaptive loop, estimates included). Time integration: steps per period doubled from 128
-   until the error is below the target (cost of the successful run only, started from the linear
+   HBM: the accuracy search a run makes (:func:`sarfe.accuracy.resolve.resolve_accuracy` at that
+   frequency from H = 2, N = 32: screening solve, H ladder, N doubling) and the solve at the H, N
+   it chooses (cold, the cost of the whole adaptive choice). Time integration: steps per period
+   doubled from 128 until the error is below the target (cost of the successful run only, started from the linear
    periodic solution as ``integrate_time`` does by default).
 2. Cost vs H and vs the number of contacts (lumped chains) with fitted exponents t ∝ H^p, t ∝ n_c^q.
 3. The error estimate the pipeline reports (``stage_error_estimate``) vs the true error on every
@@ -52,7 +53,7 @@ def amplitude_error(contacts, U, U_ref):
 def load_problem(name):
     """(label, model, contacts, excitation (2·40+1, n), erp_map, erp_areas, modal_dofs, frequencies)."""
     from sarfe.pipeline import build_linear_model, load_case, nonlinear_model
-    from sarfe.accuracy.estimates import resize_harmonics
+    from sarfe.accuracy.measures import resize_harmonics
 
     if name.startswith("lumped_chain"):
         from sarfe.tradeoff.lumped import lumped_problem
@@ -77,7 +78,7 @@ def load_problem(name):
 
 def reference(prob, omega, H=40, N=4096, initial=None):
     from sarfe.hbm import SolverOptions, solve_frequency
-    from sarfe.accuracy.estimates import resize_harmonics
+    from sarfe.accuracy.measures import resize_harmonics
 
     return solve_frequency(prob["model"], prob["contacts"], resize_harmonics(prob["excitation"], H),
                            omega, H, N, initial=None if initial is None else
@@ -88,7 +89,7 @@ def nonlinear_points(prob, count=2):
     """Frequencies where a stepped HBM sweep (H = 5, N = 128, warm starts) converges with an active
     contact (force > 0), each with its H = 40, N = 4096 reference (started from it)."""
     from sarfe.hbm import SolverOptions, solve_frequency
-    from sarfe.accuracy.estimates import resize_harmonics
+    from sarfe.accuracy.measures import resize_harmonics
 
     found, previous = [], None
     F = resize_harmonics(prob["excitation"], 5)
@@ -112,20 +113,26 @@ def nonlinear_points(prob, count=2):
 
 # ------------------------------------------------------------------------------------ part 1
 def hbm_vs_time(prob, f, ref, targets=(1e-2, 1e-3), max_steps=4096):
-    from sarfe.hbm import SolverOptions
+    from sarfe.accuracy.estimate import EstimateProblem
+    from sarfe.accuracy.measures import resize_harmonics
+    from sarfe.accuracy.resolve import resolve_accuracy
+    from sarfe.hbm import SolverOptions, solve_frequency
     from sarfe.hbm.time_integration import integrate_time
-    from sarfe.accuracy.estimates import choose_resolution, resize_harmonics
 
     omega = 2 * np.pi * f
     rows = []
     for target in targets:
         clock = time.perf_counter()
-        res = choose_resolution({"amplitude_rel": target}, prob["model"], prob["contacts"],
-                                prob["excitation"], omega, harmonics=2, samples_per_period=32,
-                                erp_map=prob["erp_map"], erp_areas=prob["erp_areas"],
-                                modal_dofs=None, options=SolverOptions(stability=False))
+        problem = EstimateProblem(prob["model"], prob["contacts"], prob["excitation"],
+                                  prob["erp_map"], prob["erp_areas"])
+        res = resolve_accuracy(problem, {"amplitude_rel": target}, [f], 2, 32, start_harmonics=2,
+                               start_samples=32, max_points_tuned=1)
+        H, N = res["harmonics"], res["samples_per_period"]
+        chosen = solve_frequency(prob["model"], prob["contacts"],
+                                 resize_harmonics(prob["excitation"], H), omega, H, N,
+                                 options=SolverOptions(stability=False))
         t_hbm = time.perf_counter() - clock
-        e_hbm = amplitude_error(prob["contacts"], resize_harmonics(res.solution.displacement, 40),
+        e_hbm = amplitude_error(prob["contacts"], resize_harmonics(chosen.displacement, 40),
                                 ref.displacement)
         fixed = hbm_smallest_sufficient(prob, omega, ref, target)
         steps, t_ti, e_ti, ok = 128, float("nan"), float("nan"), False
@@ -140,14 +147,14 @@ def hbm_vs_time(prob, f, ref, targets=(1e-2, 1e-3), max_steps=4096):
                 break
             steps *= 2
         rows.append({"case": prob["label"], "frequency_hz": f, "target": target,
-                     "hbm_H": res.harmonics, "hbm_N": res.samples_per_period, "hbm_met": res.met,
+                     "hbm_H": H, "hbm_N": N, "hbm_met": res["met"] and chosen.converged,
                      "hbm_s": t_hbm, "hbm_error": e_hbm, "ti_steps": steps if ok else None,
                      "ti_s": t_ti, "ti_error": e_ti, "ti_met": ok,
                      "ratio_ti_over_hbm": t_ti / t_hbm if ok else None, **fixed,
                      "ratio_ti_over_hbm_fixed": t_ti / fixed["hbm_fixed_s"]
                      if ok and fixed["hbm_fixed_H"] else None})
-        print(f"  {prob['label']} {f:.1f} Hz target {target:g}: HBM H={res.harmonics} "
-              f"N={res.samples_per_period} {t_hbm:.2f}s err {e_hbm:.1e} | TI {steps} steps "
+        print(f"  {prob['label']} {f:.1f} Hz target {target:g}: HBM H={H} "
+              f"N={N} {t_hbm:.2f}s err {e_hbm:.1e} | TI {steps} steps "
               f"{t_ti:.2f}s err {e_ti:.1e} | HBM fixed H={fixed['hbm_fixed_H']} "
               f"{fixed['hbm_fixed_s']:.2f}s err {fixed['hbm_fixed_error']:.1e}", flush=True)
     return rows
@@ -161,7 +168,7 @@ def hbm_smallest_sufficient(prob, omega, ref, target):
     least 64) whose cold-start solve meets the target against the reference; the cost of that solve
     only."""
     from sarfe.hbm import SolverOptions, solve_frequency
-    from sarfe.accuracy.estimates import resize_harmonics
+    from sarfe.accuracy.measures import resize_harmonics
 
     for H in HARMONIC_LADDER:
         N = max(64, 16 * H)
@@ -188,7 +195,7 @@ def cost_scaling(quick=False):
     """Seconds per Newton iteration (warm solve from 0.8 × the converged solution, best of 2) of
     chains with a rattle contact on every mass: vs H (8 contacts) and vs n_c (H = 5, N = 128)."""
     from sarfe.hbm import SolverOptions, solve_frequency
-    from sarfe.accuracy.estimates import resize_harmonics
+    from sarfe.accuracy.measures import resize_harmonics
     from sarfe.tradeoff.lumped import lumped_problem
 
     options = SolverOptions(stability=False)
@@ -287,7 +294,7 @@ def raise_harmonics(nl, solution, harmonics, samples_per_period):
     N/2 (impacts converge on some paths only); when none converges the climb ends there
     ((None, None) when the first step fails)."""
     from sarfe.hbm import SolverOptions, solve_frequency
-    from sarfe.accuracy.estimates import resize_harmonics
+    from sarfe.accuracy.measures import resize_harmonics
 
     options = SolverOptions(stability=False, max_iterations=100)
     H, previous, chain = int(solution.harmonics), solution, []
@@ -318,7 +325,7 @@ def true_errors(stage, solution, ref_stage, ref):
     """(relative first-harmonic amplitude error at the contact rows, the larger ERP level error of
     dB and dB(A) [dB]) of
     ``solution`` against ``ref`` (each with its own stage's ERP map: the models may differ)."""
-    from sarfe.accuracy.estimates import _erp_proxy
+    from sarfe.accuracy.measures import erp_proxy
 
     def amplitudes(s):
         R = np.asarray(s.contact_displacement)
@@ -328,9 +335,9 @@ def true_errors(stage, solution, ref_stage, ref):
     rel = float(np.max(np.abs(a - b)) / max(b.max(), 1e-300))
     levels = []
     for weighted in (False, True):   # the estimate bounds the larger of the dB and dB(A) errors
-        p = _erp_proxy(solution.displacement, solution.omega, stage.erp_map, stage.erp_areas,
+        p = erp_proxy(solution.displacement, solution.omega, stage.erp_map, stage.erp_areas,
                        weighted)
-        q = _erp_proxy(ref.displacement, ref.omega, ref_stage.erp_map, ref_stage.erp_areas,
+        q = erp_proxy(ref.displacement, ref.omega, ref_stage.erp_map, ref_stage.erp_areas,
                        weighted)
         levels.append(float(abs(10 * np.log10(p / q))) if p > 0 and q > 0 else float("nan"))
     return rel, max(levels)
@@ -419,9 +426,10 @@ def markdown(data):
               "steps per period, from the linear periodic response) whose error meets the target, "
               "its cost only. HBM at equal accuracy, measured the same way = the smallest H of "
               f"{', '.join(map(str, HARMONIC_LADDER))} (N = 16H ≥ 64, cold start) whose error meets "
-              "the target, its cost only. HBM adaptive = the whole `choose_resolution` loop from "
-              "H = 2, N = 32 that picks H, N by its own error estimate (no reference), every "
-              "solve and estimate included.", "",
+              "the target, its cost only. HBM adaptive = the accuracy search a run makes "
+              "(`resolve_accuracy` at that frequency from H = 2, N = 32: screening solve, H ladder "
+              "judged by the change to the next rung, N doubling; no reference) plus the solve at "
+              "the H, N it chooses, every solve included.", "",
               "| case | f [Hz] | target | TI steps | TI s | TI error | HBM H | HBM s | HBM error "
               "| **TI / HBM** | adaptive H, N | adaptive s | adaptive error | TI / adaptive |",
               "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
@@ -473,7 +481,7 @@ def shipped_markdown(rows):
              "ratio = estimate / true (≥ 1: bracketed). ref H: the highest H the reference reached "
              "(raised ×1.25 a step); floor: its amplitude / ERP change over that last step. "
              "* = the case's own H, N. Parts: raw changes H → H', N → 2N and the modal part (4) "
-             "(sarfe/accuracy/estimates.py).", "",
+             "(sarfe/accuracy/estimate.py).", "",
              "| case | f [Hz] | H, N | modes + RV | amp. estimate | amp. true | ratio | "
              "ERP est. [dB] | ERP true [dB] | ratio | H, N, modal parts (amp.) | ref H, floor | "
              "bracketed |", "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]

@@ -73,7 +73,7 @@ def cpu_seconds():
 def solve_at(nl, H, N, frequencies_hz, starts=None):
     """Warm-started stepped solves at H, N (start: ``starts[i]`` resized when given, else the
     previous point) → solutions."""
-    from sarfe.accuracy.estimates import resize_harmonics
+    from sarfe.accuracy.measures import resize_harmonics
     from sarfe.hbm import SolverOptions, solve_frequency
 
     options = SolverOptions(stability=False)
@@ -94,12 +94,12 @@ def solve_at(nl, H, N, frequencies_hz, starts=None):
 
 
 def record(stage, nl, s):
-    from sarfe.accuracy.estimates import _harmonic_powers
+    from sarfe.accuracy.measures import harmonic_powers
 
     return {"frequency_hz": float(s.omega / (2 * np.pi)), "converged": bool(s.converged),
             "harmonics": int(s.harmonics), "samples": int(s.samples_per_period),
             "contact": np.asarray(nl.contacts.gap_map @ np.asarray(s.displacement).T).T,
-            "powers": _harmonic_powers(s.displacement, s.omega, stage.erp_map, stage.erp_areas),
+            "powers": harmonic_powers(s.displacement, s.omega, stage.erp_map, stage.erp_areas),
             "contact_force": np.asarray(s.contact_force)}
 
 
@@ -174,8 +174,9 @@ def extension_changes(label, extensions=EXTENSIONS):
     """The estimate's harmonics change (a₁, dB) of each H = 15 solution on basis ``label`` for H' in
     ``extensions``, re-solved as the estimate does (:func:`newton_step` from ũ, the climb when
     it fails) → /tmp/acc5/LABEL_ext.pkl {frequency: [(H', rel, dB), ...]}."""
-    from sarfe.accuracy.estimates import (_change, _first_harmonic_amplitude, newton_correction,
-                                          newton_step, resize_harmonics, samples_for)
+    from sarfe.accuracy.correction import newton_correction, newton_step, samples_for
+    from sarfe.accuracy.measures import (first_harmonic_amplitude, resize_harmonics,
+                                         solution_change)
 
     with open(STORE / f"{label}_stage.pkl", "rb") as handle:
         kept = pickle.load(handle)
@@ -184,7 +185,7 @@ def extension_changes(label, extensions=EXTENSIONS):
         solutions = pickle.load(handle)["h15"]
     out = {}
     for f, s in zip(FREQUENCIES_HZ, solutions):
-        a_ref = np.max(_first_harmonic_amplitude(nl.contacts, s.displacement))
+        a_ref = np.max(first_harmonic_amplitude(nl.contacts, s.displacement))
         row = []
         for H_ext in extensions:
             N = samples_for(H_ext, SAMPLES)
@@ -196,7 +197,7 @@ def extension_changes(label, extensions=EXTENSIONS):
                 row.append((H_ext, float("nan"), float("nan")))
                 continue
             reached = (U.shape[0] - 1) // 2
-            rel, db = _change(nl.contacts, resize_harmonics(s.displacement, reached), U, s.omega,
+            rel, db = solution_change(nl.contacts, resize_harmonics(s.displacement, reached), U, s.omega,
                               stage.erp_map, stage.erp_areas, a_ref)
             row.append((reached, rel, db))
         out[f] = row
@@ -243,7 +244,7 @@ def load(label):
 
 def point_rows(truth, bases):
     """Per point: true H error, true cutoff error, the estimate's parts, the basis' own H change."""
-    from sarfe.accuracy.estimates import RICHARDSON, harmonics_richardson
+    from sarfe.accuracy.harmonic_truncation import RICHARDSON, harmonics_richardson
 
     rows = []
     for i, f in enumerate(FREQUENCIES_HZ):

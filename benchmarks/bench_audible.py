@@ -59,7 +59,7 @@ def samples(H):
 
 def cutoff_study():
     """Rows per (cutoff, H): dBA, dB, iterations, seconds, converged (module docstring, 1)."""
-    from sarfe.accuracy.estimates import resize_harmonics
+    from sarfe.accuracy.measures import resize_harmonics
     from sarfe.hbm import SolverOptions, solve_frequency
     from sarfe.case.read import load_case
     from sarfe.pipeline import build_linear_model, nonlinear_model

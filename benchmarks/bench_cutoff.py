@@ -13,7 +13,7 @@ Per cutoff c = factor · H · f_max (factors 0.25 … 2.0, f_max = 80 Hz; the de
    finest), of the first-harmonic contact amplitude a₁ (the estimate's measure), of the radiating
    surface's normal displacement harmonics (the response), the ERP level dB / dB(A) and the ERP
    per harmonic (max |ΔL_k| over harmonics within 30 dB of the strongest);
-4. the error estimate's modal-truncation part (sarfe.accuracy.estimates, (4)–(5): the top 1/20
+4. the error estimate's modal-truncation part (sarfe.accuracy.modal_truncation, (4)–(5): the top 1/20
    and 1/5 of the modes left out, re-solved, extrapolated with the decay fitted from both) at the
    same point, set against the measured change (does it bracket it?);
 5. the split: the point's contact forces λ̃ from the smaller basis, the displacement recovered on
@@ -109,12 +109,13 @@ def compare(case, stage, U, U_ref, s, s_ref, omega):
 
 def modal_estimate(stage, nl, solution):
     """The per-point estimate's modal part (4)–(5): (modal_rel, modal_db, seconds) or NaNs."""
-    from sarfe.accuracy.estimates import _first_harmonic_amplitude, modal_truncation_estimate
+    from sarfe.accuracy.measures import first_harmonic_amplitude
+    from sarfe.accuracy.modal_truncation import modal_truncation_estimate
     from sarfe.pipeline.solve.case_accuracy import accuracy_problem
 
     problem = accuracy_problem(stage, nl)
     clock = time.perf_counter()
-    a_ref = np.max(_first_harmonic_amplitude(problem.contacts, solution.displacement),
+    a_ref = np.max(first_harmonic_amplitude(problem.contacts, solution.displacement),
                    initial=0.0) or None
     modal = modal_truncation_estimate(solution, problem.model, problem.contacts,
                                       problem.excitation, problem.modal_dofs,
@@ -247,7 +248,7 @@ def main(meshes_mm):
 
 
 def write_md(res):
-    from sarfe.accuracy.estimates import AMPLITUDE_FLOOR, ERP_FLOOR_DB
+    from sarfe.accuracy.estimate import AMPLITUDE_FLOOR, ERP_FLOOR_DB
 
     L = ["# Craig–Bampton cutoff: what Newton needs, what the ERP needs (issue 15)", "",
          "Door trim of cases/door_trim_p1.yaml (12 pairs: 8 rattle, 4 squeak), H = 15, N = 256, "

@@ -4,14 +4,14 @@ At the cutoff study's points (benchmarks/results/cutoff.json: door trim of cases
 H = 15, 15/10/5 mm at 0.75 and 1.0 H f_max, truth = the change against 2 H f_max (1.5 at 5 mm)) and
 on the demo case cases/door_trim.yaml (H = 10, 14 mm, at cutoff_margin 1.0 and 1.25, truth = the
 change against 2.0, solved here), the raw change of each modal probe (the top 1/20, 1/10, 1/5 of
-the fixed-interface modes left out, re-solved: sarfe.accuracy.estimates.modal_truncation_change) is
+the fixed-interface modes left out, re-solved: sarfe.accuracy.modal_truncation.modal_truncation_change) is
 recorded, and the rules below are judged offline: does estimate + the estimate's resolution floor
 (1e-4 / 0.01 dB) bracket the measured change at every point, by how much does it over-report
 ((estimate + floor) / max(change, floor)), and how large is it where the check reads it.
 
 Rules: one probe × 1/((m/m')^p − 1) with p = 1 (top 1/5 × 4: the rule before; 1/10 × 9; 1/20 × 19);
 two probes with p fitted from both and kept in [1, p_max], the estimate from the larger probe
-(sarfe.accuracy.estimates (5)) or the larger of both extrapolations.
+(sarfe.accuracy.modal_truncation (5)) or the larger of both extrapolations.
 
 Usage: python benchmarks/bench_modal_estimate.py [p1:MM ...] [demo] (default: p1:15 p1:10 demo;
 5 mm takes ~10 min of linear stages) → benchmarks/results/modal_estimate.md and .json (the
@@ -39,11 +39,12 @@ DEMO_HZ = (40.0, 52.0, 67.0, 80.0)
 
 def probes(stage, nl, solution):
     """Raw change of each probe: {fraction: {rel, db, removed, m, probe_hz, s}}."""
-    from sarfe.accuracy.estimates import _first_harmonic_amplitude, modal_truncation_change
+    from sarfe.accuracy.measures import first_harmonic_amplitude
+    from sarfe.accuracy.modal_truncation import modal_truncation_change
     from sarfe.pipeline.solve.case_accuracy import accuracy_problem
 
     problem = accuracy_problem(stage, nl)
-    a_ref = np.max(_first_harmonic_amplitude(problem.contacts, solution.displacement),
+    a_ref = np.max(first_harmonic_amplitude(problem.contacts, solution.displacement),
                    initial=0.0) or None
     frequencies = np.sort(np.asarray(stage.mode_frequencies_hz))
     out = {}
@@ -119,7 +120,7 @@ def demo_points():
 
 
 def single(fraction):
-    from sarfe.accuracy.estimates import mode_richardson
+    from sarfe.accuracy.modal_truncation import mode_richardson
 
     def rule(P, key):
         p = P[str(fraction)]
@@ -129,19 +130,19 @@ def single(fraction):
 
 def fitted(q1, q2, decay_max, largest_only=True):
     """Two probes, p fitted from both in [1, decay_max]; the estimate from the larger probe
-    (sarfe.accuracy.estimates (5)) or, largest_only=False, the larger of both extrapolations."""
-    from sarfe.accuracy.estimates import mode_richardson
-    from sarfe.accuracy import estimates
+    (sarfe.accuracy.modal_truncation (5)) or, largest_only=False, the larger of both extrapolations."""
+    from sarfe.accuracy import modal_truncation
+    from sarfe.accuracy.modal_truncation import mode_richardson
 
     def rule(P, key):
         a, b = P[str(q1)], P[str(q2)]
         coarser = (a["m"] - a["removed"], b["m"] - b["removed"])
-        saved = estimates.MODE_DECAY
-        estimates.MODE_DECAY = (1.0, decay_max)
+        saved = modal_truncation.MODE_DECAY
+        modal_truncation.MODE_DECAY = (1.0, decay_max)
         try:
-            p = estimates.mode_decay(a["m"], coarser, (a[key], b[key]))
+            p = modal_truncation.mode_decay(a["m"], coarser, (a[key], b[key]))
         finally:
-            estimates.MODE_DECAY = saved
+            modal_truncation.MODE_DECAY = saved
         values = [d * mode_richardson(a["m"], c, p) for d, c in zip((a[key], b[key]), coarser)]
         return values[-1] if largest_only else max(values)
     return rule

@@ -559,3 +559,33 @@ def _newton(problem, omega, U0, options, slider=None):
             continue            # S_k(ω) singular: fall back to the full residual
         break
     return to_displacement(result.x, omega, result.evaluation), result, state["slider"]
+
+
+def newton_from(model, contacts, excitation, U, omega, harmonics, samples_per_period,
+                options=None):
+    """Newton at a fixed ω [rad/s] from a given ũ (2H+1, n) [m] on the (H, N) problem — the
+    re-solve of a nearby solution (e.g. one of another H, N or model, resized), with none of
+    :func:`solve_frequency`'s fallbacks (no homotopy, no full-DOF retry, no polish, no stability).
+
+    All harmonic orders 0…H (``options.harmonic_set`` is not used). Condensed on the contact rows
+    when there are any (x = G ũ; one condensation S_k(ω)⁻¹ Gᵀ serves every iteration; ũ recovered
+    from the contact forces at the end), else on all DOFs; chord steps (:func:`sarfe.hbm.newton.
+    newton`); the friction slider starts from ũ. ``options``: :class:`SolverOptions` as given
+    (tolerance, max_iterations, line_search_steps; the caller sets its own budget).
+
+    excitation f̃_e (2H+1, n) [N]. Returns (ũ' (2H+1, n) [m], NewtonResult): ũ' at the last
+    accepted iterate, converged or not (the caller judges ``result.converged`` and
+    ``result.residual_norm``), None when the residual at ũ is not finite. Raises
+    :class:`sarfe.hbm.newton.SingularJacobian` when some S_k(ω) or the Jacobian is singular and
+    ValueError (naming the parameter) for inputs of the wrong shape."""
+    options = options or SolverOptions()
+    problem = make_problem(model, contacts, excitation, harmonics, samples_per_period, options)
+    U = np.asarray(U, dtype=float)
+    evaluate, to_x, to_displacement = make_evaluator(problem, contacts.row_count > 0, False)
+    state = {"slider": initial_slider(problem, U)}
+    result = newton(lambda x, jacobian: evaluate(x, omega, jacobian, state["slider"]), to_x(U),
+                    options, accept=slider_acceptor(state), chord=True)
+    if result.evaluation is None:
+        return None, result
+    U_new = np.asarray(to_displacement(result.x, omega, result.evaluation))
+    return U_new.reshape(U.shape), result

@@ -7,8 +7,8 @@ import copy
 
 import numpy as np
 
-from sarfe.accuracy.estimates import (EstimateProblem, highest_natural_frequency_hz,
-                                      problem_error_estimate)
+from sarfe.accuracy.estimate import (EstimateProblem, highest_natural_frequency_hz,
+                                     problem_error_estimate)
 from sarfe.accuracy.resolve import resolve_accuracy
 from sarfe.case.config import ExcitationConfig, SolverConfig
 
@@ -164,8 +164,9 @@ def accuracy_check(solver: SolverConfig, points) -> dict | None:
     (a 5 dB error 60 dB below the headline changes nothing a user reads). The knob to raise is the
     one whose part (Richardson factors included) is largest at the worst point: harmonics →
     solver.harmonics, aliasing → solver.samples_per_period, modal → the reduction cutoff."""
-    from sarfe.accuracy.estimates import (RICHARDSON, basis_limited_extension,
-                                          harmonics_richardson, parse_accuracy)
+    from sarfe.accuracy.estimate import basis_limited_extension
+    from sarfe.accuracy.harmonic_truncation import RICHARDSON, harmonics_richardson
+    from sarfe.accuracy.target import parse_accuracy
 
     target = parse_accuracy(solver.accuracy_or_default)
     rated = [p for p in points if p["converged"] and p.get("error_estimate")

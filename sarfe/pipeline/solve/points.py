@@ -19,7 +19,7 @@ def solver_options(solver: SolverConfig):
     Case is also taken, for callers that hold only the case). The tolerance of
     ``harmonic_set: auto`` is the amplitude budget of ``solver.accuracy`` (default 'balanced')."""
     from sarfe.hbm import ContinuationOptions, SolverOptions
-    from sarfe.accuracy.estimates import parse_accuracy
+    from sarfe.accuracy.target import parse_accuracy
 
     if not isinstance(solver, SolverConfig):
         solver = solver.config.solver

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sarfe.accuracy.estimates import basis_limited_extension
+from sarfe.accuracy.estimate import basis_limited_extension
 from sarfe.case.read import load_case
 from sarfe.case.config import SolverConfig
 from sarfe.pipeline import build_linear_model, solve_case

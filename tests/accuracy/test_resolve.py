@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sarfe.accuracy.estimates import resize_harmonics
+from sarfe.accuracy.measures import resize_harmonics
 from sarfe.accuracy.resolve import (harmonics_cap, ladder_samples, representative_points,
                                     screen_grid, search_harmonics)
 from sarfe.hbm import SolverOptions, solve_frequency
