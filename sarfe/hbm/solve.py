@@ -11,8 +11,9 @@ Steps of :func:`solve_frequency`:
    ``max_homotopy_iterations`` Newton iterations; ``iterations`` counts all of them;
 3. Newton on the contact rows only (dynamic compliance condensation, :mod:`sarfe.hbm.dynamic_stiffness`) when
    that system is smaller, else — or when some S_k(ω) is singular — on all DOFs (sparse LU);
-4. recovery of all DOFs, the residual of the full equation of motion relative to ‖f̃_e‖, Hill
-   stability (:mod:`sarfe.hbm.stability.hill`).
+4. recovery of all DOFs, the residual of the full equation of motion relative to ‖f̃_e‖, the
+   stability of the orbit (:func:`sarfe.hbm.stability.stability`: Hill's method or the
+   contact-row count, per ``options.stability_method``).
 
 Harmonic sets (:mod:`sarfe.hbm.harmonic_set`): with ``harmonic_set`` = 'odd' or a list of orders,
 Newton's unknowns and equations are the kept coefficient rows only (dropped rows held at zero);
@@ -30,21 +31,16 @@ import numpy as np
 import scipy.sparse as sp
 
 from sarfe.hbm import laws
-from sarfe.hbm.aft import default_slider_start, jacobian_matrix
-from sarfe.hbm.harmonic_set import (AUTO_CANDIDATE, coefficient_rows, dropped_content, expand_rows,
-                           harmonic_set_orders)
-from sarfe.hbm.harmonics import check_harmonics, derivative_matrix, time_samples
+from sarfe.hbm.aft import default_slider_start
 from sarfe.hbm.dynamic_stiffness import condense, dynamic_stiffness_matrix, recover_displacement
+from sarfe.hbm.harmonic_set import (AUTO_CANDIDATE, coefficient_rows, dropped_content, expand_rows,
+                                    harmonic_set_orders)
+from sarfe.hbm.harmonics import check_harmonics, derivative_matrix, time_samples
 from sarfe.hbm.newton import SingularJacobian, newton, solve_linear
-from sarfe.hbm.stability.deferred import defer, deferring
 from sarfe.hbm.residual import Problem, condensed_residual, full_residual, kept_rows
 from sarfe.hbm.solution import HarmonicSolution, SolverOptions
-from sarfe.hbm.stability.hill import hill_stability
-from sarfe.hbm.stability.condensed import condensed_stability
-from sarfe.hbm.stability.contact_terms import ContactOperator
-from sarfe.hbm.stability.rows import contact_row_counts
-from sarfe.hbm.stability.trust import auto_method, checked
-from sarfe.hbm.stability.trust import check_harmonics as checked_harmonics
+from sarfe.hbm.stability import stability, stability_method
+from sarfe.hbm.stability.deferred import defer, deferring
 
 CHORD_STEPS = True       # fixed-ω Newton reuses its LU while it contracts (sarfe.hbm.newton)
 
@@ -259,50 +255,6 @@ def harmonic_set_label(problem) -> str:
         return "all"
     odd = harmonic_set_orders("odd", problem.harmonics)
     return "odd" if odd is not None and np.array_equal(orders, odd) else "orders"
-
-
-def contact_damping(problem, forces):
-    """(I⊗G)ᵀ E diag(∂λ/∂ṙ) Φ (I⊗G) (sparse) of the rate-dependent laws, or None: the velocity
-    terms of the contact forces in Hill's damping matrix (:mod:`sarfe.hbm.stability.hill`)."""
-    if not forces.damping_blocks:
-        return None
-    G, H = problem.contacts.gap_map, problem.harmonics
-    GG = sp.kron(sp.identity(2 * H + 1), G, format="csr")
-    return (GG.T @ jacobian_matrix(forces.damping_blocks, G.shape[0], H) @ GG).tocsr()
-
-
-def stability_method(problem, options) -> str:
-    """'full' | 'condensed' | 'contact_rows' (see :class:`SolverOptions`): 'auto' is the contact-row
-    count (:mod:`sarfe.hbm.stability.rows`) for every model with contacts and a modal basis, else
-    the full Hill method up to 3000 Hill rows (:func:`sarfe.hbm.stability.trust.auto_method`)."""
-    method = options.stability_method
-    return auto_method(problem) if method == "auto" else method
-
-
-def stability(problem, omega, U, ev, options):
-    """Hill stability of a converged orbit by ``options.stability_method`` (StabilityResult)."""
-    operator = ContactOperator(problem, U, omega, ev.forces)
-    method = stability_method(problem, options)
-    if method == "contact_rows":
-        result, zeros, coarse = contact_row_counts(
-            problem.model, problem.contacts, omega, problem.harmonics, ev.forces, operator,
-            tolerance=options.stability_tolerance,
-            check_harmonics=checked_harmonics(problem.harmonics))
-        if result is None:
-            result = condensed_stability(problem.model, problem.contacts, omega, problem.harmonics,
-                                         ev.forces, operator, tolerance=options.stability_tolerance)
-            if zeros and result.stable is True:   # the count is exact, the Ritz basis truncated
-                return replace(result, stable=None, note=(
-                    f"the contact-row count finds {zeros} Floquet exponent(s) right of "
-                    f"−1e-4·ω that the Ritz basis does not locate (it says {result.leading:.3g} 1/s)"))
-        # the verdict at H stands where the count at a coarser contact coupling agrees
-        return checked(result, zeros, coarse, problem)
-    if method == "condensed":
-        return condensed_stability(problem.model, problem.contacts, omega, problem.harmonics,
-                                   ev.forces, operator, tolerance=options.stability_tolerance)
-    return hill_stability(problem.model, omega, problem.harmonics, ev.jacobian,
-                          options.stability_tolerance,
-                          contact_damping=contact_damping(problem, ev.forces), operator=operator)
 
 
 def kept_residual_norm(problem, ev) -> float:

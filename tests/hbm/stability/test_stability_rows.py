@@ -229,14 +229,14 @@ def test_a_ritz_verdict_that_contradicts_the_count_is_reported_uncertain(sweep03
     names the count. Points of the NLvib 03 sweep with two or more such exponents, with the
     locator of those zeros stubbed to fail (it locates them all there: the hand-over is its last
     resort, tests/hbm/stability/test_stability_zeros.py)."""
-    import sarfe.hbm.solve as solve_module
+    import sarfe.hbm.stability.select as select
     import sarfe.hbm.stability.rows as rows_module
     from sarfe.hbm.stability.hill import StabilityResult
     from sarfe.hbm.stability.rows import contact_row_count
 
     model, contacts, F, sols = sweep03
     stub = StabilityResult(True, -1.0, "", np.array([-1.0 + 0j]))
-    monkeypatch.setattr(solve_module, "condensed_stability", lambda *a, **k: stub)
+    monkeypatch.setattr(select, "condensed_stability", lambda *a, **k: stub)
     monkeypatch.setattr(rows_module, "leading_zeros", lambda *a, **k: None)
     checked = 0
     for s in sols:
@@ -245,8 +245,8 @@ def test_a_ritz_verdict_that_contradicts_the_count_is_reported_uncertain(sweep03
         if result is not None or not zeros:
             continue
         problem = Problem(model, contacts, F, s.harmonics, s.samples_per_period)
-        verdict = solve_module.stability(problem, s.omega, s.displacement, ev,
-                                         SolverOptions(stability_method="contact_rows"))
+        verdict = select.stability(problem, s.omega, s.displacement, ev,
+                                   SolverOptions(stability_method="contact_rows"))
         assert verdict.stable is None and f"finds {zeros} Floquet" in verdict.note
         checked += 1
     assert checked >= 1
