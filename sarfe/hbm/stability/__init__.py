@@ -13,7 +13,10 @@ Modules:
     contact_terms  the contact term 𝒥(s) of Hill's operator (AFT Jacobian, Jenkins memory at s)
     march          the compiled (numba) linearized slider march of 2-D Jenkins elements at many s
     rows           the contact-row count: zeros of det(I + C(s) 𝒥(s)) right of −ε, no eigen-solve
-    zeros          locating the zeros the count found (Delves–Lyness power sums, Muller)
+    determinant    det F(s) = det(I + C(s) 𝒥(s)) on the loaded contact rows, at many s at once
+    contour        the argument principle: the half-strip's contour and the winding count along it
+    zeros          locating the zeros the count found (a real one by its sign change; several by
+                   Delves–Lyness power sums and Muller's method)
     trust          the default ('auto') method and its check at the coarser coupling H' = ⌊3H/4⌋
     deferred       stability recorded during a sweep and computed later (on worker processes)
     perturbation   an independent check: the monodromy of the time integrator's period map

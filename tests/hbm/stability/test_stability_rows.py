@@ -11,8 +11,9 @@ from sarfe.hbm.aft import jacobian_matrix
 from sarfe.hbm.modal import modal_basis
 from sarfe.hbm.residual import Problem, full_residual
 from sarfe.hbm.stability.contact_terms import ContactOperator
-from sarfe.hbm.stability.rows import (ContactRowDeterminant, contact_row_stability,
-                                      structural_exponents, winding_count)
+from sarfe.hbm.stability.contour import winding_count
+from sarfe.hbm.stability.determinant import ContactRowDeterminant, structural_exponents
+from sarfe.hbm.stability.rows import contact_row_stability
 from tests.hbm.shipped_points import full_hill, shipped_case_points
 
 
@@ -51,7 +52,7 @@ def test_real_zero_locates_the_single_sign_change(root):
     dynamic range as det F has): located to 10⁻⁹ relative — near 0 (either side), at a fold-like
     2.5 1/s and far out at 3000 1/s — with at most 30 evaluations (the bracket grid it replaces
     took 108); None where the sign does not change between the ends."""
-    from sarfe.hbm.stability.rows import real_zero
+    from sarfe.hbm.stability.zeros import real_zero
 
     calls = []
 
