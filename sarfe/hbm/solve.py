@@ -68,7 +68,8 @@ def make_problem(model, contacts, excitation, harmonics, samples_per_period, opt
                    harmonic_set_orders(harmonic_set, harmonics))
 
 
-def _check_omega(omega, name="omega"):
+def check_omega(omega, name="omega"):
+    """Raise ValueError naming ``name`` unless ω [rad/s] is a finite frequency > 0."""
     if not np.isfinite(omega) or omega <= 0:
         raise ValueError(f"{name} must be a finite frequency > 0 [rad/s], got {omega!r}")
 
@@ -328,7 +329,7 @@ def solve_frequency(model, contacts, excitation, omega, harmonics, samples_per_p
     auto = isinstance(options.harmonic_set, str) and options.harmonic_set == "auto"
     problem = make_problem(model, contacts, excitation, harmonics, samples_per_period, options,
                            None if auto else options.harmonic_set)
-    _check_omega(omega)
+    check_omega(omega)
     U0 = None
     if initial is not None:
         U0 = np.asarray(getattr(initial, "displacement", initial), dtype=float)
@@ -338,8 +339,8 @@ def solve_frequency(model, contacts, excitation, omega, harmonics, samples_per_p
         return solve_auto(problem, omega, U0, options,
                           getattr(initial, "dropped_content", float("nan")))
     if U0 is None:
-        return _solve(problem, omega, linearized_guess(problem, omega), options, homotopy=True)
-    return _solve(problem, omega, U0, options)
+        return solve_from(problem, omega, linearized_guess(problem, omega), options, homotopy=True)
+    return solve_from(problem, omega, U0, options)
 
 
 def auto_needs_full_set(previous_content, options) -> bool:
@@ -357,7 +358,7 @@ def solve_auto(problem, omega, U0, options, previous_content=float("nan"), slide
         reduced = replace(problem, harmonic_orders=harmonic_set_orders(AUTO_CANDIDATE,
                                                                        problem.harmonics))
         start = linearized_guess(reduced, omega) if U0 is None else U0
-        solution = _solve(reduced, omega, start, options, slider, homotopy=U0 is None)
+        solution = solve_from(reduced, omega, start, options, slider, homotopy=U0 is None)
         if solution.converged and solution.dropped_content <= tolerance:
             return solution
         if solution.converged:
@@ -367,7 +368,7 @@ def solve_auto(problem, omega, U0, options, previous_content=float("nan"), slide
         else:
             note = f"auto: odd set did not converge ({solution.reason})"
     start = linearized_guess(problem, omega) if U0 is None else U0
-    solution = _solve(problem, omega, start, options, slider, homotopy=U0 is None)
+    solution = solve_from(problem, omega, start, options, slider, homotopy=U0 is None)
     return replace(solution, reason=f"{solution.reason} ({note})")
 
 
@@ -446,10 +447,13 @@ def _homotopy(problem, omega, options, kind):
     return current, result, current_slider, spent, position >= 1.0
 
 
-def _solve(problem, omega, U0, options, slider=None, homotopy=False):
-    """Newton from U0 (condensed when useful, full as fallback); with ``homotopy``, a failed start
-    is retried from the end of each of :data:`COLD_START_HOMOTOPIES` in turn until Newton converges.
-    ``iterations`` of the result counts every Newton iteration spent, homotopy steps included."""
+def solve_from(problem, omega, U0, options, slider=None, homotopy=False) -> HarmonicSolution:
+    """The periodic solution of ``problem`` (:func:`make_problem`) at ω [rad/s] by Newton from
+    ũ = U0 (2H+1, n_dof) [m] (condensed when useful, full as fallback), ``slider``: the slider
+    start (None: from U0); with ``homotopy``, a failed start is retried from the end of each of
+    :data:`COLD_START_HOMOTOPIES` in turn until Newton converges; then polished and finalized
+    (:func:`finalize`: residual on all rows, stability). ``iterations`` of the result counts every
+    Newton iteration spent, homotopy steps included."""
     U, result, slider = _newton(problem, omega, U0, options, slider)
     iterations = result.iterations
     if homotopy and not result.converged:
