@@ -1,5 +1,5 @@
 r"""Contact screening and pruning (engine): contacts that never switch are solved linearly.
-The pipeline (:mod:`sarfe.pipeline.solve.pruned_points`) and the studies (:mod:`sarfe.hbm.pruning`) use it.
+The pipeline uses it (:mod:`sarfe.pipeline.solve.pruned_points`).
 
 Contact screening (a cheap linear pass). At every ω of a grid over the sweep, the response of the
 linear model with each contact linearized at u = 0 (what :func:`sarfe.hbm.solve.linearized_guess`
@@ -21,7 +21,8 @@ as a Woodbury update, no solve of model size per ω). With the gap g and a margi
 Because the other contacts' nonlinear response can drive a screened contact, :func:`check_pruning`
 re-checks every decision on the nonlinear solution (w of the dropped contacts is still G u); a
 violated decision means: solve again with the full set (:func:`solve_frequency_pruned` does that
-for one ω; :mod:`sarfe.pipeline.solve.pruned_points` for the points or the sweep of a case in ``sarfe solve``).
+for one ω; :mod:`sarfe.pipeline.solve.pruned_points` for the points or the sweep of a case in
+``sarfe solve``).
 :func:`restore_solution` re-expresses a pruned solution with all contacts, keeping the solver's own
 forces of the kept ones.
 """
