@@ -51,7 +51,10 @@ def stability_method(problem, options) -> str:
 
 
 def stability(problem, omega, U, ev, options):
-    """Hill stability of a converged orbit by ``options.stability_method`` (StabilityResult)."""
+    """StabilityResult (stable True | False | None, leading max Re s [1/s], note, exponents) of the
+    converged orbit ũ = U (2H+1, n_dof) [m] at ω [rad/s] of ``problem`` (all harmonic rows), by
+    ``options.stability_method`` (module docstring); ``ev``: its full-residual evaluation (the AFT
+    forces; ∂R/∂ũ on all DOFs assembled where the method is 'full')."""
     operator = ContactOperator(problem, U, omega, ev.forces)
     method = stability_method(problem, options)
     if method == "contact_rows":
