@@ -56,7 +56,7 @@ import yaml  # noqa: E402
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 from sarfe.hbm.residual import Problem, full_residual  # noqa: E402
-from sarfe.hbm.solve import contact_damping  # noqa: E402
+from sarfe.hbm.stability.select import contact_damping  # noqa: E402
 from sarfe.hbm.stability.hill import hill_stability  # noqa: E402
 from sarfe.hbm.stability.condensed import condensed_stability  # noqa: E402
 from sarfe.hbm.stability.contact_terms import ContactOperator  # noqa: E402
@@ -176,7 +176,7 @@ def rows_cost(path="cases/door_trim_p1.yaml", mesh=0.015, band=(60.0, 65.0)):
 def sweep_cost(path="cases/door_trim_p1.yaml", mesh=0.015):
     """Per point of the whole P1 sweep at ``mesh``: the deferred Hill stability computed serially,
     with its det F evaluations by phase (module docstring)."""
-    import sarfe.hbm.solve as solve_module
+    import sarfe.hbm.stability.select as solve_module
     import sarfe.hbm.stability.rows as rows_module
     from sarfe.hbm.stability.deferred import deferred_stability, pending, stability_of
     from sarfe.pipeline.solve.pruned_points import solve_points_pruned
@@ -356,7 +356,7 @@ def truth_study(path="cases/rattle_rig.yaml", every=6):
             for p in json.loads(saved.read_text())["points"]:
                 for key, value in p.get("time_integration", {}).items():
                     cache[(round(p["frequency_hz"], 6), int(key))] = value
-    import sarfe.hbm.solve as trust     # (its bound name 'checked' is patched)
+    import sarfe.hbm.stability.select as trust     # (its bound name 'checked' is patched)
 
     def label(job, method, check=True):
         original = trust.checked
@@ -414,7 +414,7 @@ def truth_study_nlvib03():
     from sarfe.hbm import ContinuationOptions, continuation
     from sarfe.hbm.stability.deferred import deferred_stability, stability_of
     from sarfe.hbm.stability.perturbation import perturbation_check
-    import sarfe.hbm.solve as trust     # (its bound name 'checked' is patched)
+    import sarfe.hbm.stability.select as trust     # (its bound name 'checked' is patched)
     sys.path.insert(0, str(ROOT))
     from tests.hbm.test_solver import H03, N03, example03
 
@@ -544,7 +544,7 @@ def zeros_study(points_paths):
     import pickle
     import types
     import scipy.sparse as sp
-    import sarfe.hbm.solve as solve_module
+    import sarfe.hbm.stability.select as solve_module
     import sarfe.hbm.stability.rows as rows_module
     from sarfe.hbm.aft import jacobian_matrix
     from sarfe.hbm.dynamic_stiffness import dynamic_stiffness_matrix

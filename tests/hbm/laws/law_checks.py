@@ -8,7 +8,7 @@ import numpy as np
 
 from sarfe.hbm import harmonics as hm
 from sarfe.hbm.aft import contact_forces, jacobian_matrix
-from sarfe.hbm.time_integration import _ContactLaws
+from sarfe.hbm.newmark import ContactLaws
 
 
 def aft_errors(contacts, R, N, omega, slider_start=None, step=1e-7):
@@ -48,7 +48,7 @@ def aft_errors(contacts, R, N, omega, slider_start=None, step=1e-7):
 def step_error(contacts, r, r_start, rdot_start, slider_previous, h, step=1e-7):
     """Relative error of the time step's ∂λ/∂r₊ + (2/h)∂λ/∂ṙ₊ against central differences of
     λ(r₊, ṙ₊(r₊)), ṙ₊ = (2/h)(r₊ − r) − ṙ."""
-    laws = _ContactLaws(contacts)
+    laws = ContactLaws(contacts)
     rate = 2.0 / h
 
     def force(x):
