@@ -141,7 +141,7 @@ def rows_cost(path="cases/door_trim_p1.yaml", mesh=0.015, band=(60.0, 65.0)):
                                     2 * np.pi * band[1], H, N, options=cont) if s.converged]
     cached_modal_basis(nl.model)
     counted, orders = [], []
-    original_count, original_init = rows_module.winding_count, rows_module.ContactRowDeterminant.__init__
+    original_count, original_init = rows_module.winding_counts, rows_module.ContactRowDeterminant.__init__
 
     def count(*args, **kwargs):
         out = original_count(*args, **kwargs)
@@ -152,7 +152,7 @@ def rows_cost(path="cases/door_trim_p1.yaml", mesh=0.015, band=(60.0, 65.0)):
         original_init(self, *args, **kwargs)
         orders.append(self.size)
 
-    rows_module.winding_count, rows_module.ContactRowDeterminant.__init__ = count, init
+    rows_module.winding_counts, rows_module.ContactRowDeterminant.__init__ = count, init
     points = []
     try:
         for s in sols:
@@ -166,7 +166,7 @@ def rows_cost(path="cases/door_trim_p1.yaml", mesh=0.015, band=(60.0, 65.0)):
                                lu_order=orders[-1] if orders else 0,
                                verdict=None if r is None else r.stable))
     finally:
-        rows_module.winding_count, rows_module.ContactRowDeterminant.__init__ = \
+        rows_module.winding_counts, rows_module.ContactRowDeterminant.__init__ = \
             original_count, original_init
     return {"case": f"{path} at {mesh * 1e3:g} mm, {band[0]:g}-{band[1]:g} Hz, H = {H}, N = {N}",
             "reduced_dofs": nl.model.dof_count, "contact_rows": nl.contacts.row_count,
