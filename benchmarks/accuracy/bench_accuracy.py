@@ -12,7 +12,7 @@
    coarser settings, against a reference with much higher H, N and (FE) 3× the reduction cutoff:
    first-harmonic contact amplitude and ERP level, bracketed yes/no, ratio estimate / true.
 
-Run: ``OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/bench_accuracy.py [--quick]``;
+Run: ``OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/accuracy/bench_accuracy.py [--quick]``;
 ``--estimates-only [--cache DIR]`` runs part 3 alone (parts 1, 2 kept from results/accuracy.json;
 the solutions pickled in DIR and reused, so a change of the estimator re-runs in a minute);
 ``--no-estimates`` runs parts 1, 2 alone (part 3 kept).
@@ -20,7 +20,6 @@ the solutions pickled in DIR and reused, so a change of the estimator re-runs in
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import pickle
 import platform
@@ -28,12 +27,13 @@ import sys
 import time
 import warnings
 from pathlib import Path
+import pathlib
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import ROOT, read_results, write_results  # noqa: E402
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-RESULTS = ROOT / "benchmarks" / "results"
 warnings.simplefilter("ignore")
 
 
@@ -527,8 +527,7 @@ def main(argv=None):
     data = {"created": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
             "load_average": [round(x, 1) for x in os.getloadavg()],
             "hbm_vs_time": [], "scaling": None, "estimates": [], "notes": []}
-    previous = json.loads((RESULTS / "accuracy.json").read_text()) if (
-        args.estimates_only or args.no_estimates) else {}
+    previous = read_results("accuracy") if (args.estimates_only or args.no_estimates) else {}
     if args.estimates_only:           # parts 1, 2 kept
         for key in ("hbm_vs_time", "scaling", "notes"):
             data[key] = previous.get(key)
@@ -571,10 +570,8 @@ def main(argv=None):
                       f"(H {r['harmonics_rel']:.1e}, N {r['aliasing_rel']:.1e}, modal "
                       f"{r['modal_rel']:.1e})", flush=True)
         data["estimates"] += rows
-    RESULTS.mkdir(parents=True, exist_ok=True)
-    (RESULTS / "accuracy.json").write_text(json.dumps(data, indent=1, default=float))
-    (RESULTS / "accuracy.md").write_text(markdown(data))
-    print(f"wrote {RESULTS / 'accuracy.md'}")
+    write_results("accuracy", data)
+    print(f"wrote {write_results('accuracy', markdown=markdown(data))}")
 
 
 if __name__ == "__main__":

@@ -18,16 +18,15 @@ basis' fixed-interface, residual-vector and reduced-system frequencies.
 
 Environment: SARFE_ACC5_MESH_M (default 0.005; 0.015 → results/accuracy_15mm.*), SARFE_ACC5_STORE
 (default /tmp/acc5). Usage (each stage one process; the truth's stage is large — run it niced in the background):
-  python benchmarks/bench_accuracy_5mm.py solve LABEL CUTOFF_HZ [--truth] → /tmp/acc5/LABEL.pkl
-  python benchmarks/bench_accuracy_5mm.py extensions LABEL → the change H = 15 → H' for several H'
-  python benchmarks/bench_accuracy_5mm.py report [LABEL ...] → benchmarks/results/accuracy_5mm.md
+  python benchmarks/accuracy/bench_accuracy_5mm.py solve LABEL CUTOFF_HZ [--truth] → /tmp/acc5/LABEL.pkl
+  python benchmarks/accuracy/bench_accuracy_5mm.py extensions LABEL → the change H = 15 → H' for several H'
+  python benchmarks/accuracy/bench_accuracy_5mm.py report [LABEL ...] → benchmarks/results/accuracy_5mm.md
   and .json (default labels m100 m125; this run: m100 1200, m110 1320, m125 1500 Hz)
 Measured (2026-11-24, shared machine): truth 3840 Hz, 1436 modes, stage 221 s CPU (676 s wall,
 4.5 GB peak); 1.2 kHz 58 s CPU, 1.5 kHz 83 s CPU; solves and estimates a few CPU s per basis.
 """
 from __future__ import annotations
 
-import json
 import os
 import pickle
 import sys
@@ -35,12 +34,13 @@ import time
 import warnings
 from dataclasses import replace
 from pathlib import Path
+import pathlib
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import ROOT, write_results  # noqa: E402
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-RESULTS = ROOT / "benchmarks" / "results"
 STORE = Path(os.environ.get("SARFE_ACC5_STORE", "/tmp/acc5"))
 FREQUENCIES_HZ = (45.0, 58.5, 60.0, 60.74, 61.5, 62.3, 63.0)
 HARMONICS, SAMPLES = 15, 256
@@ -310,10 +310,8 @@ def report(labels=("m100", "m125")):
                 extensions[label] = {f"{f:g}": row for f, row in pickle.load(handle).items()}
     res["extensions"] = extensions
     res["conclusion"] = conclusion(res, labels)
-    RESULTS.mkdir(exist_ok=True)
     name = f"accuracy_{MESH_M * 1000:g}mm"
-    (RESULTS / f"{name}.json").write_text(json.dumps(res, indent=1, default=float))
-    (RESULTS / f"{name}.md").write_text(markdown(res, labels))
+    write_results(name, res, markdown(res, labels))
     return res
 
 
@@ -382,7 +380,7 @@ def markdown(res, labels):
     lines = [
         f"# P1 at {MESH_M * 1000:g} mm: the per-point error estimate against the truth (issue 15, "
         "task acc5mm)", "",
-        "Script: benchmarks/bench_accuracy_5mm.py (its docstring says what is solved). P1 "
+        "Script: benchmarks/accuracy/bench_accuracy_5mm.py (its docstring says what is solved). P1 "
         f"(cases/door_trim_p1.yaml, {MESH_M * 1000:g} mm, H = 15, N = 256) point by point (warm-started steps, "
         "stability off). Truth basis: Craig–Bampton cutoff "
         f"{bases['truth']['cutoff_hz']:.0f} Hz (≥ 2 · 30 · 64 Hz). a₁: max over contact rows of "

@@ -26,13 +26,12 @@ import sys
 import tempfile
 import time
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import ROOT, child_env, write_results  # noqa: E402
+
 import numpy as np
 import yaml
 
-HERE = pathlib.Path(__file__).resolve().parent
-ROOT = HERE.parent
-sys.path.insert(0, str(ROOT))
-RESULTS = HERE / "results"
 F_HZ = 67.0
 MESH_M = 0.010
 HARMONICS = (3, 5, 10, 15, 20, 30, 40, 60)
@@ -112,8 +111,7 @@ def run_case(case, timeout=900.0):
     """Whole `sarfe solve` process: dict(wall_s, peak_rss_gb, timed_out, exit, summary)."""
     work = pathlib.Path(tempfile.mkdtemp(prefix="bench_audible_"))
     (work / "case.yaml").write_text(yaml.safe_dump(case))
-    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MPLBACKEND="Agg",
-               PYTHONPATH=str(ROOT))
+    env = child_env()
     cmd = [sys.executable, "-m", "sarfe.cli", "solve", str(work / "case.yaml"), "--output",
            str(work / "out")]
     start = time.perf_counter()
@@ -153,15 +151,14 @@ def fmt(x, spec=".2f"):
 
 
 def write(res):
-    RESULTS.mkdir(exist_ok=True)
-    (RESULTS / "audible.json").write_text(json.dumps(res, indent=1, default=str))
+    write_results("audible", res, default=str)
     study = res["cutoffs"]
     ref = study[-1]["rows"][-1]["dba"]
     L = ["# Audible band: dB(A) vs H and Craig–Bampton cutoff, the `balanced` preset (issue 15)", "",
          f"Machine: {platform.platform()}, {os.cpu_count()} cores, load average at start "
          f"{res['load_average']}; OPENBLAS_NUM_THREADS=1. Door trim {MESH_M * 1000:.0f} mm, "
          f"rattle point {F_HZ:g} Hz. Bench wall {res['wall_s']:.0f} s. Script: "
-         "benchmarks/bench_audible.py.", "",
+         "benchmarks/accuracy/bench_audible.py.", "",
          f"Converged value (H = {HARMONICS[-1]}, cutoff {study[-1]['cutoff_hz']:.0f} Hz): "
          f"**{ref:.3f} dB(A)**.", "",
          "## dB(A) vs H (rows) and cutoff (columns), Δ to the converged value", "",
@@ -200,7 +197,7 @@ def write(res):
     L += ["", "Previous (before this change, benchmarks/results/door_trim.md): balanced chose H = 14, "
           "N = 512, wall 138 s of which the accuracy stage 87.5 s."]
     L += [""] + res.get("notes", [])
-    (RESULTS / "audible.md").write_text("\n".join(L) + "\n")
+    write_results("audible", markdown=L)
 
 
 def balanced_lines(b, ref, title):

@@ -20,11 +20,10 @@ Per cutoff c = factor · H · f_max (factors 0.25 … 2.0, f_max = 80 Hz; the de
    the finest basis, ũ_k = Z_k⁻¹ (f̃_k − Gᵀ λ̃_k) (sarfe.hbm.dynamic_stiffness.recover_displacement), compared
    with the finest in the same measures — "only the recovery and ERP need the high modes".
 
-Usage: python benchmarks/bench_cutoff.py [mesh_mm[:factor,factor,...] ...] (default 10 with all
+Usage: python benchmarks/accuracy/bench_cutoff.py [mesh_mm[:factor,factor,...] ...] (default 10 with all
 factors; the largest factor given is the reference). Writes
 benchmarks/results/cutoff.md and .json (one section per mesh; earlier meshes kept from the json).
 """
-import json
 import os
 import pathlib
 import platform
@@ -32,12 +31,11 @@ import sys
 import time
 import warnings
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import ROOT, read_results, write_results  # noqa: E402
+
 import numpy as np
 
-HERE = pathlib.Path(__file__).resolve().parent
-ROOT = HERE.parent
-sys.path.insert(0, str(ROOT))
-RESULTS = HERE / "results"
 HARMONICS = 15
 SAMPLES = 256
 FACTORS = (0.25, 0.5, 0.75, 1.0, 1.5, 2.0)
@@ -228,8 +226,7 @@ def compare_across(case, stage, ref_stage, s, s_ref):
 
 
 def main(meshes_mm):
-    path = RESULTS / "cutoff.json"
-    res = json.loads(path.read_text()) if path.exists() else {}
+    res = read_results("cutoff", {})
     res.setdefault("meshes", {})
     for spec in meshes_mm:
         mm, _, factors = str(spec).partition(":")
@@ -241,8 +238,7 @@ def main(meshes_mm):
         out.update(wall_s=time.perf_counter() - clock, load_average=load,
                    machine=f"{platform.platform()}, {os.cpu_count()} cores")
         res["meshes"][f"{mm:g}" if factors == FACTORS or mm == 5 else str(spec)] = out
-        RESULTS.mkdir(exist_ok=True)
-        path.write_text(json.dumps(res, indent=1, default=float))
+        write_results("cutoff", res)
     write_md(res)
 
 
@@ -253,7 +249,7 @@ def write_md(res):
          "Door trim of cases/door_trim_p1.yaml (12 pairs: 8 rattle, 4 squeak), H = 15, N = 256, "
          "base 10 m/s², modal ζ 3 %; cutoff = factor · H · f_max (f_max = 80 Hz; the rule's default "
          "factor 1.5). Reference: the finest cutoff of each mesh. Script: "
-         "benchmarks/bench_cutoff.py (OPENBLAS_NUM_THREADS=1).", "",
+         "benchmarks/accuracy/bench_cutoff.py (OPENBLAS_NUM_THREADS=1).", "",
          "Columns: max over the points of — a₁: first-harmonic contact amplitude change "
          "(relative to the largest a₁; the estimate's measure); r̃: contact-row displacement "
          "harmonics, all k; λ̃: contact-force harmonics, all k; w̃: radiating normal "
@@ -310,11 +306,11 @@ def write_md(res):
                 for p in r["points"]))
         L.append("")
     L += res.get("notes", [])
-    (RESULTS / "cutoff.md").write_text("\n".join(L) + "\n")
+    write_results("cutoff", markdown=L)
 
 
 if __name__ == "__main__":
     if sys.argv[1:] == ["--md"]:       # rewrite the .md from the .json (notes edited there)
-        write_md(json.loads((RESULTS / "cutoff.json").read_text()))
+        write_md(read_results("cutoff"))
     else:
         main(sys.argv[1:] or ["10"])

@@ -49,12 +49,11 @@ Part 0 (reference study, rattle rig 29–34 Hz): HBM H = 10/20/40/60 and time in
 starts (linear solution, the HBM H = 10 orbit, a downward warm-started sweep), Poincaré spreads.
 
 Writes benchmarks/results/hbm_vs_time.md and .json. ≈ 20–30 min on 2 shared cores.
-Usage: python benchmarks/bench_hbm_vs_time.py [rattle_rig|door_trim|study ...]
+Usage: python benchmarks/accuracy/bench_hbm_vs_time.py [rattle_rig|door_trim|study ...]
 """
 from __future__ import annotations
 
 import dataclasses
-import json
 import os
 import pathlib
 import pickle
@@ -62,11 +61,11 @@ import platform
 import sys
 import time
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import ROOT, read_results, write_results  # noqa: E402
+
 import numpy as np
 
-HERE = pathlib.Path(__file__).resolve().parent
-ROOT = HERE.parent
-RESULTS = HERE / "results"
 POINTS = int(os.environ.get("BENCH_POINTS", 50))   # smaller only for a smoke run
 TARGET = 1e-2          # first-harmonic amplitude, relative (the headline level)
 LEVELS = (5e-2, 2e-2, 1e-2)   # the trade curve: cheapest setting of each method per level
@@ -560,7 +559,7 @@ def markdown(results):
     L = ["# HBM vs time integration at equal accuracy: 50-point sweeps (issue 15)", "",
          f"Machine: {meta['machine']}; load average at start {meta['load']} (2 cores shared with "
          "other helpers: wall times are upper bounds; both methods run in turn in one process, "
-         "one BLAS thread). Script: `benchmarks/bench_hbm_vs_time.py` (its docstring gives the "
+         "one BLAS thread). Script: `benchmarks/accuracy/bench_hbm_vs_time.py` (its docstring gives the "
          "procedure). Error e₁ = relative error of the complex first harmonic of the contact rows; "
          "ΔL = |error of the total ERP level| [dB] (target 0.5 dB), ΔL_A the same A-weighted "
          "[dB(A)] (reported, no target: see the notes); all max over the compared points.", ""]
@@ -688,11 +687,9 @@ def markdown(results):
 
 def main(parts):
     """Run the parts; a subset updates the existing results file (parts run separately)."""
-    RESULTS.mkdir(exist_ok=True)
-    path = RESULTS / "hbm_vs_time.json"
-    results = json.loads(path.read_text()) if path.exists() and len(parts) < 3 else {}
+    results = read_results("hbm_vs_time", {}) if len(parts) < 3 else {}
     if parts == ["render"]:             # only rewrite the markdown from the json
-        (RESULTS / "hbm_vs_time.md").write_text(markdown(results))
+        write_results("hbm_vs_time", markdown=markdown(results))
         return
     results["meta"] = {"machine": f"{platform.platform()}, {os.cpu_count()} cores, Python "
                                   f"{platform.python_version()}",
@@ -701,7 +698,7 @@ def main(parts):
         start = time.perf_counter()
         def save(partial, part=part):      # partial results survive a stopped run
             results[part] = {**partial, "note": "partial: the run was still going"}
-            path.write_text(json.dumps(results, indent=1, default=float))
+            write_results("hbm_vs_time", results)
 
         try:
             results[part] = reference_study() if part == "study" else run_case(part, save)
@@ -710,9 +707,9 @@ def main(parts):
             traceback.print_exc()
             results[part] = {"error": repr(exc)}
         print(f"{part}: {time.perf_counter() - start:.0f} s", flush=True)
-        path.write_text(json.dumps(results, indent=1, default=float))
-        (RESULTS / "hbm_vs_time.md").write_text(markdown(results))
-    print((RESULTS / "hbm_vs_time.md").read_text())
+        write_results("hbm_vs_time", results)
+        path = write_results("hbm_vs_time", markdown=markdown(results))
+    print(path.read_text())
 
 
 if __name__ == "__main__":

@@ -13,24 +13,21 @@ Rules: one probe × 1/((m/m')^p − 1) with p = 1 (top 1/5 × 4: the rule before
 two probes with p fitted from both and kept in [1, p_max], the estimate from the larger probe
 (sarfe.accuracy.estimates (5)) or the larger of both extrapolations.
 
-Usage: python benchmarks/bench_modal_estimate.py [p1:MM ...] [demo] (default: p1:15 p1:10 demo;
+Usage: python benchmarks/accuracy/bench_modal_estimate.py [p1:MM ...] [demo] (default: p1:15 p1:10 demo;
 5 mm takes ~10 min of linear stages) → benchmarks/results/modal_estimate.md and .json (the
 points of earlier runs kept from the json).
 """
-import json
 import os
 import pathlib
 import sys
 import time
 import warnings
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import ROOT, read_results, write_results  # noqa: E402
+
 import numpy as np
 
-HERE = pathlib.Path(__file__).resolve().parent
-ROOT = HERE.parent
-sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(HERE))
-RESULTS = HERE / "results"
 FRACTIONS = (0.05, 0.1, 0.2)
 FLOOR_REL, FLOOR_DB = 1e-4, 0.01
 DEMO_MARGINS = (1.0, 1.25, 2.0)          # the last one is the reference
@@ -64,7 +61,7 @@ def p1_points(mm, factors=(1.0, 0.75)):
     import bench_cutoff as bc
     from sarfe.pipeline import build_linear_model, nonlinear_model
 
-    truth = json.loads((RESULTS / "cutoff.json").read_text())["meshes"][f"{mm:g}"]
+    truth = read_results("cutoff")["meshes"][f"{mm:g}"]
     rows = []
     for factor in factors:
         measured = {r["factor"]: r for r in truth["rows"]}[factor]["points"]
@@ -185,7 +182,7 @@ def write_md(res):
     rows = res["points"]
     lines = ["# The modal part of the per-point error estimate against the measured truncation "
              "error (issue 15)", "",
-             "Script: benchmarks/bench_modal_estimate.py (module docstring: what is measured). "
+             "Script: benchmarks/accuracy/bench_modal_estimate.py (module docstring: what is measured). "
              "Truth: the change of the contact first-harmonic amplitude a₁ (relative to the "
              "largest) and of the ERP level (max of |ΔdB|, |ΔdB(A)|) against the finest cutoff — "
              "P1 door trim (H = 15) from benchmarks/results/cutoff.json, the demo case (H = 10, "
@@ -212,12 +209,11 @@ def write_md(res):
                      f"{r['a1_rel']:.1e} / {adopted(P, 'rel'):.1e} (before {old(P, 'rel'):.1e}), "
                      f"{r['db']:.4f} / {adopted(P, 'db'):.4f} (before {old(P, 'db'):.4f}); "
                      f"{P['0.05']['s']:.3f} s, {P['0.2']['s']:.3f} s")
-    (RESULTS / "modal_estimate.md").write_text("\n".join(lines) + "\n")
+    write_results("modal_estimate", markdown=lines)
 
 
 def main(args):
-    path = RESULTS / "modal_estimate.json"
-    res = json.loads(path.read_text()) if path.exists() else {"points": []}
+    res = read_results("modal_estimate", {"points": []})
     for arg in args or ["p1:15", "p1:10", "demo"]:
         if arg == "demo":
             new = demo_points()
@@ -230,7 +226,7 @@ def main(args):
         names = {r["case"] for r in new}
         res["points"] = [r for r in res["points"] if r["case"] not in names] + new
         res["load_average"] = " ".join(f"{x:.1f}" for x in os.getloadavg())
-        path.write_text(json.dumps(res, indent=1, default=float))
+        write_results("modal_estimate", res)
     write_md(res)
 
 

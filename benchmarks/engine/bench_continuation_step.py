@@ -14,7 +14,7 @@ Criterion for a larger default cap (issue 13, task "peer2"): on every case the s
 it does with 0.1, the peak within 0.1 % of the dense reference, the curve distance ≤ 1 % (the
 amplitude budget of the default accuracy 'balanced').
 
-Run: OPENBLAS_NUM_THREADS=1 python benchmarks/bench_continuation_step.py [case ...]
+Run: OPENBLAS_NUM_THREADS=1 python benchmarks/engine/bench_continuation_step.py [case ...]
 """
 import json
 import os
@@ -24,30 +24,25 @@ import subprocess
 import sys
 import tempfile
 
-import numpy as np
-import yaml
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import ENV, ROOT, read_case, write_case, write_results  # noqa: E402
 
-HERE = pathlib.Path(__file__).resolve().parent
-ROOT = HERE.parent
+import numpy as np
+
 CASES = {"nlvib03": "benchmarks/peer/nlvib03.yaml", "jenkins": "benchmarks/peer/jenkins.yaml",
          "lumped_rattle": "cases/lumped_rattle.yaml", "rattle_rig": "cases/rattle_rig.yaml"}
 STEPS = (0.1, 0.15, 0.25)
 DENSE_STEP = 0.02
-ENV = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MPLBACKEND="Agg",
-           PYTHONPATH=str(ROOT))
 
 
 def sweep(case, max_step, directory):
     """(ω [rad/s], first-harmonic amplitude [m], CPU s, sweep_complete) of one ``sarfe solve``."""
     import h5py
-    data = yaml.safe_load((ROOT / case).read_text())
+    data = read_case(case)
     solver = data.setdefault("solver", {})
     solver.update(error_estimate=False, stability=False)
     solver.setdefault("continuation", {})["max_step"] = max_step
-    # next to the case file, so that its relative paths (meshes) still resolve
-    handle, path = tempfile.mkstemp(suffix=".yaml", dir=ROOT / pathlib.Path(case).parent)
-    os.close(handle)
-    pathlib.Path(path).write_text(yaml.safe_dump(data))
+    path = str(write_case(data, case))   # next to the case file: its relative paths resolve
     output = pathlib.Path(directory) / f"{pathlib.Path(case).stem}_{max_step}"
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     try:
@@ -102,8 +97,7 @@ def measure(name, directory):
 
 
 def write(results):
-    (HERE / "results").mkdir(exist_ok=True)
-    (HERE / "results" / "continuation_step.json").write_text(json.dumps(results, indent=1))
+    write_results("continuation_step", results)
     lines = ["# Continuation max_step vs curve accuracy", "",
              "Dense reference: max_step 0.02, same H and N. Peak = largest first-harmonic amplitude "
              "among the points; curve distance = largest distance of a reference point from the "
@@ -119,7 +113,7 @@ def write(results):
             lines.append(f"| {name} | {step} | {r['points']} | {r['cpu_s']:.2f} | {r['complete']} | "
                          f"{r['peak_vs_dense']:+.4%} | {r['peak_omega_vs_dense']:+.4%} | "
                          f"{r['curve_distance']:.3%} ({r['curve_distance_at_omega']:.4g}) |")
-    (HERE / "results" / "continuation_step.md").write_text("\n".join(lines) + "\n")
+    write_results("continuation_step", markdown=lines)
     print("\n".join(lines))
 
 

@@ -6,33 +6,27 @@
    process on the same case (defaults, and with error estimate and stability off), median of
    ``REPEATS`` runs, against the peer pyHarm (pyharm-os 1.2.2, 255-point run, ds = 0.025) when
    ``--peer-python`` and ``--peer-script`` (benchmarks/peer/pyharm_problems.py of branch
-   ``speed``) are given — otherwise its time recorded by benchmarks/bench_peer.py is quoted.
+   ``speed``) are given — otherwise its time recorded by benchmarks/peer/bench_peer.py is quoted.
 2. One AFT evaluation of 6 contacts with 2-D Jenkins friction at N = 256, H = 7 (elliptic orbits,
    stick and slip), with and without Jacobian: the compiled march; the first call in this process
    (numba import and cache load, or compilation on a fresh install) separately.
 
-Run: OPENBLAS_NUM_THREADS=1 python benchmarks/bench_friction.py [--peer-python P --peer-script S]
+Run: OPENBLAS_NUM_THREADS=1 python benchmarks/engine/bench_friction.py [--peer-python P --peer-script S]
 """
 import argparse
 import json
-import os
 import pathlib
-import platform
-import resource
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
 
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import machine, read_results, run_timed, write_results  # noqa: E402
 
 import numpy as np  # noqa: E402
 import scipy.sparse as sp  # noqa: E402
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
-HERE = ROOT / "benchmarks"
-sys.path.insert(0, str(ROOT))
 from sarfe.hbm import (ContinuationOptions, SolverOptions, continuation,  # noqa: E402
                        make_contact_set, make_linear_model)
 
@@ -54,8 +48,6 @@ solver:
 EXTRA
 erp: {dofs: [0], areas_m2: [1.0]}
 """
-ENV = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MPLBACKEND="Agg",
-           PYTHONPATH=str(ROOT))
 
 
 def jenkins_sweeps():
@@ -83,17 +75,6 @@ def jenkins_sweeps():
     return rows
 
 
-def timed(command, cwd=None):
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    start = time.perf_counter()
-    done = subprocess.run(command, env=ENV, cwd=cwd, capture_output=True, text=True)
-    wall = time.perf_counter() - start
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    if done.returncode not in (0, 3):
-        raise RuntimeError(f"{command} failed ({done.returncode}): {done.stderr[-2000:]}")
-    return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime), done.stdout
-
-
 def whole_process(peer_python, peer_script):
     out = {}
     with tempfile.TemporaryDirectory() as directory:
@@ -108,12 +89,12 @@ def whole_process(peer_python, peer_script):
                     for v, p in cases.items()}
         if peer_python:
             commands["peer"] = [peer_python, peer_script, "jenkins", "--step", "0.025"]
-            timed(commands["peer"], directory)               # warm-up: the peer's numba cache
+            run_timed(commands["peer"], directory)               # warm-up: the peer's numba cache
         times = {k: [] for k in commands}
         peer_out = None
         for _ in range(REPEATS):                             # alternated A B C A B C …
             for key, command in commands.items():
-                wall, cpu, stdout = timed(command, directory)   # the peer logs into its cwd
+                wall, cpu, stdout = run_timed(command, directory)   # the peer logs into its cwd
                 times[key].append((wall, cpu))
                 if key == "peer":
                     peer_out = json.loads(stdout.strip().splitlines()[-1])
@@ -173,14 +154,12 @@ def main():
                         help="only rewrite friction.md from results/friction.json")
     args = parser.parse_args()
     if args.from_json:
-        results = json.loads((HERE / "results" / "friction.json").read_text())
+        results = read_results("friction")
     else:
-        results = {"machine": platform.platform(), "cpu_count": os.cpu_count(),
-                   "load_average": os.getloadavg(), "march_2d": march_2d(),
+        results = {**machine(), "march_2d": march_2d(),
                    "sweeps": jenkins_sweeps(),
                    "whole_process": whole_process(args.peer_python, args.peer_script)}
-        (HERE / "results").mkdir(exist_ok=True)
-        (HERE / "results" / "friction.json").write_text(json.dumps(results, indent=2))
+        write_results("friction", results, indent=2)
     write(results)
 
 
@@ -226,7 +205,7 @@ def write(results):
               f"First call in this process (numba import + cached kernels): "
               f"{m['first_call_s']:.2f} s; on a fresh install the kernels compile once (≈ 8 s) "
               "into numba's on-disk cache."]
-    (HERE / "results" / "friction.md").write_text("\n".join(lines) + "\n")
+    write_results("friction", markdown=lines)
     print("\n".join(lines))
 
 

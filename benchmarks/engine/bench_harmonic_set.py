@@ -15,25 +15,21 @@ the odd set on symmetric contact problems (f_nl(−u) = −f_nl(u), no mean load
 Reported: wall time, Newton unknowns, iterations, max |ũ_odd − ũ_all| / max |ũ_all| and the
 estimate η of both solutions (0 for a symmetric system).
 
-Run: OPENBLAS_NUM_THREADS=1 python benchmarks/bench_harmonic_set.py
+Run: OPENBLAS_NUM_THREADS=1 python benchmarks/engine/bench_harmonic_set.py
 """
-import json
-import os
 import pathlib
-import platform
 import sys
 import time
 
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import machine, write_results  # noqa: E402
 
 import numpy as np  # noqa: E402
 import scipy.sparse as sp  # noqa: E402
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 from sarfe.hbm import SolverOptions, make_contact_set, make_linear_model, solve_frequency  # noqa: E402
 from sarfe.hbm.solve import condensed_size, make_problem, wants_condensation  # noqa: E402
 
-HERE = pathlib.Path(__file__).resolve().parent
 OMEGA = 0.3
 
 
@@ -95,13 +91,11 @@ def compare(kind, label, dofs, pairs, H, repeat):
 
 
 def main():
-    results = {"machine": platform.platform(), "python": platform.python_version(),
-               "cpu_count": os.cpu_count(), "load_average": os.getloadavg(), "omega": OMEGA}
+    results = {**machine(), "omega": OMEGA}
     results["runs"] = ([compare("squeak", "dense chain", 22, 5, H, 3) for H in (5, 15, 40)]
                        + [compare("squeak", "sparse chain", 2000, 5, H, 2) for H in (5, 15, 40)]
                        + [compare("rattle", "dense chain", 22, 1, H, 3) for H in (5, 15)])
-    (HERE / "results").mkdir(exist_ok=True)
-    (HERE / "results" / "harmonic_set.json").write_text(json.dumps(results, indent=2))
+    write_results("harmonic_set", results, indent=2)
     lines = ["# Harmonic sets: all orders vs odd orders on symmetric contacts", "",
              f"Machine: {results['machine']}, {results['cpu_count']} cores, load average at start "
              f"{results['load_average'][0]:.1f} (shared machine: timings are upper bounds). "
@@ -129,7 +123,7 @@ def main():
               "whole period (N points, all 2H+1 rows); its Jacobian, the condensation and the "
               "Newton solve are built for the kept orders only, so the gain grows with H (fixed "
               "costs dominate at H = 5). Shared, loaded machine: single timings vary by ±30 %."]
-    (HERE / "results" / "harmonic_set.md").write_text("\n".join(lines) + "\n")
+    write_results("harmonic_set", markdown=lines)
     print("\n".join(lines))
 
 

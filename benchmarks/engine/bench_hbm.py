@@ -6,28 +6,23 @@
    with 1, 10, 50, 200 rattle pairs (H = 10, N = 256), and with 10 pairs vs H = 5, 15, 40
    (N = 8H rounded up to a power of two, ≥ 128); squeak (1-D Jenkins) pairs for comparison.
 
-Run: OPENBLAS_NUM_THREADS=1 python benchmarks/bench_hbm.py
+Run: OPENBLAS_NUM_THREADS=1 python benchmarks/engine/bench_hbm.py
 """
-import json
-import os
 import pathlib
-import platform
 import sys
 import time
 
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import machine, write_results  # noqa: E402
 
 import numpy as np  # noqa: E402
 import scipy.sparse as sp  # noqa: E402
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 from sarfe.hbm import (ContinuationOptions, SolverOptions, continuation,  # noqa: E402
                        make_contact_set, make_linear_model)
 from sarfe.hbm.newton import solve_linear  # noqa: E402
 from sarfe.hbm.solve import (condensed_size, linearized_guess, make_evaluator,  # noqa: E402
                              make_problem, wants_condensation)
-
-HERE = pathlib.Path(__file__).resolve().parent
 
 
 def example03():
@@ -101,14 +96,12 @@ def newton_iteration_time(pairs, harmonics, kind="rattle", repeat=3):
 
 
 def main():
-    results = {"machine": platform.platform(), "python": platform.python_version(),
-               "cpu_count": os.cpu_count(), "load_average": os.getloadavg()}
+    results = machine()
     results["example03"] = [sweep03(False), sweep03(True)]
     results["vs_contacts"] = [newton_iteration_time(p, 10) for p in (1, 10, 50, 200)]
     results["vs_contacts_squeak"] = [newton_iteration_time(p, 10, "squeak") for p in (1, 10, 50, 200)]
     results["vs_harmonics"] = [newton_iteration_time(10, h) for h in (5, 15, 40)]
-    (HERE / "results").mkdir(exist_ok=True)
-    (HERE / "results" / "hbm.json").write_text(json.dumps(results, indent=2))
+    write_results("hbm", results, indent=2)
     lines = ["# HBM engine benchmark", "",
              f"Machine: {results['machine']}, {results['cpu_count']} cores, load average at start "
              f"{results['load_average'][0]:.1f} (shared machine: timings are upper bounds). One BLAS thread.",
@@ -126,7 +119,7 @@ def main():
         lines.append(f"| {r['kind']} | {r['pairs']} | {r['harmonics']} | {r['samples']} | {r['dofs']} | "
                      f"{r['condensed']} | {r['unknowns']} ({r['full_unknowns']}) | "
                      f"{1e3 * r['seconds_per_iteration']:.1f} |")
-    (HERE / "results" / "hbm.md").write_text("\n".join(lines) + "\n")
+    write_results("hbm", markdown=lines)
     print("\n".join(lines))
 
 

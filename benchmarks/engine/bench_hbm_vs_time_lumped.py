@@ -14,20 +14,22 @@ the first three step counts that reach the target), with and without Richardson 
 Writes benchmarks/results/hbm_vs_time_lumped.md and .json (the case rigs: bench_hbm_vs_time.py).
 """
 import importlib.util
-import json
 import os
 import pathlib
 import platform
 import time
+import sys
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import ROOT, write_results  # noqa: E402
 
 import numpy as np
 
 import sarfe.hbm as hbm
 from sarfe.hbm.time_integration import integrate_time
 
-HERE = pathlib.Path(__file__).resolve().parent
 _spec = importlib.util.spec_from_file_location(
-    "hbm_vs_time_models", HERE.parent / "tests" / "hbm" / "test_hbm_vs_time.py")
+    "hbm_vs_time_models", ROOT / "tests" / "hbm" / "test_hbm_vs_time.py")
 models = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(models)
 
@@ -179,11 +181,8 @@ def main():
         start = time.perf_counter()
         results.append(study(name))
         print(f"{name}: {time.perf_counter() - start:.0f} s", flush=True)
-    out = HERE / "results"
-    out.mkdir(exist_ok=True)
-    (out / "hbm_vs_time_lumped.json").write_text(json.dumps({"meta": meta, "results": results}, indent=1))
-    (out / "hbm_vs_time_lumped.md").write_text(markdown(results, meta))
-    print((out / "hbm_vs_time_lumped.md").read_text())
+    write_results("hbm_vs_time_lumped", {"meta": meta, "results": results})
+    print(write_results("hbm_vs_time_lumped", markdown=markdown(results, meta)).read_text())
 
 
 if __name__ == "__main__":

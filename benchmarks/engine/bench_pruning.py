@@ -20,7 +20,7 @@ before the contact-row pass) against the contact-row pass (modal compliance + Wo
 the linearized contacts), cold (the modal basis computed, as in ``sarfe solve``) and warm (basis
 cached); the decisions of both and the largest clearance difference.
 
-Run: OPENBLAS_NUM_THREADS=1 python benchmarks/bench_pruning.py [cases,screen]  (default both; a
+Run: OPENBLAS_NUM_THREADS=1 python benchmarks/engine/bench_pruning.py [cases,screen]  (default both; a
 part not run keeps its previous results from pruning.json)
 """
 import copy
@@ -33,15 +33,13 @@ import sys
 import time
 import warnings
 
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import CASES, read_results, write_results  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 from sarfe.pipeline import build_linear_model, load_case, solve_case  # noqa: E402
 
-HERE = pathlib.Path(__file__).resolve().parent
-CASES = HERE.parent / "cases"
 
 
 def lumped_with_extra_contacts():
@@ -242,8 +240,7 @@ def machine_line():
 
 def main():
     parts = (sys.argv[1] if len(sys.argv) > 1 else "cases,screen").split(",")
-    path = HERE / "results" / "pruning.json"
-    previous = json.loads(path.read_text()) if path.exists() else {}
+    previous = read_results("pruning", {})
     machine = previous.get("machine", "")
     rows = previous.get("rows", [])
     screen = previous.get("screen")
@@ -258,9 +255,7 @@ def main():
     if "screen" in parts:
         screen = {"machine": machine_line(), "date": time.strftime("%Y-%m-%d"),
                   "rows": screen_rows()}
-    (HERE / "results").mkdir(exist_ok=True)
-    path.write_text(json.dumps({"machine": machine, "rows": rows, "screen": screen},
-                               indent=2) + "\n")
+    write_results("pruning", {"machine": machine, "rows": rows, "screen": screen}, indent=2)
     lines = ["# Contact pruning benchmark (solver.prune_contacts)", "", f"Machine: {machine}", "",
              "Pruned / full contact set, the linear stage shared. HBM wall: `timings_s.hbm_s` of "
              "summary.json (screening + HBM + check + restore). CPU: process time of the whole "
@@ -290,7 +285,7 @@ def main():
                      f"{disp} |")
     if screen:
         lines += [""] + screen_lines(screen)
-    (HERE / "results" / "pruning.md").write_text("\n".join(lines) + "\n")
+    write_results("pruning", markdown=lines)
     print("\n".join(lines))
 
 

@@ -34,12 +34,12 @@ and the verdicts at all its step counts agree. Integrator results are
 kept in results/stability_truth.json and reused by reruns (keyed by frequency and steps).
 
 Section "zeros" (``--zeros POINTS.pkl``, session hillzeros): on captured orbits
-(benchmarks/stability_counts.py capture) the points where the count finds two or more exponents
+(benchmarks/tools/stability_counts.py capture) the points where the count finds two or more exponents
 right of −ε: the default verdict with the zeros located (sarfe/hbm/stability/zeros.py) and its
 CPU, the Ritz hand-over it replaces, and the full nonlinear Hill problem on all reduced DOFs
 started at the located leading exponent. → results/stability_zeros.json.
 
-Run: OPENBLAS_NUM_THREADS=1 python benchmarks/bench_stability.py [--skip-full] [--rows] [--sweep]
+Run: OPENBLAS_NUM_THREADS=1 python benchmarks/engine/bench_stability.py [--skip-full] [--rows] [--sweep]
 [--truth] [--zeros POINTS.pkl …]
 """
 import json
@@ -49,12 +49,12 @@ import sys
 import tempfile
 import time
 
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import RESULTS, ROOT, write_results  # noqa: E402
 
 import numpy as np  # noqa: E402
 import yaml  # noqa: E402
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 from sarfe.hbm.residual import Problem, full_residual  # noqa: E402
 from sarfe.hbm.solve import contact_damping  # noqa: E402
 from sarfe.hbm.stability.hill import hill_stability  # noqa: E402
@@ -62,9 +62,6 @@ from sarfe.hbm.stability.condensed import condensed_stability  # noqa: E402
 from sarfe.hbm.stability.contact_terms import ContactOperator  # noqa: E402
 from sarfe.pipeline import build_linear_model, load_case, nonlinear_model  # noqa: E402
 from sarfe.pipeline.solve.points import solve_point, solver_options  # noqa: E402
-
-HERE = pathlib.Path(__file__).resolve().parent
-ROOT = HERE.parent
 
 
 def case_at(path, mesh=None, harmonics=None, samples=None, sweep=None, solver=None):
@@ -313,7 +310,7 @@ sweep")."""
 def write_rows_section(lines):
     """Replace the contact-row section of results/stability.md (keep the sections before it and
     the sweep section after it)."""
-    path = HERE / "results" / "stability.md"
+    path = RESULTS / "stability.md"
     text = path.read_text() if path.exists() else ""
     head = text.split(ROWS_HEADER)[0].rstrip("\n")
     tail = SWEEP_HEADER + text.split(SWEEP_HEADER, 1)[1] if SWEEP_HEADER in text else ""
@@ -323,7 +320,7 @@ def write_rows_section(lines):
 
 def write_sweep_section(lines):
     """Replace the sweep section of results/stability.md (keep everything before it)."""
-    path = HERE / "results" / "stability.md"
+    path = RESULTS / "stability.md"
     text = path.read_text() if path.exists() else ""
     head, _, rest = text.partition(SWEEP_HEADER)
     head = head.rstrip("\n")
@@ -348,7 +345,7 @@ def truth_study(path="cases/rattle_rig.yaml", every=6):
     nl = nonlinear_model(case, build_linear_model(case, progress=False))
     with deferred_stability() as jobs:
         solutions, _ = solve_points_pruned(case.config.solver, case.config.excitation, nl)
-    saved = HERE / "results" / "stability_truth.json"
+    saved = RESULTS / "stability_truth.json"
     cache = {}
 
     def read_saved():             # (re-read before each integration: another run may fill it)
@@ -509,7 +506,7 @@ def truth_lines(res):
 def write_truth_nlvib_section(lines):
     """The NLvib 03 truth table under its own header (after the rattle rig's)."""
     lines = [NLVIB_HEADER] + lines[1:]
-    path = HERE / "results" / "stability.md"
+    path = RESULTS / "stability.md"
     text = path.read_text() if path.exists() else ""
     head, _, rest = text.partition(NLVIB_HEADER)
     tail = "## " + rest.split("\n## ", 1)[1] if rest and "\n## " in rest else ""
@@ -521,7 +518,7 @@ NLVIB_HEADER = "## Verdicts against time integration: NLvib example 03 (session 
 
 def write_truth_section(lines):
     """Replace (or append) the truth section of results/stability.md."""
-    path = HERE / "results" / "stability.md"
+    path = RESULTS / "stability.md"
     text = path.read_text() if path.exists() else ""
     head, _, rest = text.partition(TRUTH_HEADER)
     tail = ""
@@ -534,7 +531,7 @@ ZEROS_HEADER = "## Two or more zeros right of −ε, located (issue 15 P1, sessi
 
 
 def zeros_study(points_paths):
-    """Per captured point (benchmarks/stability_counts.py capture) where the count finds two or
+    """Per captured point (benchmarks/tools/stability_counts.py capture) where the count finds two or
     more exponents right of −ε: the default verdict (the zeros located,
     sarfe/hbm/stability/zeros.py) and its CPU, the same with the locator stubbed to fail (the
     Ritz method of the hand-over, as before), and the full nonlinear Hill problem on all reduced
@@ -622,7 +619,7 @@ def zeros_lines(res):
 
 def write_zeros_section(lines):
     """Replace (or append at the end) the zeros section of results/stability.md."""
-    path = HERE / "results" / "stability.md"
+    path = RESULTS / "stability.md"
     text = path.read_text() if path.exists() else ""
     head, _, rest = text.partition(ZEROS_HEADER)
     tail = "## " + rest.split("\n## ", 1)[1] if "\n## " in rest else ""
@@ -634,24 +631,21 @@ def main():
         i = sys.argv.index("--compare")
         compare_sweeps(sys.argv[i + 1], sys.argv[i + 2])
         return
-    if "--zeros" in sys.argv:          # --zeros POINTS.pkl … (benchmarks/stability_counts.py capture)
+    if "--zeros" in sys.argv:          # --zeros POINTS.pkl … (benchmarks/tools/stability_counts.py capture)
         res = zeros_study(sys.argv[sys.argv.index("--zeros") + 1:])
-        (HERE / "results").mkdir(exist_ok=True)
-        (HERE / "results" / "stability_zeros.json").write_text(
-            json.dumps(res, indent=1, default=str))
+        write_results("stability_zeros", res, default=str)
         write_zeros_section(zeros_lines(res))
         print("\n".join(zeros_lines(res)))
         return
     for flag, run, name, write, table in (
-            ("--sweep", sweep_cost, "stability_sweep.json", write_sweep_section, sweep_lines),
-            ("--rows", rows_cost, "stability_rows.json", write_rows_section, rows_lines),
-            ("--truth-nlvib03", truth_study_nlvib03, "stability_truth_nlvib03.json",
+            ("--sweep", sweep_cost, "stability_sweep", write_sweep_section, sweep_lines),
+            ("--rows", rows_cost, "stability_rows", write_rows_section, rows_lines),
+            ("--truth-nlvib03", truth_study_nlvib03, "stability_truth_nlvib03",
              write_truth_nlvib_section, truth_lines),
-            ("--truth", truth_study, "stability_truth.json", write_truth_section, truth_lines)):
+            ("--truth", truth_study, "stability_truth", write_truth_section, truth_lines)):
         if flag in sys.argv:
             res = run()
-            (HERE / "results").mkdir(exist_ok=True)
-            (HERE / "results" / name).write_text(json.dumps(res, indent=1, default=str))
+            write_results(name, res, default=str)
             write(table(res))
             print("\n".join(table(res)))
             return
@@ -659,8 +653,7 @@ def main():
     results = [compare("squeak_rig", "cases/squeak_rig.yaml", [50.0, 100.0, 150.0]),
                compare("door_trim 10 mm H=5", "cases/door_trim.yaml", [40.0, 52.0, 67.0, 80.0, 95.0],
                        full=not skip_full, mesh=0.01, harmonics=5)]
-    (HERE / "results").mkdir(exist_ok=True)
-    (HERE / "results" / "stability.json").write_text(json.dumps(results, indent=1, default=str))
+    write_results("stability", results, default=str)
     lines = ["# Hill stability per point: full vs condensed (contact rows)", "",
              "Main (frozen): the Hill eigenproblem on all reduced DOFs with the Newton Jacobian as main had it. "
              "Full: the Hill eigenproblem on all reduced DOFs (dense or ARPACK shift-invert as on main, "
@@ -682,11 +675,11 @@ def main():
                          f"{r['condensed_s']:.2f} | {r['condensed_stable']} "
                          f"({r['condensed_leading']:.4g}) |")
         lines.append("")
-    (HERE / "results" / "stability.md").write_text("\n".join(lines) + "\n")
-    saved = HERE / "results" / "stability_rows.json"
+    write_results("stability", markdown=lines)
+    saved = RESULTS / "stability_rows.json"
     if saved.exists():                  # keep the contact-row section of the last --rows run
         write_rows_section(rows_lines(json.loads(saved.read_text())))
-    saved = HERE / "results" / "stability_sweep.json"
+    saved = RESULTS / "stability_sweep.json"
     if saved.exists():                  # and the sweep section of the last --sweep run
         write_sweep_section(sweep_lines(json.loads(saved.read_text())))
 

@@ -6,7 +6,7 @@ written in small-field Nastran format; the same quads, split in triangles, as a 
 file. Each path runs in its own process so that its peak memory (ru_maxrss) is its own:
   nastran: read_nastran (pyNastran parse + cross-reference + DeckModel) → assemble_deck
   gmsh:    load_mesh (gmsh API) → shell_matrices (the isotropic facet shell)
-Writes benchmarks/results/deck.md and deck.json.  Run: python benchmarks/bench_deck.py
+Writes benchmarks/results/deck.md and deck.json.  Run: python benchmarks/linear/bench_deck.py
 """
 from __future__ import annotations
 
@@ -18,7 +18,8 @@ import subprocess
 import sys
 import tempfile
 
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import child_env, write_results  # noqa: E402
 
 N_QUADS = 181
 WIDTH = 0.9
@@ -121,10 +122,8 @@ print(json.dumps(dict(read_s=read, assembly_s=assembly, dof=k.shape[0], nnz=int(
 
 
 def _run(code, path):
-    root = pathlib.Path(__file__).resolve().parents[1]
-    env = dict(os.environ, PYTHONPATH=str(root) + os.pathsep + os.environ.get("PYTHONPATH", ""))
     out = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True,
-                         text=True, env=env, check=True)
+                         text=True, env=child_env(), check=True)
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
@@ -139,9 +138,7 @@ def main() -> None:
                 dict(path="gmsh (load_mesh → shell_matrices)", **_run(_GMSH, msh))]
     for row in rows:
         print(row, flush=True)
-    here = pathlib.Path(__file__).resolve().parent / "results"
-    here.mkdir(exist_ok=True)
-    (here / "deck.json").write_text(json.dumps(dict(files=sizes, runs=rows), indent=1))
+    write_results("deck", dict(files=sizes, runs=rows))
     lines = ["# Reading + assembling a 200k-DOF deck", "",
              f"{N_QUADS}×{N_QUADS} CQUAD4 panel (2.5 mm ABS) with SPC1, 24 CBUSH, 4 RBE2, 8 CONM2; "
              f"deck {sizes['deck_mb']:.1f} MB, same mesh as MSH {sizes['msh_mb']:.1f} MB. "
@@ -154,7 +151,7 @@ def main() -> None:
         lines.append(f"| {r['path']} | {r['dof']} | {r['nnz']} | {r['read_s']:.1f} | "
                      f"{r['assembly_s']:.1f} | {r['read_s'] + r['assembly_s']:.1f} | "
                      f"{r['peak_mb']:.0f} |")
-    (here / "deck.md").write_text("\n".join(lines) + "\n")
+    write_results("deck", markdown=lines)
 
 
 if __name__ == "__main__":

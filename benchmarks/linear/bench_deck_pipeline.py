@@ -7,7 +7,7 @@ cache, shell K, M, Craig–Bampton) and the deck case (pyNastran read, checks, d
 Craig–Bampton) with the same boundary (three contact pairs), cutoff and base excitation.
 
 Writes benchmarks/results/deck_pipeline.md and .json.
-Usage: python benchmarks/bench_deck_pipeline.py [--size 0.01]
+Usage: python benchmarks/linear/bench_deck_pipeline.py [--size 0.01]
 """
 from __future__ import annotations
 
@@ -21,17 +21,17 @@ import sys
 import tempfile
 import time
 
-HERE = pathlib.Path(__file__).resolve().parent
-ROOT = HERE.parent
-sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "tests"))
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import ROOT, write_results  # noqa: E402
+
+sys.path.insert(0, str(ROOT / "tests" / "pipeline" / "model"))    # test_deck_door: the two cases
 
 
 def run_one(kind: str, size: float, directory: str) -> dict:
     import numpy as np
-    import test_pipeline_deck_door as door
+    import test_deck_door as door
 
-    from sarfe.pipeline import build_linear_model, load_case
+    from sarfe.pipeline import build_linear_model
 
     door.SIZE = size
     written = json.loads((pathlib.Path(directory) / "written.json").read_text())
@@ -60,7 +60,7 @@ def main(argv=None):
         print(json.dumps(run_one(args.one[0], args.size, args.one[1])))
         return
     from sarfe.mesh.cache import cached_mesh
-    import test_pipeline_deck_door as door
+    import test_deck_door as door
     from sarfe.mesh.formats.nastran_writer import ShellProperty, write_panel_deck
 
     directory = tempfile.mkdtemp(prefix="bench_deck_")
@@ -81,16 +81,15 @@ def main(argv=None):
         results.append(json.loads(out.stdout.strip().splitlines()[-1]))
     best = {k: min((r for r in results if r["kind"] == k), key=lambda r: r["seconds"])
             for k in ("generator", "deck")}
-    (HERE / "results").mkdir(exist_ok=True)
-    (HERE / "results" / "deck_pipeline.json").write_text(json.dumps(
-        {"size_m": args.size, "machine": platform.platform(), "runs": results}, indent=2))
+    write_results("deck_pipeline", {"size_m": args.size, "machine": platform.platform(), "runs": results},
+                  indent=2)
     g, d = best["generator"], best["deck"]
     lines = [
         "# Deck path vs generator path: door trim linear stage", "",
         f"Door trim at {args.size * 1e3:g} mm: {g['nodes']} nodes (deck: {d['nodes']} GRIDs with the "
         f"clip spiders), {g['triangles']} triangles; boundary = 3 contact pairs; cutoff 600 Hz + "
         "residual vectors; base excitation. Best of two fresh processes each, loaded 2-core machine "
-        f"({platform.machine()}). `python benchmarks/bench_deck_pipeline.py`.", "",
+        f"({platform.machine()}). `python benchmarks/linear/bench_deck_pipeline.py`.", "",
         "| path | linear stage [s] | read/mesh [s] | assembly [s] | reduction [s] | peak RSS [GB] | free DOFs | reduced DOFs | first modes [Hz] |",
         "|---|---|---|---|---|---|---|---|---|"]
     for r in (g, d):
@@ -99,7 +98,7 @@ def main(argv=None):
         lines.append(f"| {r['kind']} | {r['seconds']:.1f} | {read:.1f} | {t.get('assembly_s', 0):.1f} | "
                      f"{t.get('reduction_s', 0):.1f} | {r['peak_rss_gb']:.2f} | {r['free_dofs']} | "
                      f"{r['reduced_dofs']} | {', '.join(f'{f:.2f}' for f in r['first_modes_hz'])} |")
-    (HERE / "results" / "deck_pipeline.md").write_text("\n".join(lines) + "\n")
+    write_results("deck_pipeline", markdown=lines)
     print("\n".join(lines))
 
 

@@ -5,18 +5,18 @@ first six frequencies vs Leissa's λ = ω a² √(ρh/D); structured meshes (two
 patterns) and an unstructured Gmsh mesh at 10, 5, 2.5 mm. Also: curved panel shell vs
 scikit-fem Hex2 solid, and shell assembly of a production door-trim mesh.
 
-Writes benchmarks/results/fe.md and fe.json.  Run: python benchmarks/bench_fe.py
+Writes benchmarks/results/fe.md and fe.json.  Run: python benchmarks/linear/bench_fe.py
 """
 from __future__ import annotations
 
-import json
 import os
 import pathlib
 import platform
 import sys
 import time
 
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import write_results  # noqa: E402
 
 import numpy as np  # noqa: E402
 
@@ -124,10 +124,7 @@ def main() -> None:
     production = production_row()
     print(production, flush=True)
 
-    here = pathlib.Path(__file__).resolve().parent / "results"
-    here.mkdir(exist_ok=True)
-    (here / "fe.json").write_text(json.dumps(dict(plate=rows, curved_panel=curved,
-                                                  production=production), indent=1))
+    write_results("fe", dict(plate=rows, curved_panel=curved, production=production))
     lines = [
         "# Facet shell (sarfe.fe.shell_matrices)",
         "",
@@ -161,7 +158,7 @@ def main() -> None:
         lines += ["", "## Production mesh", "",
                   f"{production['mesh']}: {production['triangles']} triangles, {production['dof']} DOF, "
                   f"shell assembly {production['assembly_s']} s wall, {production['assembly_cpu_s']} s CPU."]
-    (here / "fe.md").write_text("\n".join(lines) + "\n")
+    write_results("fe", markdown=lines)
 
 
 if __name__ == "__main__":

@@ -18,9 +18,9 @@ these meshes finds every mode), "uncapped" (_SLICE_COLUMNS = 10⁹: the one unca
 old: _block_lanczos_modes' own loop, new: the wrapper over shifted_block_lanczos), "modes60"
 (mode_count = 60, no cutoff: the uncapped run too).
 
-Usage: python benchmarks/bench_lanczos_unified.py [--old-ref REF] [--repeats 2] [--only m:p,…]
-       python benchmarks/bench_lanczos_unified.py --variants   (new tree: block size, partial)
-       python benchmarks/bench_lanczos_unified.py --report     (rewrite the .md from the .json)
+Usage: python benchmarks/linear/bench_lanczos_unified.py [--old-ref REF] [--repeats 2] [--only m:p,…]
+       python benchmarks/linear/bench_lanczos_unified.py --variants   (new tree: block size, partial)
+       python benchmarks/linear/bench_lanczos_unified.py --report     (rewrite the .md from the .json)
 """
 from __future__ import annotations
 
@@ -34,13 +34,13 @@ import subprocess
 import sys
 import tempfile
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import THREADS, ROOT, read_results, write_results  # noqa: E402
+
 import numpy as np
 
-HERE = pathlib.Path(__file__).resolve().parent
-ROOT = HERE.parent
 PYTHON = sys.executable
-ENV = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1",
-           MPLBACKEND="Agg")
+ENV = dict(os.environ, **THREADS, MPLBACKEND="Agg")     # no PYTHONPATH: the worker picks its tree
 MODELS = {"demo": ("cases/door_trim.yaml", None), "trim15": ("cases/door_trim_p1.yaml", 0.015),
           "trim10_capped": ("cases/door_trim_p1.yaml", 0.010),
           "trim40_dense": ("cases/door_trim_p1.yaml", 0.040),
@@ -51,8 +51,10 @@ def _worker(tree, model, path_kind, variant):
     """In a fresh process: build the model's linear stage with ``tree``'s sarfe; print JSON."""
     sys.path.insert(0, tree)
     cb = importlib.import_module("sarfe.reduction.craig_bampton")
-    from sarfe.case.read import load_case, read_yaml
-    from sarfe.pipeline.model.linear_stage import build_linear_model
+    try:        # the mode search's own module since issue 28; older trees kept it in craig_bampton
+        modes = importlib.import_module("sarfe.reduction.fixed_interface_modes")
+    except ImportError:
+        modes = cb
 
     captured = {}
     craig_bampton = cb.craig_bampton
@@ -63,20 +65,23 @@ def _worker(tree, model, path_kind, variant):
             kwargs["workers"] = 1                       # one process: the capped run 0 alone
         return craig_bampton(stiffness, mass, *args, **kwargs)
 
-    cb.craig_bampton = capture       # the pipeline imports it from the module when it reduces
+    cb.craig_bampton = capture       # before the pipeline imports it
     if path_kind in ("uncapped", "modes60", "solve_uncapped"):
-        cb._SLICE_COLUMNS = 10 ** 9
+        modes._SLICE_COLUMNS = 10 ** 9
     if model == "trim10_capped":
-        cb._SLICE_COLUMNS, cb._SLICE_ENTRIES = 240, 0
+        modes._SLICE_COLUMNS, modes._SLICE_ENTRIES = 240, 0
     if variant:                                   # new tree only: the wrapper's knobs
         knobs = json.loads(variant)
         lanczos = importlib.import_module("sarfe.reduction.lanczos")
         if "partial" in knobs:
-            cb.shifted_block_lanczos = functools.partial(lanczos.shifted_block_lanczos,
-                                                         partial=knobs["partial"])
+            modes.shifted_block_lanczos = functools.partial(lanczos.shifted_block_lanczos,
+                                                            partial=knobs["partial"])
         if "block_size" in knobs:
-            cb._block_lanczos_modes = functools.partial(cb._block_lanczos_modes,
-                                                        block_size=knobs["block_size"])
+            modes._block_lanczos_modes = functools.partial(modes._block_lanczos_modes,
+                                                           block_size=knobs["block_size"])
+    from sarfe.case.read import load_case, read_yaml
+    from sarfe.pipeline import build_linear_model
+
     case_path, size = MODELS[model]
     data, _ = read_yaml(os.path.join(ROOT, case_path))
     if size is not None:
@@ -206,7 +211,7 @@ def variants(new, repeats):
 
 def report(results):
     """benchmarks/results/lanczos_unified.md from the JSON (old vs new rows, then the variants)."""
-    lines = ["# One σ = 0 block Lanczos: old vs new (benchmarks/bench_lanczos_unified.py)", "",
+    lines = ["# One σ = 0 block Lanczos: old vs new (benchmarks/linear/bench_lanczos_unified.py)", "",
              f"Old tree: `{results.get('old_ref', '?')}` (git archive); new: this tree. Fresh "
              "process per run, one BLAS thread, A B A B; CPU = Craig–Bampton's "
              "`normal_modes_cpu` (process time of the mode search), median of the runs.", "",
@@ -243,7 +248,7 @@ def report(results):
                          f"{row['applications']} | {row['cpu_s']:.3f} | "
                          f"{row['max_rel_vs_first']:.1e} |")
     lines += [""] + results.get("notes", [])
-    (HERE / "results" / "lanczos_unified.md").write_text("\n".join(lines) + "\n")
+    write_results("lanczos_unified", markdown=lines)
 
 
 def main():
@@ -257,8 +262,7 @@ def main():
     parser.add_argument("--only", default=None, help="comma-separated model:path pairs")
     parser.add_argument("--report", action="store_true", help="only rewrite the .md")
     args = parser.parse_args()
-    out = HERE / "results" / "lanczos_unified.json"
-    results = json.loads(out.read_text()) if out.exists() else {}
+    results = read_results("lanczos_unified", {})
     if args.report:
         report(results)
         return
@@ -279,7 +283,7 @@ def main():
         results.setdefault("compare", {})
         for row in compare(old, str(ROOT), plan, args.repeats):
             results["compare"][f"{row['model']}:{row['path']}"] = row
-    out.write_text(json.dumps(results, indent=1))
+    write_results("lanczos_unified", results)
     report(results)
 
 

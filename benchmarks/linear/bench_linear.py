@@ -3,7 +3,7 @@
 Writes benchmarks/results/linear.md and linear.json. Every case runs in a fresh Python process so
 that peak memory (ru_maxrss) belongs to that case alone.
 
-Usage: python benchmarks/bench_linear.py [--quick | --report | --p1]
+Usage: python benchmarks/linear/bench_linear.py [--quick | --report | --p1]
   --quick: 10 mm only, no solver comparison; --report: rewrite linear.md from linear.json;
   --p1: only the P1 linear stage (issue 15: cases/door_trim_p1.yaml, 5 mm, default cutoff 1.25·H·f_max = 1.5 kHz,
   468 fixed-interface modes by spectrum slicing; 1.8 kHz and 612 before) on one core (taskset) and on two, kept in
@@ -28,11 +28,11 @@ import subprocess
 import sys
 import time
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import ROOT, peak_rss_gb, read_results, write_results  # noqa: E402
+
 import numpy as np
 
-HERE = pathlib.Path(__file__).resolve().parent
-ROOT = HERE.parent
-sys.path.insert(0, str(ROOT))
 
 THICKNESS, YOUNG, POISSON, DENSITY = 2.5e-3, 2.2e9, 0.35, 1050.0
 MODE_COUNT = 60
@@ -40,10 +40,6 @@ BOUNDARY_NODES = 12
 MESH_SIZES_MM = (10, 5)
 SOLVERS = ("pardiso", "cholespy", "superlu")
 PART_THICKNESS = {"part_carrier": 2.5e-3, "part_ribs": 1.5e-3, "part_bosses": 2.0e-3, "part_map_pocket": 2.0e-3}
-
-
-def _rss_gb():
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e6  # Linux: kB
 
 
 def stand_in_panel(mesh_size):
@@ -128,7 +124,7 @@ def run_case(mesh_size_mm, solvers):
     out["lowest_mode_hz"] = float(reduced.mode_frequencies_hz[0])
     out["operator_applications"] = reduced.timings.get("operator_applications")
     out["linear_total_s"] = out["mesh_s"] + out["assembly_s"] + out["craig_bampton_s"]
-    out["peak_rss_gb"] = _rss_gb()
+    out["peak_rss_gb"] = peak_rss_gb()
     out["residual_vectors"] = reduced.residual_vector_count
     # the same reduction with ARPACK (single-vector shift-invert Lanczos) for comparison
     clock = time.perf_counter()
@@ -231,7 +227,7 @@ def run_p1():
     timings = stage.reduced.timings
     return {"cores": len(os.sched_getaffinity(0)), "load_average": round(load, 1), "wall_s": wall,
             "cpu_s": own_cpu, "children_cpu_s": children.ru_utime + children.ru_stime,
-            "peak_rss_self_gb": _rss_gb(), "peak_rss_children_gb": children.ru_maxrss / 1e6,
+            "peak_rss_self_gb": peak_rss_gb(), "peak_rss_children_gb": children.ru_maxrss / 1e6,
             "peak_tree_rss_gb": peak["rss"], "peak_tree_pss_gb": peak["pss"],
             "peak_pss_self_gb": peak["pss_self"], "slicing_files_at_peak_gb": peak["files"],
             "slicing_files_max_gb": peak["files_max"],
@@ -378,8 +374,7 @@ WHEELS = {
 
 
 def _stored():
-    path = HERE / "results" / "linear.json"
-    return json.loads(path.read_text()) if path.exists() else None
+    return read_results("linear")
 
 
 def write_report(cases, quick, p1=None):
@@ -474,12 +469,11 @@ def write_report(cases, quick, p1=None):
         lines += [""] + list(lanczos)
     if lanczos2:
         lines += [""] + list(lanczos2)
-    (HERE / "results").mkdir(exist_ok=True)
-    (HERE / "results" / "linear.md").write_text("\n".join(lines) + "\n")
+    write_results("linear", markdown=lines)
     data = {"cases": cases, "p1": p1, "p1_profile": profile, "p1_split_profile": split_profile,
             "p1_memory": memory, "p1_lanczos": lanczos,
             "p1_lanczos2": lanczos2} if p1 or profile or split_profile else cases
-    (HERE / "results" / "linear.json").write_text(json.dumps(data, indent=1, default=float) + "\n")
+    write_results("linear", data)
     print("\n".join(lines))
 
 

@@ -1,17 +1,18 @@
 """Mesh generation benchmark: time and size of every generator at production sizes.
 
-Writes benchmarks/results/mesh.md and mesh.json.  Run: python benchmarks/bench_mesh.py
+Writes benchmarks/results/mesh.md and mesh.json.  Run: python benchmarks/linear/bench_mesh.py
 """
 from __future__ import annotations
 
 import importlib
-import json
 import os
 import pathlib
 import platform
+import sys
 import time
 
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import write_results  # noqa: E402
 
 RUNS = [("rattle_rig", 0.005), ("squeak_rig", 0.005), ("instrument_panel", 0.01),
         ("instrument_panel", 0.005), ("door_trim", 0.01), ("door_trim", 0.005)]
@@ -32,9 +33,7 @@ def main() -> None:
                          dof=6 * mesh.n_nodes, triangles=mesh.n_triangles, contact_pairs=pairs,
                          supports=clips, seconds=round(seconds, 2)))
         print(rows[-1], flush=True)
-    here = pathlib.Path(__file__).resolve().parent / "results"
-    here.mkdir(exist_ok=True)
-    (here / "mesh.json").write_text(json.dumps(rows, indent=1))
+    write_results("mesh", rows)
     lines = ["# Mesh generation (sarfe.mesh.generators)", "",
              f"gmsh {gmsh.__version__}, one thread, {platform.machine()}, load average at end "
              f"{os.getloadavg()[0]:.1f} (shared machine: times are upper bounds).", "",
@@ -43,7 +42,7 @@ def main() -> None:
     for r in rows:
         lines.append(f"| {r['generator']} | {r['mesh_size_mm']:g} | {r['nodes']} | {r['dof']} | "
                      f"{r['triangles']} | {r['contact_pairs']} | {r['supports']} | {r['seconds']} |")
-    (here / "mesh.md").write_text("\n".join(lines) + "\n")
+    write_results("mesh", markdown=lines)
 
 
 if __name__ == "__main__":

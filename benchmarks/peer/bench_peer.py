@@ -19,25 +19,23 @@ The peer venv: $SARFE_PEER_VENV, else benchmarks/.peer-venv (created on first us
 `python3 -m venv` + `pip install pyharm-os==1.2.2`; git-ignored). Its first run compiles numba
 kernels into a cache (~40 s): each problem is run once untimed first.
 
-Run: python benchmarks/bench_peer.py [--repeats 3]
+Run: python benchmarks/peer/bench_peer.py [--repeats 3]
 """
 import argparse
 import json
 import os
 import pathlib
-import platform
-import resource
 import statistics
 import subprocess
 import sys
 import tempfile
-import time
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import BENCHMARKS, ENV, ROOT, machine, run_timed, write_results  # noqa: E402
 
 import numpy as np
 
-HERE = pathlib.Path(__file__).resolve().parent
-ROOT = HERE.parent
-PEER = HERE / "peer"
+PEER = BENCHMARKS / "peer"
 PEER_VERSION = "pyharm-os==1.2.2"
 STAGE_ROWS = ("start", "imports", "sweep (continuation, all points)", "  of which Hill stability",
               "error estimates", "point records (ERP, baseline, contributions)",
@@ -46,30 +44,15 @@ STAGE_ROWS = ("start", "imports", "sweep (continuation, all points)", "  of whic
 TARGETS = {"nlvib03": {"defaults": 0.3, "bare": 0.1}, "jenkins": {"defaults": 0.3, "bare": 0.3}}
 PEER_NAMES = {"nlvib03": "example03", "jenkins": "jenkins"}
 PEER_STEPS = {"nlvib03": 0.04, "jenkins": 0.025}
-ENV = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1",
-           MPLBACKEND="Agg", PYTHONPATH=str(ROOT))
 
 
 def peer_python() -> pathlib.Path:
-    venv = pathlib.Path(os.environ.get("SARFE_PEER_VENV", HERE / ".peer-venv"))
+    venv = pathlib.Path(os.environ.get("SARFE_PEER_VENV", BENCHMARKS / ".peer-venv"))
     python = venv / "bin" / "python"
     if not python.exists():
         subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
         subprocess.run([str(python), "-m", "pip", "install", "-q", PEER_VERSION], check=True)
     return python
-
-
-def timed(command, cwd=None):
-    """(wall s, CPU s of the child, stdout) of one whole process."""
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    start = time.perf_counter()
-    done = subprocess.run(command, env=ENV, cwd=cwd, capture_output=True, text=True)
-    wall = time.perf_counter() - start
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    if done.returncode not in (0, 3):
-        raise RuntimeError(f"{command} failed ({done.returncode}): {done.stderr[-2000:]}")
-    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-    return wall, cpu, done.stdout
 
 
 def peer_command(python, problem):
@@ -125,22 +108,22 @@ def stage_breakdown(case, output):
 def import_floor(python, code, directory, runs=3):
     """Median CPU s of an interpreter that runs ``code`` (imports only) in ``directory`` (pyHarm
     writes a log folder where it is imported)."""
-    return statistics.median(timed([str(python), "-c", code], cwd=directory)[1]
+    return statistics.median(run_timed([str(python), "-c", code], cwd=directory)[1]
                              for _ in range(runs))
 
 
 def run_problem(problem, python, repeats, directory):
     cases = {v: sarfe_case(problem, v, directory) for v in ("defaults", "bare")}
-    timed(peer_command(python, problem), cwd=directory)    # warm-up: numba compiles its cache
+    run_timed(peer_command(python, problem), cwd=directory)    # warm-up: numba compiles its cache
     times = {"peer": [], "defaults": [], "bare": []}
     peer_out = None
     for _ in range(repeats):                               # A B A B ...
-        wall, cpu, out = timed(peer_command(python, problem), cwd=directory)   # its logs there
+        wall, cpu, out = run_timed(peer_command(python, problem), cwd=directory)   # its logs there
         times["peer"].append((wall, cpu))
         peer_out = json.loads(out.strip().splitlines()[-1])
         for variant, case in cases.items():
             output = pathlib.Path(directory) / f"{problem}_{variant}_out"
-            wall, cpu, _ = timed([sys.executable, "-m", "sarfe.cli", "solve", str(case),
+            wall, cpu, _ = run_timed([sys.executable, "-m", "sarfe.cli", "solve", str(case),
                                   "-o", str(output), "--quiet"], cwd=ROOT)
             times[variant].append((wall, cpu))
     omega, amplitude, stable = sarfe_curve(pathlib.Path(directory) / f"{problem}_defaults_out")
@@ -167,8 +150,7 @@ def run_problem(problem, python, repeats, directory):
 
 
 def write(results):
-    (HERE / "results").mkdir(exist_ok=True)
-    (HERE / "results" / "peer.json").write_text(json.dumps(results, indent=2))
+    write_results("peer", results, indent=2)
     lines = ["# sarfe vs the peer HBM code pyHarm (pyharm-os 1.2.2)", "",
              f"Machine: {results['machine']}, {results['cpu_count']} cores, load average at start "
              f"{results['load_average'][0]:.2f}; OPENBLAS_NUM_THREADS=1; whole processes, median of "
@@ -211,7 +193,7 @@ def write(results):
               "sweep samples the peak below its true value). Curve difference = max |a_sarfe − "
               "a_peer| / max a_peer at sarfe's points, the peer's denser curve interpolated "
               "(single-valued curves only)."]
-    (HERE / "results" / "peer.md").write_text("\n".join(lines) + "\n")
+    write_results("peer", markdown=lines)
     print("\n".join(lines))
 
 
@@ -219,15 +201,12 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=3)
     args, _ = parser.parse_known_args()   # run_all.py passes its own arguments
-    results = {"machine": platform.platform(), "python": platform.python_version(),
-               "cpu_count": os.cpu_count(), "load_average": os.getloadavg(),
-               "repeats": args.repeats, "peer_version": PEER_VERSION}
+    results = {**machine(), "repeats": args.repeats, "peer_version": PEER_VERSION}
     try:
         python = peer_python()
     except (subprocess.CalledProcessError, OSError) as error:
         results["error"] = f"pyharm-os could not be installed: {error}"
-        (HERE / "results").mkdir(exist_ok=True)
-        (HERE / "results" / "peer.json").write_text(json.dumps(results, indent=2))
+        write_results("peer", results, indent=2)
         print(results["error"])
         return
     with tempfile.TemporaryDirectory() as directory:

@@ -5,7 +5,7 @@ linear stage (mesh, FE, Craig–Bampton) is computed once per run and that both 
 table. Uses the door trim case if its single-frequency solve works, else the next case that does
 (rattle rig, then the lumped panel) — the report says which and why.
 
-Usage: python benchmarks/bench_batch.py [--samples 200] [--case door_trim|rattle_rig|lumped_rattle]
+Usage: python benchmarks/pipeline/bench_batch.py [--samples 200] [--case door_trim|rattle_rig|lumped_rattle]
 Writes benchmarks/results/batch.md and batch.json.
 """
 from __future__ import annotations
@@ -19,11 +19,8 @@ import sys
 import tempfile
 import time
 
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-os.environ.setdefault("MPLBACKEND", "Agg")
-
-ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import ROOT, read_results, write_results  # noqa: E402
 
 import pandas as pd  # noqa: E402
 
@@ -170,8 +167,6 @@ def main(argv=None) -> int:
                         help="largest single-variant time for a case to be used (default 10 s)")
     args = parser.parse_args(argv)
 
-    results_dir = ROOT / "benchmarks" / "results"
-    results_dir.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="sarfe_bench_batch_") as tmp:
         folder = pathlib.Path(tmp)
         skipped = {}
@@ -210,18 +205,17 @@ def main(argv=None) -> int:
         "machine": {"cpus": os.cpu_count(), "python": platform.python_version(),
                     "load_average_1min_before": load_before},
     }
-    path = results_dir / "batch.json"
     try:
-        previous = json.loads(path.read_text())
+        previous = read_results("batch", {})
         reports = ({f"{previous['case']}_{previous['samples']}": previous} if "case" in previous
                    else previous.get("runs_by_case", {}))
-    except (OSError, ValueError, AttributeError, KeyError):
+    except (ValueError, AttributeError, KeyError):
         reports = {}
     reports[f"{case}_{args.samples}"] = report
-    path.write_text(json.dumps({"runs_by_case": reports}, indent=2))
-    text = "\n".join(["# Batch benchmark (`benchmarks/bench_batch.py`)", ""]
+    write_results("batch", {"runs_by_case": reports}, indent=2)
+    text = "\n".join(["# Batch benchmark (`benchmarks/pipeline/bench_batch.py`)", ""]
                      + [line for r in reports.values() for line in markdown(r)])
-    (results_dir / "batch.md").write_text(text)
+    write_results("batch", markdown=text)
     print(text)
     return 0
 

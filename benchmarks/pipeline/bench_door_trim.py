@@ -10,7 +10,7 @@ out, from the time stamps of its stage lines on stderr. P1 runs the whole sweep 
 when it does not finish in its timeout the 200-point figure is an EXTRAPOLATION (labelled so) from
 the P4 5 mm run: linear stage + outputs once, plus 200 × (HBM + estimate + postprocess s / point).
 
-Parts: ``python benchmarks/bench_door_trim.py [p4sizes,p1,p4grid,hbm_vs_time,audible]`` (default
+Parts: ``python benchmarks/pipeline/bench_door_trim.py [p4sizes,p1,p4grid,hbm_vs_time,audible]`` (default
 p4sizes,p1,p4grid); parts
 not run keep their previous results from door_trim.json, marked with the date of that run.
 Writes benchmarks/results/door_trim.md and .json. SARFE_BENCH_BUDGET_S bounds the whole script
@@ -21,18 +21,17 @@ import json
 import os
 import pathlib
 import platform
-import resource
 import subprocess
 import sys
 import tempfile
 import time
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import ROOT, child_env, read_results, tree_pss_gb, write_results  # noqa: E402
+
 import numpy as np
 import yaml
 
-HERE = pathlib.Path(__file__).resolve().parent
-ROOT = HERE.parent
-RESULTS = HERE / "results"
 BUDGET_S = float(os.environ.get("SARFE_BENCH_BUDGET_S", 3600))
 T0 = time.perf_counter()
 
@@ -58,8 +57,7 @@ def run_case(case, timeout):
     timeout = max(5.0, min(timeout, left()))
     work = pathlib.Path(tempfile.mkdtemp(prefix="bench_door_"))
     (work / "case.yaml").write_text(yaml.safe_dump(case))
-    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1",
-               MPLBACKEND="Agg", PYTHONPATH=str(ROOT))
+    env = child_env()
     cmd = [sys.executable, "-m", "sarfe.cli", "solve", str(work / "case.yaml"), "--output",
            str(work / "out")]
     start = time.perf_counter()
@@ -77,10 +75,7 @@ def run_case(case, timeout):
     reader = threading.Thread(target=read, daemon=True)
     reader.start()
     timed_out, status, usage = False, None, None
-    sys.path.insert(0, str(HERE))
-    from stage_cpu import tree_pss_gb      # tree PSS: the forked workers share the model
-
-    peak_pss = 0.0
+    peak_pss = 0.0                         # tree PSS: the forked workers share the model
     while True:
         pid, status, usage = os.wait4(proc.pid, os.WNOHANG)
         if pid:
@@ -396,8 +391,7 @@ def p4_lines(p4):
 
 
 def write(results):
-    RESULTS.mkdir(exist_ok=True)
-    (RESULTS / "door_trim.json").write_text(json.dumps(results, indent=1, default=str))
+    write_results("door_trim", results, default=str)
     L = ["# Door trim P1, P4, audible study, HBM vs time integration (issue 15)", "",
          f"Machine: {platform.platform()}, {os.cpu_count()} cores shared with other jobs (other "
          f"helpers ran in parallel: load average at start {results['load_average']}, at the end "
@@ -422,7 +416,7 @@ def write(results):
         L += audible_lines(results["audible"])
     if results.get("hbm_vs_time"):
         L += hbm_lines(results["hbm_vs_time"])
-    (RESULTS / "door_trim.md").write_text("\n".join(L) + "\n")
+    write_results("door_trim", markdown=L)
 
 
 def audible_lines(a):
@@ -489,9 +483,8 @@ def main():
     parts = (sys.argv[1] if len(sys.argv) > 1 else "p4sizes,p1,p4grid").split(",")
     results = {"load_average": " ".join(f"{x:.1f}" for x in os.getloadavg()),
                "date_utc": time.strftime("%Y-%m-%d %H:%M", time.gmtime()), "kept_from": {}}
-    previous = RESULTS / "door_trim.json"
-    if previous.exists():       # parts not rerun keep their earlier numbers, marked
-        old = json.loads(previous.read_text())
+    old = read_results("door_trim")
+    if old is not None:         # parts not rerun keep their earlier numbers, marked
         for name in ("p1", "p4sizes", "p4grid", "audible", "hbm_vs_time"):
             if name not in parts and old.get(name) and not (name == "p1" and isinstance(old[name], list)):
                 results.setdefault("notes", old.get("notes", []))

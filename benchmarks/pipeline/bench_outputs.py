@@ -34,12 +34,12 @@ temporary directory (≈ 1.1 GB for 200 maps) removed afterwards.
    its CPU seconds are exact): CPU and wall of ``point_records`` (ERP, contributions, linear
    baseline, map fields), ``write_outputs`` and ``write_summary_json``, per tree, the trees run
    in turn (A B A B with ``--repeats`` 2); the fastest CPU of the repeats. The result folders
-   of the trees are compared file by file (benchmarks/compare_outputs.py). Saved in
+   of the trees are compared file by file (benchmarks/tools/compare_outputs.py). Saved in
    results/outputs_records.json and shown as the last section of outputs.md.
 
-Run: python benchmarks/bench_outputs.py [--before TREE [--before-commit C]] [--points 200]
+Run: python benchmarks/pipeline/bench_outputs.py [--before TREE [--before-commit C]] [--points 200]
      [--repeats 3] [--whole]   (--whole: ≈ 2 min per tree on a quiet machine)
-     python benchmarks/bench_outputs.py --records CASE.yaml … --before TREE [--repeats 1]
+     python benchmarks/pipeline/bench_outputs.py --records CASE.yaml … --before TREE [--repeats 1]
 """
 import argparse
 import json
@@ -52,11 +52,10 @@ import sys
 import tempfile
 import time
 
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-os.environ.setdefault("OMP_NUM_THREADS", "1")
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import ROOT, child_env, cpu_seconds, peak_rss_gb, read_results, write_results  # noqa: E402
+from tools.compare_outputs import compare_folders  # noqa: E402
 
-HERE = pathlib.Path(__file__).resolve().parent
-ROOT = HERE.parent
 H = 15
 SAMPLES = 256
 REDUCED_DOFS = 757
@@ -73,17 +72,6 @@ def _best(function, repeats):
         walls.append(time.perf_counter() - clock)
         cpus.append(time.process_time() - cpu)
     return {"s": min(walls), "cpu_s": min(cpus)}
-
-
-def _cpu_s():
-    """User + system CPU seconds of this process and its finished children (the map's workers)."""
-    own, children = (resource.getrusage(who) for who in (resource.RUSAGE_SELF,
-                                                         resource.RUSAGE_CHILDREN))
-    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
-
-
-def _peak_rss_gb():
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e6
 
 
 def child(points, repeats, workdir):
@@ -147,7 +135,7 @@ def child(points, repeats, workdir):
     variants = {"serial": 1, "2 workers": 2} if takes_function else {"serial": 1}
     result["series"] = {}
     for label, workers in variants.items():
-        rss_before = _peak_rss_gb()
+        rss_before = peak_rss_gb()
 
         def run():
             if takes_function:
@@ -158,14 +146,14 @@ def child(points, repeats, workdir):
                                         (series_data(j) for j in range(points)), frequencies)
         walls, cpus = [], []
         for _ in range(repeats):
-            cpu, clock = _cpu_s(), time.perf_counter()
+            cpu, clock = cpu_seconds(), time.perf_counter()
             run()
             walls.append(time.perf_counter() - clock)
-            cpus.append(_cpu_s() - cpu)
+            cpus.append(cpu_seconds() - cpu)
         size = sum(f.stat().st_size for f in (workdir / "erp").glob("*.vtu"))
         result["series"][label] = {"s": min(walls), "s_per_point": min(walls) / points,
                                    "cpu_s": min(cpus), "bytes": size,
-                                   "peak_rss_added_gb": _peak_rss_gb() - rss_before}
+                                   "peak_rss_added_gb": peak_rss_gb() - rss_before}
 
     result["animation_s"] = _best(lambda: outputs.write_deflection_animation(
         workdir / "animation", mesh.points, mesh.triangles, translations, omega=omegas[loudest],
@@ -221,7 +209,7 @@ def whole_child(case_path, out):
     solve.write_outputs = timed
     result = solve_case(load_case(case_path).data, output_dir=out)
     record.update(points=len(result.summary["points"]), timings_s=result.summary["timings_s"],
-                  peak_rss_gb=_peak_rss_gb(), load_average=os.getloadavg()[0])
+                  peak_rss_gb=peak_rss_gb(), load_average=os.getloadavg()[0])
     print(json.dumps(record))
 
 
@@ -235,8 +223,7 @@ def measure_whole(trees, points):
         case = work / "case.yaml"
         case.write_text(yaml.safe_dump(whole_case(points)))
         for label, tree in trees.items():
-            env = dict(os.environ, PYTHONPATH=str(tree), OPENBLAS_NUM_THREADS="1",
-                       OMP_NUM_THREADS="1", MPLBACKEND="Agg")
+            env = child_env(tree)
             done = subprocess.run([sys.executable, __file__, "--whole-child", str(case),
                                    str(work / label)], env=env, capture_output=True, text=True)
             if done.returncode:
@@ -319,9 +306,6 @@ def records_child(case_path, out):
 
 def measure_records(cases, trees, repeats) -> dict:
     """{case name: {tree label: fastest record of records_child, "difference": compare}}."""
-    sys.path.insert(0, str(HERE))
-    from compare_outputs import compare_folders
-
     out = {}
     with tempfile.TemporaryDirectory(prefix="bench_records_") as work:
         work = pathlib.Path(work)
@@ -330,8 +314,7 @@ def measure_records(cases, trees, repeats) -> dict:
             runs = {label: [] for label in trees}
             for _ in range(repeats):
                 for label, tree in trees.items():        # A B A B: the same load for both
-                    env = dict(os.environ, PYTHONPATH=str(tree), OPENBLAS_NUM_THREADS="1",
-                               OMP_NUM_THREADS="1", MPLBACKEND="Agg")
+                    env = child_env(tree)
                     done = subprocess.run([sys.executable, __file__, "--records-child",
                                            str(case), str(work / label)], env=env,
                                           capture_output=True, text=True, cwd=case.parent)
@@ -378,8 +361,7 @@ def records_report(records) -> list:
 
 
 def measure(tree, points, repeats):
-    env = dict(os.environ, PYTHONPATH=str(tree), OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1",
-               MPLBACKEND="Agg")
+    env = child_env(tree)
     with tempfile.TemporaryDirectory(prefix="bench_outputs_") as work:
         done = subprocess.run([sys.executable, __file__, "--child", work, "--points", str(points),
                                "--repeats", str(repeats)], env=env, capture_output=True, text=True)
@@ -404,7 +386,7 @@ def report(runs, points, repeats):
              "per tree. Mesh of cases/door_trim_p1.yaml (5 mm): "
              f"{runs[cols[-1]]['nodes']} nodes, {runs[cols[-1]]['triangles']} triangles, "
              f"{runs[cols[-1]]['radiating_nodes']} radiating; H = {H}; synthetic fields of a "
-             f"P1 point's sizes (benchmarks/bench_outputs.py). Trees: "
+             f"P1 point's sizes (benchmarks/pipeline/bench_outputs.py). Trees: "
              + ", ".join(f"{c} = {runs[c]['sarfe']} ({runs[c].get('commit')})" for c in cols)
              + ".", "",
              "## Per point [ms CPU (wall)]", "",
@@ -459,9 +441,9 @@ def report(runs, points, repeats):
                       f"identical: {d['pvd_identical']}; response.h5 datasets differing: "
                       f"{d['h5_differing'] or 'none'}; summary.json points identical: "
                       f"{d['summary_points_identical']}."]
-    saved = HERE / "results" / "outputs_records.json"
-    if saved.is_file():
-        lines += records_report(json.loads(saved.read_text()))
+    saved = read_results("outputs_records")
+    if saved is not None:
+        lines += records_report(saved)
     return "\n".join(lines) + "\n"
 
 
@@ -484,15 +466,12 @@ def main():
     if args.records:
         trees = {"before": pathlib.Path(args.before).resolve()} if args.before else {}
         records = measure_records(args.records, {**trees, "now": ROOT}, args.repeats)
-        saved = HERE / "results" / "outputs_records.json"
-        old = json.loads(saved.read_text()) if saved.is_file() else {}
-        saved.write_text(json.dumps({**old, **records}, indent=1) + "\n")
+        write_results("outputs_records", {**read_results("outputs_records", {}), **records})
         print("\n".join(records_report(records)))
-        previous = HERE / "results" / "outputs.json"
-        if previous.is_file():
-            runs = json.loads(previous.read_text())
-            (HERE / "results" / "outputs.md").write_text(
-                report(runs, runs["now"]["points"], runs.get("repeats", 3)))
+        runs = read_results("outputs")
+        if runs is not None:
+            write_results("outputs", markdown=report(runs, runs["now"]["points"],
+                                                     runs.get("repeats", 3)))
         return
     if args.child:
         child(args.points, args.repeats, pathlib.Path(args.child))
@@ -500,8 +479,7 @@ def main():
     if args.whole_child:
         whole_child(*args.whole_child)
         return
-    previous = HERE / "results" / "outputs.json"
-    kept = json.loads(previous.read_text()).get("whole") if previous.is_file() else None
+    kept = (read_results("outputs") or {}).get("whole")
     runs = {}
     if args.before:
         runs["before"] = measure(pathlib.Path(args.before).resolve(), args.points, args.repeats)
@@ -514,11 +492,8 @@ def main():
     elif kept:
         runs["whole"] = dict(kept, note="(kept from an earlier run: not rerun this time)")
     runs["load_average"] = os.getloadavg()[0]     # (kept for the report when regenerated)
-    out = HERE / "results"
-    out.mkdir(exist_ok=True)
-    (out / "outputs.json").write_text(json.dumps(runs, indent=1) + "\n")
-    (out / "outputs.md").write_text(report(runs, args.points, args.repeats))
-    print((out / "outputs.md").read_text())
+    write_results("outputs", runs)
+    print(write_results("outputs", markdown=report(runs, args.points, args.repeats)).read_text())
 
 
 if __name__ == "__main__":

@@ -31,26 +31,23 @@
    processes of this tree and of BEFORE_TREE (e.g. a checkout of main) in turn (A B A B …):
    timings_s per stage (hbm, estimate, postprocess, outputs) and per point, and points per Hz.
 
-Run: python benchmarks/bench_point_cost.py [--quick] [--sweep-only] [--stages TREE]
+Run: python benchmarks/pipeline/bench_point_cost.py [--quick] [--sweep-only] [--stages TREE]
 (--sweep-only / --stages: that section alone, the others kept from results/point_cost.json)
 """
 import argparse
 import json
 import os
 import pathlib
-import platform
 import subprocess
 import sys
 import tempfile
 import time
 
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import ENV, ROOT, machine, read_results, write_results  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-HERE = pathlib.Path(__file__).resolve().parent
-ROOT = HERE.parent
-sys.path.insert(0, str(ROOT))
 import scipy.sparse as sp  # noqa: E402
 
 from sarfe.hbm import (SolverOptions, make_contact_set, make_linear_model,  # noqa: E402
@@ -58,8 +55,6 @@ from sarfe.hbm import (SolverOptions, make_contact_set, make_linear_model,  # no
 
 MESH_SIZES_M = (0.015, 0.010, 0.005)
 FREQUENCIES_HZ = (40.0, 60.0, 80.0)
-ENV = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1",
-           MPLBACKEND="Agg", PYTHONPATH=str(ROOT))
 
 
 def door_case(mesh_size, directory):
@@ -313,8 +308,7 @@ def exponent(x, t):
 
 
 def write(results):
-    (HERE / "results").mkdir(exist_ok=True)
-    (HERE / "results" / "point_cost.json").write_text(json.dumps(results, indent=2))
+    write_results("point_cost", results, indent=2)
     lines = ["# HBM seconds per point vs FE size and vs contact pairs × H (issue 15, P4)", "",
              f"Machine: {results['machine']}, {results['cpu_count']} cores, load average at start "
              f"{results['load_average'][0]:.2f}; OPENBLAS_NUM_THREADS=1. Bench wall "
@@ -408,7 +402,7 @@ def write(results):
                          f"{r['per_point_s']:.3f} |")
         for note in st.get("notes", []):
             lines += ["", note]
-    (HERE / "results" / "point_cost.md").write_text("\n".join(lines) + "\n")
+    write_results("point_cost", markdown=lines)
     print("\n".join(lines))
 
 
@@ -424,19 +418,18 @@ def main():
     args, _ = parser.parse_known_args()   # run_all.py passes its own arguments
     start = time.perf_counter()
     if args.stages:
-        results = json.loads((HERE / "results" / "point_cost.json").read_text())
+        results = read_results("point_cost")
         results["stages"] = stages_before_after(pathlib.Path(args.stages).resolve())
         write(results)
         return
     if args.sweep_only:
-        results = json.loads((HERE / "results" / "point_cost.json").read_text())
+        results = read_results("point_cost")
         with tempfile.TemporaryDirectory() as directory:
             results["door_sweep"] = door_sweep_cost(directory, points=args.sweep_points)
         results["door_sweep"]["load_average"] = os.getloadavg()
         write(results)
         return
-    results = {"machine": platform.platform(), "python": platform.python_version(),
-               "cpu_count": os.cpu_count(), "load_average": os.getloadavg()}
+    results = machine()
     sizes = MESH_SIZES_M[:-1] if args.quick else MESH_SIZES_M
     with tempfile.TemporaryDirectory() as directory:
         runs = [[door_point_cost(size, directory) for size in sizes]       # 15 10 5 15 10 5

@@ -1,9 +1,9 @@
 """CPU seconds of the stages after the linear stage, of two sarfe trees, from one linear stage
 (issue 15, task pointcpu) → results/point_cpu.md|json.
 
-    python benchmarks/bench_point_cpu.py CASE.yaml STAGE.pkl TREE_A TREE_B [--runs 2]
-    python benchmarks/bench_point_cpu.py --build CASE.yaml STAGE.pkl      (the stage, once)
-    python benchmarks/bench_point_cpu.py          (``make bench``: P1 with workers 1 and stability
+    python benchmarks/pipeline/bench_point_cpu.py CASE.yaml STAGE.pkl TREE_A TREE_B [--runs 2]
+    python benchmarks/pipeline/bench_point_cpu.py --build CASE.yaml STAGE.pkl      (the stage, once)
+    python benchmarks/pipeline/bench_point_cpu.py          (``make bench``: P1 with workers 1 and stability
                                                    off, its stage built in a temporary folder,
                                                    this tree, and $SARFE_BASELINE first if set)
 
@@ -26,7 +26,9 @@ import subprocess
 import sys
 import tempfile
 
-HERE = pathlib.Path(__file__).resolve().parent
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import RESULTS, ROOT, child_env, read_case  # noqa: E402
+
 NOTES = "## Where the CPU goes (cProfile, hand-written)"
 
 STAGES = {        # stage name: (module, function) wrapped in sarfe.pipeline.run's namespace
@@ -61,8 +63,7 @@ print(json.dumps({"cpu_s": cpu, "wall_s": time.perf_counter() - w}))
 
 
 def run_tree(tree, case, stage, output):
-    env = dict(os.environ, PYTHONPATH=str(tree), OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1",
-               MKL_NUM_THREADS="1", MPLBACKEND="Agg")
+    env = child_env(tree)
     code = f"STAGES = {STAGES!r}\n" + CHILD
     load = os.getloadavg()
     done = subprocess.run([sys.executable, "-c", code, str(case), str(stage), str(output)],
@@ -75,8 +76,7 @@ def run_tree(tree, case, stage, output):
 def build(case, stage):
     import pickle
 
-    from sarfe.case.read import load_case
-    from sarfe.pipeline.model.linear_stage import build_linear_model
+    from sarfe.pipeline import build_linear_model, load_case
 
     with open(stage, "wb") as f:
         pickle.dump(build_linear_model(load_case(case)), f, protocol=5)
@@ -87,9 +87,9 @@ def default_run():
     off, its linear stage built once in a temporary folder; this tree, after $SARFE_BASELINE."""
     import yaml
 
-    case = yaml.safe_load((HERE.parent / "cases" / "door_trim_p1.yaml").read_text())
+    case = read_case("cases/door_trim_p1.yaml")
     case.setdefault("solver", {}).update(workers=1, stability=False)
-    trees = [t for t in (os.environ.get("SARFE_BASELINE"), str(HERE.parent)) if t]
+    trees = [t for t in (os.environ.get("SARFE_BASELINE"), str(ROOT)) if t]
     with tempfile.TemporaryDirectory() as folder:
         path = pathlib.Path(folder) / "p1_one_process.yaml"
         case_text = yaml.safe_dump(case, sort_keys=False)
@@ -97,7 +97,7 @@ def default_run():
         stage = pathlib.Path(folder) / "stage.pkl"
         subprocess.run([sys.executable, str(pathlib.Path(__file__).resolve()), "--build",
                         str(path), str(stage)], check=True,
-                       env=dict(os.environ, PYTHONPATH=str(HERE.parent), OPENBLAS_NUM_THREADS="1"))
+                       env=child_env())
         main([str(path), str(stage), *trees])
 
 
@@ -108,7 +108,7 @@ def main(argv=None):
     parser.add_argument("stage")
     parser.add_argument("trees", nargs="*")
     parser.add_argument("--runs", type=int, default=2)
-    parser.add_argument("--out", default=str(HERE / "results" / "point_cpu"))
+    parser.add_argument("--out", default=str(RESULTS / "point_cpu"))
     args = parser.parse_args(argv)
     if args.build:
         build(args.case, args.stage)
@@ -123,7 +123,7 @@ def main(argv=None):
             print(t.name, i, json.dumps(result), flush=True)
     names = list(STAGES) + ["summary.json", "total after the linear stage"]
     lines = ["# CPU seconds of the stages after the linear stage (issue 15, pointcpu)", "",
-             f"`benchmarks/bench_point_cpu.py` on `{pathlib.Path(args.case).name}`, one prebuilt "
+             f"`benchmarks/pipeline/bench_point_cpu.py` on `{pathlib.Path(args.case).name}`, one prebuilt "
              "linear stage, everything in one process (workers 1), one BLAS thread; runs "
              f"alternated, {args.runs} per tree, fastest per stage. Load averages at the start of "
              "each run: " + "; ".join(f"{pathlib.Path(t).name}: " + ", ".join(
@@ -145,7 +145,7 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    if pathlib.Path(sys.argv[0]).name == "run_all.py" or len(sys.argv) == 1:
+    if len(sys.argv) == 1:
         default_run()
     else:
         main()

@@ -1,6 +1,6 @@
 """``solver.workers`` 1 vs 2 on one case: wall, CPU (solving process and its workers), peak memory.
 
-    python benchmarks/bench_workers.py [CASE.yaml] [--runs 2] [--band START END]
+    python benchmarks/pipeline/bench_workers.py [CASE.yaml] [--runs 2] [--band START END]
 
 Runs ``solve_case`` of the case (written results included) in a fresh process per run, in the
 order 1 2 1 2 … (other jobs share the machine: alternating spreads their load over both), every
@@ -23,12 +23,10 @@ import sys
 import tempfile
 import time
 
-HERE = pathlib.Path(__file__).resolve().parent
-ROOT = HERE.parent
-RESULTS = HERE / "results"
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import ENV, RESULTS, ROOT, write_results  # noqa: E402
+
 SECTION = "## Two processes: `solver.workers` 1 vs 2"
-ENV = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1",
-           MPLBACKEND="Agg", PYTHONPATH=str(ROOT))
 
 
 def one_run(case_path, workers, band, out):
@@ -36,7 +34,6 @@ def one_run(case_path, workers, band, out):
     import resource
     import threading
 
-    sys.path.insert(0, str(ROOT))
     from sarfe.case.read import load_case, read_yaml
     from sarfe.pipeline import solve_case
 
@@ -126,7 +123,7 @@ def write_section(case_path, band, runs, diffs):
                 f"{r['load_before']:.1f}–{r['load_after']:.1f} |")
 
     lines = [SECTION, "",
-             f"`benchmarks/bench_workers.py` on `{case_path}`"
+             f"`benchmarks/pipeline/bench_workers.py` on `{case_path}`"
              + (f" (band {band[0]}–{band[1]} Hz)" if band else "") + f", {runs[0]['points']} "
              "points, whole `solve_case` per fresh process, runs in the order 1 2 1 2, "
              "OPENBLAS/OMP/MKL_NUM_THREADS=1, "
@@ -181,10 +178,7 @@ def write(case_path, band, runs):
     for r in runs[1:]:
         diffs += differences(runs[0]["summary_points"], r["summary_points"])
     plain = [{k: v for k, v in r.items() if k != "summary_points"} for r in runs]
-    RESULTS.mkdir(exist_ok=True)
-    (RESULTS / "workers.json").write_text(json.dumps({"case": case_path, "band": band,
-                                                      "runs": plain, "differences": diffs[:50]},
-                                                     indent=1))
+    write_results("workers", {"case": case_path, "band": band, "runs": plain, "differences": diffs[:50]})
     write_section(case_path, band, plain, diffs)
 
 

@@ -1,7 +1,7 @@
 """Compare two sarfe result folders number by number (issue 15: the output files of a faster tree
 must hold main's numbers).
 
-    python benchmarks/compare_outputs.py REFERENCE NEW [--rtol 1e-12] [--json OUT.json] [--skip KEY]
+    python benchmarks/tools/compare_outputs.py REFERENCE NEW [--rtol 1e-12] [--json OUT.json] [--skip KEY]
 
 Every file of REFERENCE must exist in NEW (and no file more), and:
 

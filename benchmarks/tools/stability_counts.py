@@ -1,10 +1,10 @@
 """Stability verdicts and both contact-row counts (at H and at the check H' = ⌊3H/4⌋) per point
 of a sweep, for comparing two sarfe trees on the same orbits (issue 15, session hillshare).
 
-    python benchmarks/stability_counts.py capture CASE.yaml POINTS.pkl   # solve, keep the orbits
-    python benchmarks/stability_counts.py evaluate POINTS.pkl OUT.json    # with this tree (or
+    python benchmarks/tools/stability_counts.py capture CASE.yaml POINTS.pkl   # solve, keep the orbits
+    python benchmarks/tools/stability_counts.py evaluate POINTS.pkl OUT.json    # with this tree (or
                                                                           # $PYTHONPATH's sarfe)
-    python benchmarks/stability_counts.py compare BEFORE.json AFTER.json
+    python benchmarks/tools/stability_counts.py compare BEFORE.json AFTER.json
 
 ``capture`` runs the case (set ``solver: {workers: 1}``) and pickles the inputs of every
 :func:`sarfe.hbm.solve.stability` call (problem, ω, U, AFT forces, options). ``evaluate`` computes
@@ -16,13 +16,14 @@ where verdict, either count or the leading exponent (relative 10⁻⁶) differ, 
 mean evaluations.
 """
 import json
-import os
+import pathlib
 import pickle
 import sys
 import time
 import types
 
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+import benchlib  # noqa: E402,F401  (one BLAS thread; PYTHONPATH's sarfe, else this tree's)
 
 
 def capture(case_path, out):

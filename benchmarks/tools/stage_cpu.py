@@ -1,7 +1,7 @@
 """Where the wall time of a ``sarfe solve`` goes, stage by stage, and how busy the cores are.
 
-    python benchmarks/stage_cpu.py CASE.yaml [OUT.json]
-    python benchmarks/stage_cpu.py --table LABEL=OUT.json …     (markdown of saved runs)
+    python benchmarks/tools/stage_cpu.py CASE.yaml [OUT.json]
+    python benchmarks/tools/stage_cpu.py --table LABEL=OUT.json …     (markdown of saved runs)
 
 Runs ``sarfe solve CASE --output <tmp>`` (the sarfe of this tree, or of $SARFE_ROOT) (one BLAS thread per process) and samples, every 0.1 s,
 the CPU seconds of the whole process tree (user + system of the live processes plus what the
@@ -25,77 +25,21 @@ import tempfile
 import threading
 import time
 
-ROOT = pathlib.Path(os.environ.get("SARFE_ROOT") or pathlib.Path(__file__).resolve().parent.parent)
-TICK = os.sysconf("SC_CLK_TCK")
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import ROOT, child_env, process_tree, tree_cpu_seconds, tree_pss_gb  # noqa: E402
 
-
-def _children(pid) -> list[int]:
-    try:
-        tasks = pathlib.Path(f"/proc/{pid}/task").iterdir()
-        out = []
-        for task in tasks:
-            text = (task / "children").read_text().split()
-            out += [int(x) for x in text]
-        return out
-    except OSError:
-        return []
-
-
-def tree(pid) -> list[int]:
-    """pid and all its descendants (alive now)."""
-    out, todo = [], [pid]
-    while todo:
-        p = todo.pop()
-        out.append(p)
-        todo += _children(p)
-    return out
-
-
-def cpu_seconds(pids, root) -> float:
-    """user + system seconds of ``pids`` plus the waited-for children of ``root``."""
-    total = 0.0
-    for p in pids:
-        try:
-            fields = pathlib.Path(f"/proc/{p}/stat").read_text().rsplit(")", 1)[1].split()
-        except OSError:
-            continue
-        total += int(fields[11]) + int(fields[12])            # utime, stime
-        if p == root:
-            total += int(fields[13]) + int(fields[14])        # cutime, cstime
-    return total / TICK
-
-
-def pss_gb(pids) -> float:
-    total = 0
-    for p in pids:
-        try:
-            for line in pathlib.Path(f"/proc/{p}/smaps_rollup").read_text().splitlines():
-                if line.startswith("Pss:"):
-                    total += int(line.split()[1])
-                    break
-        except OSError:
-            continue
-    return total / 1024 ** 2
-
-
-def tree_pss_gb(pid) -> float | None:
-    """PSS of the tree of ``pid`` [GB]; None when a process started or ended while the files were
-    read (a fork between two reads counts the shared pages once in full and again in shares)."""
-    pids = tree(pid)
-    value = pss_gb(pids)
-    return value if set(tree(pid)) == set(pids) else None
+TREE = pathlib.Path(os.environ.get("SARFE_ROOT") or ROOT)     # the sarfe that runs
 
 
 def run(case, out_dir=None) -> dict:
     out_dir = pathlib.Path(out_dir or tempfile.mkdtemp(prefix="stage_cpu_")).resolve()
-    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1",
-               MPLBACKEND="Agg", PYTHONPATH=str(ROOT))
+    env = child_env(TREE)
     cmd = [sys.executable, "-m", "sarfe.cli", "solve", str(pathlib.Path(case).resolve()),
            "--output", str(out_dir / "out"), "--force"]
     load_start = os.getloadavg()
     start = time.perf_counter()
     proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                            cwd=ROOT)          # (python -m puts the current folder first)
+                            cwd=TREE)          # (python -m puts the current folder first)
     lines = []
 
     def read():
@@ -108,9 +52,9 @@ def run(case, out_dir=None) -> dict:
     reader.start()
     samples = []            # (t, cpu, pss)
     while proc.poll() is None:
-        pids = tree(proc.pid)
+        pids = process_tree(proc.pid)
         pss = tree_pss_gb(proc.pid)
-        samples.append((time.perf_counter() - start, cpu_seconds(pids, proc.pid),
+        samples.append((time.perf_counter() - start, tree_cpu_seconds(pids, proc.pid),
                         0.0 if pss is None else pss))
         time.sleep(0.1)
     wall = time.perf_counter() - start
