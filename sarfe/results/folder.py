@@ -38,6 +38,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from sarfe import __version__
 from sarfe.case.errors import CaseError
 from sarfe.mesh.cache import pid_alive
 
@@ -85,8 +86,6 @@ def _lock_parent(parent: Path):
 
 
 def marker_info(kind: str, case: str | None = None) -> dict:
-    from sarfe import __version__
-
     return {"sarfe_version": __version__, "kind": kind, "case": case, "pid": os.getpid(),
             "host": socket.gethostname(),
             "created_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")}

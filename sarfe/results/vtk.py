@@ -42,6 +42,8 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
+from sarfe.util.workers import start_map
+
 __all__ = ["write_erp_vtu", "write_pvd", "write_deflection_animation", "write_erp_sweep",
            "start_erp_sweep",
            "erp_point_data", "radiating_fields", "contact_markers", "period_samples",
@@ -369,8 +371,6 @@ def start_erp_sweep(directory, points, triangles, point_data_per_frequency, freq
     """:func:`write_erp_sweep` started on ``workers`` processes without waiting for them: this
     process writes the run's other files meanwhile and calls ``finish()`` (with ``workers`` ≤ 1
     the maps are written by ``finish()``)."""
-    from sarfe.util.workers import start_map
-
     directory = Path(directory)
     frequencies = np.asarray(frequencies_hz, dtype=float)
     if callable(point_data_per_frequency):

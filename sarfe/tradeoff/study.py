@@ -32,6 +32,13 @@ from pathlib import Path
 
 import numpy as np
 
+from sarfe.accuracy import resize_harmonics
+from sarfe.erp import equivalent_radiated_power
+from sarfe.hbm import SolverOptions, solve_frequency
+from sarfe.hbm.time_integration import linear_harmonic_response
+from sarfe.pipeline import build_linear_model, load_case, nonlinear_model
+from sarfe.pipeline.solve.case_accuracy import stage_error_estimate
+
 KNOBS = ("harmonics", "samples", "modes", "mesh", "penalty")
 
 
@@ -79,8 +86,6 @@ def knob_levels(case, stage, knobs=None) -> dict:
 def variant_case(case, knob, value):
     """A new Case with one knob changed (see module docstring): the case's record ``case.data`` is
     copied, edited and loaded again, so the variant gets its own normalized data and config."""
-    from sarfe.case.read import load_case
-
     data = copy.deepcopy(case.data)
     solver = data["solver"]
     if knob == "harmonics":
@@ -122,9 +127,6 @@ def solve_grid(case, stage, frequencies_hz, options=None, guesses=None):
     Returns (points, cost): one dict per frequency (converged, ERP dB / dB(A), peak normal force,
     first-harmonic normal amplitude, the HarmonicSolution under ``_solution``) and
     {'solve_s', 'iterations'}."""
-    from sarfe.hbm import SolverOptions, solve_frequency
-    from sarfe.pipeline import nonlinear_model
-
     nl = nonlinear_model(case, stage)
     solver = case.config.solver
     H, N = solver.harmonics, solver.samples_per_period
@@ -160,8 +162,6 @@ def solve_grid(case, stage, frequencies_hz, options=None, guesses=None):
 
 def erp_levels(case, stage, displacement, omega):
     """(L_W, L_WA) [dB re reference power] of displacement harmonics (2H+1, n) at ω (−inf if silent)."""
-    from sarfe.erp import equivalent_radiated_power
-
     erp = case.config.erp
     W = np.asarray(displacement) @ np.asarray(stage.erp_map).T
     if W.shape[1] == 0:
@@ -198,11 +198,6 @@ def branch_guesses(case, stage, baseline_points):
     frequencies: the displacement resized to the variant's H when the DOFs match, else (same contact
     rows, e.g. another mode count) the linear response to f̃_e − Gᵀλ̃ of the baseline contact forces;
     None where neither applies."""
-    from sarfe.hbm.time_integration import linear_harmonic_response
-    from sarfe.pipeline import nonlinear_model
-
-    from sarfe.accuracy import resize_harmonics
-
     nl = nonlinear_model(case, stage)
     H = case.config.solver.harmonics
     guesses = []
@@ -225,10 +220,6 @@ def branch_guesses(case, stage, baseline_points):
 
 def attach_estimates(case, stage, points):
     """estimate_errors at every converged grid point (adds estimate_amplitude_rel / _erp_db)."""
-    from sarfe.pipeline import nonlinear_model
-
-    from sarfe.pipeline.solve.case_accuracy import stage_error_estimate
-
     nl = nonlinear_model(case, stage)
     for p in points:
         s = p.get("_solution")
@@ -286,8 +277,6 @@ def run_variant(case, stage, knob, label, value, frequencies_hz, estimate=True,
     included when the knob rebuilds it), timed with tracemalloc on. Values and errors: the grid
     re-solved from the case-setting solutions (:func:`branch_guesses`), so every variant is compared
     on the same solution branch (folds make cold sweeps jump at slightly different frequencies)."""
-    from sarfe.pipeline import build_linear_model
-
     variant = variant_case(case, knob, value) if knob != "baseline" else case
     tracemalloc.start()
     clock = time.perf_counter()
@@ -336,9 +325,6 @@ def run_study(case, knobs=None, points=12, frequencies_hz=None, output_dir=None,
     Writes study.csv, study.json and study_pareto.png into ``output_dir`` (default
     ``<output.directory>/study``) unless ``write`` is False.
     """
-    from sarfe.case.read import load_case
-    from sarfe.pipeline import build_linear_model
-
     case = load_case(case)
     clock = time.perf_counter()
     stage = build_linear_model(case)

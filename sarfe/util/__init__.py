@@ -1,1 +1,2 @@
-"""Utilities below every layer: lazy package exports, the process pool, progress lines."""
+"""Utilities below every layer: lazy (lazy package exports, PEP 562), workers (an ordered map on
+forked worker processes), progress (tqdm bars or one line per stage)."""

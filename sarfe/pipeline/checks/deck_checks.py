@@ -188,9 +188,9 @@ def ignored_mass(case: Case, ignored: dict) -> dict:
     if path.suffix.lower() == ".inp":
         return {card: None for card in ignored}
     from sarfe.mesh.formats.deck import UNIT_SYSTEMS
-    from sarfe.mesh.formats.nastran import _load_bdf
+    from sarfe.mesh.formats.nastran_bdf import load_bdf
 
-    model = _load_bdf(path)
+    model = load_bdf(path)
     wtmass = model.params["WTMASS"].values[0] if "WTMASS" in model.params else 1.0
     scale = UNIT_SYSTEMS[fe["units"]].factor(0, 1) * wtmass
     masses = {}
@@ -394,9 +394,9 @@ def _card_of(path, deck, units, quantity, table, row, value) -> str:
             if key == quantity and np.isclose(raw * scale, value, rtol=1e-6):
                 return where
         return f"{path}: element {eid}"
-    from sarfe.mesh.formats.nastran import _load_bdf, card_where
+    from sarfe.mesh.formats.nastran_bdf import card_where, load_bdf
 
-    model = _load_bdf(path)
+    model = load_bdf(path)
     if table == "beam" and pid == 0:    # CONROD: the material is on the element
         card = model.elements.get(eid)
     else:

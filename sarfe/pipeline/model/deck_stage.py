@@ -153,7 +153,7 @@ def build_deck_stage(case: Case, progress=False) -> dict:
     """The linear stage of a deck case (the fields of :class:`sarfe.pipeline.model.linear_stage.LinearStage`)."""
     from sarfe.erp import nodal_areas, nodal_normals
     from sarfe.pipeline.model.linear_stage import ContactGeometry, _bar, _step, resolve_node_group
-    from sarfe.reduction.craig_bampton import free_dofs_system
+    from sarfe.reduction.reduced_model import free_dofs_system
     from sarfe.reduction.recovery import normal_velocity_basis
 
     timings, clock = {}, time.perf_counter()

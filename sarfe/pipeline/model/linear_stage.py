@@ -494,7 +494,7 @@ def _assemble(case: Case, fe, mesh) -> tuple:
 def _supports(mesh, fixed_nodes, stiffness, mass) -> tuple:
     """Linear stage, step 3: hold the fixed nodes (6 DOFs) and nodes on no triangle →
     (K_ff, M_ff, free DOF numbers, position of every DOF among the free ones or −1)."""
-    from sarfe.reduction.craig_bampton import free_dofs_system
+    from sarfe.reduction.reduced_model import free_dofs_system
 
     n_nodes = mesh.n_nodes
     used = np.zeros(n_nodes, bool)

@@ -46,7 +46,7 @@ def _case_damping(damping: DampingConfig, stage: LinearStage):
         return stage.damping
     if damping.rayleigh is not None:
         return damping.rayleigh["alpha_1_s"] * M + damping.rayleigh["beta_s"] * K
-    from sarfe.reduction.damping import reduced_modal_damping
+    from sarfe.fe.damping import modal_damping
 
     n = M.shape[0]
     zeta = 0.0 if damping.modal_zeta is None else damping.modal_zeta
@@ -57,7 +57,7 @@ def _case_damping(damping: DampingConfig, stage: LinearStage):
             values[first - 1:min(last, n)] = entry["zeta"]
         zeta = values
     dense = (lambda A: A.toarray() if sp.issparse(A) else np.asarray(A))
-    return reduced_modal_damping(dense(M), dense(K), zeta)
+    return modal_damping(dense(M), dense(K), zeta)
 
 
 def _dof_row(ref, n):
