@@ -64,10 +64,13 @@ def a_weighted_level(displacement, omega, erp_map, areas, density=AIR_DENSITY,
 
 
 def level_sensitivities(model, contacts, excitation, solution, erp_map, areas,
-                        names=PARAMETERS, condensed=True, relative_step=RELATIVE_STEP):
+                        names=PARAMETERS, condensed=True, relative_step=RELATIVE_STEP, **air):
     """(L_A [dB(A)], :class:`sarfe.hbm.sensitivity.Sensitivities` of L_A [dB(A) per unit of p]) of
     a converged HarmonicSolution of (``model``, ``contacts``, f̃_e = ``excitation``): one adjoint
-    solve, no re-solve. erp_map (n_s, n), areas (n_s,) [m²] as for :func:`a_weighted_level`."""
-    level, gradient = a_weighted_level(solution.displacement, solution.omega, erp_map, areas)
+    solve, no re-solve. erp_map (n_s, n), areas (n_s,) [m²] and ``air`` (density, sound_speed,
+    radiation_loss_factor, reference_power: the level's value only) as for
+    :func:`a_weighted_level`."""
+    level, gradient = a_weighted_level(solution.displacement, solution.omega, erp_map, areas,
+                                       **air)
     return level, adjoint_sensitivities(model, contacts, excitation, solution, gradient, names,
                                         condensed, relative_step)
