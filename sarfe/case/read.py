@@ -265,6 +265,7 @@ AUDIBLE_LIMIT_HZ = 20e3
 # below them a value in SI is almost surely in another unit system
 MIN_E_PA, MIN_RHO_KG_M3, _MAX_MESH_SIZE_M = 1e5, 1.0, 1.0
 SPAN_RANGE_M = (5e-3, 20.0)       # a trim part's overall size [m]
+THICKNESS_RANGE = (1e-4, 0.1)     # a shell's thickness / the model size
 
 
 def _check_plausible(case, data):

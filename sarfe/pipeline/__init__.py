@@ -12,13 +12,10 @@ outputs (result files, console table), solve (solve_case).
 """
 from sarfe.case.read import Case, load_case
 from sarfe.case.errors import EXIT_CASE_ERROR, EXIT_NOT_CONVERGED, CaseError
-from sarfe.pipeline.model.linear_stage import (
-    ContactGeometry,
-    LinearStage,
-    build_linear_model,
-    check_mesh,
-    linear_model_key,
-)
+from sarfe.pipeline.checks.mesh_checks import check_mesh
+from sarfe.pipeline.model.contact_pairs import ContactGeometry
+from sarfe.pipeline.model.linear_stage import build_linear_model
+from sarfe.pipeline.model.stage import LinearStage, linear_model_key
 from sarfe.pipeline.model.nonlinear_model import nonlinear_model
 from sarfe.pipeline.write.result_files import results_table
 from sarfe.pipeline.run import CaseResult, solve_case

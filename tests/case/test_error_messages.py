@@ -43,7 +43,7 @@ def test_craig_bampton_failures_say_their_cause():
     memory, ARPACK, anything else → that cause with the model size, under reduction."""
     from scipy.sparse.linalg import ArpackNoConvergence
 
-    from sarfe.pipeline.model.linear_stage import reduction_error
+    from sarfe.pipeline.model.fe_stage import reduction_error
 
     case = load_case(yaml.load((ROOT / "cases" / "rattle_rig.yaml").read_text(), Loader=CaseLoader))
     said = {kind: str(reduction_error(case, exc, 1200, 30)) for kind, exc in {

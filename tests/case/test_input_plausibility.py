@@ -46,7 +46,8 @@ def test_force_partly_on_fixed_nodes_warns_with_the_share_lost(tmp_path):
     """A force on the whole beam (element group part_beam) whose clamp_beam nodes are fixed: F/n
     per node, so the k clamped of n nodes put k/n of force_N into the supports — a warning
     stating k, n and k/n (the model is not changed); all nodes fixed is an error."""
-    from sarfe.pipeline.model.linear_stage import load_case_mesh, resolve_node_group
+    from sarfe.pipeline.model.case_mesh import load_case_mesh
+    from sarfe.pipeline.model.groups import resolve_node_group
 
     data = rig()
     assert not [w for w in checked(data, tmp_path).warnings if "supports" in w]

@@ -523,7 +523,7 @@ def test_point_masses_and_offsets_equal_pynastran_mass_properties(tmp_path):
     from pyNastran.bdf.mesh_utils.mass_properties import mass_properties as pyn_mass
 
     from sarfe.fe.deck_assembly import mass_properties
-    from sarfe.mesh.formats.nastran import _load_bdf
+    from sarfe.mesh.formats.nastran import load_bdf
 
     path = _write(tmp_path, _free_plate_with_rigid_elements() + """
 CORD2R,4,,0.1,0.,0.,0.1,0.,1.
@@ -532,7 +532,7 @@ CONM2,904,3,4,0.03,0.01,0.02,0.03
 CONM2,905,7,-1,0.04,0.5,0.5,0.5
 """)
     mass, cg = mass_properties(read_nastran(path))
-    ref_mass, ref_cg, _ = pyn_mass(_load_bdf(path))
+    ref_mass, ref_cg, _ = pyn_mass(load_bdf(path))
     assert mass == pytest.approx(float(ref_mass), rel=1e-9)
     assert np.allclose(cg, ref_cg, atol=1e-9)
 

@@ -47,7 +47,7 @@ from sarfe.mesh.formats.deck import (BeamElements, DeckError, DeckModel, Interpo
 from sarfe.mesh.formats.nastran_sections import isotropic, shells
 from sarfe.mesh.formats.nastran_sets import component_mask, loads, sets, supports
 
-__all__ = ["read_nastran", "nastran_deck", "bulk_fields", "card_line", "card_where", "CONTROL_CARDS",
+__all__ = ["read_nastran", "nastran_deck", "load_bdf", "bulk_fields", "card_line", "card_where", "CONTROL_CARDS",
            "MODELLED_CARDS"]
 
 #: cards sarfe turns into the model
@@ -82,7 +82,7 @@ def _one_line(error) -> str:
     return " ".join(str(error).split()) or type(error).__name__
 
 
-def _load_bdf(path: Path):
+def load_bdf(path: Path):
     """The pyNastran model of a deck, cross-referenced. pyNastran's console output while
     reading (``UserWarning: bad fields``, ``problem adding …``) is held back: the error it
     leads to is raised as one line instead. A card referring to a GRID the deck does not have
@@ -245,7 +245,7 @@ def nastran_deck(path) -> DeckModel:
     path = Path(path)
     if not path.is_file():
         raise DeckError(f"Nastran deck not found: {path}")
-    model = _load_bdf(path)
+    model = load_bdf(path)
     try:
         return _Converter(model, path).deck()
     except DeckError:

@@ -14,10 +14,15 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
-from sarfe.case.read import Case, load_case
 from sarfe.case.config import DampingConfig, ExcitationConfig
-from sarfe.pipeline.model.linear_stage import LinearStage
+from sarfe.case.read import Case, load_case
+from sarfe.fe.damping import modal_damping
+from sarfe.hbm import laws
+from sarfe.hbm.contacts import make_contact_set
+from sarfe.hbm.model import make_linear_model
+from sarfe.pipeline.model.stage import LinearStage
 
 
 @dataclass(frozen=True)
@@ -46,8 +51,6 @@ def _case_damping(damping: DampingConfig, stage: LinearStage):
         return stage.damping
     if damping.rayleigh is not None:
         return damping.rayleigh["alpha_1_s"] * M + damping.rayleigh["beta_s"] * K
-    from sarfe.reduction.damping import reduced_modal_damping
-
     n = M.shape[0]
     zeta = 0.0 if damping.modal_zeta is None else damping.modal_zeta
     if isinstance(zeta, tuple):         # per mode range: ({modes: [first, last], zeta}, …)
@@ -57,7 +60,7 @@ def _case_damping(damping: DampingConfig, stage: LinearStage):
             values[first - 1:min(last, n)] = entry["zeta"]
         zeta = values
     dense = (lambda A: A.toarray() if sp.issparse(A) else np.asarray(A))
-    return reduced_modal_damping(dense(M), dense(K), zeta)
+    return modal_damping(dense(M), dense(K), zeta)
 
 
 def _dof_row(ref, n):
@@ -76,9 +79,6 @@ def build_contacts(case: Case, stage: LinearStage):
     ``preload_N`` sets the overclosure from the law's static deflection (normal DOF) or the
     constant normal load (no normal DOF); parameters declared ``from_model`` that the case leaves
     out (the effective mass of a normal row) are computed from the model."""
-    from sarfe.hbm import laws
-    from sarfe.hbm.contacts import make_contact_set
-
     n = stage.dof_count
     rows, kind, normal_row, tangent_rows = [], [], [], []
     gap, names, tolerance, groups = [], [], [], []
@@ -200,9 +200,7 @@ def _parameter_table(table, kind):
 def _fill_from_model(parameters, mass, gap_map, normal_row):
     """Parameters declared ``from_model`` and left out (NaN): the effective mass of each normal
     row, 1/m_eff = g M⁻¹ gᵀ [kg] (g: the row of G)."""
-    from sarfe.hbm.laws import all_parameters
-
-    declared = all_parameters()
+    declared = laws.all_parameters()
     for key, values in parameters.items():
         p = declared.get(key)
         if p is None or not p.from_model:
@@ -213,7 +211,6 @@ def _fill_from_model(parameters, mass, gap_map, normal_row):
             continue
         rows = gap_map[normal_row[missing]]
         if sp.issparse(mass):
-            import scipy.sparse.linalg as spla
             solved = spla.spsolve(sp.csc_matrix(mass), rows.T.tocsc())
             solved = solved.toarray() if sp.issparse(solved) else np.asarray(solved)
         else:
@@ -235,8 +232,6 @@ def preload_gaps(stiffness, gap_map, normal_row, gap, contacts, preloaded):
     Only the preloaded contacts are assumed closed (the others open) and all are solved together.
     A singular K (a free-floating matrices model) falls back to g = −δ(λ).
     """
-    from sarfe.hbm import laws
-
     index = np.concatenate([idx for idx, _ in preloaded])
     force = np.concatenate([np.full(len(idx), load / len(idx)) for idx, load in preloaded])
     deflection = np.zeros(len(index))
@@ -273,8 +268,6 @@ def excitation_amplitude(excitation: ExcitationConfig, stage: LinearStage) -> np
 
 def nonlinear_model(case, stage: LinearStage) -> NonlinearModel:
     """LinearModel (with damping), ContactSet and excitation harmonics of a case."""
-    from sarfe.hbm.model import make_linear_model
-
     case = load_case(case)
     model = make_linear_model(stage.mass, damping_matrix(case.config.damping, stage),
                                stage.stiffness)

@@ -53,7 +53,7 @@ def test_default_cutoff_matches_twice_the_cutoff_and_the_estimate_brackets_it():
     from sarfe.accuracy.measures import first_harmonic_amplitude
     from sarfe.accuracy.modal_truncation import modal_truncation_estimate
     from sarfe.pipeline.solve.case_accuracy import accuracy_problem
-    from sarfe.pipeline.model.linear_stage import default_cutoff_hz
+    from sarfe.pipeline.model.cutoff import default_cutoff_hz
 
     default = _case({})
     assert default_cutoff_hz(default) == pytest.approx(1.0 * HARMONICS * FREQUENCY_HZ)
