@@ -98,11 +98,11 @@ def cmd_validate(args) -> int:
 def cmd_verify(args) -> int:
     """Time integration of one point against the harmonic balance: every harmonic up to H, contact
     and largest-DOF amplitudes, ERP total and dB(A), and the stability verdict (a perturbation of
-    the HBM orbit decays or grows), each with its tolerance (:mod:`sarfe.pipeline.solve.verify`)."""
+    the HBM orbit decays or grows), each with its tolerance (:mod:`sarfe.pipeline.verify`)."""
     import numpy as np
 
     from sarfe.pipeline import build_linear_model, load_case, nonlinear_model
-    from sarfe.pipeline.solve.verify import format_rows, verify_point
+    from sarfe.pipeline.verify import format_rows, verify_point
 
     if not args.frequency_hz > 0:
         raise CaseError(f"--frequency-hz must be > 0, got {args.frequency_hz}", source=args.case)

@@ -19,9 +19,11 @@ import jsonschema
 import yaml
 
 from sarfe.case.config import (DEFAULT_ACCURACY, DEFAULT_ZETA, ContinuationConfig, ErpConfig,
-                              ReductionConfig, SolverConfig, default_samples_per_period)
+                               ReductionConfig, SolverConfig, build_config,
+                               default_samples_per_period)
 from sarfe.case.errors import CaseError, format_key_path
 from sarfe.case.schema import CASE_SCHEMA
+from sarfe.hbm import laws
 
 _VALIDATOR = jsonschema.Draft202012Validator(CASE_SCHEMA)
 MESH_SUFFIXES = (".msh", ".bdf", ".nas", ".dat", ".inp")
@@ -48,8 +50,6 @@ class Case:
     def config(self):
         """The typed configuration (:class:`sarfe.case.config.CaseConfig`), built once from the
         normalized ``data``."""
-        from sarfe.case.config import build_config
-
         return build_config(self.data)
 
     @property
@@ -416,8 +416,6 @@ def _normalize_damping(case, data):
 def _normalize_contacts(case, data):
     """Contact keys checked against the contact's law (:mod:`sarfe.hbm.laws`): its parameters (with
     their defaults), normal / tangential DOFs it needs, keys of other laws not allowed."""
-    from sarfe.hbm import laws
-
     contacts = data.setdefault("contacts", [])
     fe = case.is_fe
     names = set()

@@ -7,6 +7,8 @@ two keys, node groups present in the mesh, pairing within tolerance) are checked
 """
 from __future__ import annotations
 
+from sarfe.hbm import laws
+
 
 def _object(properties, required=(), **extra):
     return {"type": "object", "additionalProperties": False, "properties": properties,
@@ -107,8 +109,6 @@ def _law_key_schema(parameter):
 def contact_schema():
     """The contact object: geometry keys, then every registered law's keys from its declaration
     (:mod:`sarfe.hbm.laws`; which keys a type allows is checked in :mod:`sarfe.case.read`)."""
-    from sarfe.hbm import laws
-
     law_keys = {}
     for law in laws.LAWS.values():
         for parameter in law.case_parameters():

@@ -7,10 +7,16 @@ import copy
 
 import numpy as np
 
-from sarfe.accuracy.estimate import (EstimateProblem, highest_natural_frequency_hz,
-                                     problem_error_estimate)
-from sarfe.accuracy.resolve import resolve_accuracy
+from sarfe.accuracy.estimate import (EstimateProblem, basis_limited_extension,
+                                     highest_natural_frequency_hz, problem_error_estimate)
+from sarfe.accuracy.harmonic_truncation import RICHARDSON, harmonics_richardson
+from sarfe.accuracy.resolve import LADDER_FACTOR, resolve_accuracy
+from sarfe.accuracy.target import parse_accuracy
 from sarfe.case.config import ExcitationConfig, SolverConfig
+from sarfe.case.read import load_case
+from sarfe.hbm import SolverOptions
+from sarfe.pipeline.model.linear_stage import build_linear_model
+from sarfe.pipeline.model.nonlinear_model import nonlinear_model
 
 
 def stage_modal_coordinates(stage):
@@ -67,15 +73,11 @@ def rule_cutoff_hz(case, harmonics) -> float | None:
 
 def search_margin(case) -> float:
     """m of :func:`rule_cutoff_hz`: max(reduction.cutoff_margin, LADDER_FACTOR)."""
-    from sarfe.accuracy.resolve import LADDER_FACTOR
-
     return float(max(case.config.reduction.cutoff_margin, LADDER_FACTOR))
 
 
 def _with_cutoff(case, cutoff_hz):
     """The case with reduction.cutoff_hz set (unchanged for None)."""
-    from sarfe.case.read import load_case
-
     if cutoff_hz is None:
         return case
     data = copy.deepcopy(case.data)
@@ -100,11 +102,6 @@ def case_resolution(case, target, points=8, start_harmonics=3, start_samples=64,
     chosen H needs c(H) above the stage's cutoff, the stage of c(H) is built and the search is
     repeated on it from ``start_harmonics`` at the tuned frequencies (at most ``max_rebuilds``
     times). The last stage is returned: the sweep reuses it (same key as the chosen case)."""
-    from sarfe.hbm import SolverOptions
-    from sarfe.case.read import load_case
-    from sarfe.pipeline.model.linear_stage import build_linear_model
-    from sarfe.pipeline.model.nonlinear_model import nonlinear_model
-
     case = load_case(case)
     solver = case.config.solver
     options = SolverOptions(tolerance=solver.tolerance, max_iterations=solver.max_iterations,
@@ -164,10 +161,6 @@ def accuracy_check(solver: SolverConfig, points) -> dict | None:
     (a 5 dB error 60 dB below the headline changes nothing a user reads). The knob to raise is the
     one whose part (Richardson factors included) is largest at the worst point: harmonics →
     solver.harmonics, aliasing → solver.samples_per_period, modal → the reduction cutoff."""
-    from sarfe.accuracy.estimate import basis_limited_extension
-    from sarfe.accuracy.harmonic_truncation import RICHARDSON, harmonics_richardson
-    from sarfe.accuracy.target import parse_accuracy
-
     target = parse_accuracy(solver.accuracy_or_default)
     rated = [p for p in points if p["converged"] and p.get("error_estimate")
              and "failed" not in p["error_estimate"]]

@@ -34,7 +34,7 @@ def _case(reduction):
 def _solve(case):
     from sarfe.hbm import SolverOptions, solve_frequency
     from sarfe.pipeline import build_linear_model, nonlinear_model
-    from sarfe.pipeline.post.records import _erp
+    from sarfe.pipeline.post.records import point_erp
 
     stage = build_linear_model(case)
     nl = nonlinear_model(case, stage)
@@ -43,7 +43,7 @@ def _solve(case):
         s = solve_frequency(nl.model, nl.contacts, nl.excitation, 2 * np.pi * FREQUENCY_HZ,
                             HARMONICS, 256, options=SolverOptions(stability=False))
     assert s.converged
-    erp, _ = _erp(case.config.erp, stage, s.displacement, s.omega)
+    erp, _ = point_erp(case.config.erp, stage, s.displacement, s.omega)
     return stage, nl, s, erp
 
 
