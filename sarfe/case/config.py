@@ -1,5 +1,5 @@
 """Typed configuration of a case: one small frozen dataclass per case section, built ONCE from the
-validated, normalized case (:func:`sarfe.case.read.normalize`) and owning the defaults.
+validated, normalized case (:func:`sarfe.case.normalize.normalize`) and owning the defaults.
 
     config = case.config                # built once per Case; CaseConfig(model, damping, reduction,
                                         #   contacts, excitation, solver, erp, output)

@@ -33,7 +33,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from sarfe.case.read import THICKNESS_RANGE, load_case
+from sarfe.case.plausibility import THICKNESS_RANGE
+from sarfe.case.read import load_case
 from sarfe.erp import nodal_normals
 from sarfe.hbm.pruning import linearized_stiffness
 from sarfe.mesh import connected_components

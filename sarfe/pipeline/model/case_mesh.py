@@ -3,7 +3,7 @@
 
     load_case_mesh(case) -> PanelMesh     CaseError naming model.fe.mesh / generator on failure
 
-A mesh whose span (bounding-box diagonal) lies outside :data:`sarfe.case.read.SPAN_RANGE_M` is
+A mesh whose span (bounding-box diagonal) lies outside :data:`sarfe.case.plausibility.SPAN_RANGE_M` is
 taken for a unit mistake (mm read as m, or the reverse) and refused.
 """
 from __future__ import annotations
@@ -13,7 +13,7 @@ import importlib
 
 import numpy as np
 
-from sarfe.case.read import SPAN_RANGE_M
+from sarfe.case.plausibility import SPAN_RANGE_M
 from sarfe.mesh import load_mesh
 from sarfe.mesh.cache import cached_mesh
 from sarfe.mesh.generators import GENERATORS, parameter_names

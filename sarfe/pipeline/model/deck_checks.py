@@ -9,7 +9,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from sarfe.case.read import MIN_E_PA, MIN_RHO_KG_M3, SPAN_RANGE_M, THICKNESS_RANGE, Case
+from sarfe.case.plausibility import MIN_E_PA, MIN_RHO_KG_M3, SPAN_RANGE_M, THICKNESS_RANGE
+from sarfe.case.read import Case
 from sarfe.mesh import quality
 from sarfe.mesh.formats.abaqus import section_values
 from sarfe.mesh.formats.deck import UNIT_SYSTEMS
@@ -254,7 +255,7 @@ def model_span(deck) -> float:
 
 def unit_findings(deck) -> list[tuple]:
     """Values of a deck (in SI after its unit conversion) that no trim part has — the
-    plausibility bounds of the case keys (:mod:`sarfe.case.read`):
+    plausibility bounds of the case keys (:mod:`sarfe.case.plausibility`):
 
         E < 1e5 Pa, 0 < ρ < 1 kg/m³ (shell sections, solids, beams),
         model span L (:func:`model_span`) > 20 m or < 5 mm,
