@@ -8,10 +8,13 @@ line of the case file).
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
-from sarfe.case.config import (DEFAULT_ACCURACY, DEFAULT_ZETA, ContinuationConfig, ErpConfig,
-                               ReductionConfig, SolverConfig, default_samples_per_period)
+from sarfe.case.config import (DEFAULT_ACCURACY, DEFAULT_ZETA, MATRICES_GAP_M,
+                               BaseAccelerationConfig, ContactConfig, ContinuationConfig,
+                               DeckConfig, DofReference, ErpConfig, FeConfig, ForceConfig,
+                               GeneratorConfig, ReductionConfig, SolverConfig, default_of,
+                               default_output_directory, default_output_files,
+                               default_samples_per_period)
 from sarfe.case.plausibility import check_plausible
 from sarfe.hbm import laws
 
@@ -50,6 +53,18 @@ def direction_vector(case, value, path):
     return [float(x) / norm for x in value]
 
 
+def _case_file(case, name, suffixes, kind, path):
+    """A file named in the case (relative to it) with one of ``suffixes`` that exists, else a
+    CaseError at ``path`` ('<kind> file must be one of …' / '<kind> file not found: …')."""
+    file = case.resolve(name)
+    if file.suffix.lower() not in suffixes:
+        raise case.error(f"{kind} file must be one of {', '.join(suffixes)}, got '{file.name}'",
+                         path)
+    if not file.is_file():
+        raise case.error(f"{kind} file not found: {file}", path)
+    return file
+
+
 def _normalize_model(case, data):
     model = data["model"]
     if "fe" in model:
@@ -63,16 +78,11 @@ def _normalize_model(case, data):
         for key in ("materials", "thickness_m", "fixed"):
             if key not in fe:
                 raise case.error(f"missing required key (with model.fe.{source})", p + (key,))
-        fe.setdefault("mesh_units", "m")
+        fe.setdefault("mesh_units", default_of(FeConfig, "mesh_units"))
         if source == "mesh":
-            mesh = case.resolve(fe["mesh"])
-            if mesh.suffix.lower() not in MESH_SUFFIXES:
-                raise case.error(f"mesh file must be one of {', '.join(MESH_SUFFIXES)}, got "
-                                 f"'{mesh.name}'", p + ("mesh",))
-            if not mesh.is_file():
-                raise case.error(f"mesh file not found: {mesh}", p + ("mesh",))
+            _case_file(case, fe["mesh"], MESH_SUFFIXES, "mesh", p + ("mesh",))
         else:
-            fe["generator"].setdefault("params", {})
+            fe["generator"].setdefault("params", default_of(GeneratorConfig, "params"))
             if "mesh_units" in fe and fe["mesh_units"] != "m":
                 raise case.error("generated meshes are in metres; mesh_units must be 'm'",
                                  p + ("mesh_units",))
@@ -81,12 +91,7 @@ def _normalize_model(case, data):
         p = ("model", "matrices")
         for key in ("mass", "stiffness", "damping"):
             if isinstance(mat.get(key), str):
-                path = case.resolve(mat[key])
-                if path.suffix.lower() not in MATRIX_SUFFIXES:
-                    raise case.error(f"matrix file must be one of {', '.join(MATRIX_SUFFIXES)}, "
-                                     f"got '{path.name}'", p + (key,))
-                if not path.is_file():
-                    raise case.error(f"matrix file not found: {path}", p + (key,))
+                _case_file(case, mat[key], MATRIX_SUFFIXES, "matrix", p + (key,))
         # an empty damping section is what normalizing a case with its own damping matrix leaves
         # (so a normalized case, e.g. after solver.accuracy chose H, loads again)
         if "damping" in mat and data.get("damping"):
@@ -97,17 +102,10 @@ def _normalize_model(case, data):
 
 def _normalize_deck(case, fe, p):
     """model.fe.deck: the file exists and is a deck; units, ignore_cards, fixed defaults."""
-    deck = case.resolve(fe["deck"])
-    if deck.suffix.lower() not in DECK_SUFFIXES:
-        raise case.error(f"deck file must be one of {', '.join(DECK_SUFFIXES)}, got "
-                         f"'{deck.name}'", p + ("deck",))
-    if not deck.is_file():
-        raise case.error(f"deck file not found: {deck}", p + ("deck",))
+    _case_file(case, fe["deck"], DECK_SUFFIXES, "deck", p + ("deck",))
     _not_allowed(case, fe, p, ("mesh_units",), "with model.fe.deck (use 'units')")
-    fe.setdefault("units", "SI")
-    fe.setdefault("ignore_cards", [])
-    fe.setdefault("node_groups", {})
-    fe.setdefault("element_groups", {})
+    for key in ("units", "ignore_cards", "node_groups", "element_groups"):
+        fe.setdefault(key, default_of(DeckConfig, key))
 
 
 def _normalize_damping(case, data):
@@ -161,8 +159,8 @@ def _normalize_contacts(case, data):
                 if pair[0] == pair[1]:
                     raise case.error(f"node {pair[0]} is paired with itself (a pair joins two "
                                      "different nodes, or a node and 'ground')", p + ("pairs", j))
-            contact.setdefault("pairing_tolerance_m", 1e-3)
-            contact.setdefault("normal", "auto")
+            for key in ("pairing_tolerance_m", "normal"):
+                contact.setdefault(key, default_of(ContactConfig, key))
             has_normal = True
         else:
             _not_allowed(case, contact, p, ("between", "pairs", "normal", "pairing_tolerance_m"),
@@ -182,8 +180,8 @@ def _normalize_contacts(case, data):
                                               for t in contact["tangential_dofs"]]
             for ref in ([contact["normal_dof"]] if has_normal else []) + contact.get(
                     "tangential_dofs", []):
-                ref.setdefault("relative_to", "ground")
-                ref.setdefault("sign", 1)
+                for key in ("relative_to", "sign"):
+                    ref.setdefault(key, default_of(DofReference, key))
         others = sorted(every_key - law.keys(), key=lambda k: list(contact).index(k)
                         if k in contact else 0)
         if law.tangent_dofs == "forbidden":
@@ -221,8 +219,8 @@ def _normalize_contacts(case, data):
                 raise case.error(str(error), p + (error.key,)) from None
         _only_one(case, contact, p, ("gap_m", "preload_N"), required=False)
         if has_normal and "preload_N" not in contact and not fe:
-            contact.setdefault("gap_m", 0.0)  # FE: default = geometric gap of each node pair
-        contact.setdefault("tolerance_m", 0.0)
+            contact.setdefault("gap_m", MATRICES_GAP_M)  # FE: the geometric gap of each pair
+        contact.setdefault("tolerance_m", default_of(ContactConfig, "tolerance_m"))
 
 
 def _normalize_excitation(case, data):
@@ -243,7 +241,8 @@ def _normalize_excitation(case, data):
                     raise case.error("needs model.fe.deck", q + ("load_set",))
                 _not_allowed(case, load, q, ("dof", "group", "direction", "force_N"),
                              "with load_set (the deck's forces times 'scale')")
-                load["force_N"] = float(load.setdefault("scale", 1.0))   # amplitude factor
+                load["force_N"] = float(load.setdefault(       # the amplitude factor
+                    "scale", default_of(ForceConfig, "scale")))
             elif fe:
                 _not_allowed(case, load, q, ("dof", "scale"), "with model.fe (use 'group')")
                 for key in ("group", "direction", "force_N"):
@@ -256,7 +255,7 @@ def _normalize_excitation(case, data):
                 for key in ("dof", "force_N"):
                     if key not in load:
                         raise case.error("missing required key", q + (key,))
-            load.setdefault("phase_deg", 0.0)
+            load.setdefault("phase_deg", default_of(ForceConfig, "phase_deg"))
     else:
         base = exc["base_acceleration"]
         q = p + ("base_acceleration",)
@@ -267,27 +266,28 @@ def _normalize_excitation(case, data):
             base["direction"] = direction_vector(case, base["direction"], q + ("direction",))
         else:
             _not_allowed(case, base, q, ("direction",), "with model.matrices (use 'influence')")
-        base.setdefault("phase_deg", 0.0)
+        base.setdefault("phase_deg", default_of(BaseAccelerationConfig, "phase_deg"))
 
 
 def _normalize_solver(case, data):
     solver = data.setdefault("solver", {})
     # no harmonics given: sarfe chooses H, N (and the mode count) for the accuracy budget
     # (default 'balanced'), starting its screening from H = 5; given harmonics are used as they are
-    solver.setdefault("resolution", "fixed" if "harmonics" in solver else "auto")
+    solver.setdefault("resolution", "fixed" if "harmonics" in solver
+                      else default_of(SolverConfig, "resolution"))
     if solver["resolution"] == "auto":
         solver.setdefault("accuracy", DEFAULT_ACCURACY)
-    H = solver.setdefault("harmonics", SolverConfig.harmonics)
+    H = solver.setdefault("harmonics", default_of(SolverConfig, "harmonics"))
     N = solver.setdefault("samples_per_period", default_samples_per_period(H))
     if N < 2 * H + 1:
         raise case.error(f"must be >= 2H+1 = {2 * H + 1} for harmonics H = {H}, got {N}",
                          ("solver", "samples_per_period"))
     for key in ("tolerance", "max_iterations", "stability", "error_estimate", "harmonic_set",
                 "prune_contacts", "workers"):          # defaults: sarfe.case.config.SolverConfig
-        solver.setdefault(key, getattr(SolverConfig, key))
+        solver.setdefault(key, default_of(SolverConfig, key))
     cont = solver.setdefault("continuation", {})
     for key in ("initial_step", "min_step", "max_step", "max_points"):
-        cont.setdefault(key, getattr(ContinuationConfig, key))
+        cont.setdefault(key, default_of(ContinuationConfig, key))
     if cont["min_step"] > cont["max_step"]:
         raise case.error("must be <= max_step", ("solver", "continuation", "min_step"))
     if not cont["min_step"] <= cont["initial_step"] <= cont["max_step"]:
@@ -301,7 +301,7 @@ def _normalize_reduction(case, data):
     red = data.setdefault("reduction", {})
     _only_one(case, red, ("reduction",), ("mode_count", "cutoff_hz"), required=False)
     for key in ("cutoff_margin", "min_mode_count", "residual_vectors"):
-        red.setdefault(key, getattr(ReductionConfig, key))   # defaults: sarfe.case.config
+        red.setdefault(key, default_of(ReductionConfig, key))
 
 
 def _normalize_erp(case, data):
@@ -317,15 +317,13 @@ def _normalize_erp(case, data):
             raise case.error(f"needs one area per DOF in erp.dofs ({len(erp['dofs'])}), got "
                              f"{len(erp['areas_m2'])}", p + ("areas_m2",))
     for key in ("rho_kg_m3", "c_m_s", "radiation_loss_factor", "reference_power_W"):
-        erp.setdefault(key, getattr(ErpConfig, key))          # defaults: sarfe.case.config
+        erp.setdefault(key, default_of(ErpConfig, key))
 
 
 def _normalize_output(case, data):
     out = data.setdefault("output", {})
-    out.setdefault("directory", str(Path("results") / data["name"]))
-    default = ["summary", "response", "plots", "table", "report"] + (
-        ["erp_vtu", "animation"] if case.is_fe else [])
-    out.setdefault("files", default)
+    out.setdefault("directory", default_output_directory(data["name"]))
+    out.setdefault("files", default_output_files(case.is_fe))
     if "summary" not in out["files"]:
         out["files"] = ["summary"] + list(out["files"])
 

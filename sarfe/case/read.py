@@ -13,26 +13,35 @@ docs/case-file.md. Checks that need the mesh (node groups, contact pairing) live
 from __future__ import annotations
 
 import copy
+import dataclasses
 import re
 from dataclasses import dataclass, field
-from functools import cached_property
 from pathlib import Path
 
 import yaml
 
-from sarfe.case.config import build_config
+from sarfe.case.config import CaseConfig, ContactConfig, build_config
 from sarfe.case.errors import CaseError, line_of
 from sarfe.case.messages import validate_schema
 from sarfe.case.normalize import normalize
 from sarfe.case.plausibility import check_finite
 
+#: contact keys with a typed field of their own in :class:`~sarfe.case.config.ContactConfig`
+CONTACT_KEYS = frozenset(f.name for f in dataclasses.fields(ContactConfig)) - {
+    "index", "name", "kind", "params"}
 
 @dataclass(frozen=True)
 class Case:
-    """A validated case with every default filled in (``data``), SI units except mesh coordinates.
+    """A validated case: ``config`` the typed configuration (:class:`sarfe.case.config.CaseConfig`,
+    what the pipeline reads), ``data`` the normalized mapping with every default filled in (what
+    is written out: summary.json ``case_data``, and hashed into the linear stage's key). SI units
+    except mesh coordinates.
 
     ``source``: the YAML file (None for a dict), ``base_dir``: directory that relative file names in
-    the case refer to, ``lines``: {key path tuple: line} for error messages.
+    the case refer to, ``lines``: {key path tuple: line} for error messages. ``config`` is None only
+    while :func:`load_case` normalizes ``data``. A changed setting is a new Case with the section
+    replaced and ``data`` updated to match (:meth:`with_solver`, :meth:`with_reduction`,
+    :meth:`with_contact`, :meth:`with_generator`), never an edited mapping loaded again.
     """
 
     name: str
@@ -40,12 +49,7 @@ class Case:
     source: str | None = None
     base_dir: Path = Path(".")
     lines: dict = field(default_factory=dict, compare=False, repr=False)
-
-    @cached_property
-    def config(self):
-        """The typed configuration (:class:`sarfe.case.config.CaseConfig`), built once from the
-        normalized ``data``."""
-        return build_config(self.data)
+    config: CaseConfig | None = field(default=None, compare=False, repr=False)
 
     @property
     def is_fe(self) -> bool:
@@ -60,6 +64,59 @@ class Case:
         """A file named in the case, relative to the case file's directory."""
         path = Path(file_name).expanduser()
         return path if path.is_absolute() else self.base_dir / path
+
+    # ----------------------------------------------------------------------- changed settings
+    def with_solver(self, **changes) -> Case:
+        """This case with :class:`~sarfe.case.config.SolverConfig` fields changed (``harmonics=H,
+        samples_per_period=N, resolution='fixed'`` …). ValueError when N < 2H + 1."""
+        solver = dataclasses.replace(self.config.solver, **changes)
+        if solver.samples_per_period < 2 * solver.harmonics + 1:
+            raise ValueError(f"samples_per_period = {solver.samples_per_period} must be >= 2H+1 "
+                             f"= {2 * solver.harmonics + 1} for harmonics H = {solver.harmonics}")
+        return self._changed(("solver",), changes, solver=solver)
+
+    def with_reduction(self, **changes) -> Case:
+        """This case (FE) with :class:`~sarfe.case.config.ReductionConfig` fields changed
+        (``cutoff_hz=f``, or ``cutoff_hz=None, mode_count=m`` …; None removes a setting).
+        ValueError when both a cutoff and a mode count remain."""
+        reduction = dataclasses.replace(self.config.reduction, **changes)
+        if reduction.cutoff_hz is not None and reduction.mode_count is not None:
+            raise ValueError("give reduction.cutoff_hz or reduction.mode_count, not both")
+        return self._changed(("reduction",), changes, reduction=reduction)
+
+    def with_generator(self, **changes) -> Case:
+        """This case (model.fe.generator) with :class:`~sarfe.case.config.GeneratorConfig` fields
+        changed (``mesh_size_m=h`` …)."""
+        fe = self.config.model.fe
+        model = dataclasses.replace(self.config.model, fe=dataclasses.replace(
+            fe, generator=dataclasses.replace(fe.generator, **changes)))
+        return self._changed(("model", "fe", "generator"), changes, model=model)
+
+    def with_contact(self, index: int, **changes) -> Case:
+        """This case with keys of contacts[index] changed: its typed fields (``gap_m``,
+        ``preload_N``, ``tolerance_m`` …) and law parameters (``normal_stiffness_N_m`` …, in
+        ``params``); None removes a key. The law's own checks are not run again."""
+        contact = self.config.contacts[index]
+        params = {k: v for k, v in {**contact.params, **changes}.items() if v is not None}
+        typed = {k: v for k, v in changes.items() if k in CONTACT_KEYS}
+        contacts = list(self.config.contacts)
+        contacts[index] = dataclasses.replace(contact, params=params, **typed)
+        return self._changed(("contacts", index), changes, contacts=tuple(contacts))
+
+    def _changed(self, path, changes, **sections) -> Case:
+        """The case with ``sections`` of its config replaced and the mapping at ``path`` of
+        ``data`` given the same ``changes`` (None: the key removed)."""
+        data = copy.deepcopy(self.data)
+        mapping = data
+        for key in path:
+            mapping = mapping[key] if isinstance(key, int) else mapping.setdefault(key, {})
+        for key, value in changes.items():
+            if value is None:
+                mapping.pop(key, None)
+            else:
+                mapping[key] = copy.deepcopy(value)
+        return dataclasses.replace(self, data=data,
+                                   config=dataclasses.replace(self.config, **sections))
 
 
 # ----------------------------------------------------------------------------------- YAML reading
@@ -145,8 +202,8 @@ def load_case(path_or_dict, base_dir=None) -> Case:
         base = Path(base_dir) if base_dir else Path(path_or_dict).resolve().parent
     check_finite(data, source, lines)
     validate_schema(data, source, lines)
-    case = Case(name=data["name"], data=data, source=source, base_dir=base, lines=lines)
-    return normalize(case)
+    case = normalize(Case(name=data["name"], data=data, source=source, base_dir=base, lines=lines))
+    return dataclasses.replace(case, config=build_config(case.data))
 
 
 __all__ = ["Case", "CaseLoader", "load_case", "read_yaml"]

@@ -14,7 +14,6 @@ from pathlib import Path
 import numpy as np
 
 from sarfe import __version__
-from sarfe.accuracy.resolve import apply_resolution
 from sarfe.case.errors import EXIT_NOT_CONVERGED
 from sarfe.case.read import load_case
 from sarfe.hbm.stability.deferred import deferred_stability, pending
@@ -25,7 +24,7 @@ from sarfe.pipeline.model.stage import linear_model_key
 from sarfe.pipeline.post.point_workers import (first_estimates, point_records, point_work,
                                                point_workers, stability_stream)
 from sarfe.pipeline.post.records import error_estimates, worst_of
-from sarfe.pipeline.solve.case_accuracy import accuracy_check, case_resolution
+from sarfe.pipeline.solve.case_accuracy import accuracy_check, case_resolution, resolved_case
 from sarfe.pipeline.solve.points import common_samples, sweep_status
 from sarfe.pipeline.solve.pruned_points import solve_points_pruned
 from sarfe.pipeline.write.result_files import write_outputs
@@ -86,7 +85,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
                                                "search_stage_modes", "search_stage_seconds",
                                                "cutoff_hz", "history", "seconds")}
         accuracy["target"] = config.solver.accuracy
-        case = load_case(apply_resolution(case.data, report), base_dir=case.base_dir)
+        case = resolved_case(case, report)
         config = case.config
         # a given stage, else the search's last one, is the sweep's when its key matches
         linear_stage = next((s for s in (linear_stage, searched)

@@ -107,7 +107,7 @@ def check_element_quality(case, mesh, joined=()) -> None:
 def check_thickness(case, mesh) -> None:
     size = float(np.linalg.norm(np.ptp(mesh.points, axis=0)))
     low, high = THICKNESS_RANGE
-    for name, t in case.config.model.fe.data["thickness_m"].items():
+    for name, t in case.config.model.fe.thickness_m.items():
         path = ("model", "fe", "thickness_m", name)
         if t > high * size:
             raise case.error(f"thickness {t:g} m is not small against the model size {size:.3g} m "
@@ -149,13 +149,13 @@ def check_loads_free(case, mesh, fixed_nodes, load_nodes) -> list:
         path = ("excitation", "forces", i, "group")
         count = int(np.count_nonzero(held[nodes]))
         if count == len(nodes):
-            raise case.error(f"the force on group {load['group']} acts on no free DOF: all of its "
+            raise case.error(f"the force on group {load.group} acts on no free DOF: all of its "
                              f"DOFs are fixed ({len(nodes)} node(s) held by model.fe.fixed or on "
                              "no triangle)", path)
         if count:
             warnings.append(f"excitation.forces[{i}]: {count} of the {len(nodes)} nodes of group "
-                            f"{load['group']} are fixed: {100 * count / len(nodes):.3g} % of "
-                            f"force_N = {load['force_N']:g} N goes straight into the supports")
+                            f"{load.group} are fixed: {100 * count / len(nodes):.3g} % of "
+                            f"force_N = {load.force_N:g} N goes straight into the supports")
     return warnings
 
 
@@ -231,13 +231,13 @@ def gap_warnings(case, mesh=None) -> list:
     tolerance_m = 0), or an open gap already larger than the structure (:func:`range_warnings`),
     no warning."""
     config = case.config
-    fe = config.model.fe.data if case.is_fe else {}
-    thickest = max((float(t) for t in fe.get("thickness_m", {}).values()), default=0.0)
+    thickness = config.model.fe.thickness_m if config.model.is_fe else {}
+    thickest = max((float(t) for t in thickness.values()), default=0.0)
     size = np.inf if mesh is None else float(np.linalg.norm(np.ptp(mesh.points, axis=0)))
     warnings = []
-    for i, contact in ((c.index, c.params) for c in config.contacts):
-        gap = contact.get("gap_m")
-        tolerance = float(contact.get("tolerance_m", 0.0))
+    for i, contact in enumerate(config.contacts):
+        gap = contact.gap_m
+        tolerance = float(contact.tolerance_m)
         reference = max(thickest, tolerance)
         if gap is None or reference <= 0.0 or abs(gap) <= GAP_RANGE * reference or gap > size:
             continue
@@ -246,7 +246,7 @@ def gap_warnings(case, mesh=None) -> list:
         kind = "an overclosure (the parts pressed" if gap < 0 else "an open gap (the parts"
         detail = (f"{kind} {abs(gap) * 1e3:.4g} mm into each other)" if gap < 0
                   else f"{kind} {gap * 1e3:.4g} mm apart)")
-        warnings.append(f"contacts[{i}] ({contact['name']}): gap_m = {gap:g} m is {detail}, "
+        warnings.append(f"contacts[{i}] ({contact.name}): gap_m = {gap:g} m is {detail}, "
                         f"more than {GAP_RANGE:g} × {what}: gap_m is in metres "
                         "(0.5 mm = 5e-4)")
     return warnings
@@ -265,10 +265,10 @@ def range_warnings(case, mesh=None) -> list:
                             f"~{limit:.4g} Hz the mesh resolves ({ELEMENTS_PER_WAVELENGTH} elements "
                             "per bending wavelength): refine the mesh or lower the harmonics")
         size = float(np.linalg.norm(np.ptp(mesh.points, axis=0)))
-        for i, contact in ((c.index, c.params) for c in config.contacts):
-            gap = contact.get("gap_m")
+        for i, contact in enumerate(config.contacts):
+            gap = contact.gap_m
             if gap is not None and gap > size:
-                warnings.append(f"contacts[{i}] ({contact['name']}): gap_m = {gap:g} m is larger "
+                warnings.append(f"contacts[{i}] ({contact.name}): gap_m = {gap:g} m is larger "
                                 f"than the structure ({size:.3g} m): the contact can never close")
     warnings += gap_warnings(case, mesh)
     cutoff = None if config.reduction is None else config.reduction.cutoff_hz
@@ -353,7 +353,7 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True)
     check_thickness(case, mesh)
     normals = nodal_normals(mesh.points, mesh.triangles)
     paired = {c.name: pair_contact(case, mesh, c.index, normals) for c in config.contacts}
-    load_nodes = [resolve_node_group(case, mesh, f["group"], ("excitation", "forces", i, "group"))
+    load_nodes = [resolve_node_group(case, mesh, f.group, ("excitation", "forces", i, "group"))
                   for i, f in enumerate(config.excitation.forces)]
     load_warnings = check_loads_free(case, mesh, fixed, load_nodes)
     surface = config.erp.surface

@@ -40,7 +40,7 @@ def check_mesh(case) -> dict:
     pairs = {c.name: len(p[0]) for c, p in zip(config.contacts, paired)}
     coincident = mesh_quality(case, mesh, [(a, b) for a, b, _, _ in paired])
     for i, f in enumerate(config.excitation.forces):
-        resolve_node_group(case, mesh, f["group"], ("excitation", "forces", i, "group"))
+        resolve_node_group(case, mesh, f.group, ("excitation", "forces", i, "group"))
     surface = config.erp.surface
     if surface is not None and surface not in mesh.element_groups:
         resolve_node_group(case, mesh, surface, ("erp", "surface"))
@@ -74,13 +74,13 @@ def check_deck(case) -> dict:
     mesh = prepared.mesh
     pairs = {name: len(p[0]) for name, p in contact_pairs(case, prepared).items()}
     for i, f in enumerate(case.config.excitation.forces):
-        if "load_set" in f:
-            if str(f["load_set"]) not in prepared.deck.loads:
-                raise case.error(f"load set '{f['load_set']}' not in the deck (available: "
+        if f.load_set is not None:
+            if str(f.load_set) not in prepared.deck.loads:
+                raise case.error(f"load set '{f.load_set}' not in the deck (available: "
                                  f"{', '.join(sorted(prepared.deck.loads)) or 'none'})",
                                  ("excitation", "forces", i, "load_set"))
         else:
-            resolve_node_group(case, mesh, f["group"], ("excitation", "forces", i, "group"))
+            resolve_node_group(case, mesh, f.group, ("excitation", "forces", i, "group"))
     deck_surface_triangles(case, mesh)
     return {"nodes": prepared.deck.n_nodes, "triangles": mesh.n_triangles,
             "contact_pairs": pairs, "ignored_cards": prepared.notes["ignored_cards"],

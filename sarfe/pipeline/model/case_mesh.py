@@ -27,36 +27,36 @@ def generate_mesh(name, mesh_size, params):
     return cached_mesh(name, mesh_size, **params)
 
 
-def check_generator_params(case, gen) -> None:
+def check_generator_params(case, generator) -> None:
     """An unknown key in model.fe.generator.params → CaseError naming it and the valid ones."""
-    if gen["name"] not in GENERATORS:
+    if generator.name not in GENERATORS:
         return
-    valid = parameter_names(gen["name"])
-    for key in gen["params"]:
+    valid = parameter_names(generator.name)
+    for key in generator.params:
         if key not in valid:
             close = difflib.get_close_matches(str(key), valid, n=1)
             hint = f"did you mean '{close[0]}'? " if close else ""
-            raise case.error(f"unknown parameter of generator {gen['name']} ({hint}valid: "
+            raise case.error(f"unknown parameter of generator {generator.name} ({hint}valid: "
                              f"{', '.join(valid)})", ("model", "fe", "generator", "params", key))
 
 
 def load_case_mesh(case):
     """The case's PanelMesh (file or generator), in metres; errors name model.fe.mesh/generator."""
-    fe = case.config.model.fe.data
-    if "mesh" in fe:
-        path = case.resolve(fe["mesh"])
+    fe = case.config.model.fe
+    if fe.source == "mesh":
+        path = case.resolve(fe.mesh)
         try:
-            mesh = load_mesh(path, length_unit=fe["mesh_units"])
+            mesh = load_mesh(path, length_unit=fe.mesh_units)
         except Exception as exc:
             raise case.error(f"cannot read mesh file {path}: {exc}", ("model", "fe", "mesh")) from None
         where = ("model", "fe", "mesh_units")
     else:
-        gen = fe["generator"]
+        gen = fe.generator
         check_generator_params(case, gen)
         try:
-            mesh = generate_mesh(gen["name"], gen["mesh_size_m"], gen["params"])
+            mesh = generate_mesh(gen.name, gen.mesh_size_m, gen.params)
         except ImportError as exc:
-            raise case.error(f"mesh generator '{gen['name']}' is not available ({exc})",
+            raise case.error(f"mesh generator '{gen.name}' is not available ({exc})",
                              ("model", "fe", "generator", "name")) from None
         except TypeError as exc:
             raise case.error(f"generator rejected a parameter: {exc}",

@@ -59,11 +59,11 @@ def pair_contact(case, mesh, index, normals_all, pairs=None):
     (a deck's GRID ids: :func:`sarfe.pipeline.model.deck_model.grid_pairs`), else the case's."""
     from scipy.spatial import cKDTree   # (scipy.spatial costs ~0.3 s to import: pairing only)
 
-    contact = case.config.contacts[index].params
+    contact = case.config.contacts[index]
     p = ("contacts", index)
     points = mesh.points
-    if "pairs" in contact:
-        pairs = contact["pairs"] if pairs is None else pairs
+    if contact.pairs is not None:
+        pairs = contact.pairs if pairs is None else pairs
         for j, (na, nb) in enumerate(pairs):
             for k, node in enumerate((na, nb)):
                 if node == "ground":
@@ -76,14 +76,14 @@ def pair_contact(case, mesh, index, normals_all, pairs=None):
         a = np.array([q[0] for q in pairs], dtype=int)
         b = np.array([-1 if q[1] == "ground" else q[1] for q in pairs], dtype=int)
     else:
-        group_a, group_b = contact["between"]
+        group_a, group_b = contact.between
         a = resolve_node_group(case, mesh, group_a, p + ("between", 0))
         if group_b == "ground":
             b = np.full(len(a), -1)
         else:
             nodes_b = resolve_node_group(case, mesh, group_b, p + ("between", 1))
             distance, nearest = cKDTree(points[nodes_b]).query(points[a])
-            tolerance = contact["pairing_tolerance_m"]
+            tolerance = contact.pairing_tolerance_m
             far = distance > tolerance * (1 + 1e-9) + 1e-12
             if np.any(far):
                 worst = int(np.argmax(distance))
@@ -94,7 +94,7 @@ def pair_contact(case, mesh, index, normals_all, pairs=None):
             b = nodes_b[nearest]
     offset = np.where(b[:, None] >= 0, points[np.maximum(b, 0)] - points[a], 0.0)
     separation = np.linalg.norm(offset, axis=1)
-    if contact["normal"] == "auto":
+    if contact.normal == "auto":
         normal = normals_all[a].copy()
         if np.any(np.linalg.norm(normal, axis=1) < 0.5):
             raise case.error("node(s) with no surface normal (not on any shell triangle); give "
@@ -103,7 +103,7 @@ def pair_contact(case, mesh, index, normals_all, pairs=None):
         flip = apart & (np.einsum("ij,ij->i", normal, offset) < 0)
         normal[flip] *= -1.0
     else:
-        vector = np.asarray(contact["normal"], dtype=float)
+        vector = np.asarray(contact.normal, dtype=float)
         length = np.linalg.norm(vector)
         if length == 0 or not np.isfinite(length):
             raise case.error("normal vector must be non-zero", p + ("normal",))

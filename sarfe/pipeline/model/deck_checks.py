@@ -71,8 +71,8 @@ def support_mask(case: Case, deck, mesh) -> np.ndarray:
     """(n, 6) bool held components, in each node's displacement (CD) frame, from the chosen
     support sets (all of the deck's when ``supports`` is not given; ``permanent`` GRID PS
     always) and the ``fixed`` node groups (all six components)."""
-    fe = case.config.model.fe.data
-    chosen = [str(s) for s in fe.get("supports", [])] or sorted(deck.supports)
+    fe = case.config.model.fe
+    chosen = [str(s) for s in fe.deck.supports] or sorted(deck.supports)
     if "permanent" in deck.supports and "permanent" not in chosen:
         chosen.append("permanent")
     held = np.zeros((deck.n_nodes, 6), dtype=bool)
@@ -83,7 +83,7 @@ def support_mask(case: Case, deck, mesh) -> np.ndarray:
                              ("model", "fe", "supports", j))
         support = deck.supports[name]
         held[support.nodes] |= support.components
-    for i, group in enumerate(fe.get("fixed", [])):
+    for i, group in enumerate(fe.fixed):
         nodes = resolve_node_group(case, mesh, group, ("model", "fe", "fixed", i),
                                    allow_elements=False)
         held[nodes] = True
@@ -186,13 +186,13 @@ def ignored_mass(case: Case, ignored: dict) -> dict:
     None per card for an Abaqus file (not computed)."""
     if not ignored:
         return {}
-    fe = case.config.model.fe.data
-    path = case.resolve(fe["deck"])
+    deck_config = case.config.model.fe.deck
+    path = case.resolve(deck_config.file)
     if path.suffix.lower() == ".inp":
         return {card: None for card in ignored}
     model = load_bdf(path)
     wtmass = model.params["WTMASS"].values[0] if "WTMASS" in model.params else 1.0
-    scale = UNIT_SYSTEMS[fe["units"]].factor(0, 1) * wtmass
+    scale = UNIT_SYSTEMS[deck_config.units].factor(0, 1) * wtmass
     masses = {}
     for card in ignored:
         key = card_key(card)
@@ -343,8 +343,8 @@ def check_units(case: Case, deck) -> None:
     findings = unit_findings(deck)
     if not findings:
         return
-    fe = case.config.model.fe.data
-    units, path = fe["units"], case.resolve(fe["deck"])
+    deck_config = case.config.model.fe.deck
+    units, path = deck_config.units, case.resolve(deck_config.file)
     quantity, table, row, value = findings[0]
     suggestion = suggested_units(deck, units)
     hint = (f"the deck looks like {suggestion}: set model.fe.units: {suggestion}" if suggestion

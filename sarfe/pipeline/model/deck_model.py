@@ -42,13 +42,13 @@ from sarfe.pipeline.model.deck_springs import hysteretic_spring, springs_to_cont
 # ----------------------------------------------------------------------------------- reading
 def read_case_deck(case: Case):
     """The case's deck in SI, ``ignore_cards`` applied; errors name model.fe.deck."""
-    fe = case.config.model.fe.data
-    path = case.resolve(fe["deck"])
+    deck_config = case.config.model.fe.deck
+    path = case.resolve(deck_config.file)
     try:
         if path.suffix.lower() == ".inp":
-            deck = to_si(read_abaqus(path), fe["units"])
+            deck = to_si(read_abaqus(path), deck_config.units)
         else:
-            deck = read_nastran(path, units=fe["units"])
+            deck = read_nastran(path, units=deck_config.units)
     except DeckError as exc:
         raise case.error(str(exc), DECK_KEY) from None
     return apply_ignore_cards(case, deck)
@@ -57,7 +57,7 @@ def read_case_deck(case: Case):
 def apply_ignore_cards(case: Case, deck):
     """Move the cards named in ``ignore_cards`` from ``unsupported`` to ``ignored``; any card
     left unsupported is an error listing every such card with its count."""
-    ignore = {card_key(c): c for c in case.config.model.fe.data["ignore_cards"]}
+    ignore = {card_key(c): c for c in case.config.model.fe.deck.ignore_cards}
     unsupported, ignored = {}, dict(deck.ignored)
     for card, count in deck.unsupported.items():
         (ignored if card_key(card) in ignore else unsupported)[card] = count
@@ -128,14 +128,14 @@ def deck_panel_mesh(case: Case, deck):
     """PanelMesh view of the deck: every deck node a point (index = deck node index), the shell
     triangles, node groups = deck node sets + ``model.fe.node_groups`` (+ the nodes of each
     element group), element groups = triangles of deck element sets + ``element_groups``."""
-    fe = case.config.model.fe.data
+    deck_config = case.config.model.fe.deck
     shells = deck.shells
     node_groups = {name: np.asarray(nodes) for name, nodes in deck.node_sets.items()}
     element_groups = {}
     element_sets = dict(deck.element_sets)
-    for name, value in fe["node_groups"].items():
+    for name, value in deck_config.node_groups.items():
         node_groups[name] = _ids_or_set(case, deck, value, ("model", "fe", "node_groups", name), "node")
-    for name, value in fe["element_groups"].items():
+    for name, value in deck_config.element_groups.items():
         element_sets[name] = _ids_or_set(case, deck, value, ("model", "fe", "element_groups", name),
                                          "element")
     for name, ids in element_sets.items():
@@ -151,8 +151,8 @@ def apply_overrides(case: Case, deck, mesh):
     """Shell sections of the element groups named in ``materials`` / ``thickness_m`` replaced by
     isotropic ones: A = t Q, B = 0, D = t³/12 Q, ρ t (later keys win; the deck's own elsewhere).
     A thickness alone keeps the deck's material (A, B, D and mass scaled by t'/t, (t'/t)³)."""
-    fe = case.config.model.fe.data
-    materials, thickness = fe.get("materials", {}), fe.get("thickness_m", {})
+    fe = case.config.model.fe
+    materials, thickness = fe.materials, fe.thickness_m
     if not materials and not thickness:
         return deck
     s = deck.shells
@@ -180,7 +180,7 @@ def apply_overrides(case: Case, deck, mesh):
         t[rows] = value
     for name, material in materials.items():
         rows = rows_of("materials", name)
-        E, nu, rho = material["E_Pa"], material["nu"], material["rho_kg_m3"]
+        E, nu, rho = material.E_Pa, material.nu, material.rho_kg_m3
         q = E / (1 - nu**2) * np.array([[1, nu, 0], [nu, 1, 0], [0, 0, (1 - nu) / 2]])
         membrane[rows] = t[rows, None, None] * q
         coupling[rows] = 0.0
@@ -198,12 +198,12 @@ def grid_pairs(case: Case, deck) -> dict:
     out = {}
     for contact in case.config.contacts:
         i = contact.index
-        if "pairs" not in contact.params:
+        if contact.pairs is None:
             continue
         out[i] = [[grid if grid == "ground" else
                    int(_node_indices(case, deck, [grid], ("contacts", i, "pairs", j, k))[0])
                    for k, grid in enumerate(pair)]
-                  for j, pair in enumerate(contact.params["pairs"])]
+                  for j, pair in enumerate(contact.pairs)]
     return out
 
 
@@ -252,14 +252,14 @@ def prepare_deck(case: Case) -> PreparedDeck:
     if free:
         raise case.error("the structure is not held after the supports: " + "; ".join(free)
                          + " (check model.fe.supports / fixed)", ("model", "fe", "supports"))
-    fe = case.config.model.fe.data
-    notes = {"deck": str(case.resolve(fe["deck"])),
-             "units": fe["units"],
+    deck_config = case.config.model.fe.deck
+    notes = {"deck": str(case.resolve(deck_config.file)),
+             "units": deck_config.units,
              "ignored_cards": dict(deck.ignored),
              "ignored_mass_kg": ignored_mass(case, deck.ignored),
              "coincident_nodes": [list(p) for p in quality["coincident_nodes"][:50]],
              "coincident_node_pairs": len(quality["coincident_nodes"]),
-             "support_sets": [str(s) for s in fe.get("supports", [])]
+             "support_sets": [str(s) for s in deck_config.supports]
              or sorted(deck.supports),
              "contact_elements": {k: v.element_ids.tolist() for k, v in element_contacts.items()},
              "deck_notes": list(deck.notes)}

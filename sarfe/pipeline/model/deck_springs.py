@@ -48,11 +48,12 @@ def springs_to_contacts(case: Case, deck):
     springs = deck.springs
     remove = np.zeros(len(springs.element_ids), dtype=bool)
     contacts, warnings = {}, []
-    for i, kind, contact in ((c.index, c.kind, c.params) for c in case.config.contacts):
-        if "from_elements" not in contact:
+    for contact in case.config.contacts:
+        i, kind = contact.index, contact.kind
+        if contact.from_elements is None:
             continue
         p = ("contacts", i, "from_elements")
-        ids = np.asarray(contact["from_elements"], dtype=np.int64)
+        ids = np.asarray(contact.from_elements, dtype=np.int64)
         rows = np.array([np.flatnonzero(springs.element_ids == e)[:1] for e in ids], dtype=object)
         missing = [int(e) for e, r in zip(ids, rows) if len(r) == 0]
         if missing:
@@ -63,8 +64,8 @@ def springs_to_contacts(case: Case, deck):
         refuse_what_a_contact_cannot_carry(case, springs, rows, p)
         remove[rows] = True
         k = springs.stiffness[rows, :3]
-        if "element_axis" in contact:
-            axis = np.full(len(rows), contact["element_axis"] - 1)
+        if contact.element_axis is not None:
+            axis = np.full(len(rows), contact.element_axis - 1)
         else:
             axis = np.argmax(k, axis=1)
             tied = np.sum(np.isclose(k, k.max(axis=1, keepdims=True), rtol=1e-12), axis=1) > 1
@@ -79,13 +80,13 @@ def springs_to_contacts(case: Case, deck):
         others = np.ones((len(rows), 3), dtype=bool)
         others[np.arange(len(rows)), axis] = False
         k_t = k[others].reshape(len(rows), 2).mean(axis=1)
-        if np.any(k_t > 0) and not laws.uses_tangent(laws.law(kind), contact):
+        if np.any(k_t > 0) and not laws.uses_tangent(laws.law(kind), contact.params):
             r = int(np.argmax(k_t))
-            warnings.append(f"contacts[{i}] ({contact['name']}): a {kind} contact has no "
+            warnings.append(f"contacts[{i}] ({contact.name}): a {kind} contact has no "
                             f"tangential stiffness: the cross-axis stiffness of its springs "
                             f"(up to {float(k_t[r]):g} N/m, {spring_name(springs, rows[r])}) "
                             "leaves the model; type: squeak keeps it as the stick stiffness")
-        contacts[contact["name"]] = ElementContact(ids, springs.node_a[rows], springs.node_b[rows],
+        contacts[contact.name] = ElementContact(ids, springs.node_a[rows], springs.node_b[rows],
                                                    frame_from_normal(normal), k_n, k_t)
     if not remove.any():
         return deck, contacts, warnings

@@ -54,7 +54,7 @@ def _kept_translations(case, system, deck, nodes, path):
 
 
 def _load_set_vector(case, system, deck, load, path):
-    name = str(load["load_set"])
+    name = str(load.load_set)
     if name not in deck.loads:
         raise case.error(f"load set '{name}' not in the deck (available: "
                          f"{', '.join(sorted(deck.loads)) or 'none'})", path)
@@ -151,8 +151,8 @@ def build_deck_stage(case: Case, progress=False) -> dict:
     paired = contact_pairs(case, prepared)
     exc = case.config.excitation
     forces = exc.forces
-    group_nodes = [None if "load_set" in f else
-                   resolve_node_group(case, mesh, f["group"], ("excitation", "forces", i, "group"))
+    group_nodes = [None if f.load_set is not None else
+                   resolve_node_group(case, mesh, f.group, ("excitation", "forces", i, "group"))
                    for i, f in enumerate(forces)]
     radiating = deck_surface_triangles(case, mesh)
 
@@ -177,7 +177,7 @@ def build_deck_stage(case: Case, progress=False) -> dict:
                                      + [np.zeros(0, np.int64)]).astype(np.int64))
     boundary_kept = _kept_translations(case, system, deck, nodes, ("contacts",)).ravel()
     set_vectors = [(_load_set_vector(case, system, deck, f, ("excitation", "forces", i, "load_set"))
-                    if "load_set" in f else None) for i, f in enumerate(forces)]
+                    if f.load_set is not None else None) for i, f in enumerate(forces)]
     loaded = np.unique(np.concatenate([np.flatnonzero(v) for v in set_vectors if v is not None]
                                       + [np.zeros(0, np.int64)]))
     residual_loads = []
@@ -193,7 +193,7 @@ def build_deck_stage(case: Case, progress=False) -> dict:
 
     base_load = None
     if exc.base_acceleration is not None:   # rigid translation ι in the kept (CD) DOFs; −M ι
-        direction = np.asarray(exc.base_acceleration["direction"], dtype=float)
+        direction = np.asarray(exc.base_acceleration.direction, dtype=float)
         local = np.einsum("nij,j->ni", deck.displacement_frames, direction)
         iota = np.where(system.dof_components < 3,
                         local[system.dof_nodes, np.minimum(system.dof_components, 2)], 0.0)
@@ -224,7 +224,7 @@ def build_deck_stage(case: Case, progress=False) -> dict:
         c = coords_of(nodes_i)
         for comp in range(3):
             ok = c[:, comp] >= 0
-            np.add.at(loads[i], c[ok, comp], load["direction"][comp] / len(nodes_i))
+            np.add.at(loads[i], c[ok, comp], load.direction[comp] / len(nodes_i))
     base = reduced_load(base_load) if base_load is not None else None
 
     added_damping = None

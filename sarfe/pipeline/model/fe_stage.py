@@ -35,7 +35,7 @@ def mesh_groups(case, mesh) -> tuple:
     fixed = fixed_nodes(case, mesh)
     normals_all = nodal_normals(mesh.points, mesh.triangles)
     paired = {c.name: pair_contact(case, mesh, c.index, normals_all) for c in config.contacts}
-    load_nodes = [resolve_node_group(case, mesh, f["group"], ("excitation", "forces", i, "group"))
+    load_nodes = [resolve_node_group(case, mesh, f.group, ("excitation", "forces", i, "group"))
                   for i, f in enumerate(config.excitation.forces)]
     return fixed, paired, load_nodes, surface_triangles(case, mesh)
 
@@ -83,7 +83,7 @@ def base_load(excitation, n_nodes, m_ff, free):
         return None
     iota = np.zeros(6 * n_nodes)
     for comp in range(3):
-        iota[6 * np.arange(n_nodes) + comp] = excitation.base_acceleration["direction"][comp]
+        iota[6 * np.arange(n_nodes) + comp] = excitation.base_acceleration.direction[comp]
     return -(m_ff @ iota[free])
 
 
@@ -146,7 +146,7 @@ def load_vectors(excitation, load_nodes, coords_of, reduced, base) -> tuple:
     loads = np.zeros((len(load_nodes), n_r))
     for i, (nodes, load) in enumerate(zip(load_nodes, excitation.forces)):
         c = coords_of(nodes)
-        direction = np.asarray(load["direction"])
+        direction = np.asarray(load.direction)
         for comp in range(3):
             ok = c[:, comp] >= 0
             np.add.at(loads[i], c[ok, comp], direction[comp] / len(nodes))

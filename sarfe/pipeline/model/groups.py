@@ -45,7 +45,7 @@ def fixed_nodes(case, mesh) -> np.ndarray:
     """The nodes of the groups of ``model.fe.fixed`` (node groups only), sorted and unique."""
     return np.unique(np.concatenate([
         resolve_node_group(case, mesh, g, ("model", "fe", "fixed", i), allow_elements=False)
-        for i, g in enumerate(case.config.model.fe.data["fixed"])]))
+        for i, g in enumerate(case.config.model.fe.fixed)]))
 
 
 def triangle_owners(case, mesh, mapping, key):
@@ -85,16 +85,16 @@ class ShellProperties:
 def shell_properties(case, mesh) -> ShellProperties:
     """Per-triangle section from ``model.fe.materials`` and ``model.fe.thickness_m`` (element
     groups → values, :func:`triangle_owners`; the materials' groups are checked first)."""
-    fe = case.config.model.fe.data
-    materials, thickness = fe["materials"], fe["thickness_m"]
+    fe = case.config.model.fe
+    materials, thickness = fe.materials, fe.thickness_m
     mat_owner = triangle_owners(case, mesh, materials, "materials")
     thick_owner = triangle_owners(case, mesh, thickness, "thickness_m")
     mats = list(materials.values())
     return ShellProperties(
         thickness=np.array(list(thickness.values()), dtype=float)[thick_owner],
-        young=np.array([m["E_Pa"] for m in mats])[mat_owner],
-        poisson=np.array([m["nu"] for m in mats])[mat_owner],
-        density=np.array([m["rho_kg_m3"] for m in mats])[mat_owner])
+        young=np.array([m.E_Pa for m in mats])[mat_owner],
+        poisson=np.array([m.nu for m in mats])[mat_owner],
+        density=np.array([m.rho_kg_m3 for m in mats])[mat_owner])
 
 
 __all__ = ["available", "resolve_node_group", "fixed_nodes", "triangle_owners",

@@ -88,24 +88,25 @@ def build_matrices_stage(case) -> dict:
         word = str(exc).split()[0]
         key = word if word in ("mass", "stiffness", "damping") else "mass"
         raise case.error(str(exc), ("model", "matrices", key)) from None
-    for i, contact in ((c.index, c.params) for c in config.contacts):
-        refs = ([("normal_dof", contact["normal_dof"])] if "normal_dof" in contact else []) + [
-            (("tangential_dofs", j), t) for j, t in enumerate(contact.get("tangential_dofs", []))]
+    for contact in config.contacts:
+        i = contact.index
+        refs = ([(("normal_dof",), contact.normal_dof)] if contact.normal_dof is not None else []) \
+            + [(("tangential_dofs", j), t) for j, t in enumerate(contact.tangential_dofs)]
         for key, ref in refs:
-            key = key if isinstance(key, tuple) else (key,)
-            check_dof(case, ref["dof"], n, ("contacts", i) + key + ("dof",))
-            check_dof(case, ref["relative_to"], n, ("contacts", i) + key + ("relative_to",))
-            if ref["relative_to"] == ref["dof"]:
+            check_dof(case, ref.dof, n, ("contacts", i) + key + ("dof",))
+            check_dof(case, ref.relative_to, n, ("contacts", i) + key + ("relative_to",))
+            if ref.relative_to == ref.dof:
                 raise case.error("a DOF cannot be relative to itself",
                                  ("contacts", i) + key + ("relative_to",))
     exc = config.excitation
     loads = np.zeros((len(exc.forces), n))
     for i, load in enumerate(exc.forces):
-        check_dof(case, load["dof"], n, ("excitation", "forces", i, "dof"))
-        loads[i, load["dof"]] = 1.0
+        check_dof(case, load.dof, n, ("excitation", "forces", i, "dof"))
+        loads[i, load.dof] = 1.0
     base = None
     if exc.base_acceleration is not None:
-        influence = np.asarray(exc.base_acceleration.get("influence", np.ones(n)), dtype=float)
+        influence = exc.base_acceleration.influence           # ι, all ones when not given
+        influence = np.ones(n) if influence is None else np.asarray(influence, dtype=float)
         if influence.shape != (n,):
             raise case.error(f"needs {n} entries (one per DOF), got {len(influence)}",
                              ("excitation", "base_acceleration", "influence"))

@@ -50,24 +50,25 @@ def _case_damping(damping: DampingConfig, stage: LinearStage):
     if stage.damping is not None:
         return stage.damping
     if damping.rayleigh is not None:
-        return damping.rayleigh["alpha_1_s"] * M + damping.rayleigh["beta_s"] * K
+        return damping.rayleigh.alpha_1_s * M + damping.rayleigh.beta_s * K
     n = M.shape[0]
     zeta = 0.0 if damping.modal_zeta is None else damping.modal_zeta
-    if isinstance(zeta, tuple):         # per mode range: ({modes: [first, last], zeta}, …)
-        values = np.full(n, zeta[-1]["zeta"])
+    if isinstance(zeta, tuple):         # per mode range: (ModalZetaRange, …)
+        values = np.full(n, zeta[-1].zeta)
         for entry in zeta:
-            first, last = entry["modes"]
-            values[first - 1:min(last, n)] = entry["zeta"]
+            first, last = entry.modes
+            values[first - 1:min(last, n)] = entry.zeta
         zeta = values
     dense = (lambda A: A.toarray() if sp.issparse(A) else np.asarray(A))
     return modal_damping(dense(M), dense(K), zeta)
 
 
 def _dof_row(ref, n):
+    """(n,) row r of a :class:`~sarfe.case.config.DofReference`: r·u = sign (u[dof] − u[relative_to])."""
     row = np.zeros(n)
-    row[ref["dof"]] += ref["sign"]
-    if ref["relative_to"] != "ground":
-        row[ref["relative_to"]] -= ref["sign"]
+    row[ref.dof] += ref.sign
+    if ref.relative_to != "ground":
+        row[ref.relative_to] -= ref.sign
     return row
 
 
@@ -113,9 +114,9 @@ def build_contacts(case: Case, stage: LinearStage):
             has_normal = True
         else:
             pairs = 1
-            has_normal = "normal_dof" in contact
-            normal_row.append(add_row(_dof_row(contact["normal_dof"], n)) if has_normal else -1)
-            t = [add_row(_dof_row(ref, n)) for ref in contact.get("tangential_dofs", [])]
+            has_normal = entry.normal_dof is not None
+            normal_row.append(add_row(_dof_row(entry.normal_dof, n)) if has_normal else -1)
+            t = [add_row(_dof_row(ref, n)) for ref in entry.tangential_dofs]
             tangent_rows.append((t + [-1, -1])[:2])
             share = 1.0
         values = {}
@@ -141,10 +142,10 @@ def build_contacts(case: Case, stage: LinearStage):
                                                               dtype=float)
         if not has_normal:
             g = np.zeros(pairs)
-            values["normal_load"] = contact["preload_N"] * share
-        elif "gap_m" in contact:
-            g = np.full(pairs, float(contact["gap_m"]))
-        elif "preload_N" in contact:    # set by preload_gaps below
+            values["normal_load"] = entry.preload_N * share
+        elif entry.gap_m is not None:
+            g = np.full(pairs, float(entry.gap_m))
+        elif entry.preload_N is not None:    # set by preload_gaps below
             g = np.zeros(pairs)
         else:  # FE default: the geometric gap of each node pair along its normal
             g = np.asarray(stage.contacts[name].distances, dtype=float)
@@ -153,11 +154,11 @@ def build_contacts(case: Case, stage: LinearStage):
         for key in table:
             value = values.get(key, np.nan)
             table[key] += list(per_pair[key]) if key in per_pair else [value] * pairs
-        kind += [contact["type"]] * pairs
+        kind += [entry.kind] * pairs
         gap += list(g)
-        tolerance += [contact["tolerance_m"]] * pairs
+        tolerance += [entry.tolerance_m] * pairs
         names += [name] if pairs == 1 else [f"{name}[{p}]" for p in range(pairs)]
-        groups.append((name, contact["type"], np.arange(start, len(kind))))
+        groups.append((name, entry.kind, np.arange(start, len(kind))))
     G = sp.csr_matrix(np.array(rows).reshape(len(rows), n))
     gap = np.array(gap, dtype=float)
     normal_row = np.array(normal_row, dtype=int)
@@ -169,8 +170,8 @@ def build_contacts(case: Case, stage: LinearStage):
     contacts = make_contact_set(G, np.array(kind, dtype=object), normal_row,
                                 np.array(tangent_rows, dtype=int).reshape(-1, 2), gap,
                                 names=names, parameters=parameters)
-    preloaded = [(idx, c["preload_N"]) for c, (_, _, idx) in zip(case.config.contacts, groups)
-                 if "preload_N" in c.params and "gap_m" not in c.params
+    preloaded = [(idx, c.preload_N) for c, (_, _, idx) in zip(case.config.contacts, groups)
+                 if c.preload_N is not None and c.gap_m is None
                  and np.all(normal_row[idx] >= 0)]
     if preloaded:
         contacts = dataclasses.replace(contacts, gap=preload_gaps(
@@ -258,10 +259,10 @@ def excitation_amplitude(excitation: ExcitationConfig, stage: LinearStage) -> np
     """F̂ (n,) complex [N]: f_e(θ) = Re(F̂ e^{iθ})."""
     amplitude = np.zeros(stage.dof_count, dtype=complex)
     for load, vector in zip(excitation.forces, stage.load_vectors):
-        amplitude += load["force_N"] * np.exp(1j * math.radians(load["phase_deg"])) * vector
+        amplitude += load.force_N * np.exp(1j * math.radians(load.phase_deg)) * vector
     if excitation.base_acceleration is not None:
         base = excitation.base_acceleration
-        amplitude += (base["amplitude_m_s2"] * np.exp(1j * math.radians(base["phase_deg"]))
+        amplitude += (base.amplitude_m_s2 * np.exp(1j * math.radians(base.phase_deg))
                       * stage.base_vector)
     return amplitude
 

@@ -32,18 +32,15 @@ from sarfe.hbm.pruning import (CLOSED, NONLINEAR, OPEN, check_pruning, linearize
 from sarfe.pipeline.model.nonlinear_model import NonlinearModel
 from sarfe.pipeline.solve.points import TIME_INTEGRATION, solve_point, solve_points, solver_options
 
-DEFAULT_MARGIN = 0.5
 SWEEP_GRID_POINTS = 201
 MAX_LISTED = 20          # violations listed in the report (all are counted)
 MAX_DENSE_EIGEN = 3000   # DOFs up to which the linearized natural frequencies are computed (dense)
 
 
 def pruning_options(solver: SolverConfig) -> tuple:
-    """(enabled, margin m) from ``solver.prune_contacts``: true | false | {margin: m}."""
-    value = solver.prune_contacts
-    if isinstance(value, dict):
-        return True, float(value.get("margin", DEFAULT_MARGIN))
-    return bool(value), DEFAULT_MARGIN
+    """(enabled, margin m) from ``solver.prune_contacts`` (true | false | {margin: m}; the margin's
+    default: :class:`sarfe.case.config.SolverConfig` ``prune_margin``)."""
+    return solver.prune_contacts, solver.prune_margin
 
 
 def linearized_natural_frequencies(model, contacts) -> np.ndarray:
