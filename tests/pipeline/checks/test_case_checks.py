@@ -11,7 +11,7 @@ import yaml
 
 from sarfe.case.read import CaseLoader, load_case
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 CASES = ROOT / "cases"
 
 
@@ -131,7 +131,7 @@ def test_gap_far_above_the_shell_thickness_warns(tmp_path, gap, warned):
         assert found[0].startswith(f"contacts[0] (tip): gap_m = {gap:g} m is ")
         assert "10 × the thickest shell, thickness_m = 0.0025 m" in found[0]
         assert ("overclosure" in found[0]) == (gap < 0)
-    assert load_case(tmp_path / "case.yaml").config.contacts[0].params["gap_m"] == gap
+    assert load_case(tmp_path / "case.yaml").config.contacts[0].gap_m == gap
 
 
 def test_gap_of_a_matrices_contact_is_judged_by_its_tolerance(tmp_path):
