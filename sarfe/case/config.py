@@ -184,7 +184,7 @@ class ReductionConfig:
     first-harmonic amplitudes by ≤ 1.7e-4, every response harmonic by ≤ 3.1e-4 and the ERP by
     ≤ 0.012 dB(A) against 2 H f_max (1.5 at 5 mm); 0.75 H f_max moves them by 1.5e-3 /
     0.023 dB(A) (harmonics above the cutoff have no modes to live in). The per-point estimate's
-    modal part (two probes, decay fitted: sarfe.accuracy.estimates (5)) brackets those changes
+    modal part (two probes, decay fitted: sarfe.accuracy.modal_truncation) brackets those changes
     at every point from 0.75 H f_max up and over-reports at H f_max by ≤ 12× (amplitude and
     dB), resolution floor included (the earlier single probe of the top fifth: 34× / 35×, which
     kept the margin at 1.25; benchmarks/results/modal_estimate.md)."""
@@ -305,7 +305,7 @@ class SolverConfig:
     """solver: harmonics H, samples_per_period N, Newton options, continuation, accuracy.
     ``resolution`` 'auto' (H, N, modes chosen for ``accuracy``) | 'fixed' (harmonics given).
     ``accuracy``: a preset 'fast' | 'balanced' | 'fine' or a target {erp_db, amplitude_rel}
-    (:func:`sarfe.accuracy.estimates.parse_accuracy`), None: 'balanced'. ``harmonic_set`` 'all' |
+    (:func:`sarfe.accuracy.target.parse_accuracy`), None: 'balanced'. ``harmonic_set`` 'all' |
     'odd' | 'auto' (:mod:`sarfe.hbm.harmonic_set`). ``prune_contacts``: contacts that never switch
     are solved linearly, with the clearance margin ``prune_margin`` (:mod:`sarfe.pipeline.solve.
     pruned_points`). ``workers`` 'auto' | n: processes for the per-point work after Newton

@@ -249,7 +249,7 @@ ESTIMATE_STRIDE = 8     # a sweep's estimate is computed at every 8th converged 
 
 
 def _error_estimate(solver: SolverConfig, stage, nl, solution):
-    """A-posteriori error estimate of a converged point (:mod:`sarfe.accuracy.estimates`): harmonic
+    """A-posteriori error estimate of a converged point (:mod:`sarfe.accuracy.estimate`): harmonic
     truncation (H → H' and N → N' solved by condensed Newton from the point, usually 1–4
     iterations), AFT aliasing (N → 2N, likewise), modal truncation (the same on the cached coarser
     Craig–Bampton model), spectral tails. None when switched off, not converged or without

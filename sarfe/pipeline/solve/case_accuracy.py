@@ -41,7 +41,7 @@ def accuracy_problem(stage, nl) -> EstimateProblem:
 
 
 def stage_error_estimate(solution, stage, nl):
-    """:func:`sarfe.accuracy.estimates.problem_error_estimate` of a case's point."""
+    """:func:`sarfe.accuracy.estimate.problem_error_estimate` of a case's point."""
     return problem_error_estimate(solution, accuracy_problem(stage, nl))
 
 
