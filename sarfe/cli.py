@@ -20,7 +20,7 @@ from sarfe.batch import cli as batch_cli
 from sarfe.case.errors import EXIT_CASE_ERROR, EXIT_NOT_CONVERGED, CaseError
 from sarfe.pipeline import build_linear_model, load_case, nonlinear_model, results_table, solve_case
 from sarfe.pipeline.checks.case_checks import check_case, output_target
-from sarfe.pipeline.solve.verify import format_rows, verify_point
+from sarfe.pipeline.verify import format_rows, verify_point
 from sarfe.results.summary import loudest_lines, pruning_line, stability_line
 from sarfe.tradeoff import cli as tradeoff_cli
 
@@ -96,7 +96,7 @@ def cmd_validate(args) -> int:
 def cmd_verify(args) -> int:
     """Time integration of one point against the harmonic balance: every harmonic up to H, contact
     and largest-DOF amplitudes, ERP total and dB(A), and the stability verdict (a perturbation of
-    the HBM orbit decays or grows), each with its tolerance (:mod:`sarfe.pipeline.solve.verify`)."""
+    the HBM orbit decays or grows), each with its tolerance (:mod:`sarfe.pipeline.verify`)."""
     if not args.frequency_hz > 0:
         raise CaseError(f"--frequency-hz must be > 0, got {args.frequency_hz}", source=args.case)
     case = load_case(args.case)

@@ -346,7 +346,7 @@ def true_errors(stage, solution, ref_stage, ref):
 def shipped_solutions(name, spec):
     """Solutions of one shipped case at its own, coarser and reference settings (picklable dict)."""
     from sarfe.pipeline import load_case
-    from sarfe.pipeline.model.linear_stage import default_cutoff_hz
+    from sarfe.pipeline.model.cutoff import default_cutoff_hz
 
     base = load_case(ROOT / "cases" / f"{name}.yaml")
     H0, N0 = base.data["solver"]["harmonics"], base.data["solver"]["samples_per_period"]

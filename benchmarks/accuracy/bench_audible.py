@@ -62,7 +62,7 @@ def cutoff_study():
     from sarfe.hbm import SolverOptions, solve_frequency
     from sarfe.case.read import load_case
     from sarfe.pipeline import build_linear_model, nonlinear_model
-    from sarfe.pipeline.post.records import _erp
+    from sarfe.pipeline.post.records import point_erp as _erp
 
     omega = 2 * np.pi * F_HZ
     options = SolverOptions(stability=False)

@@ -78,7 +78,7 @@ def first_harmonic_rel(R, R_ref):
 
 
 def erp_of(case, stage, U, omega):
-    from sarfe.pipeline.post.records import _erp
+    from sarfe.pipeline.post.records import point_erp as _erp
 
     erp, W = _erp(case.config.erp, stage, U, omega)
     return erp, W

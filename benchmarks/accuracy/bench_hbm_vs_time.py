@@ -155,7 +155,7 @@ class Metrics:
 
     def level(self, U, omega):
         """(total ERP level [dB], A-weighted [dB(A)])."""
-        from sarfe.pipeline.post.records import _erp
+        from sarfe.pipeline.post.records import point_erp as _erp
 
         result = _erp(self.erp_config, self.stage, U, omega)[0]
         return float(result.level_total_db), float(result.level_total_a_db)

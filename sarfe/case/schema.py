@@ -3,9 +3,11 @@
 Every object has ``additionalProperties: false`` so a misspelt key is an error. Physical ranges
 (E > 0, 0 ≤ μ, −1 < ν < 0.5, f > 0, H ≥ 1 …) are checked here; cross-key rules (exactly one of
 two keys, node groups present in the mesh, pairing within tolerance) are checked in
-:mod:`sarfe.case.read`. Defaults are applied in :func:`sarfe.case.read.normalize`.
+:mod:`sarfe.case.normalize`. Defaults are applied in :func:`sarfe.case.normalize.normalize`.
 """
 from __future__ import annotations
+
+from sarfe.hbm import laws
 
 
 def _object(properties, required=(), **extra):
@@ -65,7 +67,7 @@ FE_MODEL = _object({
     "materials": {"type": "object", "minProperties": 1, "additionalProperties": MATERIAL},
     "thickness_m": {"type": "object", "minProperties": 1, "additionalProperties": POSITIVE},
     "fixed": {"type": "array", "items": NAME, "minItems": 1},
-})   # materials, thickness_m and fixed are required with mesh/generator (sarfe.case.read)
+})   # materials, thickness_m and fixed are required with mesh/generator (sarfe.case.normalize)
 
 MATRICES_MODEL = _object({
     "mass": MATRIX,
@@ -106,9 +108,7 @@ def _law_key_schema(parameter):
 
 def contact_schema():
     """The contact object: geometry keys, then every registered law's keys from its declaration
-    (:mod:`sarfe.hbm.laws`; which keys a type allows is checked in :mod:`sarfe.case.read`)."""
-    from sarfe.hbm import laws
-
+    (:mod:`sarfe.hbm.laws`; which keys a type allows is checked in :mod:`sarfe.case.normalize`)."""
     law_keys = {}
     for law in laws.LAWS.values():
         for parameter in law.case_parameters():
@@ -154,7 +154,7 @@ LOAD = _object({
     "direction": DIRECTION,
     "force_N": NUMBER,
     "phase_deg": NUMBER,
-})   # force_N is required except with load_set (sarfe.case.read)
+})   # force_N is required except with load_set (sarfe.case.normalize)
 
 EXCITATION = _object({
     "forces": {"type": "array", "items": LOAD, "minItems": 1},

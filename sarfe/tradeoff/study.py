@@ -77,7 +77,7 @@ def knob_levels(case, stage, knobs=None) -> dict:
             out["modes"] = [(f"modes={v}", v) for v in values]
     fe = config.model.fe
     if "mesh" in knobs and fe is not None and fe.source == "generator":
-        h = float(fe.data["generator"].get("mesh_size_m", 0) or 0)
+        h = float(fe.generator.mesh_size_m or 0)
         if h > 0:
             out["mesh"] = [(f"h={v * 1e3:.3g}mm", v) for v in (2 * h, h, h / math.sqrt(2), h / 2)]
     return out
@@ -382,7 +382,7 @@ def _is_baseline(case, stage, knob, value):
     if knob == "modes":
         return value == stage.info.get("modes")
     if knob == "mesh":
-        return value == config.model.fe.data["generator"].get("mesh_size_m")
+        return value == config.model.fe.generator.mesh_size_m
     return False
 
 

@@ -50,7 +50,7 @@ def _reference(problem, solution, H=40, N=4096):
 
 def _levels_db(case, stage, solution):
     """(ERP level [dB], A-weighted [dB(A)]) by sarfe.erp (the pipeline's ERP)."""
-    from sarfe.pipeline.post.records import _erp
+    from sarfe.pipeline.post.records import point_erp as _erp
 
     erp, _ = _erp(case.config.erp, stage, solution.displacement, float(solution.omega))
     return float(erp.level_total_db), float(erp.level_total_a_db)
@@ -116,18 +116,18 @@ def test_fe_search_stage_is_the_sweeps(monkeypatch):
     the chosen H or above — and the sweep reuses the last one; the point's dB(A) is within
     0.5 dB(A) of H = 64, N = 2048 on a stage with twice that cutoff (on this rig the impacts put
     the dB(A) level into high harmonics: the search climbs far)."""
-    import sarfe.pipeline.model.linear_stage as linear
     import sarfe.pipeline.run as solve_module
+    import sarfe.pipeline.solve.case_accuracy as search
     from sarfe.pipeline import load_case, solve_case
 
     builds = []
-    real = linear.build_linear_model
+    real = search.build_linear_model
 
     def counting(case, *args, **kwargs):
         builds.append(load_case(case))
         return real(case, *args, **kwargs)
 
-    monkeypatch.setattr(linear, "build_linear_model", counting)
+    monkeypatch.setattr(search, "build_linear_model", counting)
     monkeypatch.setattr(solve_module, "build_linear_model", counting)
     data = load_case(CASES / "rattle_rig.yaml").data
     data.pop("case_data", None)

@@ -14,7 +14,7 @@ import scipy.sparse as sp
 
 from sarfe.hbm.contacts import make_contact_set
 from sarfe.hbm.model import make_linear_model
-from sarfe.reduction.damping import reduced_modal_damping
+from sarfe.fe.damping import modal_damping as reduced_modal_damping
 
 MASS = np.diag([0.2, 0.5, 0.2])
 STIFFNESS = np.array([[2.0e4, 0.0, -2.0e3], [0.0, 2.0e5, 0.0], [-2.0e3, 0.0, 5.0e4]])

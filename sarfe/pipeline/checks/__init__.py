@@ -1,1 +1,4 @@
-"""Stage 1 of a case: every input check (case, mesh, deck) before any work."""
+"""Stage 1 of a case: every input check before any work — case_checks (check_case, the warnings
+for inputs far outside the model's range), mesh_checks (check_mesh / check_deck: groups, pairing,
+quality without assembly). The checks a deck's reading runs are part of building it
+(:mod:`sarfe.pipeline.model.deck_checks`)."""

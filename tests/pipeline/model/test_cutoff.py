@@ -34,7 +34,7 @@ def _case(reduction):
 def _solve(case):
     from sarfe.hbm import SolverOptions, solve_frequency
     from sarfe.pipeline import build_linear_model, nonlinear_model
-    from sarfe.pipeline.post.records import _erp
+    from sarfe.pipeline.post.records import point_erp
 
     stage = build_linear_model(case)
     nl = nonlinear_model(case, stage)
@@ -43,7 +43,7 @@ def _solve(case):
         s = solve_frequency(nl.model, nl.contacts, nl.excitation, 2 * np.pi * FREQUENCY_HZ,
                             HARMONICS, 256, options=SolverOptions(stability=False))
     assert s.converged
-    erp, _ = _erp(case.config.erp, stage, s.displacement, s.omega)
+    erp, _ = point_erp(case.config.erp, stage, s.displacement, s.omega)
     return stage, nl, s, erp
 
 
@@ -53,7 +53,7 @@ def test_default_cutoff_matches_twice_the_cutoff_and_the_estimate_brackets_it():
     from sarfe.accuracy.measures import first_harmonic_amplitude
     from sarfe.accuracy.modal_truncation import modal_truncation_estimate
     from sarfe.pipeline.solve.case_accuracy import accuracy_problem
-    from sarfe.pipeline.model.linear_stage import default_cutoff_hz
+    from sarfe.pipeline.model.cutoff import default_cutoff_hz
 
     default = _case({})
     assert default_cutoff_hz(default) == pytest.approx(1.0 * HARMONICS * FREQUENCY_HZ)

@@ -21,6 +21,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from sarfe.case.config import ErpConfig, SolverConfig
+from sarfe.hbm.stability.perturbation import perturbation_check
+from sarfe.hbm.time_integration import integrate_time
+from sarfe.pipeline.post.records import point_erp
+from sarfe.pipeline.solve.points import solve_point, solver_options
 
 
 @dataclass(frozen=True)
@@ -47,11 +51,6 @@ def verify_point(solver: SolverConfig, erp: ErpConfig, stage, nl, omega, toleran
 
     solver, erp: the case's sections (``case.config.solver``, ``case.config.erp``): H, N and the
     Newton options of the HBM point, the air and reference of the ERP rows."""
-    from sarfe.hbm.stability.perturbation import perturbation_check
-    from sarfe.hbm.time_integration import integrate_time
-    from sarfe.pipeline.solve.points import solve_point, solver_options
-    from sarfe.pipeline.post.records import _erp
-
     H, N = solver.harmonics, solver.samples_per_period
     options, _ = solver_options(solver)
     hbm = solve_point(nl, omega, H, N, options, None)
@@ -80,8 +79,8 @@ def verify_point(solver: SolverConfig, erp: ErpConfig, stage, nl, omega, toleran
     diff = _relative(amp_h[j], amp_t[j]) if amp_t[j] > 1e-15 else 0.0
     rows.append(Comparison(f"largest DOF ({j}), 1st harmonic [m]", float(amp_h[j]),
                            float(amp_t[j]), diff, tolerance, "rel.", diff <= tolerance))
-    erp_h, _ = _erp(erp, stage, U_h, omega)
-    erp_t, _ = _erp(erp, stage, U_t, omega)
+    erp_h, _ = point_erp(erp, stage, U_h, omega)
+    erp_t, _ = point_erp(erp, stage, U_t, omega)
     p_h, p_t = float(erp_h.power_total), float(erp_t.power_total)
     diff = _relative(p_h, p_t) if p_t > 0 else 0.0
     rows.append(Comparison("ERP total [W]", p_h, p_t, diff, tolerance, "rel.", diff <= tolerance))

@@ -1,11 +1,21 @@
-"""Checks of a deck before any assembly (used by :mod:`sarfe.pipeline.model.deck_model`): element quality,
-the supports as held DOFs, whether the structure is held (rigid motions left per connected part),
-the mass of ignored cards. Each raises or returns what a one-line CaseError names."""
+"""The checks reading a deck runs before any assembly (:func:`sarfe.pipeline.model.deck_model.
+prepare_deck`; part of building the model, so they live in the model stage): element quality, the
+supports as held DOFs, whether the structure is held (rigid motions left per connected part), the
+mass of ignored cards, the plausibility of the deck's units. Each raises or returns what a one-line
+CaseError names."""
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
 
-from sarfe.case.read import MIN_E_PA, MIN_RHO_KG_M3, SPAN_RANGE_M, Case
+from sarfe.case.plausibility import MIN_E_PA, MIN_RHO_KG_M3, SPAN_RANGE_M, THICKNESS_RANGE
+from sarfe.case.read import Case
+from sarfe.mesh import quality
+from sarfe.mesh.formats.abaqus import section_values
+from sarfe.mesh.formats.deck import UNIT_SYSTEMS
+from sarfe.mesh.formats.nastran_bdf import card_where, load_bdf
+from sarfe.pipeline.model.groups import resolve_node_group
 
 DECK_KEY = ("model", "fe", "deck")
 
@@ -18,8 +28,6 @@ def card_key(name: str) -> str:
 def check_quality(case: Case, deck, joined=()) -> dict:
     """Duplicate and zero-area shell elements are errors (with their ids); coincident nodes
     that no element, rigid element or contact joins are returned as a note."""
-    from sarfe.mesh import quality
-
     shells = deck.shells
     corners = -np.ones((len(shells.element_ids), 4), dtype=np.int64)
     rows = np.flatnonzero(np.r_[True, np.diff(shells.triangle_element) != 0])
@@ -63,10 +71,8 @@ def support_mask(case: Case, deck, mesh) -> np.ndarray:
     """(n, 6) bool held components, in each node's displacement (CD) frame, from the chosen
     support sets (all of the deck's when ``supports`` is not given; ``permanent`` GRID PS
     always) and the ``fixed`` node groups (all six components)."""
-    from sarfe.pipeline.model.linear_stage import resolve_node_group
-
-    fe = case.config.model.fe.data
-    chosen = [str(s) for s in fe.get("supports", [])] or sorted(deck.supports)
+    fe = case.config.model.fe
+    chosen = [str(s) for s in fe.deck.supports] or sorted(deck.supports)
     if "permanent" in deck.supports and "permanent" not in chosen:
         chosen.append("permanent")
     held = np.zeros((deck.n_nodes, 6), dtype=bool)
@@ -77,7 +83,7 @@ def support_mask(case: Case, deck, mesh) -> np.ndarray:
                              ("model", "fe", "supports", j))
         support = deck.supports[name]
         held[support.nodes] |= support.components
-    for i, group in enumerate(fe.get("fixed", [])):
+    for i, group in enumerate(fe.fixed):
         nodes = resolve_node_group(case, mesh, group, ("model", "fe", "fixed", i),
                                    allow_elements=False)
         held[nodes] = True
@@ -89,9 +95,6 @@ def connected_parts(deck) -> tuple[int, np.ndarray, np.ndarray]:
     joined by shells, solids, beams, two-node springs with some stiffness and rigid /
     interpolation elements. A spring without stiffness (a dashpot, e.g. the damping B kept from a
     spring turned into a contact) uses its nodes but joins nothing: it carries no static load."""
-    import scipy.sparse as sp
-    from scipy.sparse.csgraph import connected_components
-
     n = deck.n_nodes
     springs = deck.springs
     stiff = np.any(springs.stiffness != 0.0, axis=1)
@@ -183,16 +186,13 @@ def ignored_mass(case: Case, ignored: dict) -> dict:
     None per card for an Abaqus file (not computed)."""
     if not ignored:
         return {}
-    fe = case.config.model.fe.data
-    path = case.resolve(fe["deck"])
+    deck_config = case.config.model.fe.deck
+    path = case.resolve(deck_config.file)
     if path.suffix.lower() == ".inp":
         return {card: None for card in ignored}
-    from sarfe.mesh.formats.deck import UNIT_SYSTEMS
-    from sarfe.mesh.formats.nastran_bdf import load_bdf
-
     model = load_bdf(path)
     wtmass = model.params["WTMASS"].values[0] if "WTMASS" in model.params else 1.0
-    scale = UNIT_SYSTEMS[fe["units"]].factor(0, 1) * wtmass
+    scale = UNIT_SYSTEMS[deck_config.units].factor(0, 1) * wtmass
     masses = {}
     for card in ignored:
         key = card_key(card)
@@ -255,7 +255,7 @@ def model_span(deck) -> float:
 
 def unit_findings(deck) -> list[tuple]:
     """Values of a deck (in SI after its unit conversion) that no trim part has — the
-    plausibility bounds of the case keys (:mod:`sarfe.case.read`, :mod:`sarfe.pipeline.checks.case_checks`):
+    plausibility bounds of the case keys (:mod:`sarfe.case.plausibility`):
 
         E < 1e5 Pa, 0 < ρ < 1 kg/m³ (shell sections, solids, beams),
         model span L (:func:`model_span`) > 20 m or < 5 mm,
@@ -264,8 +264,6 @@ def unit_findings(deck) -> list[tuple]:
     Returns (quantity, table, row, value) per finding, worst first within a quantity:
     quantity 'E' [Pa], 'rho' [kg/m³], 'span' [m], 'thickness' [m]; table 'shell' (row = a
     triangle), 'solid:<cell type>' or 'beam' (row = an element row), 'grid' (row = None)."""
-    from sarfe.pipeline.checks.case_checks import THICKNESS_RANGE
-
     moduli = [("shell", _section_moduli(deck.shells))]
     t = deck.shells.thickness
     densities = [("shell", _section_densities(deck.shells))]
@@ -301,8 +299,6 @@ def suggested_units(deck, units: str):
     scale); None when no other system passes.
     The deck is in SI as read with ``units``: a value v of dimension (l, m, t) becomes
     v · f_candidate / f_units."""
-    from sarfe.mesh.formats.deck import UNIT_SYSTEMS
-
     moduli = np.concatenate([_section_moduli(deck.shells), deck.beams.young,
                              *[b.young for b in deck.solids.values()]])
     rho = np.concatenate([_section_densities(deck.shells), deck.beams.density,
@@ -347,10 +343,8 @@ def check_units(case: Case, deck) -> None:
     findings = unit_findings(deck)
     if not findings:
         return
-    from sarfe.pipeline.checks.case_checks import THICKNESS_RANGE
-
-    fe = case.config.model.fe.data
-    units, path = fe["units"], case.resolve(fe["deck"])
+    deck_config = case.config.model.fe.deck
+    units, path = deck_config.units, case.resolve(deck_config.file)
     quantity, table, row, value = findings[0]
     suggestion = suggested_units(deck, units)
     hint = (f"the deck looks like {suggestion}: set model.fe.units: {suggestion}" if suggestion
@@ -386,16 +380,11 @@ def _card_of(path, deck, units, quantity, table, row, value) -> str:
         block = deck.solids[table.split(":", 1)[1]]
         eid, pid = int(block.element_ids[row]), int(block.property_ids[row])
     if path.suffix.lower() == ".inp":
-        from sarfe.mesh.formats.abaqus import section_values
-        from sarfe.mesh.formats.deck import UNIT_SYSTEMS
-
         scale = UNIT_SYSTEMS[units].factor(*_DIMENSION[quantity])
         for where, key, raw in section_values(path):
             if key == quantity and np.isclose(raw * scale, value, rtol=1e-6):
                 return where
         return f"{path}: element {eid}"
-    from sarfe.mesh.formats.nastran_bdf import card_where, load_bdf
-
     model = load_bdf(path)
     if table == "beam" and pid == 0:    # CONROD: the material is on the element
         card = model.elements.get(eid)
