@@ -29,6 +29,11 @@ SHARED_BASENAMES = {"__init__", "__main__", "cli"}
 LOCAL_IMPORTS = {
     ("sarfe.results.render", "sarfe.results.plots"):
         "matplotlib: the fallback surface map, drawn only when the pyvista render child fails",
+    ("sarfe.hbm.laws.jenkins", "sarfe.hbm.laws.jenkins_march"):
+        "numba (0.39 s of import): only 2-D friction (a squeak contact with two tangent rows) needs "
+        "the compiled disk-projection march",
+    ("sarfe.hbm.stability.contact_terms", "sarfe.hbm.stability.march"):
+        "numba: only the friction memory of 2-D sliders in the Hill stability needs it",
 }
 
 
