@@ -289,12 +289,15 @@ class ExcitationConfig:
 # ----------------------------------------------------------------------------------------- solver
 @dataclass(frozen=True)
 class ContinuationConfig:
-    """solver.continuation: arc-length steps (fractions of the band, see ContinuationOptions)."""
+    """solver.continuation: arc-length steps (fractions of the band, see ContinuationOptions);
+    ``linear_points``: a sweep takes exact linear points where every contact stays open, closed or
+    stuck and follows the branch only where one does not (:mod:`sarfe.pipeline.solve.by_need`)."""
 
     initial_step: float = 0.02
     min_step: float = 1e-6
     max_step: float = CONTINUATION_MAX_STEP
     max_points: int = 2000
+    linear_points: bool = True
 
 
 DEFAULT_ACCURACY = "balanced"
@@ -354,11 +357,15 @@ class ErpConfig:
 @dataclass(frozen=True)
 class OutputConfig:
     """output: the result folder (default results/<case name>), the files written (default
-    :data:`OUTPUT_FILES`, + :data:`FE_OUTPUT_FILES` with model.fe) and a target level [dB(A)]."""
+    :data:`OUTPUT_FILES`, + :data:`FE_OUTPUT_FILES` with model.fe), a target level [dB(A)] and
+    ``maps``, the points with an ERP map: 'loudest', {'every': N} (every N-th reported point) or
+    a tuple of frequencies [Hz] (the reported point nearest each); the loudest point always
+    (:mod:`sarfe.pipeline.write.map_points`)."""
 
     directory: str = ""
     files: tuple = ()
     target_dba: float | None = None
+    maps: str | dict | tuple = "loudest"
 
 
 def default_output_directory(name: str) -> str:
@@ -462,7 +469,8 @@ def _solver_config(solver) -> SolverConfig:
         workers=solver["workers"],
         continuation=ContinuationConfig(initial_step=cont["initial_step"],
                                         min_step=cont["min_step"], max_step=cont["max_step"],
-                                        max_points=cont["max_points"]))
+                                        max_points=cont["max_points"],
+                                        linear_points=cont["linear_points"]))
 
 
 def build_config(data: dict) -> CaseConfig:
@@ -488,7 +496,8 @@ def build_config(data: dict) -> CaseConfig:
                       c_m_s=erp["c_m_s"], radiation_loss_factor=erp["radiation_loss_factor"],
                       reference_power_W=erp["reference_power_W"]),
         output=OutputConfig(directory=out["directory"], files=tuple(out["files"]),
-                            target_dba=out.get("target_dba")))
+                            target_dba=out.get("target_dba"),
+                            maps=_frozen(out["maps"])))
 
 
 __all__ = ["CaseConfig", "ModelConfig", "FeConfig", "GeneratorConfig", "DeckConfig",

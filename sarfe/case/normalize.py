@@ -12,7 +12,8 @@ import math
 from sarfe.case.config import (DEFAULT_ACCURACY, DEFAULT_ZETA, MATRICES_GAP_M,
                                BaseAccelerationConfig, ContactConfig, ContinuationConfig,
                                DeckConfig, DofReference, ErpConfig, FeConfig, ForceConfig,
-                               GeneratorConfig, ReductionConfig, SolverConfig, default_of,
+                               GeneratorConfig, OutputConfig, ReductionConfig, SolverConfig,
+                               default_of,
                                default_output_directory, default_output_files,
                                default_samples_per_period)
 from sarfe.case.plausibility import check_plausible
@@ -286,7 +287,7 @@ def _normalize_solver(case, data):
                 "prune_contacts", "workers"):          # defaults: sarfe.case.config.SolverConfig
         solver.setdefault(key, default_of(SolverConfig, key))
     cont = solver.setdefault("continuation", {})
-    for key in ("initial_step", "min_step", "max_step", "max_points"):
+    for key in ("initial_step", "min_step", "max_step", "max_points", "linear_points"):
         cont.setdefault(key, default_of(ContinuationConfig, key))
     if cont["min_step"] > cont["max_step"]:
         raise case.error("must be <= max_step", ("solver", "continuation", "min_step"))
@@ -324,6 +325,7 @@ def _normalize_output(case, data):
     out = data.setdefault("output", {})
     out.setdefault("directory", default_output_directory(data["name"]))
     out.setdefault("files", default_output_files(case.is_fe))
+    out.setdefault("maps", default_of(OutputConfig, "maps"))
     if "summary" not in out["files"]:
         out["files"] = ["summary"] + list(out["files"])
 

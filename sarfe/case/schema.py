@@ -193,6 +193,8 @@ SOLVER = _object({
         "min_step": {"type": "number", "exclusiveMinimum": 0, "maximum": 1},
         "max_step": {"type": "number", "exclusiveMinimum": 0, "maximum": 1},
         "max_points": {"type": "integer", "minimum": 2},
+        # linear points where every contact stays open/closed/stuck (sarfe.pipeline.solve.by_need)
+        "linear_points": {"type": "boolean"},
     }),
 })
 
@@ -211,6 +213,11 @@ OUTPUT = _object({
     "directory": NAME,
     "target_dba": NUMBER,   # optional target level [dB(A)]: a line in the plots and the report
     "files": {"type": "array", "items": {"enum": OUTPUT_FILES}, "uniqueItems": True},
+    # which points get an ERP map (sarfe.pipeline.write.map_points): the loudest, every N-th, or
+    # the points nearest the listed frequencies [Hz] (the loudest always)
+    "maps": {"oneOf": [{"enum": ["loudest"]}, _object({"every": {"type": "integer", "minimum": 1}},
+                                                      required=("every",)),
+                       {"type": "array", "items": POSITIVE, "minItems": 1}]},
 })
 
 CASE_SCHEMA = {

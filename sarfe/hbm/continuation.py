@@ -103,13 +103,19 @@ def _switch_set(tangent_z, rows_from, harmonics, width, x_scale_from, x_scale_to
 
 
 def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
-                 samples_per_period, options=None, progress=None, harmonic_set=None):
+                 samples_per_period, options=None, progress=None, harmonic_set=None,
+                 stop_when=None, band_start=None):
     """Sweep ω from ω_start to ω_end [rad/s] (either direction) → list of HarmonicSolution.
 
     progress(done, total): called after each point with done = covered fraction of the range
     (0…1) and total = 1.0. Points are in continuation order (ω is not monotonic past folds).
     harmonic_set: None | 'all' | 'odd' | 'auto' | list of orders, replaces
     ``options.solver.harmonic_set`` when given.
+    stop_when(point) → bool: called with each new reported point (not the first); True ends the
+    sweep there, as complete (a sweep by need stops a branch that is linear again:
+    :mod:`sarfe.pipeline.solve.by_need`). band_start [rad/s]: where a branch turning back is
+    stopped (default ω_start; a sweep by need starts inside the band and follows a fold back
+    past its own start).
     A failed sweep returns the points found so far; the last one's ``reason`` says why it stopped.
     """
     options = options or ContinuationOptions()
@@ -280,14 +286,17 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
                 t[-1] = direction
             z_new = np.append(x / x_scale, full.omega / span)
             point = full
-        if direction * (omega_new - omega_start) < 0:     # turned back out of the band
-            return _band_edge(problem, solutions, point, omega_start, so, state["slider"])
+        edge = omega_start if band_start is None else band_start
+        if direction * (omega_new - edge) < 0:            # turned back out of the band
+            return _band_edge(problem, solutions, point, edge, so, state["slider"])
         if full is not None or np.linalg.norm(z_new - z) >= REPORT_DISTANCE:
             solutions.append(point)     # (a step shrunk to a corner adds no reported point)
         else:
             solutions[-1] = point
         if progress is not None:
             progress(float(np.clip(direction * (omega_new - omega_start) / span, 0, 1)), 1.0)
+        if stop_when is not None and stop_when(solutions[-1]):
+            return solutions
         if len(solutions) >= options.max_points:
             return stop(f"max_points {options.max_points} reached")
         previous, z = t, z_new

@@ -24,6 +24,7 @@ from sarfe.pipeline.model.stage import linear_model_key
 from sarfe.pipeline.post.point_workers import (first_estimates, point_records, point_work,
                                                point_workers, stability_stream)
 from sarfe.pipeline.post.records import error_estimates, worst_of
+from sarfe.pipeline.solve.by_need import erp_measure
 from sarfe.pipeline.solve.case_accuracy import accuracy_check, case_resolution, resolved_case
 from sarfe.pipeline.solve.points import common_samples, sweep_status
 from sarfe.pipeline.solve.pruned_points import solve_points_pruned
@@ -116,7 +117,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         with deferred_stability(enabled=deferring,
                                 on_job=None if stream is None else stream.submit) as jobs:
             solutions, pruning = solve_points_pruned(config.solver, config.excitation, nl,
-                                                     progress=progress)
+                                                     progress=progress, measure=erp_measure(stage))
         timings["hbm_s"] = time.perf_counter() - clock
         if workers > 1:
             # the first estimate in this process (it builds the caches the others share) while
@@ -139,7 +140,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
                         "raised, the sweep was solved again serially"}
             clock = time.perf_counter()
             solutions, pruning = solve_points_pruned(config.solver, config.excitation, nl,
-                                                     progress=progress)
+                                                     progress=progress, measure=erp_measure(stage))
             timings["hbm_s"] += time.perf_counter() - clock
     clock = time.perf_counter()
     if work is not None:

@@ -333,9 +333,11 @@ def erp_point_data(n_points: int, erp, normal_displacement, omega: float, displa
 
 
 def write_erp_sweep(directory, points, triangles, point_data_per_frequency, frequencies_hz,
-                    basename: str = "erp", workers: int = 1) -> Path:
+                    basename: str = "erp", workers: int = 1, indices=None) -> Path:
     """One VTU per frequency point (``<basename>_0000.vtu`` …, in sweep order) plus
     ``<basename>.pvd``. Each VTU carries field data ``frequency_hz`` and ``point_index``.
+    ``indices``: the sweep point index of each map (file ``<basename>_<index>.vtu``, field
+    ``point_index``; default 0, 1, …): the maps of a few chosen points of a sweep.
 
     ``point_data_per_frequency``: the point data of each frequency — a sequence of dicts, or a
     function j → dict called when file j is written (so the arrays of all points never coexist).
@@ -348,7 +350,7 @@ def write_erp_sweep(directory, points, triangles, point_data_per_frequency, freq
     0, 1, … (ParaView sorts and merges equal times). Returns the PVD path.
     """
     return start_erp_sweep(directory, points, triangles, point_data_per_frequency,
-                           frequencies_hz, basename, workers).finish()
+                           frequencies_hz, basename, workers, indices).finish()
 
 
 class ErpSweepWriter:
@@ -367,7 +369,7 @@ class ErpSweepWriter:
 
 
 def start_erp_sweep(directory, points, triangles, point_data_per_frequency, frequencies_hz,
-                    basename: str = "erp", workers: int = 1) -> ErpSweepWriter:
+                    basename: str = "erp", workers: int = 1, indices=None) -> ErpSweepWriter:
     """:func:`write_erp_sweep` started on ``workers`` processes without waiting for them: this
     process writes the run's other files meanwhile and calls ``finish()`` (with ``workers`` ≤ 1
     the maps are written by ``finish()``)."""
@@ -380,11 +382,15 @@ def start_erp_sweep(directory, points, triangles, point_data_per_frequency, freq
         if len(data) != frequencies.size:
             raise ValueError(f"{len(data)} point-data sets for {frequencies.size} frequencies")
         data_of = data.__getitem__
-    names = [f"{basename}_{j:04d}.vtu" for j in range(frequencies.size)]
+    index = np.arange(frequencies.size) if indices is None else np.asarray(indices, dtype=int)
+    if index.size != frequencies.size:
+        raise ValueError(f"{index.size} point indices for {frequencies.size} frequencies")
+    names = [f"{basename}_{int(i):04d}.vtu" for i in index]
 
     def write(j):
         write_erp_vtu(directory / names[j], points, triangles, data_of(j),
-                      field_data={"frequency_hz": float(frequencies[j]), "point_index": j})
+                      field_data={"frequency_hz": float(frequencies[j]),
+                                  "point_index": int(index[j])})
 
     import pyvista  # noqa: F401  (imported here once, inherited by forked workers)
     import vtkmodules.vtkIOXML  # noqa: F401

@@ -1,2 +1,2 @@
 """Stage 5 of a case: the result files and the console table (result_files), the PNG figures and
-the report's surface maps (figures)."""
+the report's surface maps (figures), which points get an ERP map (map_points: ``output.maps``)."""

@@ -12,8 +12,10 @@ import numpy as np
 from sarfe import results
 from sarfe.hbm.laws import table_column
 from sarfe.pipeline.post.point_workers import point_workers
+from sarfe.pipeline.post.records import point_erp
 from sarfe.pipeline.post.result_data import contact_pair_fields, result_groups
 from sarfe.pipeline.write import figures
+from sarfe.pipeline.write.map_points import map_indices
 from sarfe.reduction.recovery import recover_displacement
 from sarfe.results import render
 from sarfe.results.summary import shown_level
@@ -62,14 +64,19 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, di
         mesh = stage.mesh
         markers = results.contact_markers(mesh.n_nodes, [g.nodes_a for g in stage.contacts.values()])
         translations = {}
-        every_point = full_field_every_point(stage, solutions)
+        frequencies = [float(s.omega) / (2 * np.pi) for s in solutions]
+        selected = map_indices(config.output.maps, frequencies,
+                               [bool(s.converged) for s in solutions], loudest)
+        every_point = full_field_every_point(stage, solutions) or (
+            len(selected) < len(solutions)
+            and full_field_every_point(stage, [solutions[j] for j in selected]))
 
         def nodal_translations(j):
             # full-field recovery only because a VTU or a map was asked for: (2H+1, n, 3) [m];
             # kept for the loudest point only (200 points of a 5 mm door trim would hold 5 GB)
             if j in translations:
                 return translations[j]
-            if j != loudest and not every_point:
+            if j != loudest and not (every_point and j in selected):
                 return None
             u = recover_displacement(stage.reduced, np.asarray(solutions[j].displacement),
                                      all_dofs=True)
@@ -84,7 +91,11 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, di
             if j in loudest_data:     # the loudest point's arrays serve its map and the report's
                 return loudest_data[j]
             force, motion = contact_pair_fields(stage, nl, solutions[j], mesh.n_nodes)
-            data = results.erp_point_data(mesh.n_nodes, erps[j], None,
+            erp, W = erps[j], None
+            if fields[j] is None:     # a chosen map (output.maps): its ERP density made now
+                erp, W = point_erp(config.erp, stage, np.asarray(solutions[j].displacement),
+                                   float(solutions[j].omega))
+            data = results.erp_point_data(mesh.n_nodes, erp, W,
                                           float(solutions[j].omega), fields=fields[j],
                                           displacement=nodal_translations(j),
                                           radiating_nodes=stage.erp_nodes,
@@ -107,15 +118,18 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, di
                                                         if len(g.nodes_a)})
             started.append(("render", renders))
         if "erp_vtu" in files:
-            frequencies = [float(s.omega) / (2 * np.pi) for s in solutions]
-            if len(solutions) == 1:
+            if len(selected) == 1:      # one map (the loudest, or the only point): erp.vtu
+                j = selected[0]
                 results.write_erp_vtu(directory / "erp.vtu", mesh.points, mesh.triangles,
-                                      point_data(0))
+                                      point_data(j), field_data={"frequency_hz": frequencies[j],
+                                                                 "point_index": j})
                 written["erp_vtu"] = "erp.vtu"
             else:       # on the workers while this process writes the files below
                 series = results.start_erp_sweep(directory / "erp", mesh.points, mesh.triangles,
-                                                 point_data, frequencies,
-                                                 workers=map_workers(config, mesh, len(solutions)))
+                                                 lambda i: point_data(selected[i]),
+                                                 [frequencies[j] for j in selected],
+                                                 workers=map_workers(config, mesh, len(selected)),
+                                                 indices=selected)
                 started.append(("maps", series))
                 written["erp_vtu"] = "erp/erp.pvd"
         if "animation" in files and loudest is not None:
