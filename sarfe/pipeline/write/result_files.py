@@ -60,13 +60,13 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, di
         return written
     loudest = (summary.get("worst") or {}).get("index")
     maps, renders, series = {}, None, None
+    frequencies = [float(s.omega) / (2 * np.pi) for s in solutions]
+    selected = map_indices(config.output.maps, frequencies, [bool(s.converged) for s in solutions],
+                           loudest)       # the points with an ERP map (output.maps)
     if stage.kind == "fe" and ("erp_vtu" in files or "animation" in files or "report" in files):
         mesh = stage.mesh
         markers = results.contact_markers(mesh.n_nodes, [g.nodes_a for g in stage.contacts.values()])
         translations = {}
-        frequencies = [float(s.omega) / (2 * np.pi) for s in solutions]
-        selected = map_indices(config.output.maps, frequencies,
-                               [bool(s.converged) for s in solutions], loudest)
         every_point = full_field_every_point(stage, solutions) or (
             len(selected) < len(solutions)
             and full_field_every_point(stage, [solutions[j] for j in selected]))
@@ -142,8 +142,15 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, di
                                                    else {}))
             written["animation"] = "animation/deflection.pvd"
     if "response" in files:
+        reduced = getattr(stage, "reduced", None)
         results.write_response_h5(
             directory / "response.h5", solutions, contacts=nl.contacts, excitation=nl.excitation,
+            # a base excitation loads every coordinate of a reduced model: its "excitation DOFs"
+            # would be the whole reduced response (∝ modes); the contact rows and the ERP are
+            # the record (∝ points × contacts × H)
+            excitation_dofs=np.zeros(0, dtype=int) if reduced is not None
+            and config.excitation.base_acceleration is not None else None,
+            density_points=selected if stage.kind == "fe" else None,
             boundary_dofs=getattr(stage.reduced, "boundary_dofs", None),
             mode_frequencies_hz=stage.mode_frequencies_hz, erp=erps,
             radiating_nodes=stage.erp_nodes if stage.erp_map.shape[0] else None,
