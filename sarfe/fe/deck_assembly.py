@@ -28,9 +28,9 @@ import scipy.sparse as sp
 from sarfe.mesh.formats.deck import DeckError, DeckModel
 
 from sarfe.fe.constraints import constraint_matrix
+from sarfe.fe.deck_shells import shell_blocks
 from sarfe.fe.line_elements import beam_matrices, point_mass_matrices, spring_matrices
-from sarfe.fe.shell import DRILLING_PENALTY
-from sarfe.fe.shell_section import section_shell_element_matrices
+from sarfe.fe.membrane import DEFAULT_MEMBRANE, DRILLING_PENALTY
 from sarfe.fe.solid_cells import DegenerateCellError, solid_cell_matrices
 
 __all__ = ["DeckSystem", "assemble_deck", "support_dofs", "load_vector", "lumped_mass",
@@ -102,38 +102,19 @@ def lumped_mass(mass, dofs):
     return lumped
 
 
-def _element_blocks(deck: DeckModel, drilling_penalty, mass="consistent"):
+def _element_blocks(deck: DeckModel, drilling_penalty, mass="consistent",
+                    membrane=DEFAULT_MEMBRANE):
     """Yield (K_e, M_e, dofs) blocks of every element table (CONM2 never lumped)."""
-    for k, m, dofs in _structural_blocks(deck, drilling_penalty):
+    for k, m, dofs in _structural_blocks(deck, drilling_penalty, membrane):
         yield k, (lumped_mass(m, dofs) if mass == "lumped" else m), dofs
     if len(deck.point_masses.node):
         m, dofs = point_mass_matrices(deck.point_masses)
         yield np.zeros_like(m), m, dofs
 
 
-def _structural_blocks(deck: DeckModel, drilling_penalty):
+def _structural_blocks(deck: DeckModel, drilling_penalty, membrane=DEFAULT_MEMBRANE):
     """Yield (K_e, M_e, dofs) of shells, solids, beams and springs."""
-    shells = deck.shells
-    if shells.n_triangles:
-        x = deck.points[shells.triangles]
-        twice_area = np.linalg.norm(np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]), axis=1)
-        edge = np.linalg.norm(x[:, 1] - x[:, 0], axis=1)
-        bad = np.flatnonzero(twice_area <= 1e-12 * np.maximum(edge, 1e-300) ** 2)
-        if bad.size:
-            eid = int(shells.element_ids[shells.triangle_element[bad[0]]])
-            raise DeckError(f"{deck.source}: shell element {eid} has zero area "
-                            f"({bad.size} degenerate triangle(s))")
-    for start in range(0, shells.n_triangles, _BLOCK):
-        rows = slice(start, start + _BLOCK)
-        offset = shells.offset[rows]
-        mass_area = shells.mass_per_area[rows]
-        k, m = section_shell_element_matrices(
-            deck.points, shells.triangles[rows], shells.membrane[rows], shells.coupling[rows],
-            shells.bending[rows], shells.material_axis[rows], mass_area,
-            shells.rotary_inertia_per_area[rows] + mass_area * offset**2, drilling_penalty,
-            first_moment_per_area=mass_area * offset)
-        tri = shells.triangles[rows]
-        yield k, m, (6 * tri[:, :, None] + np.arange(6)).reshape(len(tri), 18)
+    yield from shell_blocks(deck, membrane, drilling_penalty)
     for kind, block in deck.solids.items():
         for start in range(0, len(block.element_ids), _BLOCK // 8):
             rows = slice(start, start + _BLOCK // 8)
@@ -210,16 +191,18 @@ def _frame_transform(frames, independent):
     return rows, cols, vals
 
 
-def global_matrices(deck: DeckModel, mass="consistent", drilling_penalty=DRILLING_PENALTY):
+def global_matrices(deck: DeckModel, mass="consistent", drilling_penalty=DRILLING_PENALTY,
+                    membrane=DEFAULT_MEMBRANE):
     """K, M (CSR (6n, 6n), global DOFs 6·node + c, global axes) before any constraint:
     e.g. for mass properties, M's rigid-body quadratic forms."""
     if mass not in ("consistent", "lumped"):
         raise ValueError(f"mass must be 'consistent' or 'lumped', got {mass!r}")
-    return _sum_blocks(_element_blocks(deck, drilling_penalty, mass), 6 * deck.n_nodes)
+    return _sum_blocks(_element_blocks(deck, drilling_penalty, mass, membrane),
+                       6 * deck.n_nodes)
 
 
 def assemble_deck(deck: DeckModel, mass="consistent",
-                  drilling_penalty=DRILLING_PENALTY) -> DeckSystem:
+                  drilling_penalty=DRILLING_PENALTY, membrane=DEFAULT_MEMBRANE) -> DeckSystem:
     """Global K, M of a deck with RBE2/RBE3 eliminated, in CD frames, zero-stiffness DOFs held.
 
     mass: 'consistent' (sarfe's element masses) or 'lumped' (:func:`lumped_mass`: diagonal
@@ -228,7 +211,7 @@ def assemble_deck(deck: DeckModel, mass="consistent",
     """
     n = deck.n_nodes
     n_dof = 6 * n
-    stiffness, mass = global_matrices(deck, mass, drilling_penalty)
+    stiffness, mass = global_matrices(deck, mass, drilling_penalty, membrane)
     structural, viscous = _spring_damping(deck, n_dof)
     try:
         c_matrix, independent = constraint_matrix(deck.points, deck.rbe2, deck.rbe3, n)

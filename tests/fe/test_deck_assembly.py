@@ -11,7 +11,10 @@ from sarfe.fe.deck_assembly import (assemble_deck, global_matrices, load_vector,
 from sarfe.mesh.formats.deck import DeckError
 from sarfe.mesh.formats.nastran import read_nastran
 
-DECKS = Path(__file__).resolve().parents[2].parent / "shared" / "decks"
+# beside the checkout (CI), or beside the folder of worktrees (/work/wt/<name> → /work/shared)
+DECKS = next((root / "shared" / "decks" for root in Path(__file__).resolve().parents[3:5]
+              if (root / "shared" / "decks").is_dir()),
+             Path(__file__).resolve().parents[3] / "shared" / "decks")
 needs_decks = pytest.mark.skipif(not (DECKS / "REFERENCE.json").is_file(),
                                  reason=f"public decks folder {DECKS} is absent")
 
