@@ -26,14 +26,15 @@ import numpy as np
 from sarfe.mesh.formats.deck import DeckError, DeckModel
 from sarfe.mesh.laminate import rotate_plane_stress
 
-from sarfe.fe.membrane import DEFAULT_MEMBRANE, MEMBRANES
+from sarfe.fe.membrane import MEMBRANES
 from sarfe.fe.shell_quad import quad_frames, quad_membrane_matrices
 from sarfe.fe.shell_section import section_shell_element_matrices
 
-__all__ = ["DECK_MEMBRANES", "shell_blocks", "quadrilaterals"]
+__all__ = ["DECK_MEMBRANES", "DECK_MEMBRANE", "shell_blocks", "quadrilaterals"]
 
-#: membrane choices for a deck's shells
+#: membrane choices for a deck's shells, and the default (the commercial solver's elements)
 DECK_MEMBRANES = ("nastran",) + MEMBRANES
+DECK_MEMBRANE = "nastran"
 
 _BLOCK = 4096
 
@@ -83,7 +84,7 @@ def _quads(deck, first, corners, drilling_penalty):
         yield k, np.zeros_like(k), (6 * quads[:, :, None] + np.arange(6)).reshape(len(quads), 24)
 
 
-def shell_blocks(deck: DeckModel, membrane=DEFAULT_MEMBRANE, drilling_penalty=1e-4):
+def shell_blocks(deck: DeckModel, membrane=DECK_MEMBRANE, drilling_penalty=1e-4):
     """Yield (K_e, M_e, dofs) blocks of the deck's shells (module docstring); DeckError names a
     degenerate element."""
     if membrane not in DECK_MEMBRANES:

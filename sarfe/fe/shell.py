@@ -1,14 +1,14 @@
-"""Flat facet shell triangle: Allman membrane + DKT plate bending, 6 DOF per node.
+"""Flat facet shell triangle: drilling membrane + DKT plate bending, 6 DOF per node.
 
 Each triangle is flat in its own local frame (e1 along edge 1→2, e3 = unit normal
 (x2−x1)×(x3−x1), e2 = e3×e1); its 18×18 local matrices are rotated to the global
 frame, K_e = Tᵀ K_local T with T = blockdiag(R, R, R, R, R, R), R = [e1; e2; e3].
 Local DOF order per node: [u, v, w, θx, θy, θz] (θz = drilling rotation).
 
-Membrane (u, v, θz): :mod:`sarfe.fe.membrane` — Felippa's optimal ANDES triangle with corner
-drilling rotations (``membrane="andes"``, the default ``DEFAULT_MEMBRANE``) or the Allman
-(1984) triangle with the drilling penalty K_d = α G t A g gᵀ (``membrane="allman"``, the
-formulation before issue 32), for D_m = E/(1−ν²)[[1,ν,0],[ν,1,0],[0,0,(1−ν)/2]], C = t D_m.
+Membrane (u, v, θz): :mod:`sarfe.fe.membrane`, C = t D_m, D_m = E/(1−ν²)[[1,ν,0],[ν,1,0],
+[0,0,(1−ν)/2]] — the Allman (1984) triangle with the drilling penalty K_d = α G t A g gᵀ
+(``membrane="allman"``, ``DEFAULT_MEMBRANE``), Felippa's optimal ANDES triangle
+(``"andes"``) or the constant-strain triangle with a weak penalty (``"cst"``).
 
 Bending (w, θx, θy): DKT (Batoz, Bathe & Ho 1980), :mod:`sarfe.fe.plate_bending`. With
 rotations β = (βx, βy) = (θy, −θx) (so Kirchhoff gives β = −∇w), β is quadratic over the
@@ -18,7 +18,9 @@ D_b = E t³/(12(1−ν²))[[1,ν,0],[ν,1,0],[0,0,(1−ν)/2]]; the integrand is
 three-midside-point rule is exact. (Sections with transverse shear use the DKMT extension,
 :mod:`sarfe.fe.shell_section`.)
 
-Consistent mass (documented choice):
+Mass: consistent (``mass="consistent"``, ``DEFAULT_MASS``; documented choice below) or its HRZ
+lumping (``"lumped"``, :func:`sarfe.fe.assembly.lumped_mass`: corners m''A/3, rotary block kept).
+Consistent mass:
   translations u, v, w: ρ t ∫ N_i N_j dA with linear N (= ρ t A/12 (1 + δ_ij)) — the
     membrane consistent mass and the bending translational consistent mass;
   rotary inertia θx, θy: (ρ t³/12) ∫ β·β dA with the DKT rotation field (degree-4 rule);
@@ -36,7 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sarfe.fe.assembly import assemble_pair, element_dofs
+from sarfe.fe.assembly import assemble_pair, element_dofs, lumped_mass
 from sarfe.fe.membrane import (DEFAULT_MEMBRANE, DRILLING_PENALTY, EDGES, MEMBRANES,
                                allman_field, andes_basic_strain, andes_stiffness,
                                cst_stiffness, drilling_vector, p2_gradients)
@@ -54,10 +56,14 @@ __all__ = [
     "to_global",
     "DRILLING_PENALTY",
     "DEFAULT_MEMBRANE",
+    "DEFAULT_MASS",
     "MEMBRANE_DOFS",
     "BENDING_DOFS",
     "DEGREE4_RULE",
 ]
+
+#: element mass of generated meshes (:func:`shell_matrices`): 'consistent' | 'lumped'
+DEFAULT_MASS = "consistent"
 
 #: elements per vectorized block (keeps the (block, 18, 18) work arrays cache-sized)
 BLOCK_SIZE = 4096
@@ -313,17 +319,22 @@ def to_global(matrix, rotation):
 
 
 def shell_matrices(points, triangles, thickness, young, poisson, density,
-                   drilling_penalty=DRILLING_PENALTY, membrane=DEFAULT_MEMBRANE):
-    """Global shell stiffness K [N/m, N, N·m] and consistent mass M [kg, kg·m²], CSR (6n, 6n).
+                   drilling_penalty=DRILLING_PENALTY, membrane=DEFAULT_MEMBRANE,
+                   mass=DEFAULT_MASS):
+    """Global shell stiffness K [N/m, N, N·m] and mass M [kg, kg·m²], CSR (6n, 6n).
 
     points (n, 3) [m]; triangles (n_el, 3) int; thickness [m], young [Pa], poisson [-],
     density [kg/m³] as scalars or (n_el,) arrays. DOF = 6·node + [ux, uy, uz, rx, ry, rz].
     Strain energy ½ uᵀ K u, kinetic energy ½ u̇ᵀ M u̇. Nodes not used by any triangle get
-    empty rows (fix them or drop them before solving). membrane: 'andes' | 'allman'
-    (:mod:`sarfe.fe.membrane`), drilling_penalty α for 'allman'.
+    empty rows (fix them or drop them before solving). membrane: 'allman' | 'andes' | 'cst'
+    (:mod:`sarfe.fe.membrane`), drilling_penalty α for 'allman' and 'cst'; mass: 'consistent'
+    (module docstring) or 'lumped' (:func:`sarfe.fe.assembly.lumped_mass`: corners m''A/3,
+    rotary inertia kept).
     """
     if membrane not in MEMBRANES:
         raise ValueError(f"membrane must be one of {MEMBRANES}, got {membrane!r}")
+    if mass not in ("consistent", "lumped"):
+        raise ValueError(f"mass must be 'consistent' or 'lumped', got {mass!r}")
     points = np.asarray(points, dtype=float)
     if points.ndim != 2 or points.shape[1] != 3:
         raise ValueError(f"points must be shaped (n, 3), got {points.shape}")
@@ -343,5 +354,6 @@ def shell_matrices(points, triangles, thickness, young, poisson, density,
                                           drilling_penalty=drilling_penalty,
                                           membrane=membrane)
         combined[block].real = k_e
-        combined[block].imag = m_e
+        combined[block].imag = (lumped_mass(m_e, element_dofs(triangles[block])) if mass == "lumped"
+                                else m_e)
     return assemble_pair(combined, None, element_dofs(triangles), 6 * points.shape[0])
