@@ -7,7 +7,8 @@ the mass and the membrane–bending coupling of :func:`sarfe.fe.shell_section.
 section_shell_element_matrices`. The membrane depends on ``membrane``:
 
 - 'nastran' (what the commercial solver does, the deck default): a quadrilateral (2 facets)
-  gets the incompatible-mode quad of :mod:`sarfe.fe.membrane_quad` on its four corners, a
+  gets the incompatible-mode quad of :mod:`sarfe.fe.shell_quad` on its four corners (a concave
+  or degenerate one, :func:`~sarfe.fe.shell_quad.regular_quads`, its two facets as triangles), a
   CTRIA3/S3 the constant-strain triangle, both with the weak drilling penalty
   α C₃₃ ∫ (θz − ω)² dA (Nastran: α = 1e-6 · K6ROT); the facets of 6/8-node elements, whose
   quadratic membrane a CST would lock, the optimal ANDES triangle.
@@ -27,7 +28,7 @@ from sarfe.mesh.formats.deck import DeckError, DeckModel
 from sarfe.mesh.laminate import rotate_plane_stress
 
 from sarfe.fe.membrane import MEMBRANES
-from sarfe.fe.shell_quad import quad_frames, quad_membrane_matrices
+from sarfe.fe.shell_quad import quad_frames, quad_membrane_matrices, regular_quads
 from sarfe.fe.shell_section import section_shell_element_matrices
 
 __all__ = ["DECK_MEMBRANES", "DECK_MEMBRANE", "shell_blocks", "quadrilaterals"]
@@ -71,7 +72,7 @@ def _triangles(deck, rows, formulation, drilling_penalty, membrane_scale=1.0,
         yield k, m, (6 * tri[:, :, None] + np.arange(6)).reshape(len(tri), 18)
 
 
-def _quads(deck, first, corners, drilling_penalty):
+def _quads(deck, first, corners, drilling_penalty):  # corners: regular quads only
     """Membrane blocks (QM6 + drilling penalty) of the quadrilaterals."""
     shells = deck.shells
     for start in range(0, len(first), _BLOCK):
@@ -105,15 +106,15 @@ def shell_blocks(deck: DeckModel, membrane=DECK_MEMBRANE, drilling_penalty=1e-4)
         yield from _triangles(deck, every, membrane, drilling_penalty)
         return
     first, second, corners = quadrilaterals(shells)
+    regular = regular_quads(deck.points, corners) if len(corners) else np.zeros(0, bool)
     counts = np.bincount(shells.triangle_element, minlength=len(shells.element_ids))
-    alone = np.flatnonzero(counts[shells.triangle_element] == 1)
+    # CTRIA3 and the facets of quads too distorted for the bilinear map: constant strain
+    alone = np.concatenate([np.flatnonzero(counts[shells.triangle_element] == 1),
+                            first[~regular], second[~regular]])
     facets = np.flatnonzero(counts[shells.triangle_element] > 2)
     # quadrilaterals: bending (DKT/DKMT), coupling and mass on the two facets, membrane on the quad
-    yield from _triangles(deck, np.concatenate([first, second]), "cst", 0.0, membrane_scale=0.0,
-                          drilling_inertia=False)
-    try:
-        yield from _quads(deck, first, corners, drilling_penalty)
-    except ValueError as error:
-        raise DeckError(f"{deck.source}: {error}") from error
+    yield from _triangles(deck, np.concatenate([first[regular], second[regular]]), "cst", 0.0,
+                          membrane_scale=0.0, drilling_inertia=False)
+    yield from _quads(deck, first[regular], corners[regular], drilling_penalty)
     yield from _triangles(deck, alone, "cst", drilling_penalty, drilling_inertia=False)
     yield from _triangles(deck, facets, "andes", drilling_penalty)

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["quad_frames", "quad_membrane_matrices"]
+__all__ = ["quad_frames", "quad_membrane_matrices", "regular_quads"]
 
 _XI = np.array([-1.0, 1.0, 1.0, -1.0])
 _ETA = np.array([-1.0, -1.0, 1.0, 1.0])
@@ -40,19 +40,31 @@ def quad_frames(points, quads):
     x = np.asarray(points, float)[np.asarray(quads)]
     d13, d24 = x[:, 2] - x[:, 0], x[:, 3] - x[:, 1]
     normal = np.cross(d13, d24)
-    size = np.linalg.norm(normal, axis=1)
-    if np.any(size <= 1e-14 * np.einsum("ei,ei->e", d13, d13)):
-        raise ValueError("degenerate quadrilateral (crossed or zero-area) in the shell mesh")
+    # parallel diagonals (a degenerate quad) leave e3 arbitrary: regular_quads rejects those
+    size = np.maximum(np.linalg.norm(normal, axis=1), 1e-300)
     e3 = normal / size[:, None]
     u13 = d13 / np.linalg.norm(d13, axis=1)[:, None]
     u24 = d24 / np.linalg.norm(d24, axis=1)[:, None]
     bisector = u13 - u24
     bisector -= np.einsum("ei,ei->e", bisector, e3)[:, None] * e3
-    e1 = bisector / np.linalg.norm(bisector, axis=1)[:, None]
+    e1 = bisector / np.maximum(np.linalg.norm(bisector, axis=1), 1e-300)[:, None]
     e2 = np.cross(e3, e1)
     rotation = np.stack([e1, e2, e3], axis=1)
     local = np.einsum("eij,ekj->eki", rotation, x - x.mean(axis=1, keepdims=True))
     return rotation, local[..., :2], local[..., 2]
+
+
+def regular_quads(points, quads, min_corner_ratio=0.05):
+    """(n_q,) bool: quads whose projection on the mean plane is convex with every corner
+    Jacobian det J_i = (x_{i+1} − x_i) × (x_{i−1} − x_i) ≥ ``min_corner_ratio`` × their mean
+    (the bilinear map is then one-to-one; a concave, arrow-shaped or degenerate pair of facets
+    is not a quadrilateral element)."""
+    _, xy, _ = quad_frames(points, quads)
+    ahead = np.roll(xy, -1, axis=1) - xy
+    behind = np.roll(xy, 1, axis=1) - xy
+    corner = ahead[..., 0] * behind[..., 1] - ahead[..., 1] * behind[..., 0]
+    return (corner.mean(axis=1) > 0) & (corner.min(axis=1) >= min_corner_ratio
+                                         * corner.mean(axis=1))
 
 
 def _gradients(xy):
