@@ -118,7 +118,7 @@ def lumped_mass(mass, dofs):
     index = np.arange(size)
     for c in range(3):
         pick = (component == c).astype(float)
-        total = np.einsum("eij,ei,ej->e", mass, pick, pick)
+        total = (pick[:, None, :] @ mass @ pick[:, :, None])[:, 0, 0]
         diag_sum = (diagonal * pick).sum(axis=1)
         scale = np.divide(total, diag_sum, out=np.zeros(n_el), where=diag_sum > 0)
         lumped[:, index, index] += diagonal * pick * scale[:, None]

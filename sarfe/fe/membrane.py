@@ -14,36 +14,34 @@ K_m = K_b + K_h:
     Q_1..3 (3×3) give the natural (edge) strains at the corners from θ̃ with the optimal
     β₁…β₉ = (1, 2, 1, 0, 1, −1, −1, −1, −2), Q_4..6 the edge midpoints, and T_e turns edge
     strains into Cartesian ones; β₀ = max(2/ĉ − 3/2, 1/100) from the material's mean
-    compliance ĉ (= (1 − 4ν²)/2 … for isotropic C: β₀ = (1 − 4ν²)/2).
+    compliance ĉ (isotropic C: β₀ = max((1 − 4ν²)/2, 1/100)). Two triangles making a
+  rectangle of any aspect ratio store exactly the energy of pure in-plane bending.
   K_h vanishes on every linear displacement field with θz equal to its rotation ω, so the
   constant-strain states stay exact; K_m has exactly three zero eigenvalues (rigid motions).
 ``"allman"`` — Allman (1984): the quadratic field with midside values
   u_ij = (u_i + u_j)/2 + (L_ij/8)(θz_j − θz_i) n_ij, K = ∫ Bᵀ C B dA (three-midside rule), plus
   the drilling penalty K_d = α C₃₃ A g gᵀ, g·q = mean(θz) − ω(centroid), which removes its
-  spurious mode (equal θz at the corners).
+  spurious mode (equal θz at the corners). Locks in in-plane bending (energy 1.8 … 4.7 × the
+  exact for rectangle pairs of aspect 1 … 4).
+``"cst"`` — the constant-strain triangle (no θz in the field) plus the weak penalty
+  α C₃₃ ∫ (θz − ω)² dA: Nastran's CTRIA3 (α = 1e-6 · K6ROT), used for decks.
 
-Measured on real decks (benchmarks/results/shell_decks.md): the Allman + penalty membrane
-is stiff on coarse membrane-dominated meshes; the optimal triangle is not, and needs no
-penalty. Everything is vectorized over elements: arrays shaped (n_el, ...).
+A true drilling membrane (ANDES, Allman) ties the in-plane rotation of a shell to a beam or a
+folded shell meeting it, which the commercial solver's weak penalty does not (measured on decks:
+benchmarks/results/shell_decks.md, sarfe.fe.deck_shells). Everything is vectorized over
+elements: arrays shaped (n_el, ...).
 """
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["MEMBRANES", "DEFAULT_MEMBRANE", "DRILLING_PENALTY", "andes_stiffness",
+__all__ = ["MEMBRANES", "DRILLING_PENALTY", "andes_stiffness",
            "andes_basic_strain", "optimal_beta0", "allman_field", "drilling_vector",
-           "p2_gradients", "EDGES"]
+           "cst_stiffness", "cst_strain", "p2_gradients", "EDGES"]
 
 #: membrane formulations understood by the shell elements
 MEMBRANES = ("andes", "allman", "cst")
 
-#: the triangle membrane of generated meshes (`sarfe.fe.shell.shell_matrices`); decks use the
-#: commercial solver's elements (`sarfe.fe.deck_shells`). On triangle meshes of a clamped
-#: cylindrical panel the optimal triangle was not more accurate than Allman + penalty (its
-#: true drilling stiffness ties the facets of a curved mesh more tightly: 30 × 22 mesh
-#: +0.71 % vs +0.48 % on mode 1 against the 160 × 120 converged shell), so this stays "allman";
-#: "andes" is the switch (exact in-plane bending of rectangular pairs, no penalty).
-DEFAULT_MEMBRANE = "allman"
 
 #: default α of the Allman drilling penalty K_d = α C₃₃ A g gᵀ (unused by "andes")
 DRILLING_PENALTY = 1e-2
@@ -158,17 +156,24 @@ def andes_stiffness(local_xy, area, c, beta0=None):
     return k_basic + k_high
 
 
-def cst_stiffness(grad_l, area, c, drilling_penalty):
-    """Constant-strain triangle with a Hughes–Brezzi drilling penalty (n_el, 9, 9): the
-    membrane of Nastran's CTRIA3, K = A Bᵀ C B + α C₃₃ ∫ (θz − ω)² dA with θz linear between
-    the corners and ω = (v,x − u,y)/2 constant (Nastran: α = 1e-6 · K6ROT)."""
-    n_el = area.shape[0]
+def cst_strain(grad_l):
+    """Constant strain operator (n_el, 3, 9) of the linear field, ε = [u,x, v,y, u,y + v,x]
+    on [u_i, v_i, θz_i] (θz columns zero); grad_l (n_el, 3, 2) area-coordinate gradients."""
+    n_el = grad_l.shape[0]
     b = np.zeros((n_el, 3, 3, 3))
     b[:, 0, :, 0] = grad_l[..., 0]
     b[:, 1, :, 1] = grad_l[..., 1]
     b[:, 2, :, 0] = grad_l[..., 1]
     b[:, 2, :, 1] = grad_l[..., 0]
-    b = b.reshape(n_el, 3, 9)
+    return b.reshape(n_el, 3, 9)
+
+
+def cst_stiffness(grad_l, area, c, drilling_penalty):
+    """Constant-strain triangle with a Hughes–Brezzi drilling penalty (n_el, 9, 9): the
+    membrane of Nastran's CTRIA3, K = A Bᵀ C B + α C₃₃ ∫ (θz − ω)² dA with θz linear between
+    the corners and ω = (v,x − u,y)/2 constant (Nastran: α = 1e-6 · K6ROT)."""
+    n_el = area.shape[0]
+    b = cst_strain(grad_l)
     k = area[:, None, None] * (b.transpose(0, 2, 1) @ c @ b)
     spin = np.zeros((n_el, 3, 3))
     spin[:, :, 0] = -0.5 * grad_l[..., 1]

@@ -75,12 +75,12 @@ def _gradients(xy):
     dxi = 0.25 * _XI[None] * (1.0 + eta[:, None] * _ETA[None])
     deta = 0.25 * _ETA[None] * (1.0 + xi[:, None] * _XI[None])
     natural = np.stack([dxi, deta], axis=2)                      # (4 g, 4 nodes, 2)
-    jac = np.einsum("gna,enb->egab", natural, xy)                 # J[a, b] = ∂x_b/∂ξ_a
+    jac = natural.transpose(0, 2, 1)[None] @ xy[:, None]         # J[a, b] = ∂x_b/∂ξ_a
     det = jac[..., 0, 0] * jac[..., 1, 1] - jac[..., 0, 1] * jac[..., 1, 0]
     if np.any(det <= 0.0):
         raise ValueError("quadrilateral with a non-positive Jacobian (concave or misordered)")
     inv = np.linalg.inv(jac)                                      # ∂ξ_a/∂x_b as inv[b, a]
-    grad = np.einsum("egba,gna->egnb", inv, natural)              # (n_q, 4 g, 4 nodes, 2)
+    grad = natural[None] @ inv.transpose(0, 1, 3, 2)             # (n_q, 4 g, 4 nodes, 2)
     centre = np.einsum("na,enb->eab", 0.25 * np.stack([_XI, _ETA], 1), xy)
     det0 = centre[:, 0, 0] * centre[:, 1, 1] - centre[:, 0, 1] * centre[:, 1, 0]
     inv0 = np.linalg.inv(centre)
@@ -88,7 +88,7 @@ def _gradients(xy):
     natural_inc = np.zeros((4, 2, 2))
     natural_inc[:, 0, 0] = -2.0 * xi
     natural_inc[:, 1, 1] = -2.0 * eta
-    grad_inc = np.einsum("eba,gma->egmb", inv0, natural_inc) * (
+    grad_inc = (natural_inc[None] @ inv0.transpose(0, 2, 1)[:, None]) * (
         det0[:, None] / det)[..., None, None]
     return grad, grad_inc, det
 
@@ -119,10 +119,11 @@ def quad_membrane_matrices(points, quads, c, drilling_penalty):
     weight = det                                          # 2×2 Gauss weights are 1
     b_c = _strain(grad)                                   # (n_q, 4 g, 3, 8)
     b_i = _strain(grad_inc)                               # (n_q, 4 g, 3, 4)
-    cb_c, cb_i = c[:, None] @ b_c, c[:, None] @ b_i
-    k_cc = np.einsum("eg,egri,egrj->eij", weight, b_c, cb_c)
-    k_ci = np.einsum("eg,egri,egrj->eij", weight, b_c, cb_i)
-    k_ii = np.einsum("eg,egri,egrj->eij", weight, b_i, cb_i)
+    # Σ_g w_g B_gᵀ C B_g as batched matmuls over the stacked (4 g × 3 strains) rows
+    b_all = np.concatenate([b_c, b_i], axis=3)            # (n_q, 4 g, 3, 12)
+    cb = (c[:, None] @ b_all) * weight[:, :, None, None]
+    k_all = b_all.reshape(n_q, 12, 12).transpose(0, 2, 1) @ cb.reshape(n_q, 12, 12)
+    k_cc, k_ci, k_ii = k_all[:, :8, :8], k_all[:, :8, 8:], k_all[:, 8:, 8:]
     k_uv = k_cc - k_ci @ np.linalg.solve(k_ii, k_ci.transpose(0, 2, 1))
 
     # drilling penalty on [u, v, θz] per node: g_gauss·q = θz(ξ) − ω(ξ)
@@ -134,7 +135,8 @@ def quad_membrane_matrices(points, quads, c, drilling_penalty):
     g[..., 2] = n_values[None]
     g = g.reshape(n_q, 4, 12)
     alpha = np.broadcast_to(np.asarray(drilling_penalty, float), (n_q,))
-    k_drill = (alpha * c[:, 2, 2])[:, None, None] * np.einsum("eg,egi,egj->eij", weight, g, g)
+    k_drill = (alpha * c[:, 2, 2])[:, None, None] * (
+        g.transpose(0, 2, 1) @ (g * weight[:, :, None]))
 
     membrane = np.zeros((n_q, 4, 3, 4, 3))
     membrane[:, :, :2, :, :2] = k_uv.reshape(n_q, 4, 2, 4, 2)
@@ -153,6 +155,6 @@ def quad_membrane_matrices(points, quads, c, drilling_penalty):
 def _to_global(local, rotation):
     """Tᵀ A T (n_q, 24, 24) for T = blockdiag(R × 8), rotation (n_q, 3, 3) rows e1, e2, e3."""
     n_q = local.shape[0]
-    blocks = local.reshape(n_q, 8, 3, 8, 3)
-    rotated = np.einsum("eai,eparq,eqj->epirj", rotation, blocks, rotation).reshape(n_q, 24, 24)
+    right = (local.reshape(n_q, 192, 3) @ rotation).reshape(n_q, 8, 3, 24)
+    rotated = (rotation.transpose(0, 2, 1)[:, None] @ right).reshape(n_q, 24, 24)
     return 0.5 * (rotated + rotated.transpose(0, 2, 1))

@@ -24,10 +24,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from sarfe.fe.membrane import DEFAULT_MEMBRANE, DRILLING_PENALTY
+from sarfe.fe.membrane import DRILLING_PENALTY
 from sarfe.fe.plate_bending import dkmt_rotation_field, dkt_rotation_field
-from sarfe.fe.shell import (BENDING_DOFS, DEGREE4_RULE, MEMBRANE_DOFS, consistent_mass,
-                            element_kinematics, membrane_stiffness, to_global, weighted_gram)
+from sarfe.fe.shell import (BENDING_DOFS, DEFAULT_MEMBRANE, DEGREE4_RULE, MEMBRANE_DOFS,
+                            consistent_mass, element_kinematics, membrane_stiffness, to_global,
+                            weighted_gram)
 from sarfe.mesh.laminate import rotate_plane_stress, rotate_transverse_shear
 
 __all__ = ["section_shell_element_matrices", "shear_compliance"]
