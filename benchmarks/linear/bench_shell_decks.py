@@ -32,7 +32,7 @@ import time
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 HERE = pathlib.Path(__file__).resolve().parent
-ROOT = HERE.parent
+ROOT = HERE.parents[1]
 SHARED = next((p / "shared" / "decks" for p in ROOT.parents if (p / "shared" / "decks").is_dir()),
               ROOT.parent / "shared" / "decks")
 BEFORE = "bf7347e"          # main at the start of issue 32's shell work
