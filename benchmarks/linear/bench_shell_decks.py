@@ -259,8 +259,8 @@ def main() -> None:
     before["timing"], after["timing"] = _best(timing_b), _best(timing_a)
     results = dict(before_ref=args.before, decks=decks, before=before, after=after,
                    machine=platform.machine(), load=os.getloadavg()[0])
-    (HERE / "results").mkdir(exist_ok=True)
-    (HERE / "results" / "shell_decks.json").write_text(json.dumps(results, indent=1))
+    (ROOT / "benchmarks" / "results").mkdir(exist_ok=True)
+    (ROOT / "benchmarks" / "results" / "shell_decks.json").write_text(json.dumps(results, indent=1))
     bt, at = before["timing"], after["timing"]
     lines = [
         "# Shell decks vs the commercial solver's stored modes (issue 32)", "",
@@ -289,7 +289,7 @@ def main() -> None:
                      f"wall | {bt['exhaust_deck']['wall_s']:.2f} | {at['exhaust_deck']['wall_s']:.2f} |")
     lines += ["", f"Best of 3 × 2 (before and after in turn, A B A B), one BLAS thread, {platform.machine()}, load average "
               f"{results['load']:.1f} at the end (shared machine: times are upper bounds)."]
-    (HERE / "results" / "shell_decks.md").write_text("\n".join(lines) + "\n")
+    (ROOT / "benchmarks" / "results" / "shell_decks.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
 
 

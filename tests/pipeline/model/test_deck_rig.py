@@ -23,8 +23,9 @@ def generator_elements(monkeypatch):
 
     from sarfe.fe import deck_assembly
     from sarfe.fe.membrane import DRILLING_PENALTY
+    from sarfe.pipeline.model import deck_stage
 
-    monkeypatch.setattr(deck_assembly, "assemble_deck", partial(
+    monkeypatch.setattr(deck_stage, "assemble_deck", partial(
         deck_assembly.assemble_deck, mass="consistent", membrane="allman",
         drilling_penalty=DRILLING_PENALTY))
 
