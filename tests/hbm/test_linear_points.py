@@ -51,9 +51,9 @@ def test_linear_point_is_the_linear_frf_and_newtons_solution():
         # forces: the stuck seal carries k_t q, the open rattle nothing
         assert np.all(point.contact_state[:, 0] == 0) and np.all(point.contact_state[:, 1] == 1)
         q = point.contact_displacement[:, 1]
-        np.testing.assert_allclose(point.contact_force[:, 1],
-                                   panel.NOMINAL["tangential_stiffness"] * q, rtol=1e-10,
-                                   atol=1e-12 * np.abs(q).max())
+        k_t = panel.NOMINAL["tangential_stiffness"]
+        np.testing.assert_allclose(point.contact_force[:, 1], k_t * q, rtol=1e-10,
+                                   atol=1e-12 * k_t * np.abs(q).max())   # AFT round-off [N]
 
 
 def test_linear_point_refuses_where_a_contact_acts():
@@ -63,12 +63,14 @@ def test_linear_point_refuses_where_a_contact_acts():
     assert linear_point(model, contacts, F, omega, H, N, options=OPTIONS) is None
     newton = solve_frequency(model, contacts, F, omega, H, N, options=OPTIONS)
     assert newton.converged and np.any(newton.contact_state[:, 0] == 1)
-    # the screen (dynamic part doubled, margin 0.5) agrees: nonlinear there, linear at 2 %
-    omegas = 2 * np.pi * np.array([30.0, 50.0])
-    np.testing.assert_array_equal(screen_linear(model, contacts, F, omegas, 64, 0.5),
-                                  [False, False])
-    np.testing.assert_array_equal(
-        screen_linear(model, contacts, panel.excitation(H, 0.02), omegas, 64, 0.5), [True, True])
+    # the screen (dynamic part doubled, margin 0.5) is conservative: nonlinear at 50 Hz, and
+    # wherever it says linear the exact check holds and Newton keeps the rattle open
+    omegas = 2 * np.pi * np.linspace(30.0, 90.0, 13)
+    screened = screen_linear(model, contacts, F, omegas, 64, 0.5)
+    assert not screened[np.argmin(np.abs(omegas - omega))] and screened.any()
+    for w in omegas[screened]:
+        assert linear_point(model, contacts, F, w, H, N, options=OPTIONS) is not None
+    assert screen_linear(model, contacts, panel.excitation(H, 0.02), omegas, 64, 0.5).all()
 
 
 def test_modal_and_direct_linear_displacements_agree():

@@ -26,8 +26,9 @@ contact closes, opens or slips (issue 30).
    (:func:`sarfe.pipeline.solve.points.solve_point`) from the previous point.
 
 Exactness: a linear point is a solution of the same equations as a Newton point (checked per
-point, not assumed from the screen); where no grid point is linear the sweep is the plain
-continuation (:func:`sweep_by_need` returns None).
+point, not assumed from the screen); where no grid point is linear, or a stretch's continuation
+stops (a branch that turns back out of the band: the whole-band continuation from the band's start
+passes such folds), the sweep is the plain continuation (:func:`sweep_by_need` returns None).
 """
 from __future__ import annotations
 
@@ -42,8 +43,8 @@ from sarfe.hbm import continuation
 from sarfe.hbm.linear_points import (linear_displacements, linear_point, linear_with_margin,
                                      screen_linear)
 from sarfe.pipeline.model.nonlinear_model import NonlinearModel
-from sarfe.pipeline.solve.points import (TIME_INTEGRATION, finish_sweep, in_band, solve_point,
-                                         solve_points, solver_options)
+from sarfe.pipeline.solve.points import (STOPPED, TIME_INTEGRATION, finish_sweep, in_band,
+                                         solve_point, solve_points, solver_options)
 from sarfe.util.progress import bar as progress_bar
 
 LINEAR_POINTS = 51      # a linear stretch's base points: this many over the band (+ its ω_n)
@@ -182,6 +183,9 @@ def sweep_by_need(nl, start, end, H, N, options, cont_options, grid, margin, nat
                                            point.samples_per_period, point.omega, margin))
         branch = list(continuation(model, contacts, F, begin, end, H, N, options=cont_options,
                                    stop_when=stop_when, band_start=start))
+        if any(STOPPED in str(p.reason) for p in branch):
+            return None     # a stretch's branch stopped (e.g. turned back out of the band): the
+            #                 whole-band continuation, which starts where the plain sweep does
         if solutions and branch and abs(branch[0].omega - solutions[-1].omega) <= 1e-12 * span:
             branch = branch[1:]              # the walk's last point again
         reached = branch[-1].omega if branch else begin
