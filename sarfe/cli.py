@@ -12,15 +12,17 @@ import argparse
 import sys
 import time
 import traceback
+from pathlib import Path
 
 import numpy as np
 
 from sarfe import __version__
 from sarfe.batch import cli as batch_cli
 from sarfe.case.errors import EXIT_CASE_ERROR, EXIT_NOT_CONVERGED, CaseError
-from sarfe.pipeline import build_linear_model, load_case, nonlinear_model, results_table, solve_case
+from sarfe.pipeline import build_linear_model, load_case, nonlinear_model, solve_case
 from sarfe.pipeline.checks.case_checks import check_case, output_target
 from sarfe.pipeline.verify import format_rows, verify_point
+from sarfe.pipeline.write.result_files import console_summary
 from sarfe.results.summary import loudest_lines, pruning_line, stability_line
 from sarfe.tradeoff import cli as tradeoff_cli
 
@@ -54,7 +56,9 @@ def cmd_solve(args) -> int:
         if pruning:
             print(pruning)
         types = {c["name"]: c["type"] for c in summary["contacts"]}
-        print(results_table(result.rows, types))
+        table = Path(result.output_dir) / "table.txt" if result.output_dir else None
+        print(console_summary(result.rows, types,   # every point in table.txt (issue 30)
+                              "table.txt" if table is not None and table.exists() else None))
         for line in loudest_lines(summary.get("worst")):
             print(line)
         print(f"results: {result.output_dir}  ({time.perf_counter() - clock:.1f} s)")
