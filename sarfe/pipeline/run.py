@@ -7,6 +7,7 @@ from __future__ import annotations
 import contextlib
 import datetime as _dt
 import functools
+import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -25,7 +26,8 @@ from sarfe.pipeline.post.point_workers import (first_estimates, point_records, p
                                                point_workers, stability_stream)
 from sarfe.pipeline.post.records import error_estimates, worst_of
 from sarfe.pipeline.solve.by_need import erp_measure
-from sarfe.pipeline.solve.case_accuracy import accuracy_check, case_resolution, resolved_case
+from sarfe.pipeline.solve.case_accuracy import (accuracy_check, case_resolution, resolution_line,
+                                                resolved_case)
 from sarfe.pipeline.solve.points import common_samples, sweep_status
 from sarfe.pipeline.solve.pruned_points import solve_points_pruned
 from sarfe.pipeline.write.result_files import write_outputs
@@ -80,7 +82,9 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     if config.solver.resolution == "auto":
         # accuracy as an input: choose H, N (the reduction cutoff follows H) by a cheap search
         clock = time.perf_counter()
-        report, searched = case_resolution(case, config.solver.accuracy)
+        report, searched = case_resolution(case, config.solver.accuracy, progress=progress)
+        if progress:       # the chosen resolution before the sweep pays for it (issue 30)
+            print(f"sarfe: {resolution_line(report, searched)}", file=sys.stderr, flush=True)
         accuracy = {k: report.get(k) for k in ("harmonics", "samples_per_period", "mode_count",
                                                "estimate", "met", "reason", "tuned_hz",
                                                "search_stage_modes", "search_stage_seconds",

@@ -211,7 +211,8 @@ def console_summary(rows, contact_types=None, full_table=None, width=CONSOLE_WID
     """The end-of-run console summary of the points, at most ``width`` characters a line: the
     compact :func:`results_table` (f, converged, ERP [dB(A)], ±dB and as many contacts as fit) of
     all points when there are at most ``max_rows``, else of the band's two ends and ``max_rows``
-    − 2 others, the level's peaks loudest first, then the loudest points (in sweep order), with a line saying so and naming ``full_table`` (the file
+    − 2 others, the level's peaks loudest first, then points spread over the sweep (in sweep
+    order), with a line saying so and naming ``full_table`` (the file
     with every point, e.g. 'table.txt'; None: not written)."""
     rows = list(rows)
     shown = list(range(len(rows)))
@@ -219,9 +220,13 @@ def console_summary(rows, contact_types=None, full_table=None, width=CONSOLE_WID
         levels = np.array([row.get("erp_dba", float("nan")) for row in rows], dtype=float)
         levels = np.where(np.isfinite(levels), levels, -np.inf)
         peak = np.r_[False, (levels[1:-1] > levels[:-2]) & (levels[1:-1] >= levels[2:]), False]
-        order = np.lexsort((-levels, ~peak))           # the peaks loudest first, then the rest
-        shown = sorted({0, len(rows) - 1, *[int(i) for i in order
-                                            if 0 < i < len(rows) - 1][:max_rows - 2]})
+        peaks = [int(i) for i in np.flatnonzero(peak)[np.argsort(-levels[peak])]]
+        spread = [int(i) for i in np.linspace(0, len(rows) - 1, max_rows).round()]
+        chosen = [0, len(rows) - 1]
+        for i in peaks[:max_rows - 2] + spread:     # the peaks loudest first, then spread
+            if len(chosen) < max_rows and i not in chosen:
+                chosen.append(i)
+        shown = sorted(chosen)
     count = len([k for k in (rows[0] if rows else {}) if k.endswith(".max_penetration_m")])
     for contacts in range(count, -1, -1):       # as many contact columns as fit the width
         table = results_table([rows[i] for i in shown], contact_types, max_contacts=contacts,
@@ -230,7 +235,7 @@ def console_summary(rows, contact_types=None, full_table=None, width=CONSOLE_WID
             break
     if len(shown) < len(rows):
         where = f"; all in {full_table}" if full_table else ""
-        table += f"\n({len(shown)} of {len(rows)} points: ends, peaks, loudest{where})"
+        table += f"\n({len(shown)} of {len(rows)} points: ends, peaks, spread{where})"
     return table
 
 
