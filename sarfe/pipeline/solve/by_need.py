@@ -35,7 +35,6 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from sarfe.accuracy.measures import erp_proxy
 from sarfe.case.config import ExcitationConfig, SolverConfig
@@ -255,6 +254,8 @@ def _refined(nl, w0, w1, v0, v1, measure, depth) -> list:
 
 def _peak(nl, w0, w1, measure) -> float:
     """ω [rad/s] of the maximum of the linear response's ``measure`` in [w0, w1]."""
+    from scipy.optimize import minimize_scalar   # heavy (tests/test_imports.py): on use only
+
     lo, hi = sorted((w0, w1))
 
     def minus(w):
