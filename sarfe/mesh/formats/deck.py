@@ -322,6 +322,7 @@ UNIT_SYSTEMS = {
     "mm-kg-s": UnitSystem("mm-kg-s", 1e-3, 1.0, 1.0),
     "m-kg-s": UnitSystem("m-kg-s", 1.0, 1.0, 1.0),
     "in-lbf-s": UnitSystem("in-lbf-s", _INCH, _LBF / _INCH, 1.0),
+    "ft-lbf-s": UnitSystem("ft-lbf-s", 12 * _INCH, _LBF / (12 * _INCH), 1.0),   # mass unit: slug
 }
 
 # dimension (length, mass, time) of every float field that carries a unit

@@ -212,6 +212,70 @@ def has_mass(deck) -> bool:
                 or np.any(deck.beams.density > 0) or np.any(deck.beams.mass_per_length > 0))
 
 
+def massless_parts(deck) -> list[str]:
+    """Connected parts (:func:`connected_parts`) none of whose nodes carries mass — their DOFs
+    would have K but no M, and the modal reduction cannot factor M (LinAlgError) — as messages
+    naming the part's GRIDs and the properties without density."""
+    count, part, used = connected_parts(deck)
+    heavy = np.zeros(deck.n_nodes, dtype=bool)
+    shells = deck.shells
+    heavy[shells.triangles[shells.mass_per_area > 0].ravel()] = True
+    for block in deck.solids.values():
+        heavy[block.connectivity[block.density > 0].ravel()] = True
+    beams = deck.beams
+    heavy[beams.nodes[(beams.density > 0) | (beams.mass_per_length > 0)].ravel()] = True
+    heavy[deck.point_masses.node[deck.point_masses.mass > 0]] = True
+    problems = []
+    for p in range(count):
+        nodes = np.flatnonzero((part == p) & used)
+        if nodes.size == 0 or heavy[nodes].any():
+            continue
+        grids = deck.node_ids[nodes]
+        in_part = np.isin(shells.triangles, nodes).any(axis=1)
+        pids = np.unique(shells.property_ids[shells.triangle_element[in_part]])
+        pids = np.concatenate([pids, np.unique(beams.property_ids[np.isin(beams.nodes, nodes)
+                                                                  .any(axis=1)])])
+        for block in deck.solids.values():
+            pids = np.concatenate([pids, block.property_ids[np.isin(block.connectivity, nodes)
+                                                             .any(axis=1)]])
+        shown = ", ".join(str(int(i)) for i in np.unique(pids)[:5] if i > 0)
+        problems.append(f"a part of {len(nodes)} nodes (GRIDs {int(grids.min())}…"
+                        f"{int(grids.max())}) has no mass"
+                        + (f" (property {shown}: its material has no density ρ)" if shown else ""))
+    return problems
+
+
+def check_material_bounds(case: Case, deck) -> None:
+    """E > 0 and −1 < ν < 0.5 for every material of the deck — the bounds the case's own
+    ``materials`` keys have (schema) — as a one-line CaseError on model.fe.deck naming the card;
+    no unit advice (no unit system makes a modulus negative). ν of a shell section is read where
+    the section is isotropic (A₁₁ = A₂₂, A₆₆ = (A₁₁ − A₁₂)/2: ν = A₁₂/A₁₁), of a beam from
+    ν = E/(2G) − 1, of a solid as given."""
+    deck_config = case.config.model.fe.deck
+    path = case.resolve(deck_config.file)
+    a = deck.shells.membrane
+    a11, a22, a12, a66 = a[:, 0, 0], a[:, 1, 1], a[:, 0, 1], a[:, 2, 2]
+    iso = np.isclose(a11, a22, rtol=1e-9) & np.isclose(a66, (a11 - a12) / 2, rtol=1e-9) & (a11 != 0)
+    shell_nu = np.where(iso, np.divide(a12, a11, out=np.zeros_like(a11), where=a11 != 0), 0.0)
+    beams = deck.beams
+    beam_nu = np.divide(beams.young, 2 * beams.shear_modulus, out=np.ones_like(beams.young),
+                        where=beams.shear_modulus != 0) - 1
+    tables = [("shell", _section_moduli(deck.shells), shell_nu), ("beam", beams.young, beam_nu)]
+    tables += [(f"solid:{kind}", b.young, b.poisson) for kind, b in deck.solids.items()]
+    for table, young, nu in tables:
+        bad_e = np.flatnonzero(np.nan_to_num(young, nan=1.0) <= 0)
+        if bad_e.size:
+            row = int(bad_e[0])
+            where = _card_of(path, deck, deck_config.units, "E", table, row, float(young[row]))
+            raise case.error(f"{where}: E = {young[row]:.4g} Pa must be > 0", DECK_KEY)
+        bad_nu = np.flatnonzero((nu >= 0.5 - 1e-12) | (nu <= -1.0))
+        if bad_nu.size:
+            row = int(bad_nu[0])
+            where = _card_of(path, deck, deck_config.units, "E", table, row, float(young[row]))
+            raise case.error(f"{where}: ν = {nu[row]:.4g} is outside −1 < ν < 0.5 (the bounds of "
+                             "a case's materials: nu)", DECK_KEY)
+
+
 def used_nodes(deck) -> np.ndarray:
     _, _, used = connected_parts(deck)
     return np.flatnonzero(used)
@@ -332,39 +396,61 @@ _SYMBOL = {"E": ("E", "Pa"), "rho": ("ρ", "kg/m³")}
 _DIMENSION = {"E": (-1, 1, -2), "rho": (-3, 1, 0), "thickness": (1, 0, 0)}
 
 
-def check_units(case: Case, deck) -> None:
-    """One-line CaseError on ``model.fe.units`` for the first implausible value of the deck in
-    SI (:func:`unit_findings`), naming the deck card (file:line: MAT1 1, PSHELL 1, …), the
-    value, the rule and, when one fits, the unit system the deck looks like:
+def units_given(case: Case) -> bool:
+    """Whether the case file names model.fe.units itself (not the default SI)."""
+    return "units" in (case.data.get("model", {}).get("fe", {}) or {})
+
+
+def check_units(case: Case, deck) -> list[str]:
+    """The plausibility of the deck's units (:func:`unit_findings`), as one line per finding
+    naming the deck card (file:line: MAT1 1, PSHELL 1, …), the value in SI, the rule and, when
+    one fits, the unit system the deck looks like:
 
         deck.bdf:1473: MAT1 1: E = 2200 Pa with units: SI — implausible for a trim part
         (E < 1e5 Pa); the deck looks like mm-t-s: set model.fe.units: mm-t-s
-    """
+
+    Returns the warnings; raises a CaseError on model.fe.units only for what the case cannot
+    mean: E, ρ or span findings when no unit system makes the deck plausible, or when another
+    system does and the case leaves ``units`` at its default (an explicit ``units:`` wins: the
+    finding is then a warning). Thickness-to-size findings are warnings (no unit system changes
+    a ratio of lengths: a real thin web or thick laminate is kept)."""
     findings = unit_findings(deck)
     if not findings:
-        return
+        return []
     deck_config = case.config.model.fe.deck
     units, path = deck_config.units, case.resolve(deck_config.file)
-    quantity, table, row, value = findings[0]
     suggestion = suggested_units(deck, units)
-    hint = (f"the deck looks like {suggestion}: set model.fe.units: {suggestion}" if suggestion
-            else "check model.fe.units and the deck's unit system")
-    if quantity == "span":
-        side = f"> {SPAN_RANGE_M[1]:g} m" if value > SPAN_RANGE_M[1] else \
-            f"< {SPAN_RANGE_M[0] * 1e3:g} mm"
-        raise case.error(f"{path}: the GRIDs span {value:.3g} m with units: {units} — "
-                         f"implausible for a trim part ({side}); {hint}", UNITS_KEY)
-    where = _card_of(path, deck, units, quantity, table, row, value)
-    if quantity == "thickness":
-        span = model_span(deck)
-        low, high = THICKNESS_RANGE
-        rule = (f"above {high:g} of the model size {span:.3g} m" if value > high * span
-                else f"below {low:g} of the model size {span:.3g} m")
-        raise case.error(f"{where}: thickness {value:.3g} m with units: {units} — {rule}: the "
-                         "thickness and the GRIDs look like different length units", UNITS_KEY)
-    symbol, unit = _SYMBOL[quantity]
-    raise case.error(f"{where}: {symbol} = {value:.4g} {unit} with units: {units} — implausible "
-                     f"for a trim part ({_RULES[quantity]}); {hint}", UNITS_KEY)
+    explicit = units_given(case)
+    warnings = []
+    for quantity, table, row, value in findings:
+        if quantity == "thickness":
+            span = model_span(deck)
+            low, high = THICKNESS_RANGE
+            rule = (f"above {high:g} of the model size {span:.3g} m" if value > high * span
+                    else f"below {low:g} of the model size {span:.3g} m")
+            where = _card_of(path, deck, units, quantity, table, row, value)
+            warnings.append(f"{where}: thickness {value:.3g} m with units: {units} — {rule}; "
+                            "kept (check that the thickness and the GRIDs share a length unit)")
+            continue
+        if quantity == "span":
+            side = f"> {SPAN_RANGE_M[1]:g} m" if value > SPAN_RANGE_M[1] else \
+                f"< {SPAN_RANGE_M[0] * 1e3:g} mm"
+            text = (f"{path}: the GRIDs span {value:.3g} m with units: {units} — "
+                    f"implausible for a trim part ({side})")
+        else:
+            symbol, unit = _SYMBOL[quantity]
+            where = _card_of(path, deck, units, quantity, table, row, value)
+            text = (f"{where}: {symbol} = {value:.4g} {unit} with units: {units} — implausible "
+                    f"for a trim part ({_RULES[quantity]})")
+        if suggestion is None:
+            raise case.error(f"{text}; no unit system makes the deck plausible: check the deck's "
+                             "values and model.fe.units", UNITS_KEY)
+        if not explicit:
+            raise case.error(f"{text}; the deck looks like {suggestion}: set model.fe.units: "
+                             f"{suggestion} (or units: {units} to keep {units})", UNITS_KEY)
+        warnings.append(f"{text}; kept as model.fe.units: {units} says (the deck would look "
+                        f"plausible in {suggestion})")
+    return warnings
 
 
 def _card_of(path, deck, units, quantity, table, row, value) -> str:
