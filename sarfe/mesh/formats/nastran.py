@@ -48,7 +48,7 @@ import numpy as np
 from sarfe.mesh.formats.beam_library import section
 from sarfe.mesh.formats.deck import (BeamElements, DeckError, DeckModel, InterpolationElements, PointMasses,
                                      RigidElements, SolidElements, SpringElements, to_si)
-from sarfe.mesh.formats.nastran_bdf import card_where, load_bdf
+from sarfe.mesh.formats.nastran_bdf import card_where, first_lines, load_bdf
 from sarfe.mesh.formats.nastran_sections import isotropic, shells
 from sarfe.mesh.formats.nastran_sets import component_mask, loads, sets, supports
 
@@ -138,7 +138,8 @@ class _Converter:
         nids = np.array(sorted(model.nodes), dtype=np.int64)
         self.node_ids = nids
         self.index = {int(n): i for i, n in enumerate(nids)}
-        self.points = (np.asarray(model.get_xyz_in_coord(cid=0, sort_ids=True), float)
+        # GRIDs only (pyNastran's get_xyz_in_coord adds a zero row per SPOINT, shifting rows)
+        self.points = (np.array([model.nodes[int(n)].get_position() for n in nids], float)
                        if len(nids) else np.zeros((0, 3)))
         self.frames = np.tile(np.eye(3), (len(nids), 1, 1))
         cds = np.array([model.nodes[int(n)].cd for n in nids], dtype=np.int64)
@@ -480,7 +481,8 @@ class _Converter:
             beams=self.beams(), springs=self.springs(), point_masses=self.point_masses(),
             rbe2=rbe2, rbe3=rbe3, supports=supports(self), loads=loads(self),
             node_sets=node_sets, element_sets=element_sets, unsupported=unsupported,
-            ignored={}, coupled_mass=self.coupled_mass,
+            ignored={}, unsupported_where=first_lines(self.path, unsupported) if unsupported else {},
+            coupled_mass=self.coupled_mass,
             drilling_penalty=self.drilling_penalty, notes=tuple(self.notes))
 
 

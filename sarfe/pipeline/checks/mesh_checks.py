@@ -16,6 +16,7 @@ from sarfe.erp import nodal_normals
 from sarfe.mesh import quality
 from sarfe.pipeline.model.case_mesh import load_case_mesh
 from sarfe.pipeline.model.contact_pairs import pair_contact
+from sarfe.pipeline.model.deck_checks import check_boundary_nodes
 from sarfe.pipeline.model.deck_model import prepare_deck
 from sarfe.pipeline.model.deck_stage import contact_pairs
 from sarfe.pipeline.model.erp_map import deck_surface_triangles
@@ -72,7 +73,12 @@ def check_deck(case) -> dict:
     """Validation of a deck case without assembly: cards, groups, quality, supports, pairing."""
     prepared = prepare_deck(case)
     mesh = prepared.mesh
-    pairs = {name: len(p[0]) for name, p in contact_pairs(case, prepared).items()}
+    paired = contact_pairs(case, prepared)
+    pairs = {name: len(p[0]) for name, p in paired.items()}
+    for contact in case.config.contacts:
+        a, b, _, _ = paired[contact.name]
+        check_boundary_nodes(case, prepared.deck, np.concatenate([a, b[b >= 0]]),
+                             ("contacts", contact.index))
     for i, f in enumerate(case.config.excitation.forces):
         if f.load_set is not None:
             if str(f.load_set) not in prepared.deck.loads:
@@ -80,7 +86,9 @@ def check_deck(case) -> dict:
                                  f"{', '.join(sorted(prepared.deck.loads)) or 'none'})",
                                  ("excitation", "forces", i, "load_set"))
         else:
-            resolve_node_group(case, mesh, f.group, ("excitation", "forces", i, "group"))
+            path = ("excitation", "forces", i, "group")
+            check_boundary_nodes(case, prepared.deck, resolve_node_group(case, mesh, f.group, path),
+                                 path)
     deck_surface_triangles(case, mesh)
     return {"nodes": prepared.deck.n_nodes, "triangles": mesh.n_triangles,
             "contact_pairs": pairs, "ignored_cards": prepared.notes["ignored_cards"],

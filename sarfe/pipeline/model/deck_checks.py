@@ -83,10 +83,18 @@ def support_mask(case: Case, deck, mesh) -> np.ndarray:
                              ("model", "fe", "supports", j))
         support = deck.supports[name]
         held[support.nodes] |= support.components
+    used = used_nodes(deck)
     for i, group in enumerate(fe.fixed):
         nodes = resolve_node_group(case, mesh, group, ("model", "fe", "fixed", i),
                                    allow_elements=False)
+        if used.size and np.isin(used, nodes).all():
+            raise case.error(f"'{group}' holds every node of the model ({len(used)} nodes): "
+                             "nothing is left to vibrate; name the group of the held nodes",
+                             ("model", "fe", "fixed", i))
         held[nodes] = True
+    if used.size and held[used].all():
+        raise case.error(f"the supports and fixed groups hold every DOF of all {len(used)} "
+                         "nodes: nothing is left to vibrate", ("model", "fe", "supports"))
     return held
 
 
@@ -274,6 +282,33 @@ def check_material_bounds(case: Case, deck) -> None:
             where = _card_of(path, deck, deck_config.units, "E", table, row, float(young[row]))
             raise case.error(f"{where}: ν = {nu[row]:.4g} is outside −1 < ν < 0.5 (the bounds of "
                              "a case's materials: nu)", DECK_KEY)
+
+
+def check_boundary_nodes(case: Case, deck, nodes, path) -> None:
+    """Contact and force nodes become physical boundary DOFs (translations, global axes): a
+    node with a rotated CD frame, or whose translations a rigid element makes dependent (an
+    RBE2 dependent node, an RBE3 reference node), is a one-line CaseError at ``path`` — the
+    same check validate and solve make before any assembly (a node without stiffness is found
+    at assembly)."""
+    nodes = np.asarray(nodes, dtype=np.int64)
+    if nodes.size == 0:
+        return
+    rotated = ~np.all(np.isclose(deck.displacement_frames[nodes], np.eye(3), atol=1e-12),
+                      axis=(1, 2))
+    if np.any(rotated):
+        raise case.error(f"GRID {int(deck.node_ids[nodes[np.argmax(rotated)]])} has a rotated "
+                         "displacement frame (CD): contact and force nodes must use the basic "
+                         "frame", path)
+    dependent = np.zeros(deck.n_nodes, dtype=bool)
+    rbe2 = deck.rbe2
+    moves = rbe2.components[rbe2.dependent_element, :3].any(axis=1) if len(rbe2.dependent) else []
+    dependent[rbe2.dependent[np.asarray(moves, dtype=bool)]] = True
+    rbe3 = deck.rbe3
+    dependent[rbe3.reference[rbe3.reference_components[:, :3].any(axis=1)]] = True
+    if np.any(dependent[nodes]):
+        bad = nodes[np.argmax(dependent[nodes])]
+        raise case.error(f"GRID {int(deck.node_ids[bad])} is a dependent node of a rigid element "
+                         "(RBE2/RBE3): use an independent node", path)
 
 
 def used_nodes(deck) -> np.ndarray:

@@ -70,13 +70,18 @@ def apply_ignore_cards(case: Case, deck):
                              f"{_listing(deck.unsupported) or 'none'})",
                              ("model", "fe", "ignore_cards", j))
     if unsupported:
-        raise case.error(f"the deck has cards sarfe does not model: {_listing(unsupported)}; "
-                         "support them or name them in model.fe.ignore_cards", DECK_KEY)
+        raise case.error(f"the deck has {len(unsupported)} card type"
+                         f"{'s' if len(unsupported) > 1 else ''} sarfe does not model: "
+                         f"{_listing(unsupported, deck.unsupported_where)}; support them or name "
+                         "them in model.fe.ignore_cards", DECK_KEY)
     return dataclasses.replace(deck, unsupported={}, ignored=ignored)
 
 
-def _listing(counts: dict) -> str:
-    return ", ".join(f"{card} ({count})" for card, count in sorted(counts.items()))
+def _listing(counts: dict, where=None) -> str:
+    """"CAERO1 (1, first at deck.bdf:12), …" — every card with its count and first line."""
+    where = where or {}
+    return ", ".join(f"{card} ({count}" + (f", first at {where[card]})" if card in where else ")")
+                     for card, count in sorted(counts.items()))
 
 
 def deck_files(path, seen=None) -> list:

@@ -18,7 +18,7 @@ from sarfe.fe.deck_assembly import assemble_deck, load_vector
 from sarfe.mesh.formats.deck import DeckError
 from sarfe.pipeline.model.contact_pairs import ContactGeometry, pair_contact, reduced_coordinates
 from sarfe.pipeline.model.cutoff import stage_cutoff_hz
-from sarfe.pipeline.model.deck_checks import DECK_KEY
+from sarfe.pipeline.model.deck_checks import DECK_KEY, check_boundary_nodes
 from sarfe.pipeline.model.deck_model import prepare_deck
 from sarfe.pipeline.model.erp_map import deck_surface_triangles, erp_map
 from sarfe.pipeline.model.groups import resolve_node_group
@@ -156,6 +156,12 @@ def build_deck_stage(case: Case, progress=False) -> dict:
                    resolve_node_group(case, mesh, f.group, ("excitation", "forces", i, "group"))
                    for i, f in enumerate(forces)]
     radiating = deck_surface_triangles(case, mesh)
+    for contact in case.config.contacts:      # as validate: before any assembly
+        a, b, _, _ = paired[contact.name]
+        check_boundary_nodes(case, deck, np.concatenate([a, b[b >= 0]]), ("contacts", contact.index))
+    for i, nodes in enumerate(group_nodes):
+        if nodes is not None:
+            check_boundary_nodes(case, deck, nodes, ("excitation", "forces", i, "group"))
 
     next_step(stages, "assembly")
     clock = time.perf_counter()
@@ -176,7 +182,9 @@ def build_deck_stage(case: Case, progress=False) -> dict:
     contact_nodes = [np.concatenate([a, b[b >= 0]]) for a, b, _, _ in paired.values()]
     nodes = np.unique(np.concatenate(contact_nodes + [g for g in group_nodes if g is not None]
                                      + [np.zeros(0, np.int64)]).astype(np.int64))
-    boundary_kept = _kept_translations(case, system, deck, nodes, ("contacts",)).ravel()
+    boundary_kept = _kept_translations(case, system, deck, nodes,
+                                       ("contacts",) if case.config.contacts
+                                       else ("excitation", "forces")).ravel()
     set_vectors = [(_load_set_vector(case, system, deck, f, ("excitation", "forces", i, "load_set"))
                     if f.load_set is not None else None) for i, f in enumerate(forces)]
     loaded = np.unique(np.concatenate([np.flatnonzero(v) for v in set_vectors if v is not None]
