@@ -444,11 +444,13 @@ def check_units(case: Case, deck) -> list[str]:
         deck.bdf:1473: MAT1 1: E = 2200 Pa with units: SI — implausible for a trim part
         (E < 1e5 Pa); the deck looks like mm-t-s: set model.fe.units: mm-t-s
 
-    Returns the warnings; raises a CaseError on model.fe.units only for what the case cannot
-    mean: E, ρ or span findings when no unit system makes the deck plausible, or when another
-    system does and the case leaves ``units`` at its default (an explicit ``units:`` wins: the
-    finding is then a warning). Thickness-to-size findings are warnings (no unit system changes
-    a ratio of lengths: a real thin web or thick laminate is kept)."""
+    Returns the warnings. E, ρ or span findings are a CaseError on model.fe.units while the case
+    leaves ``units`` at its default (with the system the deck looks like, if one fits); an
+    explicit ``units:`` wins and the finding is a warning (a real structure with near-zero ρ
+    and its mass in CONM2s, e.g. the Goland wing, is kept). Thickness-to-size findings are
+    warnings (no unit system changes a ratio of lengths: a real thin web or thick laminate is
+    kept). What no unit system can make plausible — E ≤ 0, ν outside (−1, 0.5) — is refused by
+    :func:`check_material_bounds`."""
     findings = unit_findings(deck)
     if not findings:
         return []
@@ -477,15 +479,14 @@ def check_units(case: Case, deck) -> list[str]:
             where = _card_of(path, deck, units, quantity, table, row, value)
             text = (f"{where}: {symbol} = {value:.4g} {unit} with units: {units} — implausible "
                     f"for a trim part ({_RULES[quantity]})")
-        if suggestion is None:
-            raise case.error(f"{text}; no unit system makes the deck plausible: check the deck's "
-                             "values and model.fe.units", UNITS_KEY)
         if not explicit:
-            raise case.error(f"{text}; the deck looks like {suggestion}: set model.fe.units: "
-                             f"{suggestion} (or units: {units} to keep {units})", UNITS_KEY)
-        warnings.append(f"{text}; kept as model.fe.units: {units} says (the deck would look "
-                        f"plausible in {suggestion})")
-    return warnings
+            advice = (f"the deck looks like {suggestion}: set model.fe.units: {suggestion}"
+                      if suggestion else "no unit system makes the deck plausible: check the "
+                      "deck's values")
+            raise case.error(f"{text}; {advice} (or units: {units} to keep {units})", UNITS_KEY)
+        warnings.append(f"{text}; kept as model.fe.units: {units} says" +
+                        (f" (the deck would look plausible in {suggestion})" if suggestion else ""))
+    return list(dict.fromkeys(warnings))      # one card found by several tables: once
 
 
 def _card_of(path, deck, units, quantity, table, row, value) -> str:
