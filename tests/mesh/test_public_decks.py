@@ -20,8 +20,11 @@ from sarfe.mesh.formats.nastran import nastran_deck
 
 DECKS = Path(__file__).resolve().parents[1] / "data" / "decks"
 REFERENCE = json.loads((DECKS / "REFERENCE.json").read_text())
-READ = [name for name, spec in REFERENCE.items() if isinstance(spec, dict) and "frequencies_hz" in spec]
-REFUSED = [name for name, spec in REFERENCE.items() if isinstance(spec, dict) and "refused" in spec]
+DECK_SPECS = {name: spec for name, spec in REFERENCE.items() if isinstance(spec, dict)}
+READ = [name for name, spec in DECK_SPECS.items()
+        if "frequencies_hz" in spec and "refused_cards" not in spec]
+REFUSED = [name for name, spec in DECK_SPECS.items() if "refused" in spec]
+REFUSED_CARDS = [name for name, spec in DECK_SPECS.items() if "refused_cards" in spec]
 
 
 def deck_frequencies(system, fixed, count):
@@ -72,3 +75,22 @@ def test_public_deck_refused_with_one_line(name):
     message = str(info.value)
     assert "\n" not in message and name in message
     assert REFERENCE[name]["refused"] in message
+
+
+@pytest.mark.parametrize("name", REFUSED_CARDS)
+def test_public_deck_refusal_lists_every_missing_card_type(name, tmp_path):
+    """A case on the deck is refused at validate with one line naming every card type the
+    reader lacks, with its count and first line (not the first one alone)."""
+    from sarfe.case.errors import CaseError
+    from sarfe.pipeline import check_mesh, load_case
+
+    data = {"name": "public", "model": {"fe": {"deck": str(DECKS / name), "units": "mm-t-s"}},
+            "excitation": {"base_acceleration": {"direction": "z", "amplitude_m_s2": 1.0},
+                           "frequency_hz": [100.0]}}
+    with pytest.raises(CaseError) as info:
+        check_mesh(load_case(data, base_dir=tmp_path))
+    message = str(info.value)
+    expected = REFERENCE[name]["refused_cards"]
+    assert "\n" not in message and f"{len(expected)} card types sarfe does not model" in message
+    for card, count in expected.items():
+        assert f"{card} ({count}, first at {DECKS / name}:" in message
