@@ -38,14 +38,9 @@ def _assemble(case: Case, deck):
 
 
 def _kept_translations(case, system, deck, nodes, path):
-    """(len(nodes), 3) kept DOF numbers of the translations of `nodes` (global axes)."""
+    """(len(nodes), 3) kept DOF numbers of the translations of `nodes` (global axes; rotated CD
+    frames and rigid-element dependents were refused before assembly: `check_boundary_nodes`)."""
     nodes = np.asarray(nodes, dtype=np.int64)
-    rotated = ~np.all(np.isclose(deck.displacement_frames[nodes], np.eye(3), atol=1e-12),
-                      axis=(1, 2))
-    if np.any(rotated):
-        raise case.error(f"GRID {int(deck.node_ids[nodes[np.argmax(rotated)]])} has a rotated "
-                         "displacement frame (CD): contact and force nodes must use the basic "
-                         "frame", path)
     dofs = system.dof_index(nodes[:, None], np.arange(3)[None, :])
     if np.any(dofs < 0):
         bad = nodes[np.argmax((dofs < 0).any(axis=1))]

@@ -89,22 +89,18 @@ def test_force_on_a_dependent_grid_is_named_alike_by_validate_and_solve(tmp_path
     both(_flutter_case(tmp_path, 117))       # the RBE2's independent GRID is fine
 
 
-def test_nu_one_half_in_a_deck_is_refused_as_the_yaml_is(tmp_path):
-    """MAT1 1 ν = 0.5: the case's own materials: nu has the bound ν < 0.5; the deck has too."""
+@pytest.mark.parametrize("old, new, pattern", [
+    # ν = 0.5: the case's own materials: nu has the bound ν < 0.5; the deck has it too
+    ("3.7000000000E-01", "5.0000000000E-01", r"MAT1 1: ν = 0\.5 is outside −1 < ν < 0\.5"),
+    # E < 0: no unit system makes it plausible — no unit advice
+    ("12.2000000000E+03", "1-2.200000000E+03", r"MAT1 1: E = -2\.2e\+09 Pa must be > 0"),
+])
+def test_material_bounds_refused_without_unit_advice(tmp_path, old, new, pattern):
     text = DECK.read_text()
     row = next(line for line in text.splitlines() if line.startswith("MAT1*                  1"))
-    text = _material_card(text, 1, first=row.replace("3.7000000000E-01", "5.0000000000E-01"))
-    message = refused_alike(shipped_case(tmp_path, deck_text=text),
-                            r"MAT1 1: ν = 0\.5 is outside −1 < ν < 0\.5")
+    text = _material_card(text, 1, first=row.replace(old, new))
+    message = refused_alike(shipped_case(tmp_path, deck_text=text), pattern)
     assert "model.fe.deck" in message
-
-
-def test_negative_modulus_is_an_error_without_unit_advice(tmp_path):
-    text = DECK.read_text()
-    row = next(line for line in text.splitlines() if line.startswith("MAT1*                  1"))
-    text = _material_card(text, 1, first=row.replace("12.2000000000E+03", "1-2.200000000E+03"))
-    message = refused_alike(shipped_case(tmp_path, deck_text=text),
-                            r"MAT1 1: E = -2\.2e\+09 Pa must be > 0")
     assert "looks like" not in message and "mm-kg-s" not in message
 
 
