@@ -284,6 +284,30 @@ def check_material_bounds(case: Case, deck) -> None:
                              "a case's materials: nu)", DECK_KEY)
 
 
+def dependent_components(deck) -> np.ndarray:
+    """(n, 6) bool: the components a rigid element makes dependent — an RBE2's dependent nodes
+    in its CM components, an RBE3's reference node in its REFC components (the reader refuses
+    partial masks on CD-frame nodes, so global and CD components agree where partial)."""
+    dependent = np.zeros((deck.n_nodes, 6), dtype=bool)
+    rbe2, rbe3 = deck.rbe2, deck.rbe3
+    if len(rbe2.dependent):
+        np.logical_or.at(dependent, rbe2.dependent, rbe2.components[rbe2.dependent_element])
+    if len(rbe3.reference):
+        np.logical_or.at(dependent, rbe3.reference, rbe3.reference_components)
+    return dependent
+
+
+def check_supports_on_dependents(case: Case, deck, held) -> None:
+    """A support on a component a rigid element makes dependent: the one-line CaseError solve
+    gives at assembly (:func:`sarfe.pipeline.model.deck_stage.held_kept_dofs`), before it."""
+    both = held & dependent_components(deck)
+    if np.any(both):
+        node, comp = np.argwhere(both)[0]
+        raise case.error(f"a support holds GRID {int(deck.node_ids[node])} component "
+                         f"{int(comp) + 1}, which a rigid element (RBE2/RBE3) makes dependent",
+                         ("model", "fe", "supports"))
+
+
 def check_boundary_nodes(case: Case, deck, nodes, path) -> None:
     """Contact and force nodes become physical boundary DOFs (translations, global axes): a
     node with a rotated CD frame, or whose translations a rigid element makes dependent (an
@@ -299,12 +323,7 @@ def check_boundary_nodes(case: Case, deck, nodes, path) -> None:
         raise case.error(f"GRID {int(deck.node_ids[nodes[np.argmax(rotated)]])} has a rotated "
                          "displacement frame (CD): contact and force nodes must use the basic "
                          "frame", path)
-    dependent = np.zeros(deck.n_nodes, dtype=bool)
-    rbe2 = deck.rbe2
-    moves = rbe2.components[rbe2.dependent_element, :3].any(axis=1) if len(rbe2.dependent) else []
-    dependent[rbe2.dependent[np.asarray(moves, dtype=bool)]] = True
-    rbe3 = deck.rbe3
-    dependent[rbe3.reference[rbe3.reference_components[:, :3].any(axis=1)]] = True
+    dependent = dependent_components(deck)[:, :3].any(axis=1)
     if np.any(dependent[nodes]):
         bad = nodes[np.argmax(dependent[nodes])]
         raise case.error(f"GRID {int(deck.node_ids[bad])} is a dependent node of a rigid element "

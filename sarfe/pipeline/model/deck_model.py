@@ -34,7 +34,8 @@ from sarfe.mesh.formats.abaqus import read_abaqus
 from sarfe.mesh.formats.deck import DeckError, to_si
 from sarfe.mesh.formats.nastran import read_nastran
 from sarfe.pipeline.model.deck_checks import (DECK_KEY, card_key, check_material_bounds,
-                                              check_quality, check_units,
+                                              check_quality, check_supports_on_dependents,
+                                              check_units,
                                               free_rigid_motions, has_mass, ignored_mass,
                                               massless_parts,
                                               joined_pairs, support_mask, used_nodes)
@@ -260,6 +261,7 @@ def prepare_deck(case: Case) -> PreparedDeck:
     joined = joined_pairs(deck, [(c.nodes_a, c.nodes_b) for c in element_contacts.values()])
     quality = check_quality(case, deck, joined)
     held = support_mask(case, deck, mesh)
+    check_supports_on_dependents(case, deck, held)
     free = free_rigid_motions(case, deck, held)
     if free:
         raise case.error("the structure is not held after the supports: " + "; ".join(free)

@@ -89,6 +89,18 @@ def test_force_on_a_dependent_grid_is_named_alike_by_validate_and_solve(tmp_path
     both(_flutter_case(tmp_path, 117))       # the RBE2's independent GRID is fine
 
 
+def test_support_on_a_dependent_grid_is_refused_alike_by_validate_and_solve(tmp_path):
+    """fixed: [a group of GRID 31] on the flutter deck: GRID 31 is an RBE2 dependent (was found
+    at assembly only, after validate passed)."""
+    case = _flutter_case(tmp_path, 117)
+    data = dict(case.data)
+    data["model"] = {"fe": {**case.data["model"]["fe"],
+                            "node_groups": {"load": [117], "edge": [31]}, "fixed": ["edge"]}}
+    refused_alike(load_case(data, base_dir=tmp_path),
+                  r"model\.fe\.supports: a support holds GRID 31 component 1, which a rigid "
+                  r"element \(RBE2/RBE3\) makes dependent")
+
+
 @pytest.mark.parametrize("old, new, pattern", [
     # ν = 0.5: the case's own materials: nu has the bound ν < 0.5; the deck has it too
     ("3.7000000000E-01", "5.0000000000E-01", r"MAT1 1: ν = 0\.5 is outside −1 < ν < 0\.5"),
