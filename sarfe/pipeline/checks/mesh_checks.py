@@ -18,7 +18,8 @@ from sarfe.pipeline.model.case_mesh import load_case_mesh
 from sarfe.pipeline.model.contact_pairs import pair_contact
 from sarfe.pipeline.model.deck_checks import check_boundary_nodes
 from sarfe.pipeline.model.deck_model import prepare_deck
-from sarfe.pipeline.model.deck_stage import contact_pairs
+from sarfe.pipeline.model.deck_stage import (assemble_case_deck, contact_pairs, held_kept_dofs,
+                                             kept_translations)
 from sarfe.pipeline.model.erp_map import deck_surface_triangles
 from sarfe.pipeline.model.groups import fixed_nodes, resolve_node_group, shell_properties
 from sarfe.pipeline.model.matrices_stage import build_matrices_stage
@@ -70,26 +71,35 @@ def mesh_quality(case, mesh, contact_pairs):
 
 
 def check_deck(case) -> dict:
-    """Validation of a deck case without assembly: cards, groups, quality, supports, pairing."""
+    """Validation of a deck case: cards, groups, quality, supports, pairing, and the assembly
+    (what solve refuses there), without the modal reduction."""
     prepared = prepare_deck(case)
     mesh = prepared.mesh
+    deck = prepared.deck
     paired = contact_pairs(case, prepared)
     pairs = {name: len(p[0]) for name, p in paired.items()}
+    boundary = []           # (nodes, key) of the contact and force nodes
     for contact in case.config.contacts:
         a, b, _, _ = paired[contact.name]
-        check_boundary_nodes(case, prepared.deck, np.concatenate([a, b[b >= 0]]),
-                             ("contacts", contact.index))
+        boundary.append((np.concatenate([a, b[b >= 0]]), ("contacts", contact.index)))
     for i, f in enumerate(case.config.excitation.forces):
         if f.load_set is not None:
-            if str(f.load_set) not in prepared.deck.loads:
+            if str(f.load_set) not in deck.loads:
                 raise case.error(f"load set '{f.load_set}' not in the deck (available: "
-                                 f"{', '.join(sorted(prepared.deck.loads)) or 'none'})",
+                                 f"{', '.join(sorted(deck.loads)) or 'none'})",
                                  ("excitation", "forces", i, "load_set"))
         else:
             path = ("excitation", "forces", i, "group")
-            check_boundary_nodes(case, prepared.deck, resolve_node_group(case, mesh, f.group, path),
-                                 path)
+            boundary.append((resolve_node_group(case, mesh, f.group, path), path))
+    for nodes, path in boundary:
+        check_boundary_nodes(case, deck, nodes, path)
     deck_surface_triangles(case, mesh)
+    # what solve refuses at assembly (degenerate cells, rigid-element chains, force nodes
+    # without stiffness): validate assembles too (no reduction)
+    system = assemble_case_deck(case, deck)
+    held_kept_dofs(case, prepared, system)
+    for nodes, path in boundary:
+        kept_translations(case, system, deck, nodes, path)
     return {"nodes": prepared.deck.n_nodes, "triangles": mesh.n_triangles,
             "contact_pairs": pairs, "ignored_cards": prepared.notes["ignored_cards"],
             "coincident_node_pairs": prepared.notes["coincident_node_pairs"],

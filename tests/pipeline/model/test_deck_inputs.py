@@ -207,3 +207,17 @@ def test_cquadr_and_pbarl_decks_pass_validate_and_solve(tmp_path):
     added = 7.85e-9 * 1e12 * np.pi * 2e-3**2 * 0.150      # t/mm³ → kg/m³; r = 2 mm; L = 150 mm
     assert stage.info["total_mass_kg"] == pytest.approx(reference.info["total_mass_kg"] + added,
                                                         rel=1e-9)
+
+
+def test_force_on_a_grid_without_stiffness_is_refused_alike(tmp_path):
+    """A force on a GRID no element uses: solve finds it at assembly (no stiffness); validate
+    assembles too and says the same."""
+    text = DECK.read_text().replace("ENDDATA", "GRID,9999,,0.,0.,50.\nENDDATA")
+    case = shipped_case(tmp_path, deck_text=text)
+    data = dict(case.data)
+    data["model"] = {"fe": {**case.data["model"]["fe"], "node_groups": {"loose": [9999]}}}
+    data["excitation"] = {**case.data["excitation"],
+                          "forces": [{"group": "loose", "direction": "z", "force_N": 0.05}]}
+    refused_alike(load_case(data, base_dir=tmp_path),
+                  r"excitation\.forces\[0\]\.group: GRID 9999 is a dependent node of a rigid "
+                  r"element \(RBE2/RBE3\) or has no stiffness")
