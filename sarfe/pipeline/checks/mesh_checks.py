@@ -70,9 +70,9 @@ def mesh_quality(case, mesh, contact_pairs):
                                                       1e-9 * extent, joined)]
 
 
-def check_deck(case) -> dict:
-    """Validation of a deck case: cards, groups, quality, supports, pairing, and the assembly
-    (what solve refuses there), without the modal reduction."""
+def check_deck(case, assemble=True) -> dict:
+    """Validation of a deck case: cards, groups, quality, supports, pairing, and (``assemble``)
+    the assembly — what solve refuses there — without the modal reduction."""
     prepared = prepare_deck(case)
     mesh = prepared.mesh
     deck = prepared.deck
@@ -96,10 +96,11 @@ def check_deck(case) -> dict:
     deck_surface_triangles(case, mesh)
     # what solve refuses at assembly (degenerate cells, rigid-element chains, force nodes
     # without stiffness): validate assembles too (no reduction)
-    system = assemble_case_deck(case, deck)
-    held_kept_dofs(case, prepared, system)
-    for nodes, path in boundary:
-        kept_translations(case, system, deck, nodes, path)
+    if assemble:
+        system = assemble_case_deck(case, deck)
+        held_kept_dofs(case, prepared, system)
+        for nodes, path in boundary:
+            kept_translations(case, system, deck, nodes, path)
     return {"nodes": prepared.deck.n_nodes, "triangles": mesh.n_triangles,
             "contact_pairs": pairs, "ignored_cards": prepared.notes["ignored_cards"],
             "coincident_node_pairs": prepared.notes["coincident_node_pairs"],
