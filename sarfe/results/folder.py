@@ -275,6 +275,13 @@ def _contains(outer: Path, inner: Path) -> bool:
     return inner == outer or outer in inner.parents
 
 
+def _locations(path) -> set:
+    """Where the file ``path`` lives: its own name (its folder resolved) and, for a symbolic
+    link, the file it points to — a folder containing either holds the input."""
+    path = Path(path).expanduser().absolute()
+    return {path.parent.resolve() / path.name, path.resolve()}
+
+
 def _probe_writable(folder: Path) -> None:
     handle, name = tempfile.mkstemp(prefix=".sarfe-probe-", dir=folder)
     os.close(handle)
@@ -300,13 +307,13 @@ def check_output_folder(target, *, force: bool = False, protected=(), what: str 
     if _contains(target, home):
         raise CaseError(f"the {what} would replace the home directory{'' if target == home else ' (it contains it)'};"
                         " choose a new or dedicated folder, e.g. --output results/NAME", source=given)
-    for path in protected:
-        if path is None:
-            continue
-        folder = Path(path).expanduser().resolve().parent
-        if _contains(target, folder):
-            raise CaseError(f"the {what} would replace the folder of {path}; choose a new or "
-                            "dedicated folder, e.g. --output results/NAME", source=given)
+    labels = protected if isinstance(protected, dict) else dict.fromkeys(protected)
+    for path, label in labels.items():
+        if path is not None and any(_contains(target, p) for p in _locations(path)):
+            named = f"{label}, {path}" if label else str(path)
+            raise CaseError(f"the {what} would replace the folder of an input of the case "
+                            f"({named}); choose a new or dedicated folder, e.g. --output "
+                            "results/NAME (--force never deletes an input)", source=given)
     if target.exists() and not target.is_dir():
         raise CaseError(f"the {what} is an existing file, not a folder; give a folder name",
                         source=given)

@@ -14,7 +14,8 @@ Errors (CaseError, exit 2, one line naming the key or the element):
     the stiffness has rigid-body modes and the reduction cannot factorize it); a matrices model's
     K plus the springs of the contacts closed at rest is regular (:func:`check_matrices_held`);
   * every force acts on a free DOF (a force group all fixed is an error, partly fixed a warning);
-  * the output folder: absent, empty or a sarfe result, and writable (:mod:`sarfe.results.folder`).
+  * the output folder: absent, empty or a sarfe result, and writable (:mod:`sarfe.results.folder`);
+    never a folder holding a file the case reads (:mod:`sarfe.pipeline.checks.case_inputs`).
 
 Warnings (one line each, printed and written to summary.json ``warnings``) for inputs far outside
 the model's range:
@@ -39,6 +40,7 @@ from sarfe.erp import nodal_normals
 from sarfe.hbm.pruning import linearized_stiffness
 from sarfe.mesh import connected_components
 from sarfe.mesh.quality import coincident_nodes, degenerate_elements, duplicate_elements
+from sarfe.pipeline.checks.case_inputs import case_inputs
 from sarfe.pipeline.checks.mesh_checks import check_deck
 from sarfe.pipeline.model.case_mesh import load_case_mesh
 from sarfe.pipeline.model.contact_pairs import pair_contact
@@ -328,10 +330,11 @@ def reduced_model_warnings(case, stage) -> list:
 
 def output_target(case, output_dir=None, force=False):
     """The checked result folder of a case (``output_dir`` or ``output.directory``): absent, empty
-    or a previous sarfe result (or anything but the current/case folder with ``force``), and
-    writable — else CaseError, before any work (rules: :mod:`sarfe.results.folder`)."""
+    or a previous sarfe result (or, with ``force``, anything but the current or home folder or a
+    folder holding an input of the case: :func:`sarfe.pipeline.checks.case_inputs.case_inputs`),
+    and writable — else CaseError, before any work (rules: :mod:`sarfe.results.folder`)."""
     target = output_dir if output_dir is not None else case.config.output.directory
-    return check_output_folder(target, force=force, protected=[case.source])
+    return check_output_folder(target, force=force, protected=case_inputs(case))
 
 
 def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True) -> CaseCheck:
