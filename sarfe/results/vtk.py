@@ -35,6 +35,7 @@ rub without radiating (a clip behind the panel): colour by them, or threshold th
 """
 from __future__ import annotations
 
+import errno
 import os
 import warnings
 from pathlib import Path
@@ -218,9 +219,41 @@ def write_erp_vtu(path, points, triangles, point_data: dict, field_data: dict | 
     writer.SetDataModeToAppended()
     writer.EncodeAppendedDataOff()          # raw bytes, no base64
     writer.SetCompressorTypeToLZ4()
-    if not writer.Write():
-        raise OSError(f"VTK could not write {path}")
+    if not _write_quietly(writer):
+        raise _write_error(path, writer.GetErrorCode())
     return path
+
+
+def _write_quietly(writer) -> bool:
+    """``writer.Write()`` with VTK's own error output off (its log line and the error window
+    that pyvista forwards to logging: 20 lines for a full disk); the failure is raised by the
+    caller as one OSError."""
+    from vtkmodules.vtkCommonCore import vtkObject
+
+    display = vtkObject.GetGlobalWarningDisplay()
+    vtkObject.GlobalWarningDisplayOff()
+    try:
+        return bool(writer.Write())
+    finally:
+        vtkObject.SetGlobalWarningDisplay(display)
+
+
+def _write_error(path: Path, code: int) -> OSError:
+    """The OSError of a failed VTK write of ``path`` with the errno of its cause: VTK's error
+    code is the system's errno below vtkErrorCode.FirstVTKErrorCode (ENOSPC for a full disk);
+    its own OutOfDiskSpaceError is ENOSPC; else the error that opening the file for appending
+    gives (read-only, permission), else EIO."""
+    from vtkmodules.vtkCommonMisc import vtkErrorCode
+
+    number = code if 0 < code < vtkErrorCode.FirstVTKErrorCode else (
+        errno.ENOSPC if code == vtkErrorCode.OutOfDiskSpaceError else None)
+    if number is None:
+        try:
+            with open(path, "ab"):
+                number = errno.EIO
+        except OSError as exc:
+            number = exc.errno or errno.EIO
+    return OSError(number, os.strerror(number), str(path))
 
 
 def write_pvd(path, entries) -> Path:

@@ -5,7 +5,8 @@ passes ``sarfe validate`` does not fail on its input later.
 
 Errors (CaseError, exit 2, one line naming the key or the element):
   * the case file itself (schema, non-finite numbers, signs, units: :func:`sarfe.case.read.load_case`);
-  * the mesh: readable, groups present, contacts pair (as :func:`sarfe.pipeline.checks.mesh_checks.check_mesh`);
+  * the mesh: readable, groups present, contacts pair (as :func:`sarfe.pipeline.checks.mesh_checks.check_mesh`),
+    no node pair in two contacts (:func:`~sarfe.pipeline.checks.mesh_checks.check_shared_pairs`);
   * element quality: zero-area triangles, duplicate triangles (same node set), coincident nodes
     that neither an element nor a contact pair joins (a crack) — :mod:`sarfe.mesh.quality`;
   * thickness plausibility: 1e-4·L < t < 0.1·L for the model size L (the bounding-box diagonal),
@@ -26,7 +27,9 @@ the model's range:
   * H·f_max above ``reduction.cutoff_hz`` (the harmonics have no modes to live in);
   * an open gap larger than the structure (the contact can never close), or |gap_m| more than
     :data:`GAP_RANGE` × the thickest shell or the contact's tolerance_m (:func:`gap_warnings`);
-  * reduction.mode_count above the interior DOFs; a force group partly fixed.
+  * reduction.mode_count above the interior DOFs; a force group partly fixed;
+  * values no squeak-and-rattle input has (:func:`sarfe.case.plausibility.plausibility_warnings`):
+    μ > 2, a base acceleration above 50 g, a preload pressing a contact more than 1 mm in.
 """
 from __future__ import annotations
 
@@ -34,14 +37,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from sarfe.case.plausibility import THICKNESS_RANGE
+from sarfe.case.plausibility import THICKNESS_RANGE, plausibility_warnings
 from sarfe.case.read import load_case
 from sarfe.erp import nodal_normals
 from sarfe.hbm.pruning import linearized_stiffness
 from sarfe.mesh import connected_components
 from sarfe.mesh.quality import coincident_nodes, degenerate_elements, duplicate_elements
 from sarfe.pipeline.checks.case_inputs import case_inputs
-from sarfe.pipeline.checks.mesh_checks import check_deck
+from sarfe.pipeline.checks.mesh_checks import check_deck, check_shared_pairs
 from sarfe.pipeline.model.case_mesh import load_case_mesh
 from sarfe.pipeline.model.contact_pairs import pair_contact
 from sarfe.pipeline.model.groups import fixed_nodes, resolve_node_group, shell_properties
@@ -255,9 +258,11 @@ def gap_warnings(case, mesh=None) -> list:
 
 
 def range_warnings(case, mesh=None) -> list:
-    """One-line warnings for inputs far outside the model's range (module docstring)."""
-    warnings = []
+    """One-line warnings for inputs far outside the model's range (module docstring), and
+    those of :func:`sarfe.case.plausibility.plausibility_warnings` (μ, base acceleration,
+    preload overclosure)."""
     config = case.config
+    warnings = plausibility_warnings(config)
     top = _excitation_top_hz(case)
     H = config.solver.harmonics
     if mesh is not None:
@@ -356,6 +361,7 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True)
     check_thickness(case, mesh)
     normals = nodal_normals(mesh.points, mesh.triangles)
     paired = {c.name: pair_contact(case, mesh, c.index, normals) for c in config.contacts}
+    check_shared_pairs(case, paired, mesh.points)
     load_nodes = [resolve_node_group(case, mesh, f.group, ("excitation", "forces", i, "group"))
                   for i, f in enumerate(config.excitation.forces)]
     load_warnings = check_loads_free(case, mesh, fixed, load_nodes)
