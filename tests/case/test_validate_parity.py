@@ -106,6 +106,8 @@ MUTATIONS = [
      ["excitation.forces[0].direction", "non-zero"]),
     # rattle_rig
     ("rig-unknown-surface", "rattle_rig", put(("erp", "surface"), "roof"), ["erp.surface", "roof"]),
+    ("rig-surface-without-triangles", "rattle_rig", put(("erp", "surface"), "clamp_plate"),
+     ["erp.surface", "node group 'clamp_plate' contains no whole triangle"]),   # was solve-only
     ("rig-pairing-tolerance", "rattle_rig", put(("contacts", 0, "pairing_tolerance_m"), 1e-6),
      ["contacts[0]"]),
     ("rig-thickness-mm", "rattle_rig", put(("model", "fe", "thickness_m", "part_plate"), 2.5),

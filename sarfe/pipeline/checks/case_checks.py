@@ -47,6 +47,7 @@ from sarfe.pipeline.checks.case_inputs import case_inputs
 from sarfe.pipeline.checks.mesh_checks import check_deck, check_shared_pairs
 from sarfe.pipeline.model.case_mesh import load_case_mesh
 from sarfe.pipeline.model.contact_pairs import pair_contact
+from sarfe.pipeline.model.erp_map import surface_triangles
 from sarfe.pipeline.model.groups import fixed_nodes, resolve_node_group, shell_properties
 from sarfe.pipeline.model.linear_stage import build_linear_model
 from sarfe.pipeline.model.nonlinear_model import nonlinear_model
@@ -365,9 +366,7 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True)
     load_nodes = [resolve_node_group(case, mesh, f.group, ("excitation", "forces", i, "group"))
                   for i, f in enumerate(config.excitation.forces)]
     load_warnings = check_loads_free(case, mesh, fixed, load_nodes)
-    surface = config.erp.surface
-    if surface is not None and surface not in mesh.element_groups:
-        resolve_node_group(case, mesh, surface, ("erp", "surface"))
+    surface_triangles(case, mesh)     # erp.surface: an element group, or a node group's triangles
     joined = [(int(a), int(b)) for p in paired.values() for a, b in zip(p[0], p[1])]
     check_element_quality(case, mesh, joined)
     check_held(case, mesh, fixed)

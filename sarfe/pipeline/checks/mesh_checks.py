@@ -19,7 +19,7 @@ from sarfe.pipeline.model.case_mesh import load_case_mesh
 from sarfe.pipeline.model.contact_pairs import pair_contact
 from sarfe.pipeline.model.deck_model import prepare_deck
 from sarfe.pipeline.model.deck_stage import contact_pairs
-from sarfe.pipeline.model.erp_map import deck_surface_triangles
+from sarfe.pipeline.model.erp_map import deck_surface_triangles, surface_triangles
 from sarfe.pipeline.model.groups import fixed_nodes, resolve_node_group, shell_properties
 from sarfe.pipeline.model.matrices_stage import build_matrices_stage
 
@@ -43,9 +43,7 @@ def check_mesh(case) -> dict:
     coincident = mesh_quality(case, mesh, [(a, b) for a, b, _, _ in paired])
     for i, f in enumerate(config.excitation.forces):
         resolve_node_group(case, mesh, f.group, ("excitation", "forces", i, "group"))
-    surface = config.erp.surface
-    if surface is not None and surface not in mesh.element_groups:
-        resolve_node_group(case, mesh, surface, ("erp", "surface"))
+    surface_triangles(case, mesh)     # erp.surface: an element group, or a node group's triangles
     return {"nodes": mesh.n_nodes, "triangles": mesh.n_triangles, "contact_pairs": pairs,
             "coincident_node_pairs": len(coincident), "coincident_nodes": coincident[:50]}
 
