@@ -133,3 +133,32 @@ def test_an_output_beside_the_inputs_is_fine(deck_copy, capsys):
     """A new folder inside the deck's folder holds no input: validate accepts it."""
     code = main(["validate", str(deck_copy), "--output", "meshes/results", "--quiet"])
     assert code == 0, capsys.readouterr().err
+
+
+def test_batch_never_writes_into_a_folder_holding_an_input(tmp_path, capsys, monkeypatch):
+    """`sarfe batch` (written in place: it never deletes, but would overwrite a summary.json)
+    refuses a folder holding a file a variant reads, even with --force."""
+    monkeypatch.chdir(tmp_path)
+    for folder in ("case", "matrices"):
+        (tmp_path / folder).mkdir()
+    np.save(tmp_path / "matrices" / "mass.npy", np.eye(2))
+    case = tmp_path / "case" / "tiny.yaml"
+    case.write_text("""\
+name: tiny
+model:
+  matrices:
+    mass: ../matrices/mass.npy
+    stiffness: [[2.0e+4, -1.0e+4], [-1.0e+4, 2.0e+4]]
+contacts:
+  - {name: stop, type: rattle, normal_dof: 0, gap_m: 1.0e-3, normal_stiffness_N_m: 1.0e+5}
+excitation:
+  forces: [{dof: 0, force_N: 1.0}]
+  frequency_hz: [20.0]
+solver: {harmonics: 3, stability: false, error_estimate: false}
+erp: {dofs: [0], areas_m2: [0.01]}
+""")
+    before = snapshot(tmp_path / "matrices")
+    code = main(["batch", str(case), "--workers", "0", "--output", "matrices", "--force"])
+    err = capsys.readouterr().err
+    assert code == 2 and "model.matrices.mass" in err and "input of the case" in err, err
+    assert snapshot(tmp_path / "matrices") == before
