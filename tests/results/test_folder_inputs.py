@@ -11,6 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from small_cases import tiny
+
 from sarfe.cli import main
 from sarfe.pipeline.checks.case_inputs import case_inputs, named_files
 
@@ -77,20 +79,8 @@ def test_mesh_matrix_curve_and_include_folders_are_protected(tmp_path, capsys, m
     np.save(tmp_path / "matrices" / "mass.npy", np.eye(2))
     (tmp_path / "curves" / "pad.csv").write_text("0, 0\n1e-3, 10\n2e-3, 40\n")
     matrices = tmp_path / "case" / "matrices.yaml"
-    matrices.write_text("""\
-name: tiny
-model:
-  matrices:
-    mass: ../matrices/mass.npy
-    stiffness: [[2.0e+4, -1.0e+4], [-1.0e+4, 2.0e+4]]
-contacts:
-  - {name: pad, type: tabulated, normal_dof: 0, gap_m: 1.0e-4, curve_file: ../curves/pad.csv}
-excitation:
-  forces: [{dof: 0, force_N: 1.0}]
-  frequency_hz: [20.0]
-solver: {harmonics: 3, stability: false, error_estimate: false}
-erp: {dofs: [0], areas_m2: [0.01]}
-""")
+    matrices.write_text(tiny(mass="../matrices/mass.npy", contact="{name: pad, type: tabulated, "
+                             "normal_dof: 0, gap_m: 1.0e-4, curve_file: ../curves/pad.csv}"))
     refused_everywhere(capsys, matrices, "matrices", "model.matrices.mass", "mass.npy")
     refused_everywhere(capsys, matrices, "curves", "contacts[0].curve_file", "pad.csv")
     shutil.copy(ROOT / "meshes" / "rattle_rig.msh", tmp_path / "mesh" / "rig.msh")
@@ -143,20 +133,7 @@ def test_batch_never_writes_into_a_folder_holding_an_input(tmp_path, capsys, mon
         (tmp_path / folder).mkdir()
     np.save(tmp_path / "matrices" / "mass.npy", np.eye(2))
     case = tmp_path / "case" / "tiny.yaml"
-    case.write_text("""\
-name: tiny
-model:
-  matrices:
-    mass: ../matrices/mass.npy
-    stiffness: [[2.0e+4, -1.0e+4], [-1.0e+4, 2.0e+4]]
-contacts:
-  - {name: stop, type: rattle, normal_dof: 0, gap_m: 1.0e-3, normal_stiffness_N_m: 1.0e+5}
-excitation:
-  forces: [{dof: 0, force_N: 1.0}]
-  frequency_hz: [20.0]
-solver: {harmonics: 3, stability: false, error_estimate: false}
-erp: {dofs: [0], areas_m2: [0.01]}
-""")
+    case.write_text(tiny(mass="../matrices/mass.npy"))
     before = snapshot(tmp_path / "matrices")
     code = main(["batch", str(case), "--workers", "0", "--output", "matrices", "--force"])
     err = capsys.readouterr().err

@@ -24,6 +24,8 @@ from pathlib import Path
 
 import pytest
 
+from small_cases import coarse_rig
+
 from sarfe.case.errors import CaseError
 from sarfe.results.folder import check_output_folder, os_error
 
@@ -31,28 +33,9 @@ ROOT = Path(__file__).resolve().parents[2]
 ENV = dict(os.environ, PYTHONPATH=str(ROOT), OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1",
            MKL_NUM_THREADS="1", MPLBACKEND="Agg")
 
-SMALL_RIG = """\
-name: small_rig
-model:
-  fe:
-    generator: {name: rattle_rig, mesh_size_m: 0.02, params: {gap: 0.5e-3}}
-    materials:
-      part_plate: {E_Pa: 2.2e9, nu: 0.37, rho_kg_m3: 1050}
-      part_beam:  {E_Pa: 2.1e11, nu: 0.30, rho_kg_m3: 7850}
-    thickness_m: {part_plate: 2.5e-3, part_beam: 1.5e-3}
-    fixed: [clamp_plate, clamp_beam]
-damping: {modal_zeta: 0.02}
-contacts:
-  - {name: tip, type: rattle, between: [contact_tip_a, contact_tip_b],
-     pairing_tolerance_m: 1.0e-3, normal_stiffness_N_m: 2.0e5, tolerance_m: 1.0e-4}
-excitation:
-  forces: [{group: excite_beam, direction: z, force_N: 0.05}]
-  frequency_hz: [30, 32]
-solver: {harmonics: 3, samples_per_period: 32, workers: 1, stability: false,
-         error_estimate: false}
-erp: {surface: skin}
-output: {files: [summary, erp_vtu, animation]}
-"""
+SMALL_RIG = coarse_rig([30, 32], "{harmonics: 3, samples_per_period: 32, workers: 1, "
+                      "stability: false, error_estimate: false}",
+                      "output: {files: [summary, erp_vtu, animation]}")
 
 
 def _namespaces_work() -> bool:
@@ -85,6 +68,13 @@ def in_namespace(mount: Path, options: str, *commands) -> list:
     return out + [(mount.parent / "listing").read_text().split()]
 
 
+@pytest.fixture
+def small_rig(tmp_path):
+    case = tmp_path / "small_rig.yaml"
+    case.write_text(SMALL_RIG)
+    return case
+
+
 def one_line(code, err, *words):
     lines = [line for line in err.strip().splitlines() if not line.endswith(" …")]
     assert code == 2, err
@@ -95,9 +85,8 @@ def one_line(code, err, *words):
 
 
 @needs_mounts
-def test_full_disk_is_one_line_and_leaves_nothing(tmp_path):
-    case = tmp_path / "small_rig.yaml"
-    case.write_text(SMALL_RIG)
+def test_full_disk_is_one_line_and_leaves_nothing(tmp_path, small_rig):
+    case = small_rig
     mount = tmp_path / "disk"
     mount.mkdir()
     ENV["SARFE_MESH_CACHE"] = str(tmp_path / "cache")
@@ -113,9 +102,8 @@ def test_full_disk_is_one_line_and_leaves_nothing(tmp_path):
 
 
 @needs_mounts
-def test_read_only_file_system_is_refused_before_the_solve(tmp_path):
-    case = tmp_path / "small_rig.yaml"
-    case.write_text(SMALL_RIG)
+def test_read_only_file_system_is_refused_before_the_solve(tmp_path, small_rig):
+    case = small_rig
     mount = tmp_path / "ro"
     mount.mkdir()
     *runs, _ = in_namespace(mount, "size=1m,ro", *[[command, case, "--output", mount / "out"]
@@ -125,9 +113,8 @@ def test_read_only_file_system_is_refused_before_the_solve(tmp_path):
 
 
 @needs_mounts
-def test_a_mount_point_is_refused_by_validate_and_solve(tmp_path):
-    case = tmp_path / "small_rig.yaml"
-    case.write_text(SMALL_RIG)
+def test_a_mount_point_is_refused_by_validate_and_solve(tmp_path, small_rig):
+    case = small_rig
     mount = tmp_path / "mnt"
     mount.mkdir()
     *runs, listing = in_namespace(mount, "size=4m", *[

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import psutil
 import pytest
+from small_cases import coarse_rig
 
 ROOT = Path(__file__).resolve().parents[2]
 GONE_WITHIN_S = 5.0     # the watchdog polls every second; the kernel signal is immediate
@@ -132,26 +133,8 @@ def test_render_child_dies_with_a_killed_solve(tmp_path):
     assert kill_and_watch(parent, children) < GONE_WITHIN_S
 
 
-FAST_RIG = """\
-name: fast_rig
-model:
-  fe:
-    generator: {name: rattle_rig, mesh_size_m: 0.02, params: {gap: 0.5e-3}}
-    materials:
-      part_plate: {E_Pa: 2.2e9, nu: 0.37, rho_kg_m3: 1050}
-      part_beam:  {E_Pa: 2.1e11, nu: 0.30, rho_kg_m3: 7850}
-    thickness_m: {part_plate: 2.5e-3, part_beam: 1.5e-3}
-    fixed: [clamp_plate, clamp_beam]
-damping: {modal_zeta: 0.02}
-contacts:
-  - {name: tip, type: rattle, between: [contact_tip_a, contact_tip_b],
-     pairing_tolerance_m: 1.0e-3, normal_stiffness_N_m: 2.0e5, tolerance_m: 1.0e-4}
-excitation:
-  forces: [{group: excite_beam, direction: z, force_N: 0.05}]
-  frequency_hz: [26, 28, 30, 32, 34, 36, 38, 40]
-solver: {harmonics: 5, samples_per_period: 64, workers: 2}
-erp: {surface: skin}
-"""
+FAST_RIG = coarse_rig([26, 28, 30, 32, 34, 36, 38, 40],
+                      "{harmonics: 5, samples_per_period: 64, workers: 2}")
 
 
 def test_a_killed_solve_leaves_no_worker(tmp_path):
