@@ -227,8 +227,6 @@ def _normalize_contacts(case, data):
         if has_normal and "preload_N" not in contact and not fe:
             contact.setdefault("gap_m", MATRICES_GAP_M)  # FE: the geometric gap of each pair
         contact.setdefault("tolerance_m", default_of(ContactConfig, "tolerance_m"))
-    if not fe:
-        _check_shared_dofs(case, contacts)
 
 
 def _check_contact_dofs(case, contact, p):
@@ -249,26 +247,6 @@ def _check_contact_dofs(case, contact, p):
                              f"{first}: each direction of a contact is a different relative "
                              "displacement", p + path)
         seen[key] = path
-
-
-def _check_shared_dofs(case, contacts):
-    """A relative displacement (normal or tangential DOF) in two contacts of a matrices model
-    is an error, as one node pair in two contacts of a mesh
-    (:func:`sarfe.pipeline.checks.mesh_checks.check_shared_pairs`): their forces would add."""
-    seen = {}
-    for i, contact in enumerate(contacts):
-        refs = ([(("normal_dof",), contact["normal_dof"])] if "normal_dof" in contact else []) + [
-            (("tangential_dofs", j), r) for j, r in enumerate(contact.get("tangential_dofs", []))]
-        for path, ref in refs:
-            key = frozenset((ref["dof"], ref["relative_to"]))
-            if key in seen and seen[key][0] != i:
-                first, where = seen[key]
-                raise case.error(f"DOF {ref['dof']} (relative to {ref['relative_to']}) is also "
-                                 f"{format_key_path(('contacts', first) + where)} "
-                                 f"({contacts[first]['name']}): two contact laws on one relative "
-                                 "displacement add their forces; keep it in one contact",
-                                 ("contacts", i) + path)
-            seen.setdefault(key, (i, path))
 
 
 def _normalize_excitation(case, data):

@@ -17,6 +17,8 @@ from pathlib import Path
 import pytest
 import yaml
 
+from small_cases import coarse_rig
+
 from sarfe.case.plausibility import (MAX_BASE_ACCELERATION_M_S2, MAX_FRICTION_COEFFICIENT,
                                      MAX_PRELOAD_OVERCLOSURE_M, POISSON_RANGE,
                                      STANDARD_GRAVITY_M_S2, plausibility_warnings)
@@ -95,3 +97,30 @@ def test_the_bounds_and_their_sources():
     assert 1e-4 < MAX_PRELOAD_OVERCLOSURE_M < 20e-3
     nu = MATERIAL["properties"]["nu"]
     assert (nu["exclusiveMinimum"], nu["exclusiveMaximum"]) == POISSON_RANGE == (-1.0, 0.5)
+
+
+def test_a_node_pair_in_two_contacts_is_warned_in_validate_and_solve(tmp_path, capsys,
+                                                                    monkeypatch):
+    """The same node pair in two contacts (here the rig's striker pair, once more with the groups
+    swapped) is said in one line by validate and solve: both laws act there. Not refused — a
+    side stop (another normal) or a progressive stop (another gap) is modelled that way; a pair
+    listed twice in one contact is refused (tests/case/test_validate_parity.py)."""
+    monkeypatch.setenv("SARFE_MESH_CACHE", str(tmp_path / "cache"))
+    text = coarse_rig([30.0], "{harmonics: 3, samples_per_period: 32, stability: false, "
+                              "error_estimate: false, workers: 1}", "output: {files: [summary]}")
+    text = text.replace("excitation:", "  - {name: tip_again, type: rattle, between: "
+                        "[contact_tip_b, contact_tip_a], pairing_tolerance_m: 1.0e-3, "
+                        "normal_stiffness_N_m: 2.0e5}\nexcitation:")
+    case = tmp_path / "case.yaml"
+    case.write_text(text)
+    seen = []
+    for command in ("validate", "solve"):
+        code = main([command, str(case), "--output", str(tmp_path / "out"), "--quiet"])
+        lines = [line for line in capsys.readouterr().err.splitlines()
+                 if line.startswith("sarfe: warning: ")]
+        assert code == 0 and len(lines) == 1, lines
+        assert lines[0].startswith("sarfe: warning: contacts[1] (tip_again): 1 node pair(s) also "
+                                   "in contacts[0] (tip), e.g. node pair "), lines[0]
+        assert "their forces add" in lines[0]
+        seen.append(lines[0])
+    assert seen[0] == seen[1]

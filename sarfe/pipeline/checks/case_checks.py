@@ -6,7 +6,7 @@ passes ``sarfe validate`` does not fail on its input later.
 Errors (CaseError, exit 2, one line naming the key or the element):
   * the case file itself (schema, non-finite numbers, signs, units: :func:`sarfe.case.read.load_case`);
   * the mesh: readable, groups present, contacts pair (as :func:`sarfe.pipeline.checks.mesh_checks.check_mesh`),
-    no node pair in two contacts (:func:`~sarfe.pipeline.checks.mesh_checks.check_shared_pairs`);
+    no node pair listed twice in one contact;
   * element quality: zero-area triangles, duplicate triangles (same node set), coincident nodes
     that neither an element nor a contact pair joins (a crack) — :mod:`sarfe.mesh.quality`;
   * thickness plausibility: 1e-4·L < t < 0.1·L for the model size L (the bounding-box diagonal),
@@ -27,7 +27,8 @@ the model's range:
   * H·f_max above ``reduction.cutoff_hz`` (the harmonics have no modes to live in);
   * an open gap larger than the structure (the contact can never close), or |gap_m| more than
     :data:`GAP_RANGE` × the thickest shell or the contact's tolerance_m (:func:`gap_warnings`);
-  * reduction.mode_count above the interior DOFs; a force group partly fixed;
+  * reduction.mode_count above the interior DOFs; a force group partly fixed; a node pair in two
+    contacts (:func:`~sarfe.pipeline.checks.mesh_checks.shared_pair_warnings`);
   * values no squeak-and-rattle input has (:func:`sarfe.case.plausibility.plausibility_warnings`):
     μ > 2, a base acceleration above 50 g, a preload pressing a contact more than 1 mm in.
 """
@@ -44,7 +45,7 @@ from sarfe.hbm.pruning import linearized_stiffness
 from sarfe.mesh import connected_components
 from sarfe.mesh.quality import coincident_nodes, degenerate_elements, duplicate_elements
 from sarfe.pipeline.checks.case_inputs import case_inputs
-from sarfe.pipeline.checks.mesh_checks import check_deck, check_shared_pairs
+from sarfe.pipeline.checks.mesh_checks import check_deck, shared_pair_warnings
 from sarfe.pipeline.model.case_mesh import load_case_mesh
 from sarfe.pipeline.model.contact_pairs import pair_contact
 from sarfe.pipeline.model.erp_map import surface_triangles
@@ -362,7 +363,7 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True)
     check_thickness(case, mesh)
     normals = nodal_normals(mesh.points, mesh.triangles)
     paired = {c.name: pair_contact(case, mesh, c.index, normals) for c in config.contacts}
-    check_shared_pairs(case, paired, mesh.points)
+    shared = shared_pair_warnings(case, paired, mesh.points)
     load_nodes = [resolve_node_group(case, mesh, f.group, ("excitation", "forces", i, "group"))
                   for i, f in enumerate(config.excitation.forces)]
     load_warnings = check_loads_free(case, mesh, fixed, load_nodes)
@@ -374,7 +375,8 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True)
             "contact_pairs": {name: len(p[0]) for name, p in paired.items()}}
     interior = interior_dof_count(mesh, fixed, np.concatenate(
         [np.zeros(0, int)] + [np.concatenate([p[0], p[1]]) for p in paired.values()] + load_nodes))
-    return CaseCheck(info, tuple(range_warnings(case, mesh)) + tuple(load_warnings)
+    return CaseCheck(info, tuple(range_warnings(case, mesh)) + tuple(shared)
+                     + tuple(load_warnings)
                      + tuple(mode_count_warnings(case, interior)), output)
 
 

@@ -3,7 +3,7 @@ exist, the contacts pair, the elements are sound.
 
     check_mesh(case) -> info     {nodes, triangles, contact_pairs, coincident nodes} (FE), {} else
     check_deck(case) -> info     a deck case: cards, groups, quality, supports, pairing
-    check_shared_pairs(case, paired, points)   one node pair in two contacts: an error
+    shared_pair_warnings(case, paired, points)   one node pair in two contacts: a warning
 
 Errors are one-line CaseErrors naming the key (or the element); the fuller pre-solve checks of
 ``sarfe solve`` / ``sarfe validate`` are :func:`sarfe.pipeline.checks.case_checks.check_case`.
@@ -38,7 +38,6 @@ def check_mesh(case) -> dict:
     shell_properties(case, mesh)
     normals = nodal_normals(mesh.points, mesh.triangles)
     paired = [pair_contact(case, mesh, c.index, normals) for c in config.contacts]
-    check_shared_pairs(case, {c.name: p for c, p in zip(config.contacts, paired)}, mesh.points)
     pairs = {c.name: len(p[0]) for c, p in zip(config.contacts, paired)}
     coincident = mesh_quality(case, mesh, [(a, b) for a, b, _, _ in paired])
     for i, f in enumerate(config.excitation.forces):
@@ -48,38 +47,47 @@ def check_mesh(case) -> dict:
             "coincident_node_pairs": len(coincident), "coincident_nodes": coincident[:50]}
 
 
-def check_shared_pairs(case, paired: dict, points) -> None:
-    """One node pair in two contacts (or twice in one) is a CaseError naming both contacts and
-    where the first such pair sits: two laws at one pair add their forces (twice the stiffness,
-    twice the friction), which is never what overlapping node groups mean — split the groups
-    or drop the pair from one contact. ``paired``: {contact name: (a (n_p,), b (n_p,) with −1
-    for ground, …)}; a pair is unordered (a–b = b–a); ``points`` (n, 3) [m]."""
+def shared_pair_warnings(case, paired: dict, points) -> list:
+    """A node pair in two contacts: one warning line per pair of contacts, naming both and where
+    the first shared pair sits — two laws at one pair add their forces (twice the stiffness and
+    friction where both act along the same normal), which is what overlapping node groups give
+    by mistake, but also how a side stop (another ``normal``) or a progressive stop (another
+    ``gap_m``) is modelled; so it is said, not refused. A pair listed twice in one contact is a
+    CaseError. ``paired``: {contact name: (a (n_p,), b (n_p,) with −1 for ground, …)}; a pair is
+    unordered (a–b = b–a); ``points`` (n, 3) [m]."""
     contacts = case.config.contacts
-    a = [np.asarray(paired[c.name][0], dtype=np.int64) for c in contacts]
-    b = [np.asarray(paired[c.name][1], dtype=np.int64) for c in contacts]
-    if not a or sum(x.size for x in a) == 0:
-        return
-    a, b = np.concatenate(a), np.concatenate(b)
-    owner = np.repeat(np.arange(len(contacts)), [len(paired[c.name][0]) for c in contacts])
-    ground = b < 0
-    low = np.where(ground, a, np.minimum(a, b))
-    high = np.where(ground, -1, np.maximum(a, b))
-    keys = np.stack([low, high], axis=1)
-    _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
-    repeated = np.flatnonzero(first[inverse.ravel()] != np.arange(len(keys)))
-    if not repeated.size:
-        return
-    k = repeated[0]
-    j = first[inverse.ravel()[k]]
-    one, other = contacts[owner[j]], contacts[owner[k]]
-    x, y, z = np.asarray(points)[a[k]]
-    pair = f"{a[k]}–{'ground' if b[k] < 0 else b[k]}"
-    also = (f"also in contacts[{one.index}] ({one.name})" if one.index != other.index
-            else "listed twice in this contact")
-    raise case.error(f"node pair {pair} at ({x:.4g}, {y:.4g}, {z:.4g}) m is {also} "
-                     f"({repeated.size} shared pair(s)): two contact laws at one node pair add "
-                     "their forces (twice the stiffness and friction); split the node groups or "
-                     "drop the pair from one contact", ("contacts", other.index))
+    sizes = [len(paired[c.name][0]) for c in contacts]
+    if not sum(sizes):
+        return []
+    a = np.concatenate([np.asarray(paired[c.name][0], dtype=np.int64) for c in contacts])
+    b = np.concatenate([np.asarray(paired[c.name][1], dtype=np.int64) for c in contacts])
+    owner = np.repeat(np.arange(len(contacts)), sizes)
+    low = np.where(b < 0, a, np.minimum(a, b))
+    high = np.where(b < 0, -1, np.maximum(a, b))
+    _, first, inverse = np.unique(np.stack([low, high], axis=1), axis=0, return_index=True,
+                                  return_inverse=True)
+    first = first[inverse.ravel()]                  # the first occurrence of each entry's pair
+    repeated = np.flatnonzero(first != np.arange(len(a)))
+    warnings, said = [], set()
+    for k in repeated:
+        j = first[k]
+        one, other = contacts[owner[j]], contacts[owner[k]]
+        x, y, z = np.asarray(points)[a[k]]
+        pair = f"node pair {a[k]}–{'ground' if b[k] < 0 else b[k]} at ({x:.4g}, {y:.4g}, {z:.4g}) m"
+        if one.index == other.index:
+            raise case.error(f"{pair} is listed twice in this contact; give each pair once",
+                             ("contacts", other.index))
+        if (one.index, other.index) in said:
+            continue
+        said.add((one.index, other.index))
+        count = int(np.count_nonzero((owner[repeated] == other.index)
+                                     & (owner[first[repeated]] == one.index)))
+        warnings.append(f"contacts[{other.index}] ({other.name}): {count} node pair(s) also in "
+                        f"contacts[{one.index}] ({one.name}), e.g. {pair}: both laws act there "
+                        "and their forces add (twice the stiffness and friction along one "
+                        "normal) — split the node groups unless a second direction or gap is "
+                        "meant")
+    return warnings
 
 
 def mesh_quality(case, mesh, contact_pairs):
@@ -107,7 +115,7 @@ def check_deck(case) -> dict:
     prepared = prepare_deck(case)
     mesh = prepared.mesh
     paired = contact_pairs(case, prepared)
-    check_shared_pairs(case, paired, mesh.points)
+    shared = shared_pair_warnings(case, paired, mesh.points)
     pairs = {name: len(p[0]) for name, p in paired.items()}
     for i, f in enumerate(case.config.excitation.forces):
         if f.load_set is not None:
@@ -122,7 +130,7 @@ def check_deck(case) -> dict:
             "contact_pairs": pairs, "ignored_cards": prepared.notes["ignored_cards"],
             "coincident_node_pairs": prepared.notes["coincident_node_pairs"],
             "coincident_nodes": prepared.notes["coincident_nodes"],
-            "warnings": prepared.warnings}
+            "warnings": list(prepared.warnings) + shared}
 
 
-__all__ = ["check_mesh", "check_deck", "check_shared_pairs", "mesh_quality"]
+__all__ = ["check_mesh", "check_deck", "shared_pair_warnings", "mesh_quality"]
