@@ -14,6 +14,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 
@@ -22,9 +23,11 @@ from small_cases import coarse_rig
 from sarfe.case.plausibility import (MAX_BASE_ACCELERATION_M_S2, MAX_FRICTION_COEFFICIENT,
                                      MAX_PRELOAD_OVERCLOSURE_M, POISSON_RANGE,
                                      STANDARD_GRAVITY_M_S2, plausibility_warnings)
+from sarfe.case.errors import CaseError
 from sarfe.case.read import CaseLoader, load_case
 from sarfe.case.schema import MATERIAL
 from sarfe.cli import main
+from sarfe.pipeline.checks.held_checks import contact_warnings
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 
@@ -124,3 +127,17 @@ def test_a_node_pair_in_two_contacts_is_warned_in_validate_and_solve(tmp_path, c
         assert "their forces add" in lines[0]
         seen.append(lines[0])
     assert seen[0] == seen[1]
+
+
+def test_a_contact_partly_held_is_warned(tmp_path):
+    """Pairs held on both sides (or one held node against ground) do nothing: a contact with some
+    such pairs is a warning counting them, one with all a CaseError (the parity test refuses the
+    latter through validate and solve)."""
+    case = load_case(CASES / "rattle_rig.yaml")
+    held = np.array([True, True, False, True, False, False])
+    paired = {"tip": (np.array([0, 1, 2]), np.array([3, -1, 5]))}
+    warnings = contact_warnings(case, paired, held, "model.fe.fixed")
+    assert warnings == ["contacts[0] (tip): 2 of 3 node pairs are held on both sides (e.g. node "
+                        "pair 0–3, by model.fe.fixed) and do nothing"]
+    with pytest.raises(CaseError, match="every node pair of this contact is held on both sides"):
+        contact_warnings(case, {"tip": (np.array([0, 1]), np.array([3, -1]))}, held, "x")

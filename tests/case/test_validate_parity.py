@@ -1,7 +1,8 @@
 """`sarfe validate` catches everything `sarfe solve` rejects on input (issue 32, item 7).
 
 Broken copies of every shipped case (cases/*.yaml), one mistake each — wrong keys, ranges and
-types, cross-key rules, unknown groups and sets, contacts that join a group with itself or
+types, cross-key rules, unknown groups and sets, a ``fixed`` that holds every node (``["*"]``),
+a force or a contact on held nodes only, contacts that join a group with itself or
 list a node pair twice, matrices and DOFs out of shape, deck sets and cards that are not there, an
 output folder holding an input. For each, `sarfe validate` and `sarfe solve` must give the same
 one line on stderr (naming the file and the key) and the same exit code 2, with no output folder
@@ -105,7 +106,18 @@ MUTATIONS = [
      ["contacts[0]"]),
     ("rig-thickness-mm", "rattle_rig", put(("model", "fe", "thickness_m", "part_plate"), 2.5),
      ["thickness_m.part_plate", "given in mm"]),
+    ("rig-fixed-everything", "rattle_rig", put(("model", "fe", "fixed"), ["*"]),
+     ["model.fe.fixed", "every node of the model is held (", "'*' matches every group"]),
+    ("rig-contact-held", "rattle_rig", put(("model", "fe", "fixed"),
+                                           ["clamp_*", "contact_tip_a", "contact_tip_b"]),
+     ["contacts[0]", "held on both sides", "the contact can never move"]),
     # rattle_rig_deck (the deck path)
+    ("deck-fixed-everything", "rattle_rig_deck", put(("model", "fe", "fixed"), ["*"]),
+     ["model.fe.fixed", "every node of the model is held ("]),        # was: solve "not held"
+    ("deck-contact-held", "rattle_rig_deck", put(("model", "fe", "fixed"), ["set_101", "set_102"]),
+     ["contacts[0]", "node pair 9–10", "held on both sides"]),        # was: solved as silence
+    ("deck-force-held", "rattle_rig_deck", put(("model", "fe", "fixed"), ["set_103"]),
+     ["excitation.forces[0].group", "acts on no free DOF"]),           # was: solved as silence
     ("deck-missing-support-set", "rattle_rig_deck", put(("model", "fe", "supports"), [99]),
      ["model.fe.supports"]),
     ("deck-ignored-card-absent", "rattle_rig_deck",

@@ -14,7 +14,9 @@ Errors (CaseError, exit 2, one line naming the key or the element):
   * the structure is held: every connected part of the mesh holds at least one fixed node (else
     the stiffness has rigid-body modes and the reduction cannot factorize it); a matrices model's
     K plus the springs of the contacts closed at rest is regular (:func:`check_matrices_held`);
-  * every force acts on a free DOF (a force group all fixed is an error, partly fixed a warning);
+  * something is free to move, every force acts on a free DOF and every contact on a free node
+    (a force group or a contact all held is an error, partly held a warning:
+    :mod:`sarfe.pipeline.checks.held_checks`);
   * the output folder: absent, empty or a sarfe result, and writable (:mod:`sarfe.results.folder`);
     never a folder holding a file the case reads (:mod:`sarfe.pipeline.checks.case_inputs`).
 
@@ -45,6 +47,8 @@ from sarfe.hbm.pruning import linearized_stiffness
 from sarfe.mesh import connected_components
 from sarfe.mesh.quality import coincident_nodes, degenerate_elements, duplicate_elements
 from sarfe.pipeline.checks.case_inputs import case_inputs
+from sarfe.pipeline.checks.held_checks import (check_something_free, contact_warnings,
+                                               load_warnings)
 from sarfe.pipeline.checks.mesh_checks import check_deck, shared_pair_warnings
 from sarfe.pipeline.model.case_mesh import load_case_mesh
 from sarfe.pipeline.model.contact_pairs import pair_contact
@@ -57,6 +61,7 @@ from sarfe.results.folder import check_output_folder
 ELEMENTS_PER_WAVELENGTH = 6
 COINCIDENT_TOLERANCE = 1e-7      # × model size: nodes closer than this are at the same place
 DEGENERATE_TOLERANCE = 1e-8      # area ≤ this × (longest edge)²: a zero-area triangle
+HELD_BY = "model.fe.fixed or on no triangle"
 
 
 @dataclass(frozen=True)
@@ -141,29 +146,13 @@ def check_held(case, mesh, fixed_nodes) -> None:
                          f"{members[0]}); add a fixed group on it", ("model", "fe", "fixed"))
 
 
-def check_loads_free(case, mesh, fixed_nodes, load_nodes) -> list:
-    """Every force group of an FE case acts on a free DOF (``load_nodes``: the nodes of each
-    ``excitation.forces`` group, in order). The force F of a group is split equally over its n
-    nodes (F/n each) and a fixed node's share goes into the support, so a group whose nodes are
-    all held (fixed, or on no triangle) is a CaseError naming it, and a partly held group gets a
-    warning stating the share lost. Returns the warnings (one line each)."""
+def held_nodes(mesh, fixed_nodes) -> tuple:
+    """(held (n,), used (n,)) bool: a node of ``fixed_nodes`` or on no triangle is held."""
     used = np.zeros(mesh.n_nodes, bool)
     used[mesh.triangles.ravel()] = True
     held = ~used
     held[np.asarray(fixed_nodes, dtype=int)] = True
-    warnings = []
-    for i, (load, nodes) in enumerate(zip(case.config.excitation.forces, load_nodes)):
-        path = ("excitation", "forces", i, "group")
-        count = int(np.count_nonzero(held[nodes]))
-        if count == len(nodes):
-            raise case.error(f"the force on group {load.group} acts on no free DOF: all of its "
-                             f"DOFs are fixed ({len(nodes)} node(s) held by model.fe.fixed or on "
-                             "no triangle)", path)
-        if count:
-            warnings.append(f"excitation.forces[{i}]: {count} of the {len(nodes)} nodes of group "
-                            f"{load.group} are fixed: {100 * count / len(nodes):.3g} % of "
-                            f"force_N = {load.force_N:g} N goes straight into the supports")
-    return warnings
+    return held, used
 
 
 HELD_MATRIX_LIMIT = 3000        # DOFs: a dense eigenvalue check above costs more than it finds
@@ -359,6 +348,8 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True)
         return CaseCheck(info, tuple(range_warnings(case)) + tuple(info.pop("warnings")), output)
     mesh = load_case_mesh(case)
     fixed = fixed_nodes(case, mesh)
+    held, used = held_nodes(mesh, fixed)
+    check_something_free(case, held, used)
     shell_properties(case, mesh)
     check_thickness(case, mesh)
     normals = nodal_normals(mesh.points, mesh.triangles)
@@ -366,7 +357,8 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True)
     shared = shared_pair_warnings(case, paired, mesh.points)
     load_nodes = [resolve_node_group(case, mesh, f.group, ("excitation", "forces", i, "group"))
                   for i, f in enumerate(config.excitation.forces)]
-    load_warnings = check_loads_free(case, mesh, fixed, load_nodes)
+    warned = load_warnings(case, held, load_nodes, HELD_BY)
+    warned += contact_warnings(case, paired, held, HELD_BY)
     surface_triangles(case, mesh)     # erp.surface: an element group, or a node group's triangles
     joined = [(int(a), int(b)) for p in paired.values() for a, b in zip(p[0], p[1])]
     check_element_quality(case, mesh, joined)
@@ -376,11 +368,11 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True)
     interior = interior_dof_count(mesh, fixed, np.concatenate(
         [np.zeros(0, int)] + [np.concatenate([p[0], p[1]]) for p in paired.values()] + load_nodes))
     return CaseCheck(info, tuple(range_warnings(case, mesh)) + tuple(shared)
-                     + tuple(load_warnings)
+                     + tuple(warned)
                      + tuple(mode_count_warnings(case, interior)), output)
 
 
-__all__ = ["CaseCheck", "check_case", "check_loads_free", "check_matrices_held", "output_target",
+__all__ = ["CaseCheck", "check_case", "held_nodes", "check_matrices_held", "output_target",
            "check_element_quality", "check_held", "check_thickness", "bending_resolution_hz",
            "mesh_frequency_limit_hz", "range_warnings", "reduced_model_warnings",
            "interior_dof_count", "mode_count_warnings", "gap_warnings"]

@@ -2,7 +2,8 @@
 exist, the contacts pair, the elements are sound.
 
     check_mesh(case) -> info     {nodes, triangles, contact_pairs, coincident nodes} (FE), {} else
-    check_deck(case) -> info     a deck case: cards, groups, quality, supports, pairing
+    check_deck(case) -> info     a deck case: cards, groups, quality, supports, pairing, held
+                                 inputs (:mod:`sarfe.pipeline.checks.held_checks`)
     shared_pair_warnings(case, paired, points)   one node pair in two contacts: a warning
 
 Errors are one-line CaseErrors naming the key (or the element); the fuller pre-solve checks of
@@ -17,6 +18,9 @@ from sarfe.erp import nodal_normals
 from sarfe.mesh import quality
 from sarfe.pipeline.model.case_mesh import load_case_mesh
 from sarfe.pipeline.model.contact_pairs import pair_contact
+from sarfe.pipeline.checks.held_checks import (check_something_free, contact_warnings,
+                                               load_warnings)
+from sarfe.pipeline.model.deck_checks import connected_parts
 from sarfe.pipeline.model.deck_model import prepare_deck
 from sarfe.pipeline.model.deck_stage import contact_pairs
 from sarfe.pipeline.model.erp_map import deck_surface_triangles, surface_triangles
@@ -111,20 +115,32 @@ def mesh_quality(case, mesh, contact_pairs):
 
 
 def check_deck(case) -> dict:
-    """Validation of a deck case without assembly: cards, groups, quality, supports, pairing."""
+    """Validation of a deck case without assembly: cards, groups, quality, supports, pairing,
+    something free to move, forces and contacts on free nodes."""
     prepared = prepare_deck(case)
-    mesh = prepared.mesh
+    mesh, deck = prepared.mesh, prepared.deck
+    held = prepared.held[:, :3].all(axis=1)
+    used = connected_parts(deck)[2]
+    held |= ~used
+    check_something_free(case, held, used, ("model", "fe", "fixed") if case.config.model.fe.fixed
+                         else ("model", "fe", "supports"))
     paired = contact_pairs(case, prepared)
     shared = shared_pair_warnings(case, paired, mesh.points)
     pairs = {name: len(p[0]) for name, p in paired.items()}
+    load_nodes = []
     for i, f in enumerate(case.config.excitation.forces):
         if f.load_set is not None:
-            if str(f.load_set) not in prepared.deck.loads:
+            load_nodes.append(None)
+            if str(f.load_set) not in deck.loads:
                 raise case.error(f"load set '{f.load_set}' not in the deck (available: "
-                                 f"{', '.join(sorted(prepared.deck.loads)) or 'none'})",
+                                 f"{', '.join(sorted(deck.loads)) or 'none'})",
                                  ("excitation", "forces", i, "load_set"))
         else:
-            resolve_node_group(case, mesh, f.group, ("excitation", "forces", i, "group"))
+            load_nodes.append(resolve_node_group(case, mesh, f.group,
+                                                 ("excitation", "forces", i, "group")))
+    held_by = "the supports or model.fe.fixed, or on no element"
+    shared += load_warnings(case, held, load_nodes, held_by)
+    shared += contact_warnings(case, paired, held, held_by, labels=deck.node_ids)
     deck_surface_triangles(case, mesh)
     return {"nodes": prepared.deck.n_nodes, "triangles": mesh.n_triangles,
             "contact_pairs": pairs, "ignored_cards": prepared.notes["ignored_cards"],
