@@ -106,6 +106,8 @@ MUTATIONS = [
      ["contacts[0]"]),
     ("rig-thickness-mm", "rattle_rig", put(("model", "fe", "thickness_m", "part_plate"), 2.5),
      ["thickness_m.part_plate", "given in mm"]),
+    ("rig-E-negative", "rattle_rig", lambda d: d["model"]["fe"]["materials"]["part_plate"].update(
+        E_Pa=-2.2e9), ["materials.part_plate.E_Pa", "must be > 0"]),
     ("rig-fixed-everything", "rattle_rig", put(("model", "fe", "fixed"), ["*"]),
      ["model.fe.fixed", "every node of the model is held (", "'*' matches every group"]),
     ("rig-contact-held", "rattle_rig", put(("model", "fe", "fixed"),
