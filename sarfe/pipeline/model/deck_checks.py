@@ -83,18 +83,10 @@ def support_mask(case: Case, deck, mesh) -> np.ndarray:
                              ("model", "fe", "supports", j))
         support = deck.supports[name]
         held[support.nodes] |= support.components
-    used = used_nodes(deck)
     for i, group in enumerate(fe.fixed):
         nodes = resolve_node_group(case, mesh, group, ("model", "fe", "fixed", i),
                                    allow_elements=False)
-        if used.size and np.isin(used, nodes).all():
-            raise case.error(f"'{group}' holds every node of the model ({len(used)} nodes): "
-                             "nothing is left to vibrate; name the group of the held nodes",
-                             ("model", "fe", "fixed", i))
         held[nodes] = True
-    if used.size and held[used].all():
-        raise case.error(f"the supports and fixed groups hold every DOF of all {len(used)} "
-                         "nodes: nothing is left to vibrate", ("model", "fe", "supports"))
     return held
 
 

@@ -1,7 +1,8 @@
 """What engineers' decks carry and the mistakes they hold, each in validate (check_mesh) and in
 solve (the linear stage it builds first) — issue 32 items 1, 3 and 7 (deck part):
 
-- a deck part without density, ``fixed: ["*"]``, a force on an RBE2 dependent GRID
+- a deck part without density (``fixed: ["*"]``: tests/case/test_validate_parity.py), a force
+  on an RBE2 dependent GRID
   (pyNastran's 0012_flutter), ν = 0.5 and a negative E: refused alike by both, one line;
 - SPOINT / LSEQ / TLOAD2 named in ignore_cards, Abaqus *NODAL THICKNESS and a '>**' preamble,
   the Goland wing (a real 0.0006 ft web, ρ ≈ 0 with its mass in CONM2s) with explicit units:
@@ -56,16 +57,6 @@ def test_part_without_density_is_refused_by_validate_and_solve(tmp_path):
     text = _material_card(DECK.read_text(), 2, second="*       " + " " * 16)
     message = refused_alike(shipped_case(tmp_path, deck_text=text), r"model\.fe\.deck: a part of")
     assert "has no mass (property 2: its material has no density ρ)" in message
-
-
-def test_fixed_star_is_refused_by_validate_and_solve(tmp_path):
-    case = shipped_case(tmp_path)
-    data = dict(case.data)
-    data["model"] = {"fe": {**case.data["model"]["fe"], "fixed": ["*"]}}
-    data["model"]["fe"].pop("supports", None)
-    case = load_case(data, base_dir=tmp_path)
-    refused_alike(case, r"model\.fe\.fixed\[0\]: '\*' holds every node of the model "
-                        r"\(376 nodes\): nothing is left to vibrate")
 
 
 def _flutter_case(tmp_path, grid):
