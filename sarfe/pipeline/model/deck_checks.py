@@ -9,7 +9,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from sarfe.case.plausibility import MIN_E_PA, MIN_RHO_KG_M3, SPAN_RANGE_M, THICKNESS_RANGE
+from sarfe.case.plausibility import (MIN_E_PA, MIN_RHO_KG_M3, POISSON_RANGE, SPAN_RANGE_M,
+                                     THICKNESS_RANGE)
 from sarfe.case.read import Case
 from sarfe.mesh import quality
 from sarfe.mesh.formats.abaqus import section_values
@@ -268,12 +269,13 @@ def check_material_bounds(case: Case, deck) -> None:
             row = int(bad_e[0])
             where = _card_of(path, deck, deck_config.units, "E", table, row, float(young[row]))
             raise case.error(f"{where}: E = {young[row]:.4g} Pa must be > 0", DECK_KEY)
-        bad_nu = np.flatnonzero((nu >= 0.5 - 1e-12) | (nu <= -1.0))
+        low, high = POISSON_RANGE         # the schema's bounds of materials: nu
+        bad_nu = np.flatnonzero((nu >= high - 1e-12) | (nu <= low))
         if bad_nu.size:
             row = int(bad_nu[0])
             where = _card_of(path, deck, deck_config.units, "E", table, row, float(young[row]))
-            raise case.error(f"{where}: ν = {nu[row]:.4g} is outside −1 < ν < 0.5 (the bounds of "
-                             "a case's materials: nu)", DECK_KEY)
+            raise case.error(f"{where}: ν = {nu[row]:.4g} is outside {low:g} < ν < {high:g} (the "
+                             "bounds of a case's materials: nu)", DECK_KEY)
 
 
 def dependent_components(deck) -> np.ndarray:

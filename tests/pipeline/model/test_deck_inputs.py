@@ -94,7 +94,7 @@ def test_support_on_a_dependent_grid_is_refused_alike_by_validate_and_solve(tmp_
 
 @pytest.mark.parametrize("old, new, pattern", [
     # ν = 0.5: the case's own materials: nu has the bound ν < 0.5; the deck has it too
-    ("3.7000000000E-01", "5.0000000000E-01", r"MAT1 1: ν = 0\.5 is outside −1 < ν < 0\.5"),
+    ("3.7000000000E-01", "5.0000000000E-01", r"MAT1 1: ν = 0\.5 is outside -1 < ν < 0\.5"),
     # E < 0: no unit system makes it plausible — no unit advice
     ("12.2000000000E+03", "1-2.200000000E+03", r"MAT1 1: E = -2\.2e\+09 Pa must be > 0"),
 ])
