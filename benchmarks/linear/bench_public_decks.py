@@ -125,7 +125,7 @@ def _run(tree: pathlib.Path, decks: dict) -> dict:
 
 def _cell(run, reference):
     if not run.get("read"):
-        return f"refused: {run.get('error', '')[:90]}"
+        return f"refused: {run.get('error', '')[:200]}"
     if "hz" not in run:
         return "read"
     errors = [h / r - 1 for h, r in zip(run["hz"], reference)]
