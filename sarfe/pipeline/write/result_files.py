@@ -66,6 +66,7 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, di
     if stage.kind == "fe" and ("erp_vtu" in files or "animation" in files or "report" in files):
         mesh = stage.mesh
         markers = results.contact_markers(mesh.n_nodes, [g.nodes_a for g in stage.contacts.values()])
+        parts = results.part_ids(mesh.n_triangles, mesh.element_groups)
         translations = {}
         every_point = full_field_every_point(stage, solutions) or (
             len(selected) < len(solutions)
@@ -122,14 +123,14 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, di
                 j = selected[0]
                 results.write_erp_vtu(directory / "erp.vtu", mesh.points, mesh.triangles,
                                       point_data(j), field_data={"frequency_hz": frequencies[j],
-                                                                 "point_index": j})
+                                                                 "point_index": j}, parts=parts)
                 written["erp_vtu"] = "erp.vtu"
             else:       # on the workers while this process writes the files below
                 series = results.start_erp_sweep(directory / "erp", mesh.points, mesh.triangles,
                                                  lambda i: point_data(selected[i]),
                                                  [frequencies[j] for j in selected],
                                                  workers=map_workers(config, mesh, len(selected)),
-                                                 indices=selected)
+                                                 indices=selected, parts=parts)
                 started.append(("maps", series))
                 written["erp_vtu"] = "erp/erp.pvd"
         if "animation" in files and loudest is not None:
