@@ -122,7 +122,7 @@ def test_a_solved_rig_maps_its_parts_and_marks_the_beam(tmp_path, monkeypatch):
     case = tmp_path / "rig.yaml"
     case.write_text(coarse_rig([30.0, 32.5], "{harmonics: 3, samples_per_period: 32, "
                                "stability: false, error_estimate: false, workers: 1}",
-                               "output: {files: [summary, erp_vtu]}"))
+                               "output: {files: [summary, erp_vtu], maps: {every: 1}}"))
     assert main(["solve", str(case), "--output", str(tmp_path / "out"), "--quiet"]) == 0
     pvd = (tmp_path / "out" / "erp" / "erp.pvd").read_text()
     assert re.findall(r'timestep="([^"]+)"', pvd) == ["30", "32.5"]
