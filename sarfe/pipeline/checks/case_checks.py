@@ -35,13 +35,12 @@ import numpy as np
 
 from sarfe.case.plausibility import THICKNESS_RANGE
 from sarfe.case.read import load_case
-from sarfe.erp import nodal_normals
 from sarfe.hbm.pruning import linearized_stiffness
 from sarfe.mesh import connected_components
 from sarfe.mesh.quality import coincident_nodes, degenerate_elements, duplicate_elements
 from sarfe.pipeline.checks.mesh_checks import check_deck
 from sarfe.pipeline.model.case_mesh import load_case_mesh
-from sarfe.pipeline.model.contact_pairs import pair_contact
+from sarfe.pipeline.model.fe_stage import resolve_contacts
 from sarfe.pipeline.model.groups import fixed_nodes, resolve_node_group, shell_properties
 from sarfe.pipeline.model.linear_stage import build_linear_model
 from sarfe.pipeline.model.nonlinear_model import nonlinear_model
@@ -351,23 +350,24 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True)
     fixed = fixed_nodes(case, mesh)
     shell_properties(case, mesh)
     check_thickness(case, mesh)
-    normals = nodal_normals(mesh.points, mesh.triangles)
-    paired = {c.name: pair_contact(case, mesh, c.index, normals) for c in config.contacts}
+    resolved = resolve_contacts(case, mesh)
     load_nodes = [resolve_node_group(case, mesh, f.group, ("excitation", "forces", i, "group"))
                   for i, f in enumerate(config.excitation.forces)]
     load_warnings = check_loads_free(case, mesh, fixed, load_nodes)
     surface = config.erp.surface
     if surface is not None and surface not in mesh.element_groups:
         resolve_node_group(case, mesh, surface, ("erp", "surface"))
-    joined = [(int(a), int(b)) for p in paired.values() for a, b in zip(p[0], p[1])]
+    joined = [(int(a), int(b)) for r in resolved.values() for a, b in zip(r.nodes_a, r.nodes_b)]
     check_element_quality(case, mesh, joined)
     check_held(case, mesh, fixed)
     info = {"nodes": mesh.n_nodes, "triangles": mesh.n_triangles,
-            "contact_pairs": {name: len(p[0]) for name, p in paired.items()}}
+            "contact_pairs": {name: len(r.nodes_a) for name, r in resolved.items()}}
     interior = interior_dof_count(mesh, fixed, np.concatenate(
-        [np.zeros(0, int)] + [np.concatenate([p[0], p[1]]) for p in paired.values()] + load_nodes))
+        [np.zeros(0, int)] + [np.unique(r.operator.indices // 6) for r in resolved.values()]
+        + load_nodes))
+    contact_warnings = tuple(w for r in resolved.values() for w in r.warnings)
     return CaseCheck(info, tuple(range_warnings(case, mesh)) + tuple(load_warnings)
-                     + tuple(mode_count_warnings(case, interior)), output)
+                     + contact_warnings + tuple(mode_count_warnings(case, interior)), output)
 
 
 __all__ = ["CaseCheck", "check_case", "check_loads_free", "check_matrices_held", "output_target",

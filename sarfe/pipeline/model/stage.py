@@ -86,16 +86,19 @@ def linear_model_key(case) -> str:
     parts = {
         "model": model,
         "reduction": _reduction_key(data.get("reduction", {}), case.config) if case.is_fe else None,
-        "contacts": [{k: c.get(k) for k in ("name", "between", "pairs", "pairing_tolerance_m",
-                                            "normal", "normal_dof", "tangential_dofs",
-                                            "from_elements", "element_axis")}
+        "contacts": [{k: c.get(k) for k in ("name", "between", "pairs", "points_m", "surfaces",
+                                            "pairing_tolerance_m", "normal", "patch_radius_m",
+                                            "normal_dof", "tangential_dofs", "from_elements",
+                                            "element_axis")}
                      for c in data["contacts"]],
         "forces": [{k: f.get(k) for k in ("group", "dof", "direction", "load_set")}
                    for f in exc.get("forces", [])],
         "base": {k: v for k, v in exc["base_acceleration"].items() if k in ("direction", "influence")}
         if "base_acceleration" in exc else None,
         "erp": {k: data["erp"].get(k) for k in ("surface", "dofs", "areas_m2")},
-        "sarfe_linear_stage": 1,
+        # 2: contact rows from the geometry (points on the shells' faces, the partner surface's
+        # normal), the boundary = the DOFs they touch (issue 29)
+        "sarfe_linear_stage": 2,
     }
     return sha256_hex(json.dumps(parts, sort_keys=True, default=str))
 
