@@ -20,7 +20,6 @@ The linear stage is built once and reused for harmonics / samples / penalty vari
 """
 from __future__ import annotations
 
-import copy
 import csv
 import json
 import math
@@ -84,31 +83,30 @@ def knob_levels(case, stage, knobs=None) -> dict:
 
 
 def variant_case(case, knob, value):
-    """A new Case with one knob changed (see module docstring): the case's record ``case.data`` is
-    copied, edited and loaded again, so the variant gets its own normalized data and config."""
-    data = copy.deepcopy(case.data)
-    solver = data["solver"]
+    """A new Case with one knob changed (see module docstring), through the typed case API
+    (:meth:`sarfe.case.read.Case.with_solver` …): harmonics (N doubled to at least 4H + 1),
+    samples, penalty (every contact's normal and tangential stiffness × value), modes (a mode
+    count instead of a cutoff, no minimum) or mesh (the generator's mesh size)."""
     if knob == "harmonics":
-        solver["harmonics"] = int(value)
-        N = int(solver["samples_per_period"])
+        N = int(case.config.solver.samples_per_period)
         while N < 4 * value + 1:
             N *= 2
-        solver["samples_per_period"] = N
-    elif knob == "samples":
-        solver["samples_per_period"] = int(value)
-    elif knob == "penalty":
-        for contact in data["contacts"]:
-            for key in ("normal_stiffness_N_m", "tangential_stiffness_N_m"):
-                if key in contact:
-                    contact[key] = contact[key] * value
-    elif knob == "modes":
-        red = data.setdefault("reduction", {})
-        red.pop("cutoff_hz", None)
-        red["mode_count"] = int(value)
-        red["min_mode_count"] = 0
-    elif knob == "mesh":
-        data["model"]["fe"]["generator"]["mesh_size_m"] = float(value)
-    return load_case(data, base_dir=case.base_dir)
+        return case.with_solver(harmonics=int(value), samples_per_period=N)
+    if knob == "samples":
+        return case.with_solver(samples_per_period=int(value))
+    if knob == "penalty":
+        for index, contact in enumerate(case.config.contacts):
+            changes = {key: contact.params[key] * value
+                       for key in ("normal_stiffness_N_m", "tangential_stiffness_N_m")
+                       if key in contact.params}
+            if changes:
+                case = case.with_contact(index, **changes)
+        return case
+    if knob == "modes":
+        return case.with_reduction(cutoff_hz=None, mode_count=int(value), min_mode_count=0)
+    if knob == "mesh":
+        return case.with_generator(mesh_size_m=float(value))
+    return case
 
 
 def frequency_grid(case, points=16) -> np.ndarray:

@@ -27,7 +27,8 @@ cross-references it; this module turns its cards into the reader-neutral `DeckMo
   properties → ``element_sets['pid_<id>']``.
 * Every other card is counted in ``unsupported`` (cards that cannot change K or M —
   analysis controls such as PARAM, EIGRL, and thermal materials — are listed in
-  ``CONTROL_CARDS`` and not counted). PARAM,WTMASS is applied to every mass.
+  ``CONTROL_CARDS`` and not counted). PARAM,WTMASS is applied to every mass; PARAM,COUPMASS
+  (> 0: coupled mass, else lumped) and PARAM,K6ROT (shell drilling penalty) reach the assembly.
 
 The deck file is read by :func:`sarfe.mesh.formats.nastran_bdf.load_bdf`; the sections
 (PSHELL, PCOMP, materials) are :mod:`sarfe.mesh.formats.nastran_sections`'s, the sets, supports
@@ -149,6 +150,11 @@ class _Converter:
             self.notes.append(f"PARAM,WTMASS,{self.wtmass:g} applied to every mass")
         #: PARAM,W4 [rad per deck time unit]: element GE → viscous GE·K/W4 (0: GE kept hysteretic)
         self.w4 = float(model.params["W4"].values[0]) if "W4" in model.params else 0.0
+        #: PARAM,COUPMASS > 0: coupled element mass (default lumped); PARAM,K6ROT: shell drilling
+        self.coupled_mass = ("COUPMASS" in model.params
+                             and float(model.params["COUPMASS"].values[0] or 0) > 0)
+        k6rot = float(model.params["K6ROT"].values[0]) if "K6ROT" in model.params else 100.0
+        self.drilling_penalty = 1e-6 * k6rot
         self.note_structural_damping()
 
     def note_structural_damping(self):
@@ -452,7 +458,8 @@ class _Converter:
             beams=self.beams(), springs=self.springs(), point_masses=self.point_masses(),
             rbe2=rbe2, rbe3=rbe3, supports=supports(self), loads=loads(self),
             node_sets=node_sets, element_sets=element_sets, unsupported=unsupported,
-            ignored={}, notes=tuple(self.notes))
+            ignored={}, coupled_mass=self.coupled_mass,
+            drilling_penalty=self.drilling_penalty, notes=tuple(self.notes))
 
 
 def _shear_factor(value) -> float:
