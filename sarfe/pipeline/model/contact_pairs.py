@@ -37,6 +37,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
+from sarfe.hbm import laws
 from sarfe.mesh.contact_geometry import (facet_normal_residual_deg, frames_from_normals,
                                          orient_normals, patch_normals, separation_normals)
 from sarfe.mesh.geometry import facet_normals
@@ -334,10 +335,22 @@ def resolve_contact(case, mesh, index, surface: ShellSurface, pairs=None) -> Res
         face_b = face_points(at.x_b, z_b, ns_b)
     gaps = np.where(ground, 0.0, np.einsum("ij,ij->i", normal, face_b - face_a))
     frames = frames_from_normals(normal)
+    rows = contact_rows(frames, w_a, w_b)
+    if not laws.uses_tangent(laws.law(contact.kind), contact.params):
+        rows = normal_rows_only(rows)
     return ResolvedContact(contact.name, x_a, at.x_b, at.nodes_a,
-                           np.where(ground, -1, at.nodes_b), frames,
-                           contact_rows(frames, w_a, w_b), gaps,
+                           np.where(ground, -1, at.nodes_b), frames, rows, gaps,
                            _warnings(contact, index, at, normal, residual, gaps))
+
+
+def normal_rows_only(rows: sp.csr_matrix) -> sp.csr_matrix:
+    """G (3 n_p, n_dof) with the tangent rows 3p+1, 3p+2 emptied: a law without a tangent element
+    (rattle) uses only w, so its Craig–Bampton boundary is only what moves w."""
+    keep = np.zeros(rows.shape[0])
+    keep[::3] = 1.0
+    out = sp.csr_matrix(sp.diags(keep) @ rows)
+    out.eliminate_zeros()
+    return out
 
 
 def spring_contact(name, spring, surface: ShellSurface) -> ResolvedContact:
@@ -398,5 +411,5 @@ def reduced_coordinates(boundary_global, n_nodes):
 
 
 __all__ = ["NORMAL_RESIDUAL_WARN_DEG", "COINCIDENT_M", "ResolvedContact", "ContactGeometry",
-           "group_triangles", "resolve_contact", "spring_contact", "boundary_dofs",
+           "group_triangles", "resolve_contact", "normal_rows_only", "spring_contact", "boundary_dofs",
            "contact_geometry", "reduced_coordinates"]
