@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from sarfe.case.read import load_case
+from sarfe.hbm import laws
 from sarfe.pipeline.model.cutoff import default_cutoff_hz
 from sarfe.pipeline.model.deck_model import deck_files
 from sarfe.util.hashing import file_sha256, sha256_hex
@@ -90,7 +91,9 @@ def linear_model_key(case) -> str:
                                             "pairing_tolerance_m", "normal", "patch_radius_m",
                                             "normal_dof", "tangential_dofs", "from_elements",
                                             "element_axis")}
-                     for c in data["contacts"]],
+                     # a law without a tangent element keeps only the normal rows (their boundary)
+                     | {"tangent_rows": laws.uses_tangent(laws.law(entry.kind), entry.params)}
+                     for c, entry in zip(data["contacts"], case.config.contacts)],
         "forces": [{k: f.get(k) for k in ("group", "dof", "direction", "load_set")}
                    for f in exc.get("forces", [])],
         "base": {k: v for k, v in exc["base_acceleration"].items() if k in ("direction", "influence")}

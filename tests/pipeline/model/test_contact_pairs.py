@@ -116,3 +116,43 @@ def test_points_m_couple_by_shape_functions_wherever_the_nodes_are():
         L = G[1, 6 * plate + k] / t1[k]
         assert L.sum() == pytest.approx(1.0, rel=1e-9) and np.count_nonzero(L) == 3
         np.testing.assert_allclose(L @ mesh.points[plate], x, atol=1e-12)
+
+
+def test_a_contact_on_a_rib_junction_is_warned_about_and_a_flat_spot_is_not():
+    """`auto` on a point where a rib meets the carrier skin (a T-junction: no surface has one
+    normal there) gives a one-line warning naming the contact; in the middle of the flat skin,
+    none. (A grounded pair: the normal is side a's own surface's.)"""
+    data = load_case(CASES / "door_trim.yaml").data
+    data["model"]["fe"]["generator"]["mesh_size_m"] = 0.03
+    case = load_case(data, base_dir=CASES)
+    mesh = load_case_mesh(case)
+    t = mesh.triangles
+    rib = np.unique(t[mesh.element_groups["part_ribs"]])
+    carrier = np.unique(t[mesh.element_groups["part_carrier"]])
+    junction = int(np.intersect1d(rib, carrier)[len(np.intersect1d(rib, carrier)) // 2])
+    flat = carrier[~np.isin(carrier, rib)]
+    far = np.linalg.norm(mesh.points[flat][:, None] - mesh.points[rib][None], axis=2).min(axis=1)
+    flat = int(flat[np.argmax(far)])
+    contact = {k: v for k, v in data["contacts"][0].items() if k != "between"}
+    data["contacts"] = [contact | {"name": "on_rib", "pairs": [[junction, "ground"]]},
+                        contact | {"name": "on_skin", "pairs": [[flat, "ground"]]}]
+    case = load_case(data, base_dir=CASES)
+    resolved = resolve_contacts(case, mesh)
+    (warning,) = resolved["on_rib"].warnings
+    assert warning.startswith("contacts[0] (on_rib): the surface under 1 of 1 point(s) is folded")
+    assert "give normal: [x, y, z]" in warning
+    assert resolved["on_skin"].warnings == ()
+
+
+def test_a_rattle_variant_of_a_squeak_contact_is_another_linear_stage():
+    """A rattle keeps only the normal rows (and their boundary), so a cached squeak stage must
+    not serve it, nor the reverse: the law's use of tangent rows is in the stage key."""
+    from sarfe.pipeline.model.stage import linear_model_key
+
+    case, _ = rig("squeak_rig")
+    data = case.data
+    rattle = {k: v for k, v in data["contacts"][0].items()
+              if k not in ("tangential_stiffness_N_m", "friction_coefficient")} | {"type": "rattle"}
+    other = load_case({**data, "contacts": [rattle]}, base_dir=CASES)
+    assert linear_model_key(other) != linear_model_key(case)
+    assert linear_model_key(load_case(data, base_dir=CASES)) == linear_model_key(case)
