@@ -183,7 +183,7 @@ def build_deck_stage(case: Case, progress=False) -> dict:
                    for i, f in enumerate(forces)]
     radiating = deck_surface_triangles(case, mesh)
     for contact in case.config.contacts:      # as validate: before any assembly
-        a, b, _, _ = paired[contact.name]
+        a, b = paired[contact.name].nodes_a, paired[contact.name].nodes_b
         check_boundary_nodes(case, deck, np.concatenate([a, b[b >= 0]]), ("contacts", contact.index))
     for i, nodes in enumerate(group_nodes):
         if nodes is not None:
