@@ -54,18 +54,12 @@ def kept_translations(case, system, deck, nodes, path):
 
 
 def _kept_dofs(case, system, deck, nodes, components, path, held_ok=False):
-    """Kept DOF numbers (m,) of the global DOFs (node, component 0–5): they must be the kept DOFs
-    themselves (independent node, basic frame) — a dependent node of a rigid element or a rotated
-    displacement frame (CD) is a one-line error. ``held_ok``: DOFs held for lack of stiffness are
-    −1 (a contact row through them sees u = 0) instead of an error."""
+    """Kept DOF numbers (m,) of the global DOFs (node, component 0–5) the contact rows touch
+    (rotated CD frames and rigid-element dependents of the contact nodes were refused before
+    assembly: `check_boundary_nodes`); one without stiffness is a one-line error, or −1 with
+    ``held_ok`` when it was held for lack of stiffness (a contact row through it sees u = 0)."""
     nodes = np.asarray(nodes, dtype=np.int64)
     components = np.asarray(components, dtype=np.int64)
-    rotated = ~np.all(np.isclose(deck.displacement_frames[nodes], np.eye(3), atol=1e-12),
-                      axis=(1, 2))
-    if np.any(rotated):
-        raise case.error(f"GRID {int(deck.node_ids[nodes[np.argmax(rotated)]])} has a rotated "
-                         "displacement frame (CD): contact and force nodes must use the basic "
-                         "frame", path)
     dofs = system.dof_index(nodes, components)
     bad = dofs < 0
     if held_ok and np.any(bad):
