@@ -12,13 +12,12 @@ from __future__ import annotations
 import numpy as np
 
 from sarfe.case.read import load_case
-from sarfe.erp import nodal_normals
 from sarfe.mesh import quality
 from sarfe.pipeline.model.case_mesh import load_case_mesh
-from sarfe.pipeline.model.contact_pairs import pair_contact
 from sarfe.pipeline.model.deck_model import prepare_deck
 from sarfe.pipeline.model.deck_stage import contact_pairs
 from sarfe.pipeline.model.erp_map import deck_surface_triangles
+from sarfe.pipeline.model.fe_stage import resolve_contacts
 from sarfe.pipeline.model.groups import fixed_nodes, resolve_node_group, shell_properties
 from sarfe.pipeline.model.matrices_stage import build_matrices_stage
 
@@ -35,10 +34,9 @@ def check_mesh(case) -> dict:
     mesh = load_case_mesh(case)
     fixed_nodes(case, mesh)
     shell_properties(case, mesh)
-    normals = nodal_normals(mesh.points, mesh.triangles)
-    paired = [pair_contact(case, mesh, c.index, normals) for c in config.contacts]
-    pairs = {c.name: len(p[0]) for c, p in zip(config.contacts, paired)}
-    coincident = mesh_quality(case, mesh, [(a, b) for a, b, _, _ in paired])
+    resolved = resolve_contacts(case, mesh)
+    pairs = {name: len(r.nodes_a) for name, r in resolved.items()}
+    coincident = mesh_quality(case, mesh, [(r.nodes_a, r.nodes_b) for r in resolved.values()])
     for i, f in enumerate(config.excitation.forces):
         resolve_node_group(case, mesh, f.group, ("excitation", "forces", i, "group"))
     surface = config.erp.surface
@@ -72,7 +70,8 @@ def check_deck(case) -> dict:
     """Validation of a deck case without assembly: cards, groups, quality, supports, pairing."""
     prepared = prepare_deck(case)
     mesh = prepared.mesh
-    pairs = {name: len(p[0]) for name, p in contact_pairs(case, prepared).items()}
+    resolved = contact_pairs(case, prepared)
+    pairs = {name: len(r.nodes_a) for name, r in resolved.items()}
     for i, f in enumerate(case.config.excitation.forces):
         if f.load_set is not None:
             if str(f.load_set) not in prepared.deck.loads:
@@ -86,7 +85,8 @@ def check_deck(case) -> dict:
             "contact_pairs": pairs, "ignored_cards": prepared.notes["ignored_cards"],
             "coincident_node_pairs": prepared.notes["coincident_node_pairs"],
             "coincident_nodes": prepared.notes["coincident_nodes"],
-            "warnings": prepared.warnings}
+            "warnings": prepared.warnings + tuple(w for r in resolved.values()
+                                                  for w in r.warnings)}
 
 
 __all__ = ["check_mesh", "check_deck", "mesh_quality"]
