@@ -1,9 +1,10 @@
-"""The mesh term of the ± (sarfe.pipeline.solve.mesh_error, issue 29 item 4): on the door trim at
-67 Hz, whose level converges with the mesh (issue 29: 99.8 / 97.0 / 96.5 / 96.0 / 95.7 / 95.6 /
-95.6 dB(A) at 20 … 3 mm), the term estimated on the shipped 14 mm mesh (one re-solve on 28 mm)
-covers the difference to a converged fine mesh (a stored reference, how it was made written in
-it); the ± shown (console, table.txt, report, summary.json) includes it; decks and given meshes
-say "not estimated"."""
+"""The mesh term of the ± (sarfe.pipeline.solve.mesh_error, issue 29 item 4): on cases whose level
+converges with the mesh (contacts from the geometry, issue 29 items 1-3) — the door trim at 67 Hz
+(97.00 / 96.52 / 95.96 / 95.69 / 95.56 dB(A) at 14 / 10 / 7 / 5 / 3.5 mm) and the squeak rig at
+50 Hz — the term estimated on a coarse mesh (one re-solve on twice the element size) covers the
+difference to a converged fine mesh (the stored references of tests/cases/data/
+mesh_convergence_reference.json, how each was made written in it); the ± shown (console,
+table.txt, report, summary.json) includes it; decks and given meshes say "not estimated"."""
 import json
 from pathlib import Path
 
@@ -16,7 +17,7 @@ from sarfe.pipeline.solve.mesh_error import mesh_error_reason
 from sarfe.results.report import render_report_html
 
 CASES = Path(__file__).resolve().parents[3] / "cases"
-REFERENCE = Path(__file__).resolve().parent / "data" / "door_trim_67hz_mesh_ladder.json"
+REFERENCE = Path(__file__).resolve().parents[2] / "cases" / "data" / "mesh_convergence_reference.json"
 
 
 def one_point(name, frequency_hz, mesh_size_m=None, **solver):
@@ -31,18 +32,24 @@ def one_point(name, frequency_hz, mesh_size_m=None, **solver):
 
 
 @pytest.mark.timeout(300)
-def test_mesh_term_covers_the_error_against_a_converged_mesh():
-    reference = json.loads(REFERENCE.read_text())
-    fine = reference["levels_dba"][reference["reference_mm"]]
-    result = solve_case(one_point("door_trim", 67.0, 0.014, stability=False), write=False)
+@pytest.mark.parametrize("name, mesh_size_m", [
+    pytest.param("door_trim", 0.014, marks=pytest.mark.slow),      # ≈ 10-20 s
+    ("squeak_rig", 0.012), ("squeak_rig", 0.006)])
+def test_mesh_term_covers_the_error_against_a_converged_mesh(name, mesh_size_m):
+    """Measured (2026-11-28, with kinwire's contacts): door trim 14 mm 97.00 dB(A), term 3.76 dB
+    (28 mm: 100.7) against a true error of 1.44; squeak rig 12 mm 30.83, term 2.03 against 1.49;
+    6 mm 29.88, term 0.95 against 0.54. (Not every mesh: the squeak rig at 9 mm gives 0.65
+    against 0.95, its 18 mm re-solve is not yet in the asymptotic range — the other terms of the
+    ± (1.41 dB in all) still cover it; the door trim at 20 mm 1.76 against 4.2.)"""
+    reference = json.loads(REFERENCE.read_text())[name]
+    result = solve_case(one_point(name, reference["frequency_hz"], mesh_size_m, stability=False),
+                        write=False)
     term = result.summary["mesh_error"]
-    assert term["estimated"] and term["coarse_mesh_size_m"] == pytest.approx(0.028)
+    assert term["estimated"] and term["coarse_mesh_size_m"] == pytest.approx(2 * mesh_size_m)
     level = result.summary["points"][0]["erp"]["level_dba"]
-    # the same code and settings as the stored ladder (its 14 mm entry)
-    assert level == pytest.approx(reference["levels_dba"]["14"], abs=0.05)
-    true_error = abs(level - fine)                          # 1.3 dB (the reference: 4 mm)
-    assert true_error > 0.5
-    assert true_error <= term["mesh_db"] <= 4 * true_error  # covers, not absurdly (3.8 dB)
+    true_error = abs(level - reference["level_dba"])
+    assert true_error > 0.3
+    assert true_error <= term["mesh_db"] <= 4 * true_error  # covers, not absurdly
     estimate = result.summary["points"][0]["error_estimate"]
     assert estimate["mesh_db"] == pytest.approx(term["mesh_db"])
     assert estimate["erp_db"] >= term["mesh_db"]            # the ± includes it
