@@ -6,7 +6,9 @@ of twice the element size, Richardson-extrapolated (:mod:`sarfe.accuracy.mesh_re
 One linear stage built on the coarser mesh (the case's reduction rule and cutoff, so the modal
 basis covers the same band) and one Newton solve of the harmonic balance at the loudest point's
 ω, H, N, started from the linear response to the fine point's contact forces (same contact
-rows), else from the linear response. The term is measured at the loudest point and added to every
+rows), else from the linear response. Where the two meshes' contacts are in different states at ω
+(one closes, the other does not: the mesh moved the contact onset, e.g. a rattle near its fold)
+the level change is no Richardson estimate: the term is "not estimated" with that reason. The term is measured at the loudest point and added to every
 estimated point's ERP bound (``error_estimate.mesh_db``, ``erp_db`` includes it): the headline
 carries it where it was measured; elsewhere it stands for the mesh error of the run.
 
@@ -42,6 +44,12 @@ def mesh_error_reason(case) -> str | None:
         return (f"not estimated (a {fe.source} mesh: no coarser mesh to re-solve on; the level's "
                 "mesh error is not in the ±)")
     return None
+
+
+def touches(solution) -> bool:
+    """Whether any contact carries force over the period (max |λ(t)| > 0)."""
+    force = np.asarray(solution.contact_force_time, dtype=float)
+    return bool(force.size and np.max(np.abs(force)) > 0.0)
 
 
 def coarse_start(nl_coarse, solution, H):
@@ -102,6 +110,16 @@ def mesh_error_term(case, points, solutions, ratio=MESH_RATIO, order=MESH_ORDER)
         out["reason"] = (f"not estimated (the re-solve on the {1e3 * ratio * h:.3g} mm mesh did "
                          f"not converge: {getattr(s, 'reason', '')})")
         return out
+    touching = (touches(fine), touches(s))
+    if touching[0] != touching[1]:      # one mesh's contacts close at ω, the other's do not
+        out["reason"] = (f"not estimated: at {out['frequency_hz']:.2f} Hz the "
+                         f"{1e3 * ratio * h:.3g} mm mesh's contacts "
+                         f"{'do not close' if touching[0] else 'close'} "
+                         f"({out['coarse_level_dba']:.1f} against {out['level_dba']:.1f} dB(A)): "
+                         "another branch, its level change is no Richardson estimate (the mesh "
+                         "moves the contact onset; refine the mesh or compare the sweeps with "
+                         "`sarfe study --knobs mesh`)")
+        return out
     mesh_db = max(mesh_richardson(out["level_db"], out["coarse_level_db"], order, ratio),
                   mesh_richardson(out["level_dba"], out["coarse_level_dba"], order, ratio))
     out.update(estimated=bool(np.isfinite(mesh_db)), mesh_db=float(mesh_db), reason=None)
@@ -136,4 +154,4 @@ def mesh_line(term: dict | None) -> str | None:
             f"{term.get('seconds', 0.0):.1f} s")
 
 
-__all__ = ["mesh_error_reason", "coarse_start", "mesh_error_term", "with_mesh_term", "mesh_line"]
+__all__ = ["mesh_error_reason", "touches", "coarse_start", "mesh_error_term", "with_mesh_term", "mesh_line"]
