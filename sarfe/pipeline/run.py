@@ -25,7 +25,8 @@ from sarfe.pipeline.post.point_workers import (first_estimates, point_records, p
                                                point_workers, stability_stream)
 from sarfe.pipeline.post.records import error_estimates, worst_of
 from sarfe.pipeline.solve.case_accuracy import accuracy_check, case_resolution, resolved_case
-from sarfe.pipeline.solve.mesh_error import mesh_error_term, mesh_line, with_mesh_term
+from sarfe.pipeline.solve.mesh_error import (mesh_checked, mesh_error_term, mesh_line,
+                                             with_mesh_term)
 from sarfe.pipeline.solve.points import common_samples, sweep_status
 from sarfe.pipeline.solve.pruned_points import solve_points_pruned
 from sarfe.pipeline.write.result_files import write_outputs
@@ -198,7 +199,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         "points": points,
         "worst": worst_of(points),
         "accuracy": accuracy,                    # None unless solver.accuracy was given
-        "accuracy_check": accuracy_check(config.solver, points),   # estimates vs the accuracy budget
+        "accuracy_check": mesh_checked(accuracy_check(config.solver, points), mesh_term, case),
         "mesh_error": mesh_term,                 # the ± mesh term (sarfe.pipeline.solve.mesh_error)
         "warnings": warnings,                    # inputs far outside the model's range
         "timings_s": timings,

@@ -141,6 +141,18 @@ def with_mesh_term(points, rows, term) -> None:
         row["erp_error_db"] = e["erp_db"]
 
 
+def mesh_checked(check: dict | None, term: dict, case) -> dict | None:
+    """The run's accuracy check (:func:`sarfe.pipeline.solve.case_accuracy.accuracy_check`) with
+    the mesh term's failure counted: where the term was due (a generated mesh, on) but could not be
+    estimated, the budget is not 'met' and the warning says why."""
+    if check is None or term.get("estimated") or mesh_error_reason(case) is not None:
+        return check
+    check = dict(check, met=False)
+    check["warning"] = ((check["warning"] + "; ") if check.get("warning") else "accuracy: ") + \
+        f"mesh error {term.get('reason') or 'not estimated'}"
+    return check
+
+
 def mesh_line(term: dict | None) -> str | None:
     """Console / report line of the mesh term: 'mesh: ±0.42 dB (…)' or 'mesh: not estimated (…)'."""
     if not term:
@@ -154,4 +166,5 @@ def mesh_line(term: dict | None) -> str | None:
             f"{term.get('seconds', 0.0):.1f} s")
 
 
-__all__ = ["mesh_error_reason", "touches", "coarse_start", "mesh_error_term", "with_mesh_term", "mesh_line"]
+__all__ = ["mesh_error_reason", "touches", "coarse_start", "mesh_error_term", "with_mesh_term",
+           "mesh_checked", "mesh_line"]
