@@ -67,7 +67,8 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     bar = progress_bar(progress and linear_stage is None, "checking the case: mesh, groups, quality", None,
                unit="step")
     try:
-        checked = check_case(case, output_dir, force, write=write, mesh_checks=linear_stage is None)
+        checked = check_case(case, output_dir, force, write=write, mesh_checks=linear_stage is None,
+                             assemble=False)   # the linear stage assembles (a deck) right after
     finally:
         if bar is not None:
             bar.close()

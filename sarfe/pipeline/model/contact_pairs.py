@@ -370,6 +370,13 @@ def spring_contact(name, spring, surface: ShellSurface) -> ResolvedContact:
                            tangential_stiffness=spring.tangential_stiffness)
 
 
+def node_pairs(resolved: dict) -> dict:
+    """{name: (nodes_a (n_p,), nodes_b (n_p,), −1 for ground)}: each contact point's node on
+    either side (the node it lies at, or the nearest of its element) — what the input checks
+    (shared pairs, held pairs, element quality at joined nodes) name."""
+    return {name: (r.nodes_a, r.nodes_b) for name, r in resolved.items()}
+
+
 # -------------------------------------------------------------------------- reduced coordinates
 def boundary_dofs(resolved: dict) -> np.ndarray:
     """Global DOFs (6·node + component) that the rows of the contacts {name: ResolvedContact}
@@ -411,5 +418,5 @@ def reduced_coordinates(boundary_global, n_nodes):
 
 
 __all__ = ["NORMAL_RESIDUAL_WARN_DEG", "COINCIDENT_M", "ResolvedContact", "ContactGeometry",
-           "group_triangles", "resolve_contact", "normal_rows_only", "spring_contact", "boundary_dofs",
+           "group_triangles", "resolve_contact", "normal_rows_only", "node_pairs", "spring_contact", "boundary_dofs",
            "contact_geometry", "reduced_coordinates"]

@@ -20,7 +20,7 @@ from sarfe.pipeline.model.contact_pairs import (boundary_dofs, contact_geometry,
                                                 reduced_coordinates, resolve_contact,
                                                 spring_contact)
 from sarfe.pipeline.model.cutoff import stage_cutoff_hz
-from sarfe.pipeline.model.deck_checks import DECK_KEY
+from sarfe.pipeline.model.deck_checks import DECK_KEY, check_boundary_nodes
 from sarfe.pipeline.model.deck_model import prepare_deck
 from sarfe.pipeline.model.erp_map import deck_surface_triangles, erp_map
 from sarfe.pipeline.model.groups import resolve_node_group
@@ -32,18 +32,25 @@ from sarfe.util.progress import bar as progress_bar
 _LOADED_BOUNDARY_LIMIT = 60   # load-set DOFs kept physically up to this count (else residuals)
 
 
-def _assemble(case: Case, deck):
+def assemble_case_deck(case: Case, deck):
+    """The deck's `DeckSystem`; an assembly refusal (degenerate cell, I12 ≠ 0, an undetermined
+    RBE3, …) is a one-line CaseError on model.fe.deck."""
     try:
         return assemble_deck(deck)
     except DeckError as exc:
         raise case.error(str(exc), DECK_KEY) from None
 
 
-def _kept_translations(case, system, deck, nodes, path):
-    """(len(nodes), 3) kept DOF numbers of the translations of `nodes` (global axes)."""
+def kept_translations(case, system, deck, nodes, path):
+    """(len(nodes), 3) kept DOF numbers of the translations of `nodes` (global axes; rotated CD
+    frames and rigid-element dependents were refused before assembly: `check_boundary_nodes`)."""
     nodes = np.asarray(nodes, dtype=np.int64)
-    return _kept_dofs(case, system, deck, np.repeat(nodes, 3), np.tile(np.arange(3), len(nodes)),
-                      path).reshape(-1, 3)
+    dofs = system.dof_index(nodes[:, None], np.arange(3)[None, :])
+    if np.any(dofs < 0):
+        bad = nodes[np.argmax((dofs < 0).any(axis=1))]
+        raise case.error(f"GRID {int(deck.node_ids[bad])} is a dependent node of a rigid element "
+                         "(RBE2/RBE3) or has no stiffness: use an independent node", path)
+    return dofs
 
 
 def _kept_dofs(case, system, deck, nodes, components, path, held_ok=False):
@@ -175,10 +182,16 @@ def build_deck_stage(case: Case, progress=False) -> dict:
                    resolve_node_group(case, mesh, f.group, ("excitation", "forces", i, "group"))
                    for i, f in enumerate(forces)]
     radiating = deck_surface_triangles(case, mesh)
+    for contact in case.config.contacts:      # as validate: before any assembly
+        a, b = paired[contact.name].nodes_a, paired[contact.name].nodes_b
+        check_boundary_nodes(case, deck, np.concatenate([a, b[b >= 0]]), ("contacts", contact.index))
+    for i, nodes in enumerate(group_nodes):
+        if nodes is not None:
+            check_boundary_nodes(case, deck, nodes, ("excitation", "forces", i, "group"))
 
     next_step(stages, "assembly")
     clock = time.perf_counter()
-    system = _assemble(case, deck)
+    system = assemble_case_deck(case, deck)
     timings["assembly_s"] = time.perf_counter() - clock
     mass_kg = _translational_mass(system, deck)
     if not mass_kg > 0:
@@ -198,7 +211,14 @@ def build_deck_stage(case: Case, progress=False) -> dict:
                               held_ok=True)
     nodes = np.unique(np.concatenate([g for g in group_nodes if g is not None]
                                      + [np.zeros(0, np.int64)]).astype(np.int64))
-    boundary_kept = np.union1d(contact_kept[contact_kept >= 0], _kept_translations(
+    for contact in case.config.contacts:      # each on its own key, as validate
+        r = paired[contact.name]
+        kept_translations(case, system, deck, np.concatenate([r.nodes_a, r.nodes_b[r.nodes_b >= 0]]),
+                          ("contacts", contact.index))
+    for i, group in enumerate(group_nodes):
+        if group is not None:
+            kept_translations(case, system, deck, group, ("excitation", "forces", i, "group"))
+    boundary_kept = np.union1d(contact_kept[contact_kept >= 0], kept_translations(
         case, system, deck, nodes, ("excitation", "forces")).ravel())
     set_vectors = [(_load_set_vector(case, system, deck, f, ("excitation", "forces", i, "load_set"))
                     if f.load_set is not None else None) for i, f in enumerate(forces)]
@@ -287,4 +307,5 @@ def _translational_mass(system, deck) -> float:
     return float(iota @ (system.mass @ iota))
 
 
-__all__ = ["build_deck_stage", "deck_shell_surface", "contact_pairs", "expanded_reduced_model", "held_kept_dofs"]
+__all__ = ["build_deck_stage", "deck_shell_surface", "contact_pairs", "expanded_reduced_model",
+           "held_kept_dofs", "assemble_case_deck", "kept_translations"]
