@@ -79,7 +79,10 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     timings = {}
     accuracy = None
     config = case.config
-    if config.solver.resolution == "auto":
+    if config.solver.resolution == "auto" and not config.contacts and warn is not None:
+        warn("no contacts: the response is linear (one modal sum per point), so resolution "
+             f"'auto' searches no H; solved at harmonics = {config.solver.harmonics}")
+    if config.solver.resolution == "auto" and config.contacts:
         # accuracy as an input: choose H, N (the reduction cutoff follows H) by a cheap search
         clock = time.perf_counter()
         report, searched = case_resolution(case, config.solver.accuracy)
