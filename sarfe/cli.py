@@ -61,6 +61,8 @@ def cmd_solve(args) -> int:
         print(results_table(result.rows, types))
         for line in loudest_lines(summary.get("worst")):
             print(line)
+        if (summary.get("mesh_error") or {}).get("line"):
+            print(summary["mesh_error"]["line"])
         print(f"results: {result.output_dir}  ({time.perf_counter() - clock:.1f} s)")
     if summary["non_converged_points"]:
         print(f"sarfe: {len(summary['non_converged_points'])} point(s) did not converge: "

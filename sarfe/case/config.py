@@ -316,7 +316,9 @@ class SolverConfig:
     'odd' | 'auto' (:mod:`sarfe.hbm.harmonic_set`). ``prune_contacts``: contacts that never switch
     are solved linearly, with the clearance margin ``prune_margin`` (:mod:`sarfe.pipeline.solve.
     pruned_points`). ``workers`` 'auto' | n: processes for the per-point work after Newton
-    (:mod:`sarfe.util.workers`)."""
+    (:mod:`sarfe.util.workers`). ``mesh_error``: the mesh term of the ± ('auto': on for
+    generator meshes, 'not estimated' said for decks and given meshes; true: required; false: off;
+    :mod:`sarfe.pipeline.solve.mesh_error`)."""
 
     harmonics: int = 5
     samples_per_period: int = 128
@@ -330,6 +332,7 @@ class SolverConfig:
     prune_contacts: bool = True
     prune_margin: float = 0.5
     workers: int | str = "auto"
+    mesh_error: bool | str = "auto"     # the ± mesh term: 'auto' on for generator meshes (mesh_error)
     continuation: ContinuationConfig = field(default_factory=ContinuationConfig)
 
     @property
@@ -467,7 +470,7 @@ def _solver_config(solver) -> SolverConfig:
         stability=solver["stability"], error_estimate=solver["error_estimate"],
         harmonic_set=solver["harmonic_set"],
         prune_contacts=True if isinstance(prune, dict) else bool(prune), **margin,
-        workers=solver["workers"],
+        workers=solver["workers"], mesh_error=solver["mesh_error"],
         continuation=ContinuationConfig(initial_step=cont["initial_step"],
                                         min_step=cont["min_step"], max_step=cont["max_step"],
                                         max_points=cont["max_points"]))

@@ -323,8 +323,12 @@ def _normalize_solver(case, data):
         raise case.error(f"must be >= 2H+1 = {2 * H + 1} for harmonics H = {H}, got {N}",
                          ("solver", "samples_per_period"))
     for key in ("tolerance", "max_iterations", "stability", "error_estimate", "harmonic_set",
-                "prune_contacts", "workers"):          # defaults: sarfe.case.config.SolverConfig
+                "prune_contacts", "workers", "mesh_error"):   # defaults: sarfe.case.config.SolverConfig
         solver.setdefault(key, default_of(SolverConfig, key))
+    generated = "generator" in data.get("model", {}).get("fe", {})
+    if solver["mesh_error"] is True and not generated:     # sarfe.pipeline.solve.mesh_error
+        raise case.error("true needs a generated mesh (model.fe.generator) to coarsen; use "
+                         "'auto' or false", ("solver", "mesh_error"))
     cont = solver.setdefault("continuation", {})
     for key in ("initial_step", "min_step", "max_step", "max_points"):
         cont.setdefault(key, default_of(ContinuationConfig, key))

@@ -195,6 +195,8 @@ SOLVER = _object({
         "margin": {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1}})]},
     # processes for the per-point work after Newton (stability, estimates, records): sarfe.util.workers
     "workers": {"oneOf": [{"enum": ["auto"]}, {"type": "integer", "minimum": 1}]},
+    # the mesh term of the ± (sarfe.pipeline.solve.mesh_error): 'auto' = on for generator meshes
+    "mesh_error": {"oneOf": [{"enum": ["auto"]}, {"type": "boolean"}]},
     "continuation": _object({
         "initial_step": {"type": "number", "exclusiveMinimum": 0, "maximum": 1},
         "min_step": {"type": "number", "exclusiveMinimum": 0, "maximum": 1},
