@@ -3,7 +3,8 @@
 Exit codes: 0 success; 2 a problem in the case file (one line on stderr naming the key, no
 traceback unless ``--debug``); 3 the run finished but some frequency point did not converge (see
 summary.json ``non_converged_points``); 1 an unexpected internal error; 130 interrupted.
-Subcommands ``study`` (``sarfe.tradeoff.cli``) and ``batch`` (``sarfe.batch.cli``) are added by their
+Subcommands ``study`` (``sarfe.tradeoff.cli``), ``batch`` (``sarfe.batch.cli``) and ``compare``
+(``sarfe.compare.cli``) are added by their
 ``register(subparsers)`` functions.
 """
 from __future__ import annotations
@@ -18,6 +19,7 @@ import numpy as np
 from sarfe import __version__
 from sarfe.batch import cli as batch_cli
 from sarfe.case.errors import EXIT_CASE_ERROR, EXIT_NOT_CONVERGED, CaseError
+from sarfe.compare import cli as compare_cli
 from sarfe.pipeline import build_linear_model, load_case, nonlinear_model, results_table, solve_case
 from sarfe.pipeline.checks.case_checks import check_case, output_target
 from sarfe.pipeline.verify import format_rows, verify_point
@@ -162,6 +164,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     tradeoff_cli.register(sub)
     batch_cli.register(sub)
+    compare_cli.register(sub)
     return parser
 
 
