@@ -45,7 +45,9 @@ _CASE_SECTIONS = ("name", "description", "model", "damping", "reduction", "conta
                   "solver", "erp", "output")
 # per-contact columns of CaseResult.rows: "<contact>.<quantity>"; maxima over frequency per variant
 CONTACT_MAXIMA = ("max_penetration_m", "peak_normal_force_N", "peak_friction_force_N")
-RATTLE_COLUMN = "max_penetration_m"  # a contact rattles when it closes: penetration > 0
+RATTLE_COLUMN = "max_penetration_m"  # fallback: a contact rattles when it closes: penetration > 0
+IMPACT_COLUMN = "impacts_per_period"  # a contact rattles when it opens and impacts (> 0 per period)
+SLIP_COLUMN = "slip_fraction"        # a contact squeaks (slips) when part of the period slides
 
 
 def parameter_columns(table) -> list[str]:
@@ -82,10 +84,18 @@ def variant_levels(table: pd.DataFrame) -> pd.DataFrame:
         for contact, column in contact_columns(table, quantity).items():
             values = pd.to_numeric(table[column], errors="coerce")
             levels[column] = values.groupby(table["variant_index"]).max().to_numpy()
+    impacts = contact_columns(table, IMPACT_COLUMN)
     for contact, column in contact_columns(table, RATTLE_COLUMN).items():
-        values = pd.to_numeric(table[column], errors="coerce")
+        if contact in impacts:   # rattle = the contact opens and impacts (any law, preloaded too)
+            values = pd.to_numeric(table[impacts[contact]], errors="coerce")
+        else:                    # records without impact counts: closes at all (penetration > 0)
+            values = pd.to_numeric(table[column], errors="coerce")
         if values.notna().any():  # contacts without a normal direction (pure squeak) have NaN
             levels[f"{contact}.rattles"] = (values.fillna(0) > 0).groupby(table["variant_index"]).any().to_numpy()
+    for contact, column in contact_columns(table, SLIP_COLUMN).items():
+        values = pd.to_numeric(table[column], errors="coerce")
+        if values.notna().any():
+            levels[f"{contact}.slips"] = (values.fillna(0) > 0).groupby(table["variant_index"]).any().to_numpy()
     return levels
 
 
@@ -427,6 +437,12 @@ def summarize(table: pd.DataFrame, stats=None) -> dict:
         summary["rattle_probability_ci95"] = {
             f[: -len(".rattles")]: [float(v) for v in wilson_interval(ok[f].sum(), len(ok))]
             for f in flags}
+    slips = [c for c in levels.columns if c.endswith(".slips")]
+    if slips and len(ok):
+        summary["slip_probability"] = {f[: -len(".slips")]: float(ok[f].mean()) for f in slips}
+        summary["slip_probability_ci95"] = {
+            f[: -len(".slips")]: [float(v) for v in wilson_interval(ok[f].sum(), len(ok))]
+            for f in slips}
     for parameter in parameter_columns(table):
         values = pd.to_numeric(levels[parameter], errors="coerce") if parameter in levels else pd.Series([], dtype=float)
         if values.notna().any():

@@ -94,3 +94,19 @@ def test_variants_of_one_case_keep_statistics_and_few_are_dots(tmp_path):
     assert summary["sample"] == "one case"
     assert summary["max_erp_dba"]["count"] == 2 and summary["max_erp_dba"]["mean"] == pytest.approx(30.5)
     assert "erp_histogram.png" in summary["plots"]
+
+
+def test_preloaded_squeak_contact_slips_but_does_not_rattle(tmp_path):
+    """A preloaded squeak contact always penetrates (preload) but never opens: P(rattle) counts
+    opening-and-impact (impacts_per_period > 0), P(slip) counts sliding (slip_fraction > 0)."""
+    rows = []
+    for v, slip in enumerate((0.0, 0.0, 0.4, 0.6)):
+        rows.append({"variant_index": v, "variant_id": f"v{v}", "source": "mu_study", "status": "ok",
+                     "error": None, "frequency_hz": 100.0, "erp_db": 40.0, "erp_dba": 30.0,
+                     "rub.max_penetration_m": 2e-5, "rub.impacts_per_period": 0,
+                     "rub.slip_fraction": slip, "rub.open_fraction": 0.0,
+                     "clip.max_penetration_m": 1e-6 * v, "clip.impacts_per_period": int(v >= 2),
+                     "clip.slip_fraction": 0.0})
+    summary = write_report(pd.DataFrame(rows), tmp_path)
+    assert summary["rattle_probability"] == {"rub": 0.0, "clip": 0.5}
+    assert summary["slip_probability"] == {"rub": 0.5, "clip": 0.0}
