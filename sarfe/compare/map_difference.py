@@ -24,7 +24,7 @@ GEOMETRY_RTOL = 1e-6
 @dataclass(frozen=True)
 class MapDifference:
     """``delta_db`` (n,) [dB] (NaN where neither map radiates) on ``points_m``/``triangles`` of the
-    reference map, at ``frequency_hz``; ``max_increase_db``/``max_decrease_db`` over the nodes."""
+    reference map, at ``frequency_hz``; ``stats()``: ``delta_min_db``/``delta_max_db`` over the nodes."""
     points_m: np.ndarray
     triangles: np.ndarray
     delta_db: np.ndarray
@@ -34,8 +34,8 @@ class MapDifference:
         finite = self.delta_db[np.isfinite(self.delta_db)]
         return {"frequency_hz": self.frequency_hz, "nodes": int(self.delta_db.size),
                 "radiating_nodes": int(np.count_nonzero(~np.isnan(self.delta_db))),
-                "max_increase_db": float(finite.max()) if finite.size else None,
-                "max_decrease_db": float(finite.min()) if finite.size else None}
+                "delta_max_db": float(finite.max()) if finite.size else None,
+                "delta_min_db": float(finite.min()) if finite.size else None}
 
 
 def meshes_agree(a: ErpMap, b: ErpMap) -> bool:

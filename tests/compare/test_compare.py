@@ -53,7 +53,7 @@ def test_result_against_itself_is_zero(two_mu, capsys):
     assert len(deltas) > 3 * len(FREQUENCIES_HZ)       # totals, contact, bands, sources
     assert all(d is not None and abs(d) < 1e-12 for d in deltas)
     (m,) = data["maps"]
-    assert m["available"] and m["max_increase_db"] == 0.0 and m["max_decrease_db"] == 0.0
+    assert m["available"] and m["delta_max_db"] == 0.0 and m["delta_min_db"] == 0.0
     assert (tmp / "aa" / "compare.html").is_file()
 
 
