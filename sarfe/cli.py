@@ -1,8 +1,11 @@
 """Command line: ``sarfe solve | verify | validate CASE.yaml`` and ``sarfe --version``.
 
 Exit codes: 0 success; 2 a problem in the case file (one line on stderr naming the key, no
-traceback unless ``--debug``); 3 the run finished but some frequency point did not converge (see
-summary.json ``non_converged_points``); 1 an unexpected internal error; 130 interrupted.
+traceback unless ``--debug``), or of the system met reading or writing (a full disk, a read-only
+file system, no permission, a busy mount point: one line naming the path,
+:func:`sarfe.results.folder.os_error`); 3 the run finished but some frequency point did not
+converge (see summary.json ``non_converged_points``); 1 an unexpected internal error; 130
+interrupted.
 Subcommands ``study`` (``sarfe.tradeoff.cli``), ``batch`` (``sarfe.batch.cli``) and ``compare``
 (``sarfe.compare.cli``) are added by their
 ``register(subparsers)`` functions.
@@ -23,6 +26,7 @@ from sarfe.compare import cli as compare_cli
 from sarfe.pipeline import build_linear_model, load_case, nonlinear_model, results_table, solve_case
 from sarfe.pipeline.checks.case_checks import check_case, output_target
 from sarfe.pipeline.verify import format_rows, verify_point
+from sarfe.results.folder import os_error
 from sarfe.results.summary import loudest_lines, pruning_line, stability_line
 from sarfe.tradeoff import cli as tradeoff_cli
 
@@ -189,13 +193,25 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("sarfe: interrupted", file=sys.stderr)
         return 130
-    except Exception as exc:  # an internal error: one line unless --debug
+    except OSError as exc:    # a full disk, a read-only file system …: one line, exit 2
+        error = os_error(exc)
+        if error is None:
+            return _internal_error(exc, debug)
         if debug:
             traceback.print_exc()
-        else:
-            print(f"sarfe: internal error: {type(exc).__name__}: {exc} (rerun with --debug for "
-                  "the traceback)", file=sys.stderr)
-        return 1
+        print(f"sarfe: error: {error}", file=sys.stderr)
+        return EXIT_CASE_ERROR
+    except Exception as exc:  # an internal error: one line unless --debug
+        return _internal_error(exc, debug)
+
+
+def _internal_error(exc, debug) -> int:
+    if debug:
+        traceback.print_exc()
+    else:
+        print(f"sarfe: internal error: {type(exc).__name__}: {exc} (rerun with --debug for "
+              "the traceback)", file=sys.stderr)
+    return 1
 
 
 if __name__ == "__main__":

@@ -15,6 +15,7 @@ from sarfe.case.config import (DEFAULT_ACCURACY, DEFAULT_ZETA, MATRICES_GAP_M,
                                GeneratorConfig, ReductionConfig, SolverConfig, default_of,
                                default_output_directory, default_output_files,
                                default_samples_per_period)
+from sarfe.case.errors import format_key_path
 from sarfe.case.plausibility import check_plausible
 from sarfe.hbm import laws
 
@@ -155,6 +156,10 @@ def _normalize_contacts(case, data):
                 raise case.error("only with from_elements", p + ("element_axis",))
             if "between" in contact and contact["between"][0] == "ground":
                 raise case.error("the first group cannot be 'ground'", p + ("between", 0))
+            if "between" in contact and contact["between"][0] == contact["between"][1]:
+                raise case.error(f"group '{contact['between'][0]}' is on both sides: a contact "
+                                 "joins two different groups (or a group and 'ground')",
+                                 p + ("between", 1))
             for j, pair in enumerate(contact.get("pairs", [])):
                 if pair[0] == pair[1]:
                     raise case.error(f"node {pair[0]} is paired with itself (a pair joins two "
@@ -182,6 +187,7 @@ def _normalize_contacts(case, data):
                     "tangential_dofs", []):
                 for key in ("relative_to", "sign"):
                     ref.setdefault(key, default_of(DofReference, key))
+            _check_contact_dofs(case, contact, p)
         others = sorted(every_key - law.keys(), key=lambda k: list(contact).index(k)
                         if k in contact else 0)
         if law.tangent_dofs == "forbidden":
@@ -221,6 +227,26 @@ def _normalize_contacts(case, data):
         if has_normal and "preload_N" not in contact and not fe:
             contact.setdefault("gap_m", MATRICES_GAP_M)  # FE: the geometric gap of each pair
         contact.setdefault("tolerance_m", default_of(ContactConfig, "tolerance_m"))
+
+
+def _check_contact_dofs(case, contact, p):
+    """A matrices contact's DOFs: none measured against itself (r = u[d] − u[d] ≡ 0), no
+    direction given twice (the same relative displacement as two tangents, or as the normal and
+    a tangent: its force would count twice)."""
+    refs = ([(("normal_dof",), contact["normal_dof"])] if "normal_dof" in contact else []) + [
+        (("tangential_dofs", j), ref) for j, ref in enumerate(contact.get("tangential_dofs", []))]
+    seen = {}
+    for path, ref in refs:
+        if ref["relative_to"] == ref["dof"]:
+            raise case.error(f"DOF {ref['dof']} is measured relative to itself (a relative "
+                             "displacement that is always 0)", p + path + ("relative_to",))
+        key = frozenset((ref["dof"], ref["relative_to"]))     # u0 − u1 and u1 − u0 alike
+        if key in seen:
+            first = format_key_path(p + seen[key])
+            raise case.error(f"DOF {ref['dof']} (relative to {ref['relative_to']}) is already "
+                             f"{first}: each direction of a contact is a different relative "
+                             "displacement", p + path)
+        seen[key] = path
 
 
 def _normalize_excitation(case, data):

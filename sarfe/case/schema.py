@@ -7,6 +7,7 @@ two keys, node groups present in the mesh, pairing within tolerance) are checked
 """
 from __future__ import annotations
 
+from sarfe.case.plausibility import POISSON_RANGE
 from sarfe.hbm import laws
 
 
@@ -39,7 +40,8 @@ MATRIX = {"type": ["string", "array"], "minLength": 1, "minItems": 1,
           "items": {"type": "array", "minItems": 1, "items": NUMBER}}
 MATERIAL = _object({
     "E_Pa": POSITIVE,
-    "nu": {"type": "number", "exclusiveMinimum": -1, "exclusiveMaximum": 0.5},
+    "nu": {"type": "number", "exclusiveMinimum": POISSON_RANGE[0],
+           "exclusiveMaximum": POISSON_RANGE[1]},
     "rho_kg_m3": POSITIVE,
 }, required=("E_Pa", "nu", "rho_kg_m3"))
 
