@@ -10,3 +10,11 @@
                     sarfe/results/templates/compare.html.j2)
     cli             the ``compare`` subcommand
 """
+from sarfe.util.lazy import lazy_exports
+
+# exports load on first use (sarfe.util.lazy): h5py, matplotlib, jinja2 only when a comparison runs
+_EXPORTS = {"read_result": ".result_reader", "Result": ".result_reader",
+            "compare_all": ".deltas", "write_comparison": ".compare_report",
+            "map_difference": ".map_difference"}
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
+__all__ = ["read_result", "Result", "compare_all", "write_comparison", "map_difference"]

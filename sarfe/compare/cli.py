@@ -13,8 +13,7 @@ import sys
 from pathlib import Path
 
 from sarfe.case.errors import EXIT_CASE_ERROR, CaseError
-from sarfe.compare.compare_report import write_comparison
-from sarfe.compare.result_reader import read_result
+from sarfe import compare    # its exports load on first use: h5py, matplotlib only when it runs
 
 HELP = "compare solve results of design variants (deltas in dB(A) against the first)"
 EPILOG = "exit codes: 0 written, 2 a folder is not a sarfe result or the output is refused, 1 internal error"
@@ -41,13 +40,13 @@ def run(args: argparse.Namespace) -> int:
     """Handler of ``sarfe compare``; returns the exit code."""
     inputs = [Path(p) for p in args.results]
     try:
-        results = [read_result(p) for p in inputs]
+        results = [compare.read_result(p) for p in inputs]
         output = Path(args.output)
         _check_output(output, inputs)
     except CaseError as error:
         print(f"sarfe compare: {error}", file=sys.stderr)
         return EXIT_CASE_ERROR
-    data = write_comparison(results, output)
+    data = compare.write_comparison(results, output)
     if not getattr(args, "quiet", False):
         for h, c in zip(data["headlines"], [None] + data["comparisons"]):
             delta = "reference" if c is None else f"Δ {c['worst_delta_dba']:+.2f} dB(A)"
