@@ -6,7 +6,8 @@ file system, no permission, a busy mount point: one line naming the path,
 :func:`sarfe.results.folder.os_error`); 3 the run finished but some frequency point did not
 converge (see summary.json ``non_converged_points``); 1 an unexpected internal error; 130
 interrupted.
-Subcommands ``study`` (``sarfe.tradeoff.cli``) and ``batch`` (``sarfe.batch.cli``) are added by their
+Subcommands ``study`` (``sarfe.tradeoff.cli``), ``batch`` (``sarfe.batch.cli``) and ``compare``
+(``sarfe.compare.cli``) are added by their
 ``register(subparsers)`` functions.
 """
 from __future__ import annotations
@@ -21,6 +22,7 @@ import numpy as np
 from sarfe import __version__
 from sarfe.batch import cli as batch_cli
 from sarfe.case.errors import EXIT_CASE_ERROR, EXIT_NOT_CONVERGED, CaseError
+from sarfe.compare import cli as compare_cli
 from sarfe.pipeline import build_linear_model, load_case, nonlinear_model, results_table, solve_case
 from sarfe.pipeline.checks.case_checks import check_case, output_target
 from sarfe.pipeline.verify import format_rows, verify_point
@@ -168,6 +170,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     tradeoff_cli.register(sub)
     batch_cli.register(sub)
+    compare_cli.register(sub)
     return parser
 
 
