@@ -169,12 +169,14 @@ def _short_value(value) -> str:
 
 
 def evaluate_gate(table: pd.DataFrame, fail_above_db: float | None = None,
-                  allow_nonconverged: bool = False) -> GateResult:
-    """CI gate: a variant fails when its max ERP level > ``fail_above_db`` [dB], when it did not
+                  allow_nonconverged: bool = False, weighted: bool = False) -> GateResult:
+    """CI gate: a variant fails when its max ERP level > ``fail_above_db`` [dB, or dB(A) when
+    ``weighted``: the A-weighted level the review speaks], when it did not
     converge (unless ``allow_nonconverged``), or when it failed with an error.
     Exit code of a failed gate: ``GATE_EXIT_CODE`` (4)."""
     levels = variant_levels(table) if len(table) else pd.DataFrame()
     parameters = parameter_columns(table)
+    column, unit = ("max_erp_dba", "dB(A)") if weighted else ("max_erp_db", "dB")
     offenders, lines = [], []
     for _, row in levels.iterrows():
         reason = None
@@ -182,9 +184,9 @@ def evaluate_gate(table: pd.DataFrame, fail_above_db: float | None = None,
             reason = f"failed: {row['error']}"
         elif row["status"] == "nonconverged" and not allow_nonconverged:
             reason = "did not converge (use --allow-nonconverged to accept)"
-        elif fail_above_db is not None and "max_erp_db" in row and row["max_erp_db"] > fail_above_db:
-            at = f" at {row['frequency_at_max_hz']:.6g} Hz" if "frequency_at_max_hz" in row else ""
-            reason = f"ERP {row['max_erp_db']:.2f} dB{at} > {fail_above_db:g} dB"
+        elif fail_above_db is not None and column in row and row[column] > fail_above_db:
+            at = f" at {row['frequency_at_max_hz']:.6g} Hz" if "frequency_at_max_hz" in row and not weighted else ""
+            reason = f"ERP {row[column]:.2f} {unit}{at} > {fail_above_db:g} {unit}"
         if reason is not None:
             offenders.append({"variant_id": row["variant_id"], "variant_index": int(row["variant_index"]),
                               "reason": reason})
@@ -192,12 +194,12 @@ def evaluate_gate(table: pd.DataFrame, fail_above_db: float | None = None,
     total = len(levels)
     if offenders:
         if fail_above_db is not None:
-            head = f"gate failed: {len(offenders)} of {total} variants (threshold {fail_above_db:g} dB)"
+            head = f"gate failed: {len(offenders)} of {total} variants (threshold {fail_above_db:g} {unit})"
         else:
             head = f"{len(offenders)} of {total} variants failed or did not converge"
         message = "\n".join([head + ":"] + lines)
     else:
-        message = f"gate passed: {total} variants" + (f" at or below {fail_above_db:g} dB" if fail_above_db is not None else "")
+        message = f"gate passed: {total} variants" + (f" at or below {fail_above_db:g} {unit}" if fail_above_db is not None else "")
     return GateResult(passed=not offenders, threshold_db=fail_above_db, offenders=offenders, message=message)
 
 

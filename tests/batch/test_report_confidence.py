@@ -3,7 +3,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from sarfe.batch.batch_report import (dkw_epsilon, quantile_band, rattle_probability, wilson_interval,
+from sarfe.batch.batch_report import (dkw_epsilon, evaluate_gate, quantile_band, rattle_probability, wilson_interval,
                                 write_report)
 
 
@@ -110,3 +110,14 @@ def test_preloaded_squeak_contact_slips_but_does_not_rattle(tmp_path):
     summary = write_report(pd.DataFrame(rows), tmp_path)
     assert summary["rattle_probability"] == {"rub": 0.0, "clip": 0.5}
     assert summary["slip_probability"] == {"rub": 0.5, "clip": 0.0}
+
+
+def test_gate_speaks_dba():
+    """--fail-above-dba: the gate compares each variant's loudest A-weighted level."""
+    rows = [{"variant_index": i, "variant_id": f"v{i}", "source": "s", "status": "ok", "error": None,
+             "frequency_hz": 67.0, "erp_db": dba + 20.0, "erp_dba": dba} for i, dba in enumerate((88.0, 93.0))]
+    table = pd.DataFrame(rows)
+    gate = evaluate_gate(table, 90.0, weighted=True)
+    assert not gate.passed and len(gate.offenders) == 1 and "93.00 dB(A) > 90 dB(A)" in gate.message
+    assert evaluate_gate(table, 95.0, weighted=True).passed
+    assert not evaluate_gate(table, 95.0).passed        # unweighted: 108, 113 dB > 95 dB
