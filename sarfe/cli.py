@@ -6,7 +6,8 @@ file system, no permission, a busy mount point: one line naming the path,
 :func:`sarfe.results.folder.os_error`); 3 the run finished but some frequency point did not
 converge (see summary.json ``non_converged_points``); 1 an unexpected internal error; 130
 interrupted.
-Subcommands ``study`` (``sarfe.tradeoff.cli``) and ``batch`` (``sarfe.batch.cli``) are added by their
+Subcommands ``study`` (``sarfe.tradeoff.cli``), ``batch`` (``sarfe.batch.cli``) and ``compare``
+(``sarfe.compare.cli``) are added by their
 ``register(subparsers)`` functions.
 """
 from __future__ import annotations
@@ -22,6 +23,7 @@ import numpy as np
 from sarfe import __version__
 from sarfe.batch import cli as batch_cli
 from sarfe.case.errors import EXIT_CASE_ERROR, EXIT_NOT_CONVERGED, CaseError
+from sarfe.compare import cli as compare_cli
 from sarfe.pipeline import build_linear_model, load_case, nonlinear_model, solve_case
 from sarfe.pipeline.checks.case_checks import check_case, output_target
 from sarfe.pipeline.verify import format_rows, verify_point
@@ -65,6 +67,8 @@ def cmd_solve(args) -> int:
                               "table.txt" if table is not None and table.exists() else None))
         for line in loudest_lines(summary.get("worst")):
             print(line)
+        if (summary.get("mesh_error") or {}).get("line"):
+            print(summary["mesh_error"]["line"])
         print(f"results: {result.output_dir}  ({time.perf_counter() - clock:.1f} s)")
     if summary["non_converged_points"]:
         print(f"sarfe: {len(summary['non_converged_points'])} point(s) did not converge: "
@@ -170,6 +174,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     tradeoff_cli.register(sub)
     batch_cli.register(sub)
+    compare_cli.register(sub)
     return parser
 
 

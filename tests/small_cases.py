@@ -44,7 +44,8 @@ model:
 damping: {{modal_zeta: 0.02}}
 contacts:
   - {{name: tip, type: rattle, between: [contact_tip_a, contact_tip_b],
-     pairing_tolerance_m: 1.0e-3, normal_stiffness_N_m: 2.0e5, tolerance_m: 1.0e-4}}
+     gap_m: 0.5e-3, pairing_tolerance_m: 1.0e-3, normal_stiffness_N_m: 2.0e5,
+     tolerance_m: 1.0e-4}}
 excitation:
   forces: [{{group: excite_beam, direction: z, force_N: 0.05}}]
   frequency_hz: {list(frequencies_hz)}

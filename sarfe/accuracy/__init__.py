@@ -13,7 +13,8 @@ Modules:
 - modal_truncation: the Craig–Bampton mode-truncation part (coarser models, two probes, decay);
 - estimate: the per-point estimate combining them (:func:`estimate_errors`,
   :class:`EstimateProblem`, :func:`problem_error_estimate`);
-- resolve: a sweep's accuracy target → H, N (:func:`resolve_accuracy`).
+- resolve: a sweep's accuracy target → H, N (:func:`resolve_accuracy`);
+- mesh_refinement: the mesh term's Richardson extrapolation of a level on h and 2h (stated order).
 """
 from sarfe.accuracy.estimate import (ErrorEstimate, EstimateProblem, estimate_errors,
                                      problem_error_estimate)

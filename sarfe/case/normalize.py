@@ -151,10 +151,21 @@ def _normalize_contacts(case, data):
             if "from_elements" in contact and not deck:
                 raise case.error("needs model.fe.deck (CBUSH/CELAS elements of a deck)",
                                  p + ("from_elements",))
-            if "between" not in contact and "pairs" not in contact and "from_elements" not in contact:
+            if not any(k in contact for k in ("between", "pairs", "from_elements", "points_m")):
                 raise case.error("missing required key (node groups [a, b] or [a, ground], "
-                                 "or explicit node 'pairs', or deck 'from_elements')", p + ("between",))
-            _only_one(case, contact, p, ("between", "pairs", "from_elements"))
+                                 "or explicit node 'pairs', or contact 'points_m' with "
+                                 "'surfaces', or deck 'from_elements')", p + ("between",))
+            _only_one(case, contact, p, ("between", "pairs", "from_elements", "points_m"))
+            if "points_m" in contact and "surfaces" not in contact:
+                raise case.error("missing required key (the element groups [a, b] or "
+                                 "[a, ground] the points_m lie on)", p + ("surfaces",))
+            if "surfaces" in contact and not any(k in contact for k in ("between", "points_m")):
+                raise case.error("only with between or points_m", p + ("surfaces",))
+            if "surfaces" in contact and contact["surfaces"][0] == "ground":
+                raise case.error("the first surface cannot be 'ground'", p + ("surfaces", 0))
+            if "from_elements" in contact:
+                _not_allowed(case, contact, p, ("normal", "patch_radius_m"),
+                             "with from_elements (the spring axis is the normal)")
             if "element_axis" in contact and "from_elements" not in contact:
                 raise case.error("only with from_elements", p + ("element_axis",))
             if "between" in contact and contact["between"][0] == "ground":
@@ -167,11 +178,12 @@ def _normalize_contacts(case, data):
                 if pair[0] == pair[1]:
                     raise case.error(f"node {pair[0]} is paired with itself (a pair joins two "
                                      "different nodes, or a node and 'ground')", p + ("pairs", j))
-            for key in ("pairing_tolerance_m", "normal"):
+            for key in ("pairing_tolerance_m", "normal", "patch_radius_m"):
                 contact.setdefault(key, default_of(ContactConfig, key))
             has_normal = True
         else:
-            _not_allowed(case, contact, p, ("between", "pairs", "normal", "pairing_tolerance_m"),
+            _not_allowed(case, contact, p, ("between", "pairs", "normal", "pairing_tolerance_m",
+                                            "points_m", "surfaces", "patch_radius_m"),
                          "with model.matrices (use 'normal_dof' / 'tangential_dofs')")
             has_normal = "normal_dof" in contact
             if law.normal_dof == "required" and not has_normal:
@@ -312,8 +324,12 @@ def _normalize_solver(case, data):
         raise case.error(f"must be >= 2H+1 = {2 * H + 1} for harmonics H = {H}, got {N}",
                          ("solver", "samples_per_period"))
     for key in ("tolerance", "max_iterations", "stability", "error_estimate", "harmonic_set",
-                "prune_contacts", "workers"):          # defaults: sarfe.case.config.SolverConfig
+                "prune_contacts", "workers", "mesh_error"):   # defaults: sarfe.case.config.SolverConfig
         solver.setdefault(key, default_of(SolverConfig, key))
+    generated = "generator" in data.get("model", {}).get("fe", {})
+    if solver["mesh_error"] is True and not generated:     # sarfe.pipeline.solve.mesh_error
+        raise case.error("true needs a generated mesh (model.fe.generator) to coarsen; use "
+                         "'auto' or false", ("solver", "mesh_error"))
     cont = solver.setdefault("continuation", {})
     for key in ("initial_step", "min_step", "max_step", "max_points", "linear_points"):
         cont.setdefault(key, default_of(ContinuationConfig, key))

@@ -127,8 +127,13 @@ def contact_schema():
                   "items": {"type": "array", "minItems": 2, "maxItems": 2,
                             "items": {"type": ["integer", "string"], "minimum": 0,
                                       "pattern": "^ground$"}}},
-        "normal": {"type": ["string", "array"], "pattern": "^auto$",
+        # FE models: contact points by coordinates on two element groups (b may be 'ground')
+        "points_m": {"type": "array", "minItems": 1,
+                     "items": {"type": "array", "items": NUMBER, "minItems": 3, "maxItems": 3}},
+        "surfaces": {"type": "array", "items": NAME, "minItems": 2, "maxItems": 2},
+        "normal": {"type": ["string", "array"], "pattern": "^(auto|separation)$",
                    "items": NUMBER, "minItems": 3, "maxItems": 3},
+        "patch_radius_m": POSITIVE,
         # FE decks: CBUSH/CELAS element ids turned into this contact (removed from the linear
         # model; their stiffness along element_axis is the penalty stiffness)
         "from_elements": {"type": "array", "items": {"type": "integer", "minimum": 1},
@@ -190,6 +195,8 @@ SOLVER = _object({
         "margin": {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1}})]},
     # processes for the per-point work after Newton (stability, estimates, records): sarfe.util.workers
     "workers": {"oneOf": [{"enum": ["auto"]}, {"type": "integer", "minimum": 1}]},
+    # the mesh term of the ± (sarfe.pipeline.solve.mesh_error): 'auto' = on for generator meshes
+    "mesh_error": {"oneOf": [{"enum": ["auto"]}, {"type": "boolean"}]},
     "continuation": _object({
         "initial_step": {"type": "number", "exclusiveMinimum": 0, "maximum": 1},
         "min_step": {"type": "number", "exclusiveMinimum": 0, "maximum": 1},

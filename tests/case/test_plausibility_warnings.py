@@ -112,7 +112,7 @@ def test_a_node_pair_in_two_contacts_is_warned_in_validate_and_solve(tmp_path, c
     text = coarse_rig([30.0], "{harmonics: 3, samples_per_period: 32, stability: false, "
                               "error_estimate: false, workers: 1}", "output: {files: [summary]}")
     text = text.replace("excitation:", "  - {name: tip_again, type: rattle, between: "
-                        "[contact_tip_b, contact_tip_a], pairing_tolerance_m: 1.0e-3, "
+                        "[contact_tip_b, contact_tip_a], gap_m: 0.5e-3, pairing_tolerance_m: 1.0e-3, "
                         "normal_stiffness_N_m: 2.0e5}\nexcitation:")
     case = tmp_path / "case.yaml"
     case.write_text(text)

@@ -42,7 +42,6 @@ import numpy as np
 
 from sarfe.case.plausibility import THICKNESS_RANGE, plausibility_warnings
 from sarfe.case.read import load_case
-from sarfe.erp import nodal_normals
 from sarfe.hbm.pruning import linearized_stiffness
 from sarfe.mesh import connected_components
 from sarfe.mesh.quality import coincident_nodes, degenerate_elements, duplicate_elements
@@ -51,8 +50,9 @@ from sarfe.pipeline.checks.held_checks import (check_something_free, contact_war
                                                load_warnings)
 from sarfe.pipeline.checks.mesh_checks import check_deck, shared_pair_warnings
 from sarfe.pipeline.model.case_mesh import load_case_mesh
-from sarfe.pipeline.model.contact_pairs import pair_contact
+from sarfe.pipeline.model.contact_pairs import boundary_dofs, node_pairs
 from sarfe.pipeline.model.erp_map import surface_triangles
+from sarfe.pipeline.model.fe_stage import resolve_contacts
 from sarfe.pipeline.model.groups import fixed_nodes, resolve_node_group, shell_properties
 from sarfe.pipeline.model.linear_stage import build_linear_model
 from sarfe.pipeline.model.nonlinear_model import nonlinear_model
@@ -276,17 +276,18 @@ def range_warnings(case, mesh=None) -> list:
     return warnings
 
 
-def interior_dof_count(mesh, fixed_nodes, boundary_nodes) -> int:
+def interior_dof_count(mesh, fixed_nodes, boundary_dofs) -> int:
     """Interior DOFs of the Craig–Bampton split, as the linear stage makes it: 6 per node on a
-    triangle that is not fixed, minus the 3 translations of each free contact or load node (the
-    boundary). At most this many fixed-interface modes exist."""
+    triangle that is not fixed, minus the boundary DOFs (global numbers 6·node + component: what
+    the contact rows touch and the load nodes' translations) on such nodes. At most this many
+    fixed-interface modes exist."""
     used = np.zeros(mesh.n_nodes, bool)
     used[mesh.triangles.ravel()] = True
     free = used.copy()
     free[np.asarray(fixed_nodes, dtype=int)] = False
-    boundary = np.unique(np.asarray(boundary_nodes, dtype=int))
-    boundary = boundary[(boundary >= 0) & free[np.maximum(boundary, 0)]]
-    return int(6 * np.count_nonzero(free) - 3 * boundary.size)
+    boundary = np.unique(np.asarray(boundary_dofs, dtype=np.int64))
+    boundary = boundary[(boundary >= 0) & free[np.maximum(boundary, 0) // 6]]
+    return int(6 * np.count_nonzero(free) - boundary.size)
 
 
 def mode_count_warnings(case, interior) -> list:
@@ -355,8 +356,8 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True,
     check_something_free(case, held, used)
     shell_properties(case, mesh)
     check_thickness(case, mesh)
-    normals = nodal_normals(mesh.points, mesh.triangles)
-    paired = {c.name: pair_contact(case, mesh, c.index, normals) for c in config.contacts}
+    resolved = resolve_contacts(case, mesh)
+    paired = node_pairs(resolved)
     shared = shared_pair_warnings(case, paired, mesh.points)
     load_nodes = [resolve_node_group(case, mesh, f.group, ("excitation", "forces", i, "group"))
                   for i, f in enumerate(config.excitation.forces)]
@@ -368,10 +369,12 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True,
     check_held(case, mesh, fixed)
     info = {"nodes": mesh.n_nodes, "triangles": mesh.n_triangles,
             "contact_pairs": {name: len(p[0]) for name, p in paired.items()}}
-    interior = interior_dof_count(mesh, fixed, np.concatenate(
-        [np.zeros(0, int)] + [np.concatenate([p[0], p[1]]) for p in paired.values()] + load_nodes))
+    loads = np.concatenate([np.zeros(0, int)] + load_nodes)
+    interior = interior_dof_count(mesh, fixed, np.union1d(
+        boundary_dofs(resolved), (6 * loads[:, None] + np.arange(3)).ravel()))
+    geometry = tuple(w for r in resolved.values() for w in r.warnings)
     return CaseCheck(info, tuple(range_warnings(case, mesh)) + tuple(shared)
-                     + tuple(warned)
+                     + tuple(warned) + geometry
                      + tuple(mode_count_warnings(case, interior)), output)
 
 

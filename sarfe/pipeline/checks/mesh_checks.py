@@ -14,17 +14,17 @@ from __future__ import annotations
 import numpy as np
 
 from sarfe.case.read import load_case
-from sarfe.erp import nodal_normals
 from sarfe.mesh import quality
 from sarfe.pipeline.model.case_mesh import load_case_mesh
-from sarfe.pipeline.model.contact_pairs import pair_contact
 from sarfe.pipeline.checks.held_checks import (check_something_free, contact_warnings,
                                                load_warnings)
+from sarfe.pipeline.model.contact_pairs import node_pairs
 from sarfe.pipeline.model.deck_checks import check_boundary_nodes, connected_parts
 from sarfe.pipeline.model.deck_model import prepare_deck
 from sarfe.pipeline.model.deck_stage import (assemble_case_deck, contact_pairs, held_kept_dofs,
                                              kept_translations)
 from sarfe.pipeline.model.erp_map import deck_surface_triangles, surface_triangles
+from sarfe.pipeline.model.fe_stage import resolve_contacts
 from sarfe.pipeline.model.groups import fixed_nodes, resolve_node_group, shell_properties
 from sarfe.pipeline.model.matrices_stage import build_matrices_stage
 
@@ -41,10 +41,9 @@ def check_mesh(case) -> dict:
     mesh = load_case_mesh(case)
     fixed_nodes(case, mesh)
     shell_properties(case, mesh)
-    normals = nodal_normals(mesh.points, mesh.triangles)
-    paired = [pair_contact(case, mesh, c.index, normals) for c in config.contacts]
-    pairs = {c.name: len(p[0]) for c, p in zip(config.contacts, paired)}
-    coincident = mesh_quality(case, mesh, [(a, b) for a, b, _, _ in paired])
+    resolved = resolve_contacts(case, mesh)
+    pairs = {name: len(r.nodes_a) for name, r in resolved.items()}
+    coincident = mesh_quality(case, mesh, [(r.nodes_a, r.nodes_b) for r in resolved.values()])
     for i, f in enumerate(config.excitation.forces):
         resolve_node_group(case, mesh, f.group, ("excitation", "forces", i, "group"))
     surface_triangles(case, mesh)     # erp.surface: an element group, or a node group's triangles
@@ -126,12 +125,13 @@ def check_deck(case, assemble=True) -> dict:
     held |= ~used
     check_something_free(case, held, used, ("model", "fe", "fixed") if case.config.model.fe.fixed
                          else ("model", "fe", "supports"))
-    paired = contact_pairs(case, prepared)
+    resolved = contact_pairs(case, prepared)
+    paired = node_pairs(resolved)
     shared = shared_pair_warnings(case, paired, mesh.points)
     pairs = {name: len(p[0]) for name, p in paired.items()}
     boundary = []           # (nodes, key) of the contact and force nodes
     for contact in case.config.contacts:
-        a, b, _, _ = paired[contact.name]
+        a, b = paired[contact.name]
         boundary.append((np.concatenate([a, b[b >= 0]]), ("contacts", contact.index)))
     load_nodes = []
     for i, f in enumerate(case.config.excitation.forces):
@@ -162,7 +162,8 @@ def check_deck(case, assemble=True) -> dict:
             "contact_pairs": pairs, "ignored_cards": prepared.notes["ignored_cards"],
             "coincident_node_pairs": prepared.notes["coincident_node_pairs"],
             "coincident_nodes": prepared.notes["coincident_nodes"],
-            "warnings": list(prepared.warnings) + shared}
+            "warnings": list(prepared.warnings) + shared
+                        + [w for r in resolved.values() for w in r.warnings]}
 
 
 __all__ = ["check_mesh", "check_deck", "shared_pair_warnings", "mesh_quality"]

@@ -202,7 +202,7 @@ def apply_overrides(case: Case, deck, mesh):
 
 def grid_pairs(case: Case, deck) -> dict:
     """{contact index: [[a, b], …]} of the contacts that list ``pairs``: their GRID ids as deck
-    node indices ('ground' kept), for :func:`sarfe.pipeline.model.contact_pairs.pair_contact`."""
+    node indices ('ground' kept), for :func:`sarfe.pipeline.model.contact_pairs.resolve_contact`."""
     out = {}
     for contact in case.config.contacts:
         i = contact.index

@@ -53,8 +53,9 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, di
     written["summary"] = "summary.json"
     if "table" in files:
         types = {name: kind for name, kind, _ in nl.groups}
-        (directory / "table.txt").write_text(results_table(rows, types, max_contacts=100) + "\n",
-                                             encoding="utf-8")
+        mesh = (summary.get("mesh_error") or {}).get("line")    # the ± mesh term's line
+        (directory / "table.txt").write_text(results_table(rows, types, max_contacts=100) + "\n"
+                                             + (f"{mesh}\n" if mesh else ""), encoding="utf-8")
         written["table"] = "table.txt"
     if not solutions:
         return written
