@@ -10,7 +10,8 @@ A result is a folder ``sarfe solve`` wrote (marker ``.sarfe-result`` of kind ``s
 * the sweep L_A(f) from response.h5 (``frequency_hz``, ``erp/level_total_a_db``) when it is there,
   else from summary.json;
 * the ERP map of a point: node coordinates (n, 3) [m] and ERP density (n,) [W/m²] from
-  ``erp/erp_<j:04d>.vtu`` (read with pyvista, imported when a map is asked for).
+  ``erp/erp_<j:04d>.vtu`` or the loudest point's ``erp.vtu`` (read with pyvista, imported when a
+  map is asked for).
 
 Anything else (a missing folder, a batch folder, no or unreadable summary.json) is a
 :class:`~sarfe.case.errors.CaseError` of one line naming the folder.
@@ -146,15 +147,23 @@ class ErpMap:
 
 
 def read_erp_map(result: Result, point_index: int) -> ErpMap | None:
-    """The ERP map of point ``point_index`` (``erp/erp_<j:04d>.vtu``), None when the result has no
-    map of that point (``output.files`` without ``erp_vtu``) or it cannot be read."""
-    vtu = result.path / "erp" / f"erp_{point_index:04d}.vtu"
-    if not vtu.is_file():
-        return None
+    """The ERP map of point ``point_index``: ``erp/erp_<j:04d>.vtu`` of a series (``output.maps``
+    every N or a list), or the single ``erp.vtu`` of the loudest point (``output.maps: loudest``,
+    the default) when its field ``point_index`` is j; None when the result has no map of that
+    point (``output.files`` without ``erp_vtu``) or it cannot be read."""
     import pyvista   # heavy (VTK): only when a map is compared
 
+    series, single = result.path / "erp" / f"erp_{point_index:04d}.vtu", result.path / "erp.vtu"
     try:
-        grid = pyvista.read(vtu)
+        if series.is_file():
+            grid = pyvista.read(series)
+        elif single.is_file():
+            grid = pyvista.read(single)
+            index = np.asarray(grid.field_data.get("point_index", [-1])).ravel()
+            if index.size == 0 or int(index[0]) != int(point_index):
+                return None
+        else:
+            return None
         density = np.asarray(grid.point_data["erp_density_W_m2"], float)
     except (OSError, KeyError, ValueError):
         return None
