@@ -1,23 +1,32 @@
 """Command line: ``sarfe solve | verify | validate CASE.yaml`` and ``sarfe --version``.
 
 Exit codes: 0 success; 2 a problem in the case file (one line on stderr naming the key, no
-traceback unless ``--debug``); 3 the run finished but some frequency point did not converge (see
-summary.json ``non_converged_points``); 1 an unexpected internal error; 130 interrupted.
-Subcommands from ``sarfe.tradeoff.cli`` / ``sarfe.batch.cli`` (a ``register(subparsers)`` function) are
-added when those modules exist.
+traceback unless ``--debug``), or of the system met reading or writing (a full disk, a read-only
+file system, no permission, a busy mount point: one line naming the path,
+:func:`sarfe.results.folder.os_error`); 3 the run finished but some frequency point did not
+converge (see summary.json ``non_converged_points``); 1 an unexpected internal error; 130
+interrupted.
+Subcommands ``study`` (``sarfe.tradeoff.cli``) and ``batch`` (``sarfe.batch.cli``) are added by their
+``register(subparsers)`` functions.
 """
 from __future__ import annotations
 
 import argparse
-import importlib
 import sys
 import time
 import traceback
 
-from sarfe import __version__
-from sarfe.case.errors import EXIT_CASE_ERROR, EXIT_NOT_CONVERGED, CaseError
+import numpy as np
 
-EXTENSION_MODULES = ("sarfe.tradeoff.cli", "sarfe.batch.cli")
+from sarfe import __version__
+from sarfe.batch import cli as batch_cli
+from sarfe.case.errors import EXIT_CASE_ERROR, EXIT_NOT_CONVERGED, CaseError
+from sarfe.pipeline import build_linear_model, load_case, nonlinear_model, results_table, solve_case
+from sarfe.pipeline.checks.case_checks import check_case, output_target
+from sarfe.pipeline.verify import format_rows, verify_point
+from sarfe.results.folder import os_error
+from sarfe.results.summary import loudest_lines, pruning_line, stability_line
+from sarfe.tradeoff import cli as tradeoff_cli
 
 
 def _say(args, text):
@@ -30,10 +39,6 @@ def _warn(line):
 
 
 def cmd_solve(args) -> int:
-    from sarfe.results.summary import loudest_lines, pruning_line, stability_line
-    from sarfe.pipeline import load_case, results_table, solve_case
-    from sarfe.pipeline.checks.case_checks import output_target
-
     case = load_case(args.case)
     output_target(case, args.output, args.force)   # before any work (solve_case checks it all)
     clock = time.perf_counter()
@@ -72,9 +77,6 @@ def cmd_solve(args) -> int:
 
 def cmd_validate(args) -> int:
     """Every check `solve` makes before the heavy work (sarfe.pipeline.checks.case_checks); warnings on stderr."""
-    from sarfe.pipeline import load_case
-    from sarfe.pipeline.checks.case_checks import check_case
-
     case = load_case(args.case)
     checked = check_case(case, output_dir=args.output, force=args.force)
     for line in checked.warnings:
@@ -98,12 +100,7 @@ def cmd_validate(args) -> int:
 def cmd_verify(args) -> int:
     """Time integration of one point against the harmonic balance: every harmonic up to H, contact
     and largest-DOF amplitudes, ERP total and dB(A), and the stability verdict (a perturbation of
-    the HBM orbit decays or grows), each with its tolerance (:mod:`sarfe.pipeline.solve.verify`)."""
-    import numpy as np
-
-    from sarfe.pipeline import build_linear_model, load_case, nonlinear_model
-    from sarfe.pipeline.solve.verify import format_rows, verify_point
-
+    the HBM orbit decays or grows), each with its tolerance (:mod:`sarfe.pipeline.verify`)."""
     if not args.frequency_hz > 0:
         raise CaseError(f"--frequency-hz must be > 0, got {args.frequency_hz}", source=args.case)
     case = load_case(args.case)
@@ -167,16 +164,8 @@ def build_parser() -> argparse.ArgumentParser:
     output_options(p)
     p.set_defaults(func=cmd_validate)
 
-    for name in EXTENSION_MODULES:  # optional subcommands (study, batch)
-        try:
-            module = importlib.import_module(name)
-        except ImportError as exc:
-            if exc.name and name.startswith(exc.name):
-                continue
-            raise
-        register = getattr(module, "register", None)
-        if callable(register):
-            register(sub)
+    tradeoff_cli.register(sub)
+    batch_cli.register(sub)
     return parser
 
 
@@ -201,13 +190,25 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("sarfe: interrupted", file=sys.stderr)
         return 130
-    except Exception as exc:  # an internal error: one line unless --debug
+    except OSError as exc:    # a full disk, a read-only file system …: one line, exit 2
+        error = os_error(exc)
+        if error is None:
+            return _internal_error(exc, debug)
         if debug:
             traceback.print_exc()
-        else:
-            print(f"sarfe: internal error: {type(exc).__name__}: {exc} (rerun with --debug for "
-                  "the traceback)", file=sys.stderr)
-        return 1
+        print(f"sarfe: error: {error}", file=sys.stderr)
+        return EXIT_CASE_ERROR
+    except Exception as exc:  # an internal error: one line unless --debug
+        return _internal_error(exc, debug)
+
+
+def _internal_error(exc, debug) -> int:
+    if debug:
+        traceback.print_exc()
+    else:
+        print(f"sarfe: internal error: {type(exc).__name__}: {exc} (rerun with --debug for "
+              "the traceback)", file=sys.stderr)
+    return 1
 
 
 if __name__ == "__main__":

@@ -1,4 +1,4 @@
-"""The ``sarfe`` command: version, help, subcommand hook, validate."""
+"""The ``sarfe`` command: version, help, subcommands, validate."""
 from __future__ import annotations
 
 import subprocess
@@ -34,21 +34,14 @@ def test_console_script_and_module_entry_point():
     assert proc.stdout.strip().endswith("valid")
 
 
-def test_extension_subcommands_are_registered(monkeypatch):
-    """Modules in EXTENSION_MODULES with register(subparsers) add subcommands; missing ones are
-    skipped."""
-    import types
-
-    module = types.ModuleType("sarfe_fake_ext")
-
-    def register(subparsers):
-        p = subparsers.add_parser("fake", help="a fake extension")
-        p.set_defaults(func=lambda args: 0)
-
-    module.register = register
-    monkeypatch.setitem(sys.modules, "sarfe_fake_ext", module)
-    monkeypatch.setattr(cli, "EXTENSION_MODULES", ("sarfe_fake_ext", "sarfe.not_there.cli"))
-    assert cli.main(["fake"]) == 0
+def test_study_and_batch_subcommands_are_registered(capsys):
+    """``sarfe study`` (sarfe.tradeoff.cli) and ``sarfe batch`` (sarfe.batch.cli) are subcommands."""
+    parser = cli.build_parser()
+    for command in ("solve", "verify", "validate", "study", "batch"):
+        with pytest.raises(SystemExit) as info:
+            parser.parse_args([command, "--help"])
+        assert info.value.code == 0
+        assert f"usage: sarfe {command}" in capsys.readouterr().out
 
 
 def test_validate_reports_pairs(capsys):

@@ -6,7 +6,7 @@ r"""Accuracy of a whole sweep as an input: a target (``fast | balanced | fine | 
 2. The representative point: the loudest converged screening point with an active contact, by the
    A-weighted ERP P_A = Σ_k 10^{A(kf)/10} (kω)² Σ_s a_s |w_{s,k}|² (the headline the user reads);
    up to ``max_points_tuned`` − 1 more points, those with the largest contact-force spectral tail
-   (:func:`sarfe.accuracy.estimates.spectral_tail`: the strongest nonlinearity), are checked from
+   (:func:`sarfe.accuracy.measures.spectral_tail`: the strongest nonlinearity), are checked from
    the H found there.
 3. H ladder at a point: H_{i+1} = max(H_i + 2, round(1.5 H_i)), each solve warm-started from the
    previous solution padded with zero harmonics (a few Newton iterations on the contact rows; the
@@ -14,7 +14,7 @@ r"""Accuracy of a whole sweep as an input: a target (``fast | balanced | fine | 
    larger of the start N and 16 H_i (a power of two). The search stops at the first H_i whose
    change to H_{i+1} — first-harmonic contact amplitude (relative) and ERP level (the larger of the
    dB and dB(A) changes) — times the Richardson factor max(2, 1/(1 − H_i/H_{i+1})) (an error
-   ∝ H^{−p}, p ≥ 1: :func:`sarfe.accuracy.estimates.harmonics_richardson`) is within half the
+   ∝ H^{−p}, p ≥ 1: :func:`sarfe.accuracy.harmonic_truncation.harmonics_richardson`) is within half the
    budget. H is capped at the audible band: H·f ≤ ``audible_top_hz`` (5 kHz; harmonics above it
    carry little of the A-weighted ERP) and ``max_harmonics``.
 4. N at the chosen H: N → 2N (warm start) until RICHARDSON × the change is within the other half.
@@ -32,8 +32,8 @@ The level change counts dB(A) only when the finer rung reaches AUDIBLE_BOTTOM_HZ
 it the A-weighting (−50 dB and falling) turns the weighted level into a measure of the top
 harmonic alone.
 
-Works on plain arrays (:class:`sarfe.accuracy.estimates.EstimateProblem`); the case layer builds
-them (:mod:`sarfe.pipeline.solve.case_accuracy`) and applies the result with :func:`apply_resolution`.
+Works on plain arrays (:class:`sarfe.accuracy.estimate.EstimateProblem`); the case layer builds
+them (:mod:`sarfe.pipeline.solve.case_accuracy`) and applies the result (:func:`sarfe.pipeline.solve.case_accuracy.resolved_case`).
 """
 from __future__ import annotations
 
@@ -45,8 +45,11 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from sarfe.accuracy.estimates import (RICHARDSON, EstimateProblem, _change, _erp_proxy, harmonics_richardson,
-                        parse_accuracy, resize_harmonics, spectral_tail)
+from sarfe.accuracy.estimate import EstimateProblem
+from sarfe.accuracy.harmonic_truncation import RICHARDSON, harmonics_richardson
+from sarfe.accuracy.measures import erp_proxy, resize_harmonics, solution_change, spectral_tail
+from sarfe.accuracy.target import parse_accuracy
+from sarfe.hbm import SolverOptions, solve_frequency
 
 AUDIBLE_TOP_HZ = 5000.0   # A-weighted ERP of impacts: harmonics in 0.5–5 kHz (issue 15)
 AUDIBLE_BOTTOM_HZ = 20.0  # below it dB(A) is not a level anyone hears: the dB change is used
@@ -81,7 +84,7 @@ def contact_active(solution, contacts) -> bool:
 
 def a_weighted_power(solution, problem: EstimateProblem) -> float:
     """P_A ∝ the A-weighted ERP of a solution (module docstring, 2) [arbitrary units]."""
-    return _erp_proxy(solution.displacement, float(solution.omega), problem.erp_map,
+    return erp_proxy(solution.displacement, float(solution.omega), problem.erp_map,
                       problem.erp_areas, a_weighted=True)
 
 
@@ -146,8 +149,6 @@ class LadderResult:
 
 def _solve(problem, omega, H, N, guess, options):
     """Solve at (H, N) from ``guess`` (padded), cold once when the warm start fails."""
-    from sarfe.hbm import solve_frequency
-
     F = resize_harmonics(problem.excitation, H)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -170,9 +171,9 @@ def _measured_change(problem, coarse, fine):
     H, omega = int(fine.harmonics), float(fine.omega)
     U0 = resize_harmonics(coarse.displacement, H)
     U1 = np.asarray(fine.displacement, dtype=float)
-    rel, db = _change(problem.contacts, U0, U1, omega, problem.erp_map, problem.erp_areas)
+    rel, db = solution_change(problem.contacts, U0, U1, omega, problem.erp_map, problem.erp_areas)
     if db != 0.0 and H * omega / (2 * np.pi) < AUDIBLE_BOTTOM_HZ:
-        p0, p1 = (_erp_proxy(U, omega, problem.erp_map, problem.erp_areas) for U in (U0, U1))
+        p0, p1 = (erp_proxy(U, omega, problem.erp_map, problem.erp_areas) for U in (U0, U1))
         db = 10 * np.log10(p1 / p0) if p0 > 0 and p1 > 0 else (0.0 if p0 == p1 else np.inf)
     return float(rel), float(abs(db))
 
@@ -254,7 +255,6 @@ def resolve_accuracy(problem: EstimateProblem, target, frequencies_hz, harmonics
     clock = time.perf_counter()
     target = parse_accuracy(target)
     if options is None:
-        from sarfe.hbm import SolverOptions
         options = SolverOptions(stability=False)
     options = replace(options, stability=False)
     H0, N0 = int(start_harmonics), ladder_samples(int(start_harmonics), int(start_samples))
@@ -305,24 +305,6 @@ def resolve_accuracy(problem: EstimateProblem, target, frequencies_hz, harmonics
             "seconds": seconds, "text": text}
 
 
-def apply_resolution(case_data: dict, report: dict) -> dict:
-    """Case data (a copy) with solver.harmonics / samples_per_period set, ``resolution: fixed``
-    (chosen; ``accuracy`` stays the run's error budget) and reduction.cutoff_hz (or mode_count)
-    when the report gives one (the case layer's search: the reduction's rule at the chosen H)."""
-    data = copy.deepcopy(case_data)
-    data.setdefault("solver", {})
-    data["solver"]["harmonics"] = int(report["harmonics"])
-    data["solver"]["samples_per_period"] = int(report["samples_per_period"])
-    data["solver"]["resolution"] = "fixed"
-    if report.get("cutoff_hz"):      # the search's reduction cutoff (FE; none given by the user)
-        data.setdefault("reduction", {})["cutoff_hz"] = float(report["cutoff_hz"])
-    elif report.get("mode_count"):
-        red = data.setdefault("reduction", {})
-        red.pop("cutoff_hz", None)
-        red["mode_count"] = int(report["mode_count"])
-    return data
-
-
 __all__ = ["AUDIBLE_TOP_HZ", "screen_grid", "contact_active", "a_weighted_power",
            "representative_points", "ladder_samples", "next_harmonics", "harmonics_cap",
-           "LadderResult", "search_harmonics", "resolve_accuracy", "apply_resolution"]
+           "LadderResult", "search_harmonics", "resolve_accuracy"]

@@ -9,8 +9,9 @@ first use (:mod:`sarfe.util.lazy`: pandas and dask only when a batch runs).
 from sarfe.util.lazy import lazy_exports
 
 _EXPORTS = {"GATE_EXIT_CODE": ".batch_report", "evaluate_gate": ".batch_report", "run_study": ".runner",
+            "default_output_dir": ".runner",
             "StudyError": ".variants", "Variant": ".variants", "collect_variants": ".variants",
             "load_study": ".variants"}
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
-__all__ = ["run_study", "load_study", "collect_variants", "evaluate_gate", "Variant", "StudyError",
-           "GATE_EXIT_CODE"]
+__all__ = ["run_study", "default_output_dir", "load_study", "collect_variants", "evaluate_gate",
+           "Variant", "StudyError", "GATE_EXIT_CODE"]

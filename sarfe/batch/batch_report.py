@@ -22,6 +22,7 @@ import numpy as np
 import pandas as pd
 
 from sarfe.batch import store
+from sarfe.results.report import data_uri, environment
 
 GATE_EXIT_CODE = 4
 # columns of CaseResult.rows (sarfe.pipeline.run): total ERP level [dB re 1 pW], A-weighted [dB(A)]
@@ -340,8 +341,6 @@ def write_batch_report_html(levels: pd.DataFrame, summary: dict, output: pathlib
     """``report.html`` of a batch: the distribution of the loudest level with its confidence
     bands, P(rattle) per contact vs each scattered parameter (Wilson bands), the loudest variants
     and the failures; self-contained (images as base64, CSS inline)."""
-    from sarfe.results.report import data_uri, environment
-
     column = _level_column(levels)
     loudest = []
     if column is not None:

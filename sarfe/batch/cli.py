@@ -13,7 +13,9 @@ import argparse
 import importlib.util
 import sys
 
-EXIT_NOT_CONVERGED = 3  # = sarfe.case.errors.EXIT_NOT_CONVERGED
+from sarfe import batch    # its exports load on first use: pandas and dask only when a batch runs
+from sarfe.case.errors import EXIT_NOT_CONVERGED, CaseError
+
 EXIT_VARIANTS_FAILED = 5
 # The optional dependencies of ``sarfe batch`` (pyproject extra ``batch``); the solve never imports
 # them. distributed (Dask) only runs the variants in parallel: ``--workers 0`` needs none of it.
@@ -67,43 +69,30 @@ def run(args: argparse.Namespace) -> int:
               f"{', '.join(missing)}: install them with pip install 'sarfe[{BATCH_EXTRA}]' "
               f"(from a source tree: pip install -e '.[{BATCH_EXTRA}]')", file=sys.stderr)
         return 2
-    from sarfe.batch.batch_report import GATE_EXIT_CODE, evaluate_gate
-    from sarfe.batch.runner import default_output_dir, run_study
-    from sarfe.batch.variants import StudyError, collect_variants
-
     if args.workers < 0:
         print("sarfe batch: --workers must be >= 0", file=sys.stderr)
         return 2
-    case_errors = _case_error_types()
     try:
         output = args.output
         if output is None:
-            output = default_output_dir(collect_variants(args.inputs))
-        table = run_study(args.inputs, workers=args.workers, scheduler=args.scheduler, output_dir=output,
+            output = batch.default_output_dir(batch.collect_variants(args.inputs))
+        table = batch.run_study(args.inputs, workers=args.workers, scheduler=args.scheduler, output_dir=output,
                           write_variant_outputs=args.write_variant_outputs, retry_failed=args.retry_failed,
                           cache_linear_stages=not args.no_cache, progress=True,
                           force=getattr(args, "force", False))
-    except (StudyError, *case_errors) as error:
+    except (batch.StudyError, CaseError) as error:
         print(f"sarfe batch: {error}", file=sys.stderr)
         return 2
     summary = table.attrs.get("summary", {})
     print(_summary_line(summary, output))
-    gate = evaluate_gate(table, args.fail_above_db, args.allow_nonconverged)
+    gate = batch.evaluate_gate(table, args.fail_above_db, args.allow_nonconverged)
     if args.fail_above_db is not None or not gate.passed:
         print(f"sarfe batch: {gate.message}", file=sys.stderr if not gate.passed else sys.stdout)
     if args.fail_above_db is not None:
-        return 0 if gate.passed else GATE_EXIT_CODE
+        return 0 if gate.passed else batch.GATE_EXIT_CODE
     if summary.get("failed"):
         return EXIT_VARIANTS_FAILED
     return EXIT_NOT_CONVERGED if summary.get("nonconverged") and not args.allow_nonconverged else 0
-
-
-def _case_error_types() -> tuple:
-    try:
-        from sarfe.case.errors import CaseError
-    except ImportError:
-        return ()
-    return (CaseError,)
 
 
 def _summary_line(summary: dict, output) -> str:

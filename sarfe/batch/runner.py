@@ -18,7 +18,6 @@ process only, except per-variant outputs with ``write_variant_outputs``).
 from __future__ import annotations
 
 import importlib
-import inspect
 import logging
 import os
 import pathlib
@@ -29,8 +28,10 @@ from dataclasses import dataclass, field
 
 import pandas as pd
 
-from sarfe.batch import store
+from sarfe.batch import batch_report, store
 from sarfe.batch.variants import StudyError, Variant, collect_variants
+from sarfe.pipeline.checks.case_inputs import named_files
+from sarfe.results.folder import check_output_folder, claim_folder, marker_info
 
 PIPELINE = "sarfe.pipeline"
 _BLAS_ENV = {name: "1" for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")}
@@ -42,14 +43,7 @@ def _pipeline(name: str):
 
 def load_variant_case(pipeline, variant: Variant):
     """``load_case`` of the variant's case mapping (relative paths resolved from its case file)."""
-    load_case = pipeline.load_case
-    try:
-        accepts_base = "base_dir" in inspect.signature(load_case).parameters
-    except (TypeError, ValueError):
-        accepts_base = False
-    if accepts_base:
-        return load_case(variant.case, base_dir=variant.case_dir)
-    return load_case(variant.case)
+    return pipeline.load_case(variant.case, base_dir=variant.case_dir)
 
 
 def _error_text(error: BaseException) -> str:
@@ -90,11 +84,9 @@ def solve_variant(variant: Variant, linear_stage, pipeline_name: str = PIPELINE,
     try:
         pipeline = _pipeline(pipeline_name)
         case = load_variant_case(pipeline, variant)
-        options = {}
-        if "write" in inspect.signature(pipeline.solve_case).parameters:
-            options["write"] = variant_output is not None  # no files per variant unless asked
         result = pipeline.solve_case(case, linear_stage=linear_stage, output_dir=variant_output,
-                                     progress=False, **options)
+                                     progress=False,
+                                     write=variant_output is not None)  # no files unless asked
         summary = {k: v for k, v in (getattr(result, "summary", None) or {}).items() if k != "points"}
         record.update(status="ok" if _converged(result) else "nonconverged",
                       exit_code=getattr(result, "exit_code", None), summary=summary,
@@ -267,12 +259,13 @@ def default_output_dir(variants: list[Variant]) -> pathlib.Path:
 
 def claim_output(output, study_or_cases, variants, force=False) -> pathlib.Path:
     """Check the batch folder (module ``sarfe.results.folder``) and mark it as sarfe's."""
-    from sarfe.results.folder import check_output_folder, claim_folder, marker_info
-
     inputs = study_or_cases if isinstance(study_or_cases, (list, tuple)) else [study_or_cases]
-    protected = [item for item in inputs if isinstance(item, (str, os.PathLike))]
-    protected += list(dict.fromkeys(str(pathlib.Path(v.case_dir) / "case") for v in variants
-                                    if getattr(v, "case_dir", None)))
+    protected = {item: "a study or case file" for item in inputs
+                 if isinstance(item, (str, os.PathLike))}
+    for variant in variants:      # the files the variants read (mesh, deck, matrices, curves …)
+        if getattr(variant, "case_dir", None):
+            protected.setdefault(str(pathlib.Path(variant.case_dir) / "case"), "the folder of a case")
+            protected.update(named_files(variant.case, variant.case_dir))
     target = check_output_folder(output, force=force, protected=protected,
                                  what="batch output folder", write_inside=True)
     names = list(dict.fromkeys(v.source for v in variants))
@@ -300,8 +293,6 @@ def run_study(study_or_cases, workers: int = 2, scheduler: str | None = None, ou
     ``table.attrs['summary']`` = the dict written to ``summary.json``. Raises ``StudyError`` for an
     unusable study/case file before anything is run.
     """
-    from sarfe.batch import batch_report as report
-
     start = time.perf_counter()
     variants = collect_variants(study_or_cases)
     output = pathlib.Path(output_dir) if output_dir is not None else default_output_dir(variants)
@@ -357,7 +348,7 @@ def run_study(study_or_cases, workers: int = 2, scheduler: str | None = None, ou
     table = store.records_table(variants, done)
     store.write_table(table, output)
     stats.wall_time_s = time.perf_counter() - start
-    table.attrs["summary"] = report.write_report(table, output, stats)
+    table.attrs["summary"] = batch_report.write_report(table, output, stats)
     return table
 
 

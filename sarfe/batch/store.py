@@ -20,6 +20,7 @@ import tempfile
 import numpy as np
 import pandas as pd
 
+from sarfe.batch.stage_file import StageFileError, load_stage_file, stage_bytes
 from sarfe.batch.variants import Variant, canonical_json
 
 # Table columns that describe the variant; the varied inputs and CaseResult.rows keys follow.
@@ -91,8 +92,6 @@ def stage_cache_path(output, key: str) -> pathlib.Path:
 def load_stage(output, key: str, modules=()):
     """Cached linear stage for ``key`` or None (missing, damaged, edited, for another key or
     holding classes other than sarfe's / ``modules``': rebuilt). Never unpickles."""
-    from sarfe.batch.stage_file import StageFileError, load_stage_file
-
     path = stage_cache_path(output, key)
     if not path.is_file():
         return None
@@ -103,8 +102,6 @@ def load_stage(output, key: str, modules=()):
 
 
 def save_stage(output, key: str, stage) -> None:
-    from sarfe.batch.stage_file import stage_bytes
-
     try:
         data = stage_bytes(stage, key)
     except TypeError:  # a stage holding something a data file cannot carry: not cached

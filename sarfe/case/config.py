@@ -1,16 +1,16 @@
-"""Typed configuration of a case: one small frozen dataclass per case section, built ONCE from the
-validated, normalized case (:func:`sarfe.case.read.normalize`) and owning the defaults.
+"""Typed configuration of a case: small frozen dataclasses, one per case section and entry, built
+ONCE from the validated, normalized case (:func:`sarfe.case.normalize.normalize`) and owning the
+defaults.
 
-    config = case.config                # built once per Case; CaseConfig(model, damping, reduction,
-                                        #   contacts, excitation, solver, erp, output)
-    config.solver.harmonics, config.solver.continuation.max_step, config.erp.density_kg_m3 ...
+    config = case.config                # CaseConfig(model, damping, reduction, contacts,
+                                        #   excitation, solver, erp, output)
+    config.solver.harmonics, config.model.fe.materials["abs"].E_Pa, config.contacts[0].gap_m …
 
-The section dataclasses' field defaults are the single source of the case defaults: the case
-layer's ``normalize`` fills missing keys from them (``SolverConfig.tolerance`` …), so a default is
-written once. The law parameters of a contact stay generic (``ContactConfig.params``, the mapping of
-the case entry): the laws own them (:mod:`sarfe.hbm.laws`). Sections whose content is a model
-description read by the model builders (model.fe, model.matrices) keep their mapping next to the
-few typed fields the pipeline asks for.
+The dataclasses' field defaults are the single source of the case defaults: ``normalize`` fills
+missing keys from them (:func:`default_of`), so a default is written once. The pipeline reads these
+typed fields, never a case mapping; a changed setting is a new Case with the section replaced
+(:meth:`sarfe.case.read.Case.with_solver` …). The law parameters of a contact stay generic
+(``ContactConfig.params``, the entry as normalized): the laws own them (:mod:`sarfe.hbm.laws`).
 
 Defaults that disagreed and which one won:
 - continuation ``max_step``: 0.1 (case layer) vs 0.25 (``sarfe.hbm.ContinuationOptions``). 0.1 is
@@ -23,14 +23,20 @@ Defaults that disagreed and which one won:
 from __future__ import annotations
 
 import copy
+import dataclasses
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
 from types import MappingProxyType
 
 from sarfe.erp.erp import AIR_DENSITY, REFERENCE_POWER, SOUND_SPEED
 
 DEFAULT_ZETA = 0.02                 # modal damping ratio when the case gives no damping
 CONTINUATION_MAX_STEP = 0.1         # see the module docstring (0.1 vs the engine's 0.25)
+MATRICES_GAP_M = 0.0                # gap of a matrices contact with a normal DOF and no preload
+RESULTS_DIRECTORY = "results"       # output.directory default: results/<case name>
+OUTPUT_FILES = ("summary", "response", "plots", "table", "report")   # output.files default
+FE_OUTPUT_FILES = ("erp_vtu", "animation")                           # … and with model.fe
 
 
 def _frozen(value):
@@ -42,14 +48,71 @@ def _frozen(value):
     return value
 
 
+def _empty():
+    return MappingProxyType({})
+
+
+def default_of(section, name):
+    """The default of field ``name`` of the config dataclass ``section`` as a plain value for a
+    case mapping (tuples as lists, read-only mappings as dicts): what ``normalize`` writes."""
+    spec = section.__dataclass_fields__[name]
+    value = spec.default if spec.default is not dataclasses.MISSING else spec.default_factory()
+    if isinstance(value, tuple):
+        return list(value)
+    if isinstance(value, MappingProxyType):
+        return dict(value)
+    return value
+
+
 # ------------------------------------------------------------------------------------------ model
 @dataclass(frozen=True)
+class MaterialConfig:
+    """An isotropic shell material: Young's modulus E [Pa], Poisson's ratio ν, density ρ [kg/m³]."""
+
+    E_Pa: float
+    nu: float
+    rho_kg_m3: float
+
+
+@dataclass(frozen=True)
+class GeneratorConfig:
+    """model.fe.generator: a parametric mesh (:mod:`sarfe.mesh.generators`) of element size
+    ``mesh_size_m`` [m] with the generator's own ``params`` (keyword arguments of its
+    ``generate``, passed on as the case gives them: a plain copy, not to be edited)."""
+
+    name: str
+    mesh_size_m: float
+    params: dict = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class DeckConfig:
+    """model.fe.deck: an engineer's Nastran/Abaqus deck (``file``, relative to the case) in the unit
+    system ``units``; cards to ignore, support sets to use (empty: all of the deck's), and the
+    case's own node / element groups (id lists or deck set names)."""
+
+    file: str
+    units: str = "SI"
+    ignore_cards: tuple = ()
+    supports: tuple = ()
+    node_groups: MappingProxyType = field(default_factory=_empty)
+    element_groups: MappingProxyType = field(default_factory=_empty)
+
+
+@dataclass(frozen=True)
 class FeConfig:
-    """model.fe: ``source`` 'mesh' | 'generator' | 'deck' and the section's mapping (read by the
-    mesh / deck builders: thickness_m, materials, supports, groups …)."""
+    """model.fe: the geometry ``source`` ('mesh' | 'generator' | 'deck') and its settings; the
+    shell sections by element group (``materials``, ``thickness_m`` [m]; overrides on a deck) and
+    the ``fixed`` node groups (all six DOFs held)."""
 
     source: str
-    data: MappingProxyType
+    mesh: str | None = None            # the mesh file (source 'mesh'), relative to the case
+    mesh_units: str = "m"              # length unit of a mesh file's coordinates
+    generator: GeneratorConfig | None = None
+    deck: DeckConfig | None = None
+    materials: MappingProxyType = field(default_factory=_empty)      # {group: MaterialConfig}
+    thickness_m: MappingProxyType = field(default_factory=_empty)    # {group: t [m]}
+    fixed: tuple = ()
 
     @property
     def is_deck(self) -> bool:
@@ -58,18 +121,20 @@ class FeConfig:
     @property
     def where(self) -> tuple:
         """Key path of the geometry source, for error messages."""
-        return ("model", "fe", "mesh" if self.source == "mesh" else
-                "deck" if self.source == "deck" else "generator")
+        return ("model", "fe", self.source)
 
 
 @dataclass(frozen=True)
 class MatricesConfig:
-    """model.matrices: the file (or inline) entries of mass, stiffness, damping by key."""
+    """model.matrices: mass, stiffness and (optional) damping, each a file name (.npz, .npy,
+    .mtx, relative to the case) or inline rows."""
 
-    data: MappingProxyType
+    mass: object
+    stiffness: object
+    damping: object = None
 
     def entry(self, key):
-        return self.data.get(key)
+        return getattr(self, key)
 
 
 @dataclass(frozen=True)
@@ -84,13 +149,28 @@ class ModelConfig:
 
 # ---------------------------------------------------------------------------------------- damping
 @dataclass(frozen=True)
-class DampingConfig:
-    """damping: modal_zeta (a number or per-mode-range entries) or rayleigh {alpha, beta}; both
-    None when the matrices case brings its own damping matrix."""
+class ModalZetaRange:
+    """ζ of the modes ``modes`` = (first, last) (1-based, inclusive) of the reduced model."""
 
-    modal_zeta: object = None
-    rayleigh: MappingProxyType | None = None
-    data: MappingProxyType = field(default_factory=lambda: MappingProxyType({}))
+    modes: tuple
+    zeta: float
+
+
+@dataclass(frozen=True)
+class RayleighConfig:
+    """D = α M + β K: α [1/s], β [s]."""
+
+    alpha_1_s: float
+    beta_s: float
+
+
+@dataclass(frozen=True)
+class DampingConfig:
+    """damping: modal_zeta (a number, or per-mode-range entries) or rayleigh; both None when the
+    matrices case brings its own damping matrix."""
+
+    modal_zeta: float | tuple | None = None      # ζ, or (ModalZetaRange, …)
+    rayleigh: RayleighConfig | None = None
 
 
 # -------------------------------------------------------------------------------------- reduction
@@ -104,7 +184,7 @@ class ReductionConfig:
     first-harmonic amplitudes by ≤ 1.7e-4, every response harmonic by ≤ 3.1e-4 and the ERP by
     ≤ 0.012 dB(A) against 2 H f_max (1.5 at 5 mm); 0.75 H f_max moves them by 1.5e-3 /
     0.023 dB(A) (harmonics above the cutoff have no modes to live in). The per-point estimate's
-    modal part (two probes, decay fitted: sarfe.accuracy.estimates (5)) brackets those changes
+    modal part (two probes, decay fitted: sarfe.accuracy.modal_truncation) brackets those changes
     at every point from 0.75 H f_max up and over-reports at H f_max by ≤ 12× (amplitude and
     dB), resolution floor included (the earlier single probe of the top fifth: 34× / 35×, which
     kept the margin at 1.25; benchmarks/results/modal_estimate.md)."""
@@ -118,41 +198,85 @@ class ReductionConfig:
 
 # --------------------------------------------------------------------------------------- contacts
 @dataclass(frozen=True)
+class DofReference:
+    """A DOF of a matrices model: r = sign · (u[dof] − u[relative_to]) ('ground': u = 0)."""
+
+    dof: int
+    relative_to: int | str = "ground"
+    sign: int = 1
+
+
+@dataclass(frozen=True)
 class ContactConfig:
-    """One contacts[] entry: index in the case, name, law (``kind``: the entry's ``type``), and the
-    entry's mapping ``params`` (gap_m, stiffness, … — owned by the law, :mod:`sarfe.hbm.laws`,
-    which reads it as the case gave it: a plain copy, not to be edited)."""
+    """One contacts[] entry: index in the case, name, law (``kind``: the entry's ``type``), where it
+    acts and its gap, and ``params``: the entry's mapping as normalized, which the law reads for
+    its own parameters (stiffness, friction …; :mod:`sarfe.hbm.laws`; a plain copy, not to be
+    edited).
+
+    FE: ``between`` two node groups (b may be 'ground') paired within ``pairing_tolerance_m`` [m],
+    or explicit ``pairs`` of nodes (a deck's GRID ids), or a deck's springs ``from_elements``
+    (along ``element_axis``); ``normal`` 'auto' (the mesh normal) or a vector. Matrices:
+    ``normal_dof`` and ``tangential_dofs``. Every law: ``gap_m`` [m] (None: an FE pair's geometric
+    gap) or a static ``preload_N`` [N], and the rattle ``tolerance_m`` [m]."""
 
     index: int
     name: str
     kind: str
     params: dict
-
-    def get(self, key, default=None):
-        return self.params.get(key, default)
-
-    def __getitem__(self, key):
-        return self.params[key]
+    between: tuple | None = None
+    pairs: tuple | None = None
+    from_elements: tuple | None = None
+    element_axis: int | None = None
+    normal: str | tuple = "auto"
+    pairing_tolerance_m: float = 1e-3
+    normal_dof: DofReference | None = None
+    tangential_dofs: tuple = ()
+    gap_m: float | None = None
+    preload_N: float | None = None
+    tolerance_m: float = 0.0
 
 
 # ------------------------------------------------------------------------------------- excitation
 @dataclass(frozen=True)
+class ForceConfig:
+    """One excitation.forces entry: amplitude ``force_N`` [N] (with a deck ``load_set``: its
+    ``scale``) at ``phase_deg`` [°], on a node ``group`` along the unit ``direction`` (FE), on a
+    ``dof`` (matrices) or the deck's load set."""
+
+    force_N: float
+    phase_deg: float = 0.0
+    group: str | None = None
+    direction: tuple | None = None
+    dof: int | None = None
+    load_set: str | int | None = None
+    scale: float = 1.0
+
+
+@dataclass(frozen=True)
+class BaseAccelerationConfig:
+    """excitation.base_acceleration: amplitude [m/s²] at ``phase_deg`` [°] along the unit
+    ``direction`` (FE) or the ``influence`` vector ι (matrices; None: all ones)."""
+
+    amplitude_m_s2: float
+    phase_deg: float = 0.0
+    direction: tuple | None = None
+    influence: tuple | None = None
+
+
+@dataclass(frozen=True)
 class SweepConfig:
     start_hz: float
     end_hz: float
-    points: int | None = None
-    data: MappingProxyType = field(default_factory=lambda: MappingProxyType({}))
 
 
 @dataclass(frozen=True)
 class ExcitationConfig:
-    """excitation: forces (tuple of entries) or base_acceleration; frequency_hz (tuple) or sweep."""
+    """excitation: forces (ForceConfig, …) or base_acceleration; frequency_hz (tuple) or sweep."""
 
     forces: tuple = ()
-    base_acceleration: MappingProxyType | None = None
+    base_acceleration: BaseAccelerationConfig | None = None
     frequency_hz: tuple | None = None
     sweep: SweepConfig | None = None
-    data: MappingProxyType = field(default_factory=lambda: MappingProxyType({}))
 
     @property
     def max_frequency_hz(self) -> float:
@@ -173,32 +297,38 @@ class ContinuationConfig:
     max_points: int = 2000
 
 
+DEFAULT_ACCURACY = "balanced"
+
+
 @dataclass(frozen=True)
 class SolverConfig:
     """solver: harmonics H, samples_per_period N, Newton options, continuation, accuracy.
     ``resolution`` 'auto' (H, N, modes chosen for ``accuracy``) | 'fixed' (harmonics given).
-    ``workers`` 'auto' | n: processes for the per-point work after Newton (:mod:`sarfe.util.workers`)."""
+    ``accuracy``: a preset 'fast' | 'balanced' | 'fine' or a target {erp_db, amplitude_rel}
+    (:func:`sarfe.accuracy.target.parse_accuracy`), None: 'balanced'. ``harmonic_set`` 'all' |
+    'odd' | 'auto' (:mod:`sarfe.hbm.harmonic_set`). ``prune_contacts``: contacts that never switch
+    are solved linearly, with the clearance margin ``prune_margin`` (:mod:`sarfe.pipeline.solve.
+    pruned_points`). ``workers`` 'auto' | n: processes for the per-point work after Newton
+    (:mod:`sarfe.util.workers`)."""
 
     harmonics: int = 5
     samples_per_period: int = 128
     resolution: str = "auto"
-    accuracy: object = None          # 'balanced' by default with resolution auto (see normalize)
+    accuracy: str | dict | None = None    # 'balanced' by default with resolution auto (normalize)
     tolerance: float = 1e-9
     max_iterations: int = 50
     stability: bool = True
     error_estimate: bool = True
-    harmonic_set: object = "all"
-    prune_contacts: object = True
-    workers: object = "auto"         # processes for the per-point work: 'auto' | n (sarfe.util.workers)
+    harmonic_set: str = "all"
+    prune_contacts: bool = True
+    prune_margin: float = 0.5
+    workers: int | str = "auto"
     continuation: ContinuationConfig = field(default_factory=ContinuationConfig)
 
     @property
     def accuracy_or_default(self):
         """The accuracy budget of the run: the given one, else 'balanced'."""
         return DEFAULT_ACCURACY if self.accuracy is None else self.accuracy
-
-
-DEFAULT_ACCURACY = "balanced"
 
 
 def default_samples_per_period(harmonics: int) -> int:
@@ -223,9 +353,20 @@ class ErpConfig:
 # ----------------------------------------------------------------------------------------- output
 @dataclass(frozen=True)
 class OutputConfig:
+    """output: the result folder (default results/<case name>), the files written (default
+    :data:`OUTPUT_FILES`, + :data:`FE_OUTPUT_FILES` with model.fe) and a target level [dB(A)]."""
+
     directory: str = ""
     files: tuple = ()
     target_dba: float | None = None
+
+
+def default_output_directory(name: str) -> str:
+    return str(Path(RESULTS_DIRECTORY) / name)
+
+
+def default_output_files(fe: bool) -> list:
+    return list(OUTPUT_FILES) + (list(FE_OUTPUT_FILES) if fe else [])
 
 
 # ------------------------------------------------------------------------------------------- case
@@ -242,52 +383,106 @@ class CaseConfig:
     output: OutputConfig
 
 
+# ------------------------------------------------------------------ the normalized mapping → typed
+def _given(mapping, section, keys, convert=None):
+    """Keyword arguments of ``section`` for the ``keys`` present in ``mapping`` (absent: the
+    field's default), each through ``convert`` (default: a read-only copy)."""
+    convert = convert or _frozen
+    return {key: convert(mapping[key]) for key in keys if key in mapping}
+
+
 def _fe_config(fe) -> FeConfig:
     source = "deck" if "deck" in fe else "mesh" if "mesh" in fe else "generator"
-    return FeConfig(source=source, data=_frozen(fe))
+    generator = fe.get("generator")
+    deck = None
+    if source == "deck":
+        deck = DeckConfig(file=fe["deck"], **_given(fe, DeckConfig, (
+            "units", "ignore_cards", "supports", "node_groups", "element_groups")))
+    return FeConfig(
+        source=source, mesh=fe.get("mesh"),
+        generator=None if generator is None else GeneratorConfig(
+            name=generator["name"], mesh_size_m=generator["mesh_size_m"],
+            **_given(generator, GeneratorConfig, ("params",), copy.deepcopy)),
+        deck=deck,
+        materials=MappingProxyType({name: MaterialConfig(m["E_Pa"], m["nu"], m["rho_kg_m3"])
+                                    for name, m in fe.get("materials", {}).items()}),
+        **_given(fe, FeConfig, ("mesh_units", "thickness_m", "fixed")))
+
+
+def _damping_config(damping) -> DampingConfig:
+    zeta = damping.get("modal_zeta")
+    if isinstance(zeta, list):
+        zeta = tuple(ModalZetaRange(tuple(e["modes"]), e["zeta"]) for e in zeta)
+    rayleigh = damping.get("rayleigh")
+    return DampingConfig(modal_zeta=zeta, rayleigh=None if rayleigh is None else RayleighConfig(
+        rayleigh["alpha_1_s"], rayleigh["beta_s"]))
+
+
+def _dof_reference(ref) -> DofReference:
+    return DofReference(ref["dof"], **_given(ref, DofReference, ("relative_to", "sign")))
+
+
+def contact_config(index: int, contact: dict) -> ContactConfig:
+    """The typed contacts[index] of its normalized mapping ``contact``."""
+    typed = _given(contact, ContactConfig, ("between", "pairs", "from_elements", "element_axis",
+                                            "normal", "pairing_tolerance_m", "gap_m", "preload_N",
+                                            "tolerance_m"))
+    if "normal_dof" in contact:
+        typed["normal_dof"] = _dof_reference(contact["normal_dof"])
+    typed["tangential_dofs"] = tuple(_dof_reference(r) for r in contact.get("tangential_dofs", []))
+    return ContactConfig(index=index, name=contact["name"], kind=contact["type"],
+                         params=copy.deepcopy(contact), **typed)
+
+
+def _excitation_config(exc) -> ExcitationConfig:
+    base, sweep = exc.get("base_acceleration"), exc.get("sweep")
+    return ExcitationConfig(
+        forces=tuple(ForceConfig(force_N=load["force_N"], **_given(load, ForceConfig, (
+            "phase_deg", "group", "direction", "dof", "load_set", "scale")))
+            for load in exc.get("forces", [])),
+        base_acceleration=None if base is None else BaseAccelerationConfig(
+            amplitude_m_s2=base["amplitude_m_s2"],
+            **_given(base, BaseAccelerationConfig, ("phase_deg", "direction", "influence"))),
+        frequency_hz=None if exc.get("frequency_hz") is None else tuple(exc["frequency_hz"]),
+        sweep=None if sweep is None else SweepConfig(sweep["start_hz"], sweep["end_hz"]))
+
+
+def _solver_config(solver) -> SolverConfig:
+    cont = solver["continuation"]
+    prune = solver["prune_contacts"]              # true | false | {margin: m}
+    margin = {"prune_margin": float(prune["margin"])} \
+        if isinstance(prune, dict) and "margin" in prune else {}
+    return SolverConfig(
+        harmonics=solver["harmonics"], samples_per_period=solver["samples_per_period"],
+        resolution=solver["resolution"], accuracy=copy.deepcopy(solver.get("accuracy")),
+        tolerance=solver["tolerance"], max_iterations=solver["max_iterations"],
+        stability=solver["stability"], error_estimate=solver["error_estimate"],
+        harmonic_set=solver["harmonic_set"],
+        prune_contacts=True if isinstance(prune, dict) else bool(prune), **margin,
+        workers=solver["workers"],
+        continuation=ContinuationConfig(initial_step=cont["initial_step"],
+                                        min_step=cont["min_step"], max_step=cont["max_step"],
+                                        max_points=cont["max_points"]))
 
 
 def build_config(data: dict) -> CaseConfig:
     """The typed configuration of a normalized case's ``data`` (every default already filled)."""
     model = data["model"]
-    solver, exc, erp, out = data["solver"], data["excitation"], data["erp"], data["output"]
-    cont = solver["continuation"]
-    damping = data.get("damping") or {}
+    erp, out = data["erp"], data["output"]
     red = data.get("reduction")
-    sweep = exc.get("sweep")
     return CaseConfig(
         name=data["name"],
         model=ModelConfig(fe=_fe_config(model["fe"]) if "fe" in model else None,
-                          matrices=MatricesConfig(_frozen(model["matrices"]))
-                          if "matrices" in model else None),
-        damping=DampingConfig(modal_zeta=_frozen(damping.get("modal_zeta")),
-                              rayleigh=_frozen(damping.get("rayleigh")), data=_frozen(damping)),
+                          matrices=MatricesConfig(**_given(model["matrices"], MatricesConfig, (
+                              "mass", "stiffness", "damping"))) if "matrices" in model else None),
+        damping=_damping_config(data.get("damping") or {}),
         reduction=None if red is None else ReductionConfig(
             mode_count=red.get("mode_count"), cutoff_hz=red.get("cutoff_hz"),
             cutoff_margin=red["cutoff_margin"], min_mode_count=red["min_mode_count"],
             residual_vectors=red["residual_vectors"]),
-        contacts=tuple(ContactConfig(index=i, name=c["name"], kind=c["type"],
-                                     params=copy.deepcopy(c))
-                       for i, c in enumerate(data.get("contacts", []))),
-        excitation=ExcitationConfig(
-            forces=_frozen(exc.get("forces", [])), base_acceleration=_frozen(
-                exc.get("base_acceleration")),
-            frequency_hz=None if exc.get("frequency_hz") is None else tuple(exc["frequency_hz"]),
-            sweep=None if sweep is None else SweepConfig(
-                start_hz=sweep["start_hz"], end_hz=sweep["end_hz"], points=sweep.get("points"),
-                data=_frozen(sweep)),
-            data=_frozen(exc)),
-        solver=SolverConfig(
-            harmonics=solver["harmonics"], samples_per_period=solver["samples_per_period"],
-            resolution=solver["resolution"], accuracy=copy.deepcopy(solver.get("accuracy")),
-            tolerance=solver["tolerance"], max_iterations=solver["max_iterations"],
-            stability=solver["stability"], error_estimate=solver["error_estimate"],
-            harmonic_set=copy.deepcopy(solver["harmonic_set"]),
-            prune_contacts=copy.deepcopy(solver["prune_contacts"]),
-            workers=solver["workers"],
-            continuation=ContinuationConfig(initial_step=cont["initial_step"],
-                                            min_step=cont["min_step"], max_step=cont["max_step"],
-                                            max_points=cont["max_points"])),
+        contacts=tuple(contact_config(i, c) for i, c in enumerate(data.get("contacts", []))),
+        excitation=_excitation_config(data["excitation"]),
+        solver=_solver_config(data["solver"]),
         erp=ErpConfig(surface=erp.get("surface"), dofs=_frozen(erp.get("dofs")),
                       areas_m2=_frozen(erp.get("areas_m2")), rho_kg_m3=erp["rho_kg_m3"],
                       c_m_s=erp["c_m_s"], radiation_loss_factor=erp["radiation_loss_factor"],
@@ -296,8 +491,11 @@ def build_config(data: dict) -> CaseConfig:
                             target_dba=out.get("target_dba")))
 
 
-__all__ = ["CaseConfig", "ModelConfig", "FeConfig", "MatricesConfig", "DampingConfig",
-           "ReductionConfig", "ContactConfig", "ExcitationConfig", "SweepConfig", "SolverConfig",
-           "ContinuationConfig", "ErpConfig", "OutputConfig", "build_config",
-           "DEFAULT_ZETA", "DEFAULT_ACCURACY", "CONTINUATION_MAX_STEP",
+__all__ = ["CaseConfig", "ModelConfig", "FeConfig", "GeneratorConfig", "DeckConfig",
+           "MaterialConfig", "MatricesConfig", "DampingConfig", "ModalZetaRange",
+           "RayleighConfig", "ReductionConfig", "ContactConfig", "DofReference", "ForceConfig",
+           "BaseAccelerationConfig", "ExcitationConfig", "SweepConfig", "SolverConfig",
+           "ContinuationConfig", "ErpConfig", "OutputConfig", "build_config", "contact_config",
+           "default_of", "default_output_directory", "default_output_files",
+           "DEFAULT_ZETA", "DEFAULT_ACCURACY", "CONTINUATION_MAX_STEP", "MATRICES_GAP_M",
            "default_samples_per_period"]

@@ -21,6 +21,15 @@ def format_key_path(path) -> str:
     return text
 
 
+def line_of(lines: dict, path) -> int | None:
+    """1-based line of the deepest key of ``path`` that ``lines`` ({key path tuple: line}, from
+    :func:`sarfe.case.read.read_yaml`) knows; None when it knows none."""
+    path = tuple(path)
+    while path and path not in lines:
+        path = path[:-1]
+    return lines.get(path) if path else None
+
+
 class CaseError(ValueError):
     """A problem in a case file (or a file it refers to) that the user must fix.
 

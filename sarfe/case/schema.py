@@ -3,9 +3,12 @@
 Every object has ``additionalProperties: false`` so a misspelt key is an error. Physical ranges
 (E > 0, 0 ≤ μ, −1 < ν < 0.5, f > 0, H ≥ 1 …) are checked here; cross-key rules (exactly one of
 two keys, node groups present in the mesh, pairing within tolerance) are checked in
-:mod:`sarfe.case.read`. Defaults are applied in :func:`sarfe.case.read.normalize`.
+:mod:`sarfe.case.normalize`. Defaults are applied in :func:`sarfe.case.normalize.normalize`.
 """
 from __future__ import annotations
+
+from sarfe.case.plausibility import POISSON_RANGE
+from sarfe.hbm import laws
 
 
 def _object(properties, required=(), **extra):
@@ -37,7 +40,8 @@ MATRIX = {"type": ["string", "array"], "minLength": 1, "minItems": 1,
           "items": {"type": "array", "minItems": 1, "items": NUMBER}}
 MATERIAL = _object({
     "E_Pa": POSITIVE,
-    "nu": {"type": "number", "exclusiveMinimum": -1, "exclusiveMaximum": 0.5},
+    "nu": {"type": "number", "exclusiveMinimum": POISSON_RANGE[0],
+           "exclusiveMaximum": POISSON_RANGE[1]},
     "rho_kg_m3": POSITIVE,
 }, required=("E_Pa", "nu", "rho_kg_m3"))
 
@@ -65,7 +69,7 @@ FE_MODEL = _object({
     "materials": {"type": "object", "minProperties": 1, "additionalProperties": MATERIAL},
     "thickness_m": {"type": "object", "minProperties": 1, "additionalProperties": POSITIVE},
     "fixed": {"type": "array", "items": NAME, "minItems": 1},
-})   # materials, thickness_m and fixed are required with mesh/generator (sarfe.case.read)
+})   # materials, thickness_m and fixed are required with mesh/generator (sarfe.case.normalize)
 
 MATRICES_MODEL = _object({
     "mass": MATRIX,
@@ -106,9 +110,7 @@ def _law_key_schema(parameter):
 
 def contact_schema():
     """The contact object: geometry keys, then every registered law's keys from its declaration
-    (:mod:`sarfe.hbm.laws`; which keys a type allows is checked in :mod:`sarfe.case.read`)."""
-    from sarfe.hbm import laws
-
+    (:mod:`sarfe.hbm.laws`; which keys a type allows is checked in :mod:`sarfe.case.normalize`)."""
     law_keys = {}
     for law in laws.LAWS.values():
         for parameter in law.case_parameters():
@@ -154,7 +156,7 @@ LOAD = _object({
     "direction": DIRECTION,
     "force_N": NUMBER,
     "phase_deg": NUMBER,
-})   # force_N is required except with load_set (sarfe.case.read)
+})   # force_N is required except with load_set (sarfe.case.normalize)
 
 EXCITATION = _object({
     "forces": {"type": "array", "items": LOAD, "minItems": 1},

@@ -2,7 +2,7 @@
 
 K φ = ω² M φ on the free DOFs, solved by shift-invert Lanczos (ARPACK) around
 σ = −(2π·shift_hz)²: (K − σM) is positive definite even for free-free models, so it is
-factorized by ``sarfe.reduction.factorize`` (PARDISO, cholespy or SuperLU, whichever is there).
+factorized by ``sarfe.linalg.factorize`` (PARDISO, cholespy or SuperLU, whichever is there).
 """
 
 from __future__ import annotations
@@ -12,6 +12,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
 from sarfe.fe.assembly import free_dofs
+from sarfe.linalg import factorize
 
 __all__ = ["natural_frequencies"]
 
@@ -28,9 +29,7 @@ def natural_frequencies(stiffness, mass, count=6, fixed=None, shift_hz=1.0, retu
     k = sp.csr_matrix(stiffness)[free][:, free]
     m = sp.csr_matrix(mass)[free][:, free]
     sigma = -(2.0 * np.pi * shift_hz) ** 2
-    from sarfe.linalg import factorize  # K − σM with σ < 0 is SPD
-
-    operator = factorize(k - sigma * m, structure="spd").as_operator()
+    operator = factorize(k - sigma * m, structure="spd").as_operator()   # K − σM, σ < 0: SPD
     start = np.random.default_rng(0).standard_normal(k.shape[0])   # fixed: repeatable runs
     eigenvalues, vectors = sla.eigsh(k.tocsc(), count, m.tocsc(), sigma=sigma, which="LM",
                                      OPinv=operator, v0=start)

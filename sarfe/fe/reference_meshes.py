@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from sarfe.mesh.gmsh_model import gmsh_session
+
 __all__ = [
     "rectangle_triangles",
     "cylindrical_panel_triangles",
@@ -93,8 +95,6 @@ def cylindrical_panel_solid(radius, angle, length, thickness, n_arc, n_axial, la
 def gmsh_rectangle_triangles(length_x, length_y, size, algorithm=6):
     """Unstructured Gmsh triangle mesh of [0, length_x] × [0, length_y] (z = 0), target
     element size ``size`` [m]; algorithm 6 = Frontal-Delaunay. Returns points, triangles."""
-    from sarfe.mesh.gmsh_model import gmsh_session
-
     with gmsh_session() as gmsh:    # the process-wide lock, headless and seeded like every mesh
         gmsh.model.occ.addRectangle(0.0, 0.0, 0.0, length_x, length_y)
         gmsh.model.occ.synchronize()

@@ -2,11 +2,27 @@
 
     R(ũ, ω) = S(ω) ũ + f̃_nl(ũ) − f̃_e = 0,    f̃_nl = Gᵀ λ̃(G ũ)  (AFT, analytic Jacobian)
 
-Modules: harmonics (Fourier convention), contacts (ContactSet), laws (one module per contact law
-and its registration: rattle, squeak, damped_impact, tabulated, the Jenkins element), aft (forces +
-Jacobian), linear (S(ω), condensation), residual, newton, solve (one ω), continuation
-(pseudo-arclength in ω), stability (Hill), solution (options + result), harmonic_set (solve a
-subset of the orders, e.g. odd only, ``harmonic_set='odd' | 'auto'``).
+Modules (in the order a solve uses them):
+    harmonics          the Fourier convention (cos/sin rows, 2H+1 of them), time ↔ harmonics, ∇
+    model              LinearModel: M, D, K on the kept DOFs
+    modal              the model's modal basis (Vᵀ K V = I, diagonal damping) for the compliance
+    dynamic_stiffness  S(ω) per harmonic, dynamic compliance condensation to the contact rows,
+                       recovery of all DOFs (S(ω) Û = F̃)
+    contacts           ContactSet: the gap map G (rows of all contacts) and each contact's law
+    laws/              one module per contact law and its registration (rattle, squeak,
+                       damped_impact, tabulated); jenkins, jenkins_march: the friction element and
+                       its compiled 2-D march; contract: what a law provides
+    aft                alternating frequency–time: contact force harmonics λ̃(r̃) and ∂λ̃/∂r̃
+    residual           R(ũ, ω) and its Jacobian, full or condensed to the contact rows
+    newton             damped Newton with line search (and chord steps at fixed ω)
+    harmonic_set       solving a subset of the orders (odd only, 'auto') and the dropped content η
+    solution           SolverOptions, ContinuationOptions, HarmonicSolution (the result)
+    solve              one ω: first guess, homotopies, Newton, polish, finalize (solve_frequency)
+    continuation       the sweep: pseudo-arclength continuation in ω through folds
+    stability/         is the orbit stable? one entry, stability(...) (Hill, contact-row count, …)
+    pruning            contact screening: contacts that never switch solved linearly
+    newmark            the Newmark march with contacts (the time integrator's step and periods)
+    time_integration   periodic steady state by time integration: the HBM's independent check
 
 Example (NLvib example 03)::
 

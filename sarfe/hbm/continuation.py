@@ -73,12 +73,13 @@ from dataclasses import replace
 import numpy as np
 import scipy.sparse as sp
 
-from sarfe.hbm.harmonic_set import expand_rows, harmonic_set_orders
+from sarfe.hbm.harmonic_set import expand_rows
 from sarfe.hbm.newton import SingularJacobian, newton, solve_linear
 from sarfe.hbm.residual import Evaluation, kept_rows
 from sarfe.hbm.solution import ContinuationOptions
-from sarfe.hbm.solve import (_check_omega, _solve, finalize, initial_slider, linearized_guess,
-                    make_evaluator, make_problem, slider_acceptor, solve_auto, wants_condensation)
+from sarfe.hbm.solve import (check_omega, finalize, initial_slider, linearized_guess, make_evaluator,
+                             make_problem, slider_acceptor, solve_auto, solve_from,
+                             wants_condensation)
 
 REPORT_DISTANCE = 1e-4   # scaled arclength below which a new point replaces the last one reported
 MAX_SAMPLES_FACTOR = 16  # N may be raised to 16× the requested one at turns of ω (docstring)
@@ -152,16 +153,16 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
                         line_search_steps=min(so.line_search_steps, 3))
     full_problem = make_problem(model, contacts, excitation, harmonics, samples_per_period, so,
                                 None if auto else so.harmonic_set)
-    _check_omega(omega_start, "omega_start")
-    _check_omega(omega_end, "omega_end")
+    check_omega(omega_start, "omega_start")
+    check_omega(omega_end, "omega_end")
     if omega_start == omega_end:
         raise ValueError("omega_start and omega_end must differ")
     direction = np.sign(omega_end - omega_start)
     span = abs(omega_end - omega_start)
     state = {"slider": None}
     first = (solve_auto(full_problem, omega_start, None, so) if auto else
-             _solve(full_problem, omega_start, linearized_guess(full_problem, omega_start), so,
-                    homotopy=True))
+             solve_from(full_problem, omega_start, linearized_guess(full_problem, omega_start), so,
+                        homotopy=True))
     solutions = [first]
     if not first.converged:
         return solutions
@@ -173,7 +174,7 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
         if not (auto and problem.harmonic_orders is not None and point.converged
                 and point.dropped_content > so.harmonic_set_tolerance):
             return None
-        full = _solve(full_problem, point.omega, guess, so, state["slider"])
+        full = solve_from(full_problem, point.omega, guess, so, state["slider"])
         return replace(full, reason=f"{full.reason} (auto: odd set rejected, dropped content "
                                     f"η {point.dropped_content:.3g} > "
                                     f"{so.harmonic_set_tolerance:g}; all orders from here on)")
@@ -202,7 +203,7 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
         while N_fine <= factor * samples_per_period:
             fine = replace(problem, samples_per_period=N_fine)
             for k in dict.fromkeys((max(0, len(solutions) - 1 - BACKUP), len(solutions) - 1)):
-                point = _solve(fine, solutions[k].omega, solutions[k].displacement, so, None)
+                point = solve_from(fine, solutions[k].omega, solutions[k].displacement, so, None)
                 if point.converged:
                     return k, point
             N_fine *= 2
@@ -418,7 +419,7 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
             fraction = (omega_end - z[-1] * span) / (omega_new - z[-1] * span)
             U_prev = solutions[-1].displacement
             guess = U_prev + fraction * (U_new - U_prev)
-            last = _solve(problem, omega_end, guess, so, state["slider"])
+            last = solve_from(problem, omega_end, guess, so, state["slider"])
             solutions.append(escalate(last, last.displacement) or last)
             if progress is not None:
                 progress(1.0, 1.0)
@@ -483,7 +484,7 @@ def _band_edge(problem, solutions, point, omega_start, options, slider):
     last = solutions[-1]
     fraction = (omega_start - last.omega) / (point.omega - last.omega)
     guess = last.displacement + fraction * (point.displacement - last.displacement)
-    edge = _solve(problem, omega_start, guess, options, slider)
+    edge = solve_from(problem, omega_start, guess, options, slider)
     reason = (f"the branch turned back past the start of the band ({omega_start:.6g} rad/s): "
               "sweep stopped at the band edge")
     solutions.append(replace(edge, reason=f"{edge.reason}; sweep stopped: {reason}"))

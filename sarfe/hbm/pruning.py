@@ -1,5 +1,5 @@
 r"""Contact screening and pruning (engine): contacts that never switch are solved linearly.
-The pipeline (:mod:`sarfe.pipeline.solve.pruned_points`) and the studies (:mod:`sarfe.hbm.pruning`) use it.
+The pipeline uses it (:mod:`sarfe.pipeline.solve.pruned_points`).
 
 Contact screening (a cheap linear pass). At every ω of a grid over the sweep, the response of the
 linear model with each contact linearized at u = 0 (what :func:`sarfe.hbm.solve.linearized_guess`
@@ -21,16 +21,27 @@ as a Woodbury update, no solve of model size per ω). With the gap g and a margi
 Because the other contacts' nonlinear response can drive a screened contact, :func:`check_pruning`
 re-checks every decision on the nonlinear solution (w of the dropped contacts is still G u); a
 violated decision means: solve again with the full set (:func:`solve_frequency_pruned` does that
-for one ω; :mod:`sarfe.pipeline.solve.pruned_points` for the points or the sweep of a case in ``sarfe solve``).
+for one ω; :mod:`sarfe.pipeline.solve.pruned_points` for the points or the sweep of a case in
+``sarfe solve``).
 :func:`restore_solution` re-expresses a pruned solution with all contacts, keeping the solver's own
 forces of the kept ones.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from sarfe.hbm.dynamic_stiffness import apply_dynamic_stiffness, from_complex, to_complex
+from sarfe.hbm.harmonics import time_samples
+from sarfe.hbm.laws import linearization, pruning_rules
+from sarfe.hbm.modal import cached_modal_basis, real_product
+from sarfe.hbm.model import make_linear_model
+from sarfe.hbm.solution import HarmonicSolution
+from sarfe.hbm.solve import linearized_rows, solve_frequency
+from sarfe.hbm.time_integration import linear_harmonic_response
 
 OPEN, CLOSED, NONLINEAR = "open", "closed", "nonlinear"
 
@@ -67,7 +78,6 @@ def linearized_stiffness(model, contacts):
     and k_t on the stuck tangents; f_pre = −Gᵀ p [N], p the laws' preloads on the normal rows
     (:func:`sarfe.hbm.solve.linearized_rows`). Dense (n, n) [N/m] if the model is dense, else
     sparse CSC."""
-    from sarfe.hbm.solve import linearized_rows
 
     k, _, preload = linearized_rows(contacts)
     G = sp.csr_matrix(contacts.gap_map)
@@ -80,7 +90,6 @@ def linearized_stiffness(model, contacts):
 def linearized_damping(model, contacts):
     """D + Gᵀ diag(c) G with the laws' dashpots c of the contacts closed at u = 0 (D itself when
     every law is rate independent) [N s/m]."""
-    from sarfe.hbm.solve import linearized_rows
 
     c = linearized_rows(contacts)[1]
     D = model.damping
@@ -92,7 +101,6 @@ def linearized_damping(model, contacts):
 
 
 def _solve(A, b):
-    import scipy.sparse.linalg as spla
 
     if sp.issparse(A):
         return spla.spsolve(sp.csc_matrix(A), b)
@@ -137,9 +145,6 @@ def _modal_row_responses(basis, contacts, excitation, omegas):
     r"""(r̃ (n_ω, 2h+1, n_rows) [m], bad (n_ω,) bool): the linearized model's response at the rows
     of G from the modal basis of the model (no solve of model size per ω; h: the excitation's
     highest order), ``bad`` where some Z_k(ω) is singular. See :func:`contact_row_responses`."""
-    from sarfe.hbm.dynamic_stiffness import from_complex, to_complex
-    from sarfe.hbm.modal import real_product
-    from sarfe.hbm.solve import linearized_rows
 
     c = contacts
     springs, dashpots, preload = linearized_rows(c)
@@ -221,7 +226,6 @@ def contact_row_responses(model, contacts, excitation, omegas, modal=True) -> np
     pairs (a few listed frequencies: a handful of solves costs less than the basis, and the model's
     cache is left as the points find it), and ``modal`` False (the direct solves: a reference).
     """
-    from sarfe.hbm.modal import cached_modal_basis
 
     F = np.asarray(excitation, dtype=float)
     omegas = np.atleast_1d(np.asarray(omegas, dtype=float))
@@ -251,8 +255,6 @@ def screen_contacts(model, contacts, excitation, omegas, margin=0.5, samples=64,
     The pass reads the contact rows only (:func:`contact_row_responses`; ``modal`` False: its
     direct solves of model size).
     """
-    from sarfe.hbm.harmonics import time_samples
-    from sarfe.hbm.laws import pruning_rules
 
     F = np.asarray(excitation, dtype=float)
     # the linear response has only the harmonics of the excitation: screen with those (exact)
@@ -331,8 +333,6 @@ def prune_contacts(model, contacts, excitation, decisions) -> PrunedProblem:
     Closed: λ = k w + p, w = gᵣ u → K += k gᵣᵀ gᵣ and f̃_e,0 −= p gᵣᵀ (exact while closed; for the
     penalty law k = k_n, p = −k_n g).
     """
-    from sarfe.hbm.laws import linearization
-    from sarfe.hbm.model import make_linear_model
 
     F = np.asarray(excitation, dtype=float).copy()
     K = model.stiffness
@@ -356,7 +356,6 @@ def check_pruning(contacts, decisions, displacement, samples=256) -> list:
     the AFT samples N checks every sample the nonlinear solver saw, and more): ``open`` holds while
     max w ≤ g, ``closed`` while min w ≥ g.
     """
-    from sarfe.hbm.harmonics import time_samples
 
     screened = [d for d in decisions if d.decision != NONLINEAR]
     if not screened:
@@ -393,11 +392,7 @@ def restore_solution(solution, model, contacts, excitation, decisions):
     state 0. Residual ‖S ũ + Gᵀλ̃ − f̃_e‖ / ‖f̃_e‖ of the
     full equations (on the solved harmonic rows when the solution used a harmonic subset).
     """
-    from dataclasses import replace
 
-    from sarfe.hbm.harmonics import time_samples
-    from sarfe.hbm.laws import linearization
-    from sarfe.hbm.dynamic_stiffness import apply_dynamic_stiffness
 
     U = np.asarray(solution.displacement, dtype=float)
     F = np.asarray(excitation, dtype=float)
@@ -440,14 +435,12 @@ def solve_frequency_pruned(model, contacts, excitation, omega, harmonics, sample
     Returns (HarmonicSolution with all contacts, report dict {'kept', 'dropped', 'violations',
     'fallback'}).
     """
-    from sarfe.hbm.solve import solve_frequency
 
     pruned = prune_contacts(model, contacts, excitation, decisions)
     dropped = [d.name for d in decisions if d.decision != NONLINEAR]
     report = {"kept": [contacts.names[i] for i in pruned.kept], "dropped": dropped,
               "violations": [], "fallback": False}
     if pruned.contacts.count == 0:
-        from sarfe.hbm.time_integration import linear_harmonic_response
 
         U = linear_harmonic_response(pruned.model, pruned.excitation, omega)
         solution = _linear_solution(U, omega, harmonics, samples_per_period)
@@ -469,7 +462,6 @@ def solve_frequency_pruned(model, contacts, excitation, omega, harmonics, sample
 
 
 def _linear_solution(U, omega, harmonics, samples_per_period):
-    from sarfe.hbm.solution import HarmonicSolution
 
     z = np.zeros((U.shape[0], 0))
     return HarmonicSolution(omega=float(omega), harmonics=int(harmonics),

@@ -11,8 +11,9 @@ Steps of :func:`solve_frequency`:
    ``max_homotopy_iterations`` Newton iterations; ``iterations`` counts all of them;
 3. Newton on the contact rows only (dynamic compliance condensation, :mod:`sarfe.hbm.dynamic_stiffness`) when
    that system is smaller, else — or when some S_k(ω) is singular — on all DOFs (sparse LU);
-4. recovery of all DOFs, the residual of the full equation of motion relative to ‖f̃_e‖, Hill
-   stability (:mod:`sarfe.hbm.stability.hill`).
+4. recovery of all DOFs, the residual of the full equation of motion relative to ‖f̃_e‖, the
+   stability of the orbit (:func:`sarfe.hbm.stability.stability`: Hill's method or the
+   contact-row count, per ``options.stability_method``).
 
 Harmonic sets (:mod:`sarfe.hbm.harmonic_set`): with ``harmonic_set`` = 'odd' or a list of orders,
 Newton's unknowns and equations are the kept coefficient rows only (dropped rows held at zero);
@@ -30,21 +31,16 @@ import numpy as np
 import scipy.sparse as sp
 
 from sarfe.hbm import laws
-from sarfe.hbm.aft import default_slider_start, jacobian_matrix
-from sarfe.hbm.harmonic_set import (AUTO_CANDIDATE, coefficient_rows, dropped_content, expand_rows,
-                           harmonic_set_orders)
-from sarfe.hbm.harmonics import check_harmonics, derivative_matrix, time_samples
+from sarfe.hbm.aft import default_slider_start
 from sarfe.hbm.dynamic_stiffness import condense, dynamic_stiffness_matrix, recover_displacement
+from sarfe.hbm.harmonic_set import (AUTO_CANDIDATE, coefficient_rows, dropped_content, expand_rows,
+                                    harmonic_set_orders)
+from sarfe.hbm.harmonics import check_harmonics, derivative_matrix, time_samples
 from sarfe.hbm.newton import SingularJacobian, newton, solve_linear
-from sarfe.hbm.stability.deferred import defer, deferring
 from sarfe.hbm.residual import Problem, condensed_residual, full_residual, kept_rows
 from sarfe.hbm.solution import HarmonicSolution, SolverOptions
-from sarfe.hbm.stability.hill import hill_stability
-from sarfe.hbm.stability.condensed import condensed_stability
-from sarfe.hbm.stability.contact_terms import ContactOperator
-from sarfe.hbm.stability.rows import contact_row_counts
-from sarfe.hbm.stability.trust import auto_method, checked
-from sarfe.hbm.stability.trust import check_harmonics as checked_harmonics
+from sarfe.hbm.stability import stability, stability_method
+from sarfe.hbm.stability.deferred import defer, deferring
 
 CHORD_STEPS = True       # fixed-ω Newton reuses its LU while it contracts (sarfe.hbm.newton)
 
@@ -72,7 +68,8 @@ def make_problem(model, contacts, excitation, harmonics, samples_per_period, opt
                    harmonic_set_orders(harmonic_set, harmonics))
 
 
-def _check_omega(omega, name="omega"):
+def check_omega(omega, name="omega"):
+    """Raise ValueError naming ``name`` unless ω [rad/s] is a finite frequency > 0."""
     if not np.isfinite(omega) or omega <= 0:
         raise ValueError(f"{name} must be a finite frequency > 0 [rad/s], got {omega!r}")
 
@@ -261,50 +258,6 @@ def harmonic_set_label(problem) -> str:
     return "odd" if odd is not None and np.array_equal(orders, odd) else "orders"
 
 
-def contact_damping(problem, forces):
-    """(I⊗G)ᵀ E diag(∂λ/∂ṙ) Φ (I⊗G) (sparse) of the rate-dependent laws, or None: the velocity
-    terms of the contact forces in Hill's damping matrix (:mod:`sarfe.hbm.stability.hill`)."""
-    if not forces.damping_blocks:
-        return None
-    G, H = problem.contacts.gap_map, problem.harmonics
-    GG = sp.kron(sp.identity(2 * H + 1), G, format="csr")
-    return (GG.T @ jacobian_matrix(forces.damping_blocks, G.shape[0], H) @ GG).tocsr()
-
-
-def stability_method(problem, options) -> str:
-    """'full' | 'condensed' | 'contact_rows' (see :class:`SolverOptions`): 'auto' is the contact-row
-    count (:mod:`sarfe.hbm.stability.rows`) for every model with contacts and a modal basis, else
-    the full Hill method up to 3000 Hill rows (:func:`sarfe.hbm.stability.trust.auto_method`)."""
-    method = options.stability_method
-    return auto_method(problem) if method == "auto" else method
-
-
-def stability(problem, omega, U, ev, options):
-    """Hill stability of a converged orbit by ``options.stability_method`` (StabilityResult)."""
-    operator = ContactOperator(problem, U, omega, ev.forces)
-    method = stability_method(problem, options)
-    if method == "contact_rows":
-        result, zeros, coarse = contact_row_counts(
-            problem.model, problem.contacts, omega, problem.harmonics, ev.forces, operator,
-            tolerance=options.stability_tolerance,
-            check_harmonics=checked_harmonics(problem.harmonics))
-        if result is None:
-            result = condensed_stability(problem.model, problem.contacts, omega, problem.harmonics,
-                                         ev.forces, operator, tolerance=options.stability_tolerance)
-            if zeros and result.stable is True:   # the count is exact, the Ritz basis truncated
-                return replace(result, stable=None, note=(
-                    f"the contact-row count finds {zeros} Floquet exponent(s) right of "
-                    f"−1e-4·ω that the Ritz basis does not locate (it says {result.leading:.3g} 1/s)"))
-        # the verdict at H stands where the count at a coarser contact coupling agrees
-        return checked(result, zeros, coarse, problem)
-    if method == "condensed":
-        return condensed_stability(problem.model, problem.contacts, omega, problem.harmonics,
-                                   ev.forces, operator, tolerance=options.stability_tolerance)
-    return hill_stability(problem.model, omega, problem.harmonics, ev.jacobian,
-                          options.stability_tolerance,
-                          contact_damping=contact_damping(problem, ev.forces), operator=operator)
-
-
 def kept_residual_norm(problem, ev) -> float:
     """‖R‖/‖f̃_e‖ of a full-residual evaluation ``ev`` on the kept coefficient rows of ``problem``
     (all rows for the full harmonic set): what ``full_tolerance`` is compared with."""
@@ -376,7 +329,7 @@ def solve_frequency(model, contacts, excitation, omega, harmonics, samples_per_p
     auto = isinstance(options.harmonic_set, str) and options.harmonic_set == "auto"
     problem = make_problem(model, contacts, excitation, harmonics, samples_per_period, options,
                            None if auto else options.harmonic_set)
-    _check_omega(omega)
+    check_omega(omega)
     U0 = None
     if initial is not None:
         U0 = np.asarray(getattr(initial, "displacement", initial), dtype=float)
@@ -386,8 +339,8 @@ def solve_frequency(model, contacts, excitation, omega, harmonics, samples_per_p
         return solve_auto(problem, omega, U0, options,
                           getattr(initial, "dropped_content", float("nan")))
     if U0 is None:
-        return _solve(problem, omega, linearized_guess(problem, omega), options, homotopy=True)
-    return _solve(problem, omega, U0, options)
+        return solve_from(problem, omega, linearized_guess(problem, omega), options, homotopy=True)
+    return solve_from(problem, omega, U0, options)
 
 
 def auto_needs_full_set(previous_content, options) -> bool:
@@ -405,7 +358,7 @@ def solve_auto(problem, omega, U0, options, previous_content=float("nan"), slide
         reduced = replace(problem, harmonic_orders=harmonic_set_orders(AUTO_CANDIDATE,
                                                                        problem.harmonics))
         start = linearized_guess(reduced, omega) if U0 is None else U0
-        solution = _solve(reduced, omega, start, options, slider, homotopy=U0 is None)
+        solution = solve_from(reduced, omega, start, options, slider, homotopy=U0 is None)
         if solution.converged and solution.dropped_content <= tolerance:
             return solution
         if solution.converged:
@@ -415,7 +368,7 @@ def solve_auto(problem, omega, U0, options, previous_content=float("nan"), slide
         else:
             note = f"auto: odd set did not converge ({solution.reason})"
     start = linearized_guess(problem, omega) if U0 is None else U0
-    solution = _solve(problem, omega, start, options, slider, homotopy=U0 is None)
+    solution = solve_from(problem, omega, start, options, slider, homotopy=U0 is None)
     return replace(solution, reason=f"{solution.reason} ({note})")
 
 
@@ -494,10 +447,13 @@ def _homotopy(problem, omega, options, kind):
     return current, result, current_slider, spent, position >= 1.0
 
 
-def _solve(problem, omega, U0, options, slider=None, homotopy=False):
-    """Newton from U0 (condensed when useful, full as fallback); with ``homotopy``, a failed start
-    is retried from the end of each of :data:`COLD_START_HOMOTOPIES` in turn until Newton converges.
-    ``iterations`` of the result counts every Newton iteration spent, homotopy steps included."""
+def solve_from(problem, omega, U0, options, slider=None, homotopy=False) -> HarmonicSolution:
+    """The periodic solution of ``problem`` (:func:`make_problem`) at ω [rad/s] by Newton from
+    ũ = U0 (2H+1, n_dof) [m] (condensed when useful, full as fallback), ``slider``: the slider
+    start (None: from U0); with ``homotopy``, a failed start is retried from the end of each of
+    :data:`COLD_START_HOMOTOPIES` in turn until Newton converges; then polished and finalized
+    (:func:`finalize`: residual on all rows, stability). ``iterations`` of the result counts every
+    Newton iteration spent, homotopy steps included."""
     U, result, slider = _newton(problem, omega, U0, options, slider)
     iterations = result.iterations
     if homotopy and not result.converged:
@@ -559,3 +515,33 @@ def _newton(problem, omega, U0, options, slider=None):
             continue            # S_k(ω) singular: fall back to the full residual
         break
     return to_displacement(result.x, omega, result.evaluation), result, state["slider"]
+
+
+def newton_from(model, contacts, excitation, U, omega, harmonics, samples_per_period,
+                options=None):
+    """Newton at a fixed ω [rad/s] from a given ũ (2H+1, n) [m] on the (H, N) problem — the
+    re-solve of a nearby solution (e.g. one of another H, N or model, resized), with none of
+    :func:`solve_frequency`'s fallbacks (no homotopy, no full-DOF retry, no polish, no stability).
+
+    All harmonic orders 0…H (``options.harmonic_set`` is not used). Condensed on the contact rows
+    when there are any (x = G ũ; one condensation S_k(ω)⁻¹ Gᵀ serves every iteration; ũ recovered
+    from the contact forces at the end), else on all DOFs; chord steps (:func:`sarfe.hbm.newton.
+    newton`); the friction slider starts from ũ. ``options``: :class:`SolverOptions` as given
+    (tolerance, max_iterations, line_search_steps; the caller sets its own budget).
+
+    excitation f̃_e (2H+1, n) [N]. Returns (ũ' (2H+1, n) [m], NewtonResult): ũ' at the last
+    accepted iterate, converged or not (the caller judges ``result.converged`` and
+    ``result.residual_norm``), None when the residual at ũ is not finite. Raises
+    :class:`sarfe.hbm.newton.SingularJacobian` when some S_k(ω) or the Jacobian is singular and
+    ValueError (naming the parameter) for inputs of the wrong shape."""
+    options = options or SolverOptions()
+    problem = make_problem(model, contacts, excitation, harmonics, samples_per_period, options)
+    U = np.asarray(U, dtype=float)
+    evaluate, to_x, to_displacement = make_evaluator(problem, contacts.row_count > 0, False)
+    state = {"slider": initial_slider(problem, U)}
+    result = newton(lambda x, jacobian: evaluate(x, omega, jacobian, state["slider"]), to_x(U),
+                    options, accept=slider_acceptor(state), chord=True)
+    if result.evaluation is None:
+        return None, result
+    U_new = np.asarray(to_displacement(result.x, omega, result.evaluation))
+    return U_new.reshape(U.shape), result

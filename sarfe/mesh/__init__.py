@@ -1,7 +1,11 @@
 """sarfe.mesh: shell meshes of panels — data structure, geometry, file loading, generators.
 
-`PanelMesh` (frozen, SI) and `load_mesh(path, length_unit)`; parametric gmsh geometries live in
-`sarfe.mesh.generators.<rattle_rig|squeak_rig|door_trim|instrument_panel>.generate(...)`.
+Modules: mesh (``PanelMesh``, frozen, SI, named node and element groups), io (``load_mesh(path,
+length_unit)``), geometry (areas, normals, contact frames, connectivity), quality (checks naming
+bad elements), cache (generated meshes kept on disk), laminate (classical lamination theory),
+gmsh_model (one headless, seeded gmsh session); generators/ (parametric gmsh geometries:
+``sarfe.mesh.generators.<rattle_rig|squeak_rig|door_trim|instrument_panel>.generate(...)``);
+formats/ (Nastran and Abaqus decks → ``DeckModel``).
 """
 from sarfe.mesh.geometry import (
     contact_frames,

@@ -24,7 +24,7 @@ import numpy as np
 
 from sarfe.mesh.gmsh_model import assemble_mesh, gmsh_session, mesh_from_gmsh, split_quads
 from sarfe.mesh.mesh import PanelMesh
-from sarfe.mesh.formats.nastran import bulk_fields
+from sarfe.mesh.formats.nastran_bdf import bulk_fields
 
 LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "in": 0.0254}
 

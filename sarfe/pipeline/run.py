@@ -13,20 +13,24 @@ from pathlib import Path
 
 import numpy as np
 
-from sarfe.hbm.stability.deferred import deferred_stability, pending
-from sarfe.case.read import load_case
+from sarfe import __version__
 from sarfe.case.errors import EXIT_NOT_CONVERGED
-from sarfe.pipeline.solve.case_accuracy import accuracy_check
+from sarfe.case.read import load_case
+from sarfe.hbm.stability.deferred import deferred_stability, pending
 from sarfe.pipeline.checks.case_checks import check_case, reduced_model_warnings
-from sarfe.pipeline.model.linear_stage import build_linear_model, linear_model_key
-from sarfe.pipeline.model.nonlinear_model import NonlinearModel, nonlinear_model
-from sarfe.pipeline.write.result_files import write_outputs, results_table
-from sarfe.pipeline.solve.points import common_samples, solve_points, sweep_status
-from sarfe.util.progress import bar as _bar
+from sarfe.pipeline.model.linear_stage import build_linear_model
+from sarfe.pipeline.model.nonlinear_model import nonlinear_model
+from sarfe.pipeline.model.stage import linear_model_key
 from sarfe.pipeline.post.point_workers import (first_estimates, point_records, point_work,
-                                          point_workers, stability_stream)
-from sarfe.pipeline.solve.pruned_points import solve_points_pruned
+                                               point_workers, stability_stream)
 from sarfe.pipeline.post.records import error_estimates, worst_of
+from sarfe.pipeline.solve.case_accuracy import accuracy_check, case_resolution, resolved_case
+from sarfe.pipeline.solve.points import common_samples, sweep_status
+from sarfe.pipeline.solve.pruned_points import solve_points_pruned
+from sarfe.pipeline.write.result_files import write_outputs
+from sarfe.results.folder import marker_info, write_result_folder
+from sarfe.results.summary import write_summary_json
+from sarfe.util.progress import bar as progress_bar
 
 
 @dataclass
@@ -56,11 +60,9 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     failed run leaves the previous result as it was.
     Raises CaseError for problems in the case; a non-converged point gives ``exit_code`` 3.
     """
-    from sarfe import __version__
-
     started = time.perf_counter()
     case = load_case(case)
-    bar = _bar(progress and linear_stage is None, "checking the case: mesh, groups, quality", None,
+    bar = progress_bar(progress and linear_stage is None, "checking the case: mesh, groups, quality", None,
                unit="step")
     try:
         checked = check_case(case, output_dir, force, write=write, mesh_checks=linear_stage is None)
@@ -76,9 +78,6 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     config = case.config
     if config.solver.resolution == "auto":
         # accuracy as an input: choose H, N (the reduction cutoff follows H) by a cheap search
-        from sarfe.accuracy.resolve import apply_resolution
-        from sarfe.pipeline.solve.case_accuracy import case_resolution
-
         clock = time.perf_counter()
         report, searched = case_resolution(case, config.solver.accuracy)
         accuracy = {k: report.get(k) for k in ("harmonics", "samples_per_period", "mode_count",
@@ -86,7 +85,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
                                                "search_stage_modes", "search_stage_seconds",
                                                "cutoff_hz", "history", "seconds")}
         accuracy["target"] = config.solver.accuracy
-        case = load_case(apply_resolution(case.data, report), base_dir=case.base_dir)
+        case = resolved_case(case, report)
         config = case.config
         # a given stage, else the search's last one, is the sweep's when its key matches
         linear_stage = next((s for s in (linear_stage, searched)
@@ -146,7 +145,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     if work is not None:
         solutions, records = work
     else:
-        bar = _bar(progress, "ERP and error estimates" if config.solver.error_estimate else "ERP",
+        bar = progress_bar(progress, "ERP and error estimates" if config.solver.error_estimate else "ERP",
                    len(solutions), unit="point")
         try:
             # each at the N it was solved with
@@ -201,9 +200,6 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     if not write:
         summary["timings_s"]["total_s"] = time.perf_counter() - started
         return result
-    from sarfe.results import write_summary_json
-    from sarfe.results.folder import marker_info, write_result_folder
-
     def write_files(folder):
         clock = time.perf_counter()
         summary["timings_s"]["outputs_s"] = 0.0
@@ -214,7 +210,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         summary["timings_s"]["total_s"] = time.perf_counter() - started
         write_summary_json(folder / "summary.json", summary)
 
-    bar = _bar(progress, "writing results", None, unit="file")
+    bar = progress_bar(progress, "writing results", None, unit="file")
     try:
         write_result_folder(target, write_files, marker_info("solve", case.name), force=force)
     finally:
@@ -237,5 +233,4 @@ def _node_pairs(stage, name) -> dict:
             "node_numbering": "deck ids" if ids is not None else "mesh indices"}
 
 
-__all__ = ["CaseResult", "NonlinearModel", "nonlinear_model", "results_table", "solve_case",
-           "solve_points"]
+__all__ = ["CaseResult", "solve_case"]

@@ -12,8 +12,8 @@ T = Qᵀ M A Q (m, m); T's eigenpairs (θ, y) give Ritz pairs (σ + 1/θ, Q y) w
 solve with ``block_size`` columns (cheaper per column than single solves).
 
 σ = 0 (A = K⁻¹ M, K positive definite): the lowest modes, used by Craig–Bampton both for a whole
-search (:func:`sarfe.reduction.craig_bampton._block_lanczos_modes`) and for run 0 of spectrum
-slicing (``_capped_run0``). σ > 0: the shifted runs of :mod:`sarfe.reduction.spectrum_slicing`.
+search and for run 0 of spectrum slicing (:mod:`sarfe.reduction.fixed_interface_modes`). σ > 0:
+the shifted runs of :mod:`sarfe.reduction.spectrum_slicing`.
 
 A Ritz pair is converged when ‖A φ − θ φ‖_M ≤ tol·|θ|, relative to its own θ: a value next to
 the shift, with a huge θ, must not loosen the test for the others. At σ = 0 a test relative to

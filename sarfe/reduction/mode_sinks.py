@@ -13,12 +13,14 @@ have certified (up to 0.45 GB each on the door trim at 5 mm) are not needed agai
 In :class:`FileSink` they wait on disk: written pages are page cache, which the kernel writes
 back and may evict — not memory of either process (a tmpfs directory, such as /dev/shm or a
 memory-backed TMPDIR, would make them memory again). The file is removed once mapped; its maps
-end with the last block copied.
+end with the last block copied. :func:`park_arrays` puts other arrays (Ψ, the residual loads and
+their statics) in such a file for the same span.
 """
 from __future__ import annotations
 
 import os
 import tempfile
+import weakref
 
 import numpy as np
 
@@ -127,3 +129,25 @@ class FileSink:
             os.remove(self.path)
         except OSError:
             pass
+
+
+def park_arrays(*arrays):
+    """Write (n, k) arrays (or None) to a temporary :class:`FileSink` on disk and return a
+    function that reads them back, in their memory order, and removes the file."""
+    sink = FileSink(next(a.shape[0] for a in arrays if a is not None))
+    try:
+        parked = [None if a is None else (sink.put(a), "F" if np.isfortran(a) else "C")
+                  for a in arrays]
+    except BaseException:
+        sink.remove()
+        raise
+
+    def restore():
+        try:
+            return [None if p is None else np.array(sink.read(p[0]), order=p[1])
+                    for p in parked]
+        finally:
+            sink.remove()
+
+    weakref.finalize(restore, sink.remove)      # an error on the way: the file goes too
+    return restore

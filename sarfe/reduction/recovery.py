@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from sarfe.reduction.craig_bampton import ReducedModel, free_dof_positions
+from sarfe.reduction.reduced_model import ReducedModel, free_dof_positions
 
 
 def recover_displacement(reduced: ReducedModel, q, all_dofs: bool = False) -> np.ndarray:

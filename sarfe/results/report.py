@@ -20,7 +20,7 @@ import base64
 import math
 from pathlib import Path
 
-from sarfe.results.summary import headline_level, headline_notes, level_text, shown_level
+from sarfe.results.summary import headline_level, headline_notes, level_text, shown_level, to_jsonable
 
 __all__ = ["write_report_html", "render_report_html", "data_uri", "environment"]
 
@@ -103,8 +103,6 @@ def _band_rows(point) -> list:
 
 def render_report_html(summary: dict, images: dict | None = None, notes: dict | None = None) -> str:
     """The report page (module docstring) as a string."""
-    from sarfe.results.summary import to_jsonable
-
     summary = to_jsonable(dict(summary))       # plain lists and numbers; NaN/±inf → None ("-")
     images = {k: data_uri(v) for k, v in (images or {}).items() if v and Path(v).exists()}
     points = summary.get("points") or []

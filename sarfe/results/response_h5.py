@@ -53,6 +53,8 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from sarfe import __version__
+
 __all__ = ["write_response_h5", "read_response_h5", "FOURIER_CONVENTION", "FORMAT_VERSION"]
 
 FORMAT_VERSION = 1
@@ -129,8 +131,6 @@ def write_response_h5(
     extra_groups : {group: {name: array | (array, units)}}, e.g. the linear baseline.
     attributes : extra root attributes (str/number), e.g. {"case": name, "model_key": key}.
     """
-    from sarfe import __version__
-
     solutions = list(solutions)
     if not solutions:
         raise ValueError("solutions is empty: nothing to write")

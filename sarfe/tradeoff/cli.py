@@ -4,6 +4,10 @@ from __future__ import annotations
 
 import time
 
+from sarfe.case.errors import CaseError
+from sarfe.pipeline.solve.case_accuracy import resolve_case_accuracy
+from sarfe.tradeoff.study import KNOBS, run_study, study_table
+
 
 def register(subparsers):
     p = subparsers.add_parser(
@@ -26,10 +30,6 @@ def register(subparsers):
 
 
 def cmd_study(args) -> int:
-    from sarfe.case.errors import CaseError
-
-    from sarfe.tradeoff.study import KNOBS, run_study, study_table
-
     knobs = None
     if args.knobs:
         knobs = [k.strip() for k in args.knobs.split(",") if k.strip()]
@@ -50,10 +50,6 @@ def cmd_study(args) -> int:
 
 
 def cmd_accuracy(args) -> int:
-    from sarfe.case.errors import CaseError
-
-    from sarfe.pipeline.solve.case_accuracy import resolve_case_accuracy
-
     try:
         report = resolve_case_accuracy(args.case, args.accuracy, points=args.points)
     except ValueError as exc:

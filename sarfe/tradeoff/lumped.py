@@ -15,6 +15,9 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from sarfe.hbm.contacts import make_contact_set
+from sarfe.hbm.model import make_linear_model
+
 
 @dataclass(frozen=True)
 class LumpedProblem:
@@ -30,9 +33,6 @@ def lumped_problem(n_masses=1, *, mass=1.0, stiffness=1.0e4, coupling=None, zeta
                    friction_coefficient=0.3, normal_load=1.0, tangential_ratio=10.0, force=10.0,
                    harmonics=5, force_all=False) -> LumpedProblem:
     """Build the chain (module docstring). gap: scalar or one per rattle DOF [m]."""
-    from sarfe.hbm.contacts import make_contact_set
-    from sarfe.hbm.model import make_linear_model
-
     n = int(n_masses)
     kc = stiffness if coupling is None else coupling
     K = np.diag(np.full(n, float(stiffness)))

@@ -20,7 +20,6 @@ The linear stage is built once and reused for harmonics / samples / penalty vari
 """
 from __future__ import annotations
 
-import copy
 import csv
 import json
 import math
@@ -31,6 +30,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+
+from sarfe.accuracy import resize_harmonics
+from sarfe.erp import equivalent_radiated_power
+from sarfe.hbm import SolverOptions, solve_frequency
+from sarfe.hbm.time_integration import linear_harmonic_response
+from sarfe.pipeline import build_linear_model, load_case, nonlinear_model
+from sarfe.pipeline.solve.case_accuracy import stage_error_estimate
 
 KNOBS = ("harmonics", "samples", "modes", "mesh", "penalty")
 
@@ -70,40 +76,37 @@ def knob_levels(case, stage, knobs=None) -> dict:
             out["modes"] = [(f"modes={v}", v) for v in values]
     fe = config.model.fe
     if "mesh" in knobs and fe is not None and fe.source == "generator":
-        h = float(fe.data["generator"].get("mesh_size_m", 0) or 0)
+        h = float(fe.generator.mesh_size_m or 0)
         if h > 0:
             out["mesh"] = [(f"h={v * 1e3:.3g}mm", v) for v in (2 * h, h, h / math.sqrt(2), h / 2)]
     return out
 
 
 def variant_case(case, knob, value):
-    """A new Case with one knob changed (see module docstring): the case's record ``case.data`` is
-    copied, edited and loaded again, so the variant gets its own normalized data and config."""
-    from sarfe.case.read import load_case
-
-    data = copy.deepcopy(case.data)
-    solver = data["solver"]
+    """A new Case with one knob changed (see module docstring), through the typed case API
+    (:meth:`sarfe.case.read.Case.with_solver` …): harmonics (N doubled to at least 4H + 1),
+    samples, penalty (every contact's normal and tangential stiffness × value), modes (a mode
+    count instead of a cutoff, no minimum) or mesh (the generator's mesh size)."""
     if knob == "harmonics":
-        solver["harmonics"] = int(value)
-        N = int(solver["samples_per_period"])
+        N = int(case.config.solver.samples_per_period)
         while N < 4 * value + 1:
             N *= 2
-        solver["samples_per_period"] = N
-    elif knob == "samples":
-        solver["samples_per_period"] = int(value)
-    elif knob == "penalty":
-        for contact in data["contacts"]:
-            for key in ("normal_stiffness_N_m", "tangential_stiffness_N_m"):
-                if key in contact:
-                    contact[key] = contact[key] * value
-    elif knob == "modes":
-        red = data.setdefault("reduction", {})
-        red.pop("cutoff_hz", None)
-        red["mode_count"] = int(value)
-        red["min_mode_count"] = 0
-    elif knob == "mesh":
-        data["model"]["fe"]["generator"]["mesh_size_m"] = float(value)
-    return load_case(data, base_dir=case.base_dir)
+        return case.with_solver(harmonics=int(value), samples_per_period=N)
+    if knob == "samples":
+        return case.with_solver(samples_per_period=int(value))
+    if knob == "penalty":
+        for index, contact in enumerate(case.config.contacts):
+            changes = {key: contact.params[key] * value
+                       for key in ("normal_stiffness_N_m", "tangential_stiffness_N_m")
+                       if key in contact.params}
+            if changes:
+                case = case.with_contact(index, **changes)
+        return case
+    if knob == "modes":
+        return case.with_reduction(cutoff_hz=None, mode_count=int(value), min_mode_count=0)
+    if knob == "mesh":
+        return case.with_generator(mesh_size_m=float(value))
+    return case
 
 
 def frequency_grid(case, points=16) -> np.ndarray:
@@ -122,9 +125,6 @@ def solve_grid(case, stage, frequencies_hz, options=None, guesses=None):
     Returns (points, cost): one dict per frequency (converged, ERP dB / dB(A), peak normal force,
     first-harmonic normal amplitude, the HarmonicSolution under ``_solution``) and
     {'solve_s', 'iterations'}."""
-    from sarfe.hbm import SolverOptions, solve_frequency
-    from sarfe.pipeline import nonlinear_model
-
     nl = nonlinear_model(case, stage)
     solver = case.config.solver
     H, N = solver.harmonics, solver.samples_per_period
@@ -160,8 +160,6 @@ def solve_grid(case, stage, frequencies_hz, options=None, guesses=None):
 
 def erp_levels(case, stage, displacement, omega):
     """(L_W, L_WA) [dB re reference power] of displacement harmonics (2H+1, n) at ω (−inf if silent)."""
-    from sarfe.erp import equivalent_radiated_power
-
     erp = case.config.erp
     W = np.asarray(displacement) @ np.asarray(stage.erp_map).T
     if W.shape[1] == 0:
@@ -198,11 +196,6 @@ def branch_guesses(case, stage, baseline_points):
     frequencies: the displacement resized to the variant's H when the DOFs match, else (same contact
     rows, e.g. another mode count) the linear response to f̃_e − Gᵀλ̃ of the baseline contact forces;
     None where neither applies."""
-    from sarfe.hbm.time_integration import linear_harmonic_response
-    from sarfe.pipeline import nonlinear_model
-
-    from sarfe.accuracy import resize_harmonics
-
     nl = nonlinear_model(case, stage)
     H = case.config.solver.harmonics
     guesses = []
@@ -225,10 +218,6 @@ def branch_guesses(case, stage, baseline_points):
 
 def attach_estimates(case, stage, points):
     """estimate_errors at every converged grid point (adds estimate_amplitude_rel / _erp_db)."""
-    from sarfe.pipeline import nonlinear_model
-
-    from sarfe.pipeline.solve.case_accuracy import stage_error_estimate
-
     nl = nonlinear_model(case, stage)
     for p in points:
         s = p.get("_solution")
@@ -286,8 +275,6 @@ def run_variant(case, stage, knob, label, value, frequencies_hz, estimate=True,
     included when the knob rebuilds it), timed with tracemalloc on. Values and errors: the grid
     re-solved from the case-setting solutions (:func:`branch_guesses`), so every variant is compared
     on the same solution branch (folds make cold sweeps jump at slightly different frequencies)."""
-    from sarfe.pipeline import build_linear_model
-
     variant = variant_case(case, knob, value) if knob != "baseline" else case
     tracemalloc.start()
     clock = time.perf_counter()
@@ -336,9 +323,6 @@ def run_study(case, knobs=None, points=12, frequencies_hz=None, output_dir=None,
     Writes study.csv, study.json and study_pareto.png into ``output_dir`` (default
     ``<output.directory>/study``) unless ``write`` is False.
     """
-    from sarfe.case.read import load_case
-    from sarfe.pipeline import build_linear_model
-
     case = load_case(case)
     clock = time.perf_counter()
     stage = build_linear_model(case)
@@ -396,7 +380,7 @@ def _is_baseline(case, stage, knob, value):
     if knob == "modes":
         return value == stage.info.get("modes")
     if knob == "mesh":
-        return value == config.model.fe.data["generator"].get("mesh_size_m")
+        return value == config.model.fe.generator.mesh_size_m
     return False
 
 

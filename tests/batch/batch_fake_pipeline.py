@@ -13,11 +13,7 @@ import os
 import time
 from dataclasses import dataclass
 
-try:
-    from sarfe.case.errors import CaseError
-except ImportError:  # case layer not there yet
-    class CaseError(Exception):
-        pass
+from sarfe.case.errors import CaseError
 
 
 @dataclass(frozen=True)
@@ -47,7 +43,7 @@ def _log(what: str) -> None:
             stream.write(f"{what} {os.getpid()}\n")
 
 
-def load_case(data) -> Case:
+def load_case(data, base_dir=None) -> Case:
     if not isinstance(data, dict):
         raise CaseError("fake pipeline takes mappings only")
     for index, contact in enumerate(data.get("contacts", [])):
@@ -68,7 +64,7 @@ def build_linear_model(case: Case, progress=False) -> LinearStage:
     return LinearStage(linear_model_key(case), mass, stiffness, 2 * model["damping_ratio"] * math.sqrt(stiffness * mass))
 
 
-def solve_case(case: Case, linear_stage=None, output_dir=None, progress=False) -> CaseResult:
+def solve_case(case: Case, linear_stage=None, output_dir=None, progress=False, write=True) -> CaseResult:
     _log("solve")
     data = case.data
     if linear_stage is None:
@@ -96,7 +92,7 @@ def solve_case(case: Case, linear_stage=None, output_dir=None, progress=False) -
         impact = sum(v for k, v in row.items() if k.endswith(".peak_normal_force_N"))
         row["erp_db"] += 10 * math.log10(1.0 + impact)
         rows.append(row)
-    if output_dir is not None:
+    if write and output_dir is not None:
         os.makedirs(output_dir, exist_ok=True)
         with open(os.path.join(output_dir, "summary.json"), "w") as stream:
             json.dump({"points": len(rows)}, stream)

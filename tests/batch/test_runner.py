@@ -4,6 +4,7 @@ SIGKILL, a dying worker retried. The same study on the real pipeline: test_lumpe
 import argparse
 import json
 import os
+import pathlib
 import signal
 import subprocess
 import sys
@@ -15,8 +16,8 @@ import pytest
 from sarfe.batch import GATE_EXIT_CODE, run_study
 from sarfe.batch.cli import main, register
 
-from conftest import FAKE, HERE
-
+HERE = pathlib.Path(__file__).resolve().parent
+FAKE = "batch_fake_pipeline"   # tests/batch/batch_fake_pipeline.py, on sys.path (conftest.py)
 
 
 def study(tmp_path, variations, extra=""):

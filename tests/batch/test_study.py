@@ -1,5 +1,6 @@
 """Study files, parameter paths and deterministic variant generation."""
 import math
+import pathlib
 
 import numpy as np
 import pytest
@@ -7,7 +8,7 @@ import pytest
 from sarfe.batch.paths import PathError, set_path
 from sarfe.batch.variants import StudyError, collect_variants, load_study, parameter_sets, read_yaml
 
-from conftest import HERE
+HERE = pathlib.Path(__file__).resolve().parent
 
 CASE = {"excitation": {"forces": [{"force_N": 1.0}]},
         "contacts": [{"name": "pocket_1", "gap_m": 1e-4}, {"name": "pocket_2", "gap_m": 2e-4}]}

@@ -3,7 +3,7 @@ spots, H = 15, a sweep; its groups resolve on a coarse mesh of the same generato
 from pathlib import Path
 
 from sarfe.pipeline import load_case
-from sarfe.pipeline.model.linear_stage import check_mesh
+from sarfe.pipeline.checks.mesh_checks import check_mesh
 
 CASE = Path(__file__).resolve().parents[2] / "cases" / "door_trim_p1.yaml"
 

@@ -35,7 +35,7 @@ def full_hill(model, contacts, F, s):
     """The full Hill method at a converged point ``s`` (the reference the other stability methods
     are compared with) → (StabilityResult, the point's Evaluation, its ContactOperator)."""
     from sarfe.hbm.residual import Problem, full_residual
-    from sarfe.hbm.solve import contact_damping
+    from sarfe.hbm.stability.select import contact_damping
     from sarfe.hbm.stability.hill import hill_stability
     from sarfe.hbm.stability.contact_terms import ContactOperator
 

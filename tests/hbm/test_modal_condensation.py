@@ -12,7 +12,8 @@ from sarfe.hbm.dynamic_stiffness import (condense, condensed_omega_derivative, m
                               recover_displacement)
 from sarfe.hbm.harmonic_set import coefficient_rows
 from sarfe.hbm.modal import cached_modal_basis, modal_basis
-from sarfe.reduction import craig_bampton, free_dofs_system, reduced_modal_damping
+from sarfe.fe.damping import modal_damping
+from sarfe.reduction import craig_bampton, free_dofs_system
 
 H = 5
 
@@ -28,7 +29,7 @@ def chain(n=6, damping="modal"):
     K = np.diag(k + np.r_[k[1:], 0.0]) - np.diag(k[1:], 1) - np.diag(k[1:], -1)
     M = np.diag(m)
     if damping == "modal":
-        D = reduced_modal_damping(M, K, np.linspace(0.01, 0.05, n))
+        D = modal_damping(M, K, np.linspace(0.01, 0.05, n))
     elif damping == "rayleigh":
         D = 0.8 * M + 2e-4 * K
     elif damping == "dashpot":          # one discrete dashpot: not diagonal in the modes
@@ -57,7 +58,7 @@ def plate_reduced(damping):
     boundary = np.array([position[6 * node + 2] for node in nodes])       # z translations
     reduced = craig_bampton(k_ff, m_ff, boundary, cutoff_hz=2000.0, residual_vectors=True)
     Kr, Mr = reduced.stiffness, reduced.mass
-    D = {"modal": reduced_modal_damping(Mr, Kr, 0.03), "rayleigh": 5.0 * Mr + 1e-5 * Kr,
+    D = {"modal": modal_damping(Mr, Kr, 0.03), "rayleigh": 5.0 * Mr + 1e-5 * Kr,
          "none": None}[damping]
     return make_linear_model(Mr, D, Kr)
 

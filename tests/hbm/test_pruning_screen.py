@@ -105,7 +105,7 @@ def test_few_frequencies_leave_the_model_cache_alone(monkeypatch):
     points' first condensation still finds the model unseen)."""
     p, contacts = mixed_contacts()
     calls = []
-    monkeypatch.setattr(modal, "cached_modal_basis", lambda model: calls.append(model))
+    monkeypatch.setattr(pruning, "cached_modal_basis", lambda model: calls.append(model))
     decisions = screen_contacts(p.model, contacts, p.excitation, [60.0, 90.0])
     assert not calls and len(decisions) == contacts.count
 

@@ -3,6 +3,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
+import sarfe.hbm.newmark as newmark
 import sarfe.hbm.time_integration as ti
 from sarfe.hbm.contacts import make_contact_set
 from sarfe.hbm.laws.jenkins import SLIP, STICK
@@ -237,7 +238,8 @@ def test_acceleration_and_sparse_path_give_the_same_orbit(monkeypatch):
     assert fast.steady and plain.steady and fast.periods < plain.periods
     scale = np.abs(plain.displacement_harmonics).max()
     assert np.abs(fast.displacement_harmonics - plain.displacement_harmonics).max() < 1e-8 * scale
-    monkeypatch.setattr(ti, "DENSE_LIMIT", 0)
+    monkeypatch.setattr(ti, "DENSE_LIMIT", 0)          # the output DOFs
+    monkeypatch.setattr(newmark, "DENSE_LIMIT", 0)     # the propagator and the contact rows
     sparse_model = make_linear_model(*(sp.csr_matrix(np.asarray(x)) for x in
                                        (model.mass, model.damping, model.stiffness)))
     sparse = integrate_time(sparse_model, contacts, F, omega, 1, steps_per_period=N,

@@ -71,7 +71,7 @@ def test_debris_of_killed_runs_is_cleaned_only_when_stale(tmp_path):
 
 def test_solve_and_validate_use_the_cache(tmp_path, monkeypatch):
     from sarfe.pipeline import load_case
-    from sarfe.pipeline.model.linear_stage import load_case_mesh
+    from sarfe.pipeline.model.case_mesh import load_case_mesh
 
     monkeypatch.setenv("SARFE_MESH_CACHE", str(tmp_path))
     case = load_case({"name": "c", "model": {"fe": {

@@ -20,9 +20,9 @@ DECK_FILES = ["a101x.dat", "plate.bdf", "plate_py.dat", "mode_solid_shell_bar.bd
 
 
 def _pynastran_model(path):
-    from sarfe.mesh.formats.nastran import _load_bdf
+    from sarfe.mesh.formats.nastran_bdf import load_bdf
 
-    return _load_bdf(Path(path))
+    return load_bdf(Path(path))
 
 
 @needs_decks

@@ -8,7 +8,8 @@ from pathlib import Path
 import pytest
 
 from sarfe.mesh.formats.deck import DeckError
-from sarfe.mesh.formats.nastran import card_line, read_nastran
+from sarfe.mesh.formats.nastran import read_nastran
+from sarfe.mesh.formats.nastran_bdf import card_line
 
 DECK = Path(__file__).resolve().parents[2] / "meshes" / "rattle_rig_deck.bdf"
 FIRST_QUAD = ("CQUAD4*                1               1             239             214\n"

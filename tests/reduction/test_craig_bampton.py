@@ -5,7 +5,7 @@ import scipy.linalg as sla
 import scipy.sparse.linalg as spla
 
 from sarfe.reduction import (craig_bampton, factorize, free_dof_positions, node_dofs, normal_velocity_basis,
-                             recover_displacement, reduced_modal_damping, with_rayleigh_damping)
+                             recover_displacement, with_modal_damping, with_rayleigh_damping)
 
 # Boundary = x, y, z translations of 4 nodes. The plate's first in-plane bending mode (~411 Hz) is
 # carried only by the constraint modes (its fixed-interface counterparts lie far above any cutoff):
@@ -169,7 +169,7 @@ def test_recovery_and_normal_velocity(plate, reduced):
 def test_reduced_modal_damping(reduced):
     """Every reduced mode gets ζ: Xᵀ D_r X = diag(2ζω)."""
     zeta = 0.02
-    damping = reduced_modal_damping(reduced.mass, reduced.stiffness, zeta)
+    damping = with_modal_damping(reduced, zeta).damping
     omega2, modes = sla.eigh(reduced.stiffness, reduced.mass)
     np.testing.assert_allclose(modes.T @ damping @ modes, np.diag(2 * zeta * np.sqrt(omega2)),
                                atol=1e-9 * 2 * zeta * np.sqrt(omega2.max()))
@@ -179,7 +179,7 @@ def test_reduced_modal_damping_gives_each_mode_its_ratio(reduced):
     """Every mode x_j of (K_r, M_r), x_jᵀ M_r x_j = 1, sees x_jᵀ D_r x_j = 2 ζ ω_j and no coupling."""
     import scipy.linalg as sla
 
-    damping = reduced_modal_damping(reduced.mass, reduced.stiffness, 0.03)
+    damping = with_modal_damping(reduced, 0.03).damping
     omega2, modes = sla.eigh(reduced.stiffness, reduced.mass)
     modal = modes.T @ damping @ modes
     omega = np.sqrt(np.clip(omega2, 0.0, None))
@@ -289,7 +289,7 @@ def test_spectrum_slicing_finds_every_mode_below_the_cutoff(plate, monkeypatch):
 
     if "pardiso" not in available_solvers():
         pytest.skip("spectrum slicing needs PARDISO's inertia")
-    module = importlib.import_module("sarfe.reduction.craig_bampton")
+    module = importlib.import_module("sarfe.reduction.fixed_interface_modes")
     monkeypatch.setattr(module, "_SLICE_COLUMNS", 64)
     monkeypatch.setattr(module, "_SLICE_ENTRIES", 0)
     b = boundary_positions(plate)

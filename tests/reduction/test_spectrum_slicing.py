@@ -59,7 +59,7 @@ def twin():
 @pytest.fixture(scope="module")
 def capped():
     """Run 0 capped at 64 columns: the modes above come from spectrum slicing."""
-    module = importlib.import_module("sarfe.reduction.craig_bampton")
+    module = importlib.import_module("sarfe.reduction.fixed_interface_modes")
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(module, "_SLICE_COLUMNS", 64)
         patch.setattr(module, "_SLICE_ENTRIES", 0)
@@ -160,7 +160,7 @@ def test_split_by_count_gives_the_same_modes(twin, one, capped):
     """As a user's run: the worker places λ_s by count — N(λ_s) within 2 % of the total of the
     balanced count (N(λ_c) + lead)/2 (lead: run 0's head start for its column cap), exact by
     the dense reference — and the modes equal the dense reference and the one-process run."""
-    module = importlib.import_module("sarfe.reduction.craig_bampton")
+    module = importlib.import_module("sarfe.reduction.fixed_interface_modes")
     slicing = importlib.import_module("sarfe.reduction.spectrum_slicing")
     reduced = reduce(twin, workers=2)
     record = reduced.timings["slicing"]
@@ -228,9 +228,10 @@ def test_failure_after_the_early_fork_stops_the_worker(twin, capped, monkeypatch
 
     monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
     module = importlib.import_module("sarfe.reduction.craig_bampton")
+    modes = importlib.import_module("sarfe.reduction.fixed_interface_modes")
     started = []
-    start = module._start_upper_slices
-    monkeypatch.setattr(module, "_start_upper_slices",
+    start = modes._start_upper_slices
+    monkeypatch.setattr(modes, "_start_upper_slices",
                         lambda *args: started.append(start(*args)) or started[-1])
 
     def singular(*args, **kwargs):
@@ -349,7 +350,7 @@ def test_run0_goes_on_to_a_split_just_above_its_yield(twin, one, capped):
     assert record["split_count"] == np.count_nonzero(omega2 <= split) > yielded
     assert record["run0_extended_to_split"] == record["split_count"]
     assert record["shifts"] == [] and record["factorizations"] == 0
-    extension = importlib.import_module("sarfe.reduction.craig_bampton")._RUN0_EXTENSION
+    extension = importlib.import_module("sarfe.reduction.fixed_interface_modes")._RUN0_EXTENSION
     assert 64 < record["run0_columns"] <= 64 * (1 + extension)
     assert record["upper"]["cpu_s"] > 0 and record["upper"]["idle_s"] >= 0 and record["cpu_s"] > 0
     check_against_dense(reduced, twin)

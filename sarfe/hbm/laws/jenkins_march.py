@@ -22,10 +22,12 @@ from numba import njit
 
 
 @njit(cache=True, inline="always")
-def _project(w0, w1, q0, q1, rho):
-    """One return-map step of one contact → (w0, w1, ratio, slipping, u0, u1, separated).
+def return_map_step(w0, w1, q0, q1, rho):
+    """One return-map step of one contact (module docstring): the slider (w0, w1) [m] projected on
+    the disk of radius ρ = ``rho`` [m] around q = (q0, q1) [m] → (w0, w1, ratio, slipping, u0, u1,
+    separated), the new slider and what :func:`return_map_derivative` needs.
 
-    ratio = ρ/|t| in slip, 1 otherwise; (u0, u1) = t/|t| (0 for t = 0)."""
+    ratio = ρ/|t| in slip, 1 otherwise; (u0, u1) = t/|t| (0 for t = 0); separated: ρ ≤ 0."""
     r = rho if rho > 0.0 else 0.0
     t0, t1 = w0 - q0, w1 - q1
     norm = np.sqrt(t0 * t0 + t1 * t1)
@@ -36,9 +38,10 @@ def _project(w0, w1, q0, q1, rho):
 
 
 @njit(cache=True, inline="always")
-def _step_derivative(ratio, slipping, u0, u1, separated):
-    """P_j = ∂w_j/∂w_{j−1} of one step → (p00, p01, p10, p11, s0, s1): (ρ/|t|)(I − n nᵀ) in slip,
-    I in stick, 0 separated; (s0, s1) = n in slip, 0 otherwise."""
+def return_map_derivative(ratio, slipping, u0, u1, separated):
+    """P_j = ∂w_j/∂w_{j−1} of one :func:`return_map_step` (from its outputs) → (p00, p01, p10, p11,
+    s0, s1): (ρ/|t|)(I − n nᵀ) in slip, I in stick, 0 separated; (s0, s1) = ∂w_j/∂ρ_j = n in
+    slip, 0 otherwise."""
     coefficient = 0.0 if separated else ratio
     s0 = u0 if slipping else 0.0
     s1 = u1 if slipping else 0.0
@@ -66,9 +69,9 @@ def periodic_start(q, rho, start, tolerance, pass_cap):
             a00, a01, a10, a11 = 1.0, 0.0, 0.0, 1.0
             x0, x1 = w[c, 0], w[c, 1]
             for j in range(N):
-                x0, x1, ratio, slipping, u0, u1, separated = _project(
+                x0, x1, ratio, slipping, u0, u1, separated = return_map_step(
                     x0, x1, q[j, c, 0], q[j, c, 1], rho[j, c])
-                p00, p01, p10, p11, s0, s1 = _step_derivative(ratio, slipping, u0, u1, separated)
+                p00, p01, p10, p11, s0, s1 = return_map_derivative(ratio, slipping, u0, u1, separated)
                 a00, a01, a10, a11 = (p00 * a00 + p01 * a10, p00 * a01 + p01 * a11,
                                       p10 * a00 + p11 * a10, p10 * a01 + p11 * a11)
             w[c, 0], w[c, 1] = x0, x1
@@ -115,14 +118,14 @@ def final_pass(q, rho, drho_dw, k_t, start, Phi, jacobian):
         h00, h01, h10, h11 = 1.0, 0.0, 0.0, 1.0
         dw[:, :] = 0.0
         for j in range(N):
-            x0, x1, ratio, slipping, u0, u1, separated = _project(
+            x0, x1, ratio, slipping, u0, u1, separated = return_map_step(
                 x0, x1, q[j, c, 0], q[j, c, 1], rho[j, c])
             force[j, c, 0] = k_t[c] * (q[j, c, 0] - x0)
             force[j, c, 1] = k_t[c] * (q[j, c, 1] - x1)
             state[j, c] = 0 if separated else (2 if slipping else 1)
             if not jacobian:
                 continue
-            p00, p01, p10, p11, s0, s1 = _step_derivative(ratio, slipping, u0, u1, separated)
+            p00, p01, p10, p11, s0, s1 = return_map_derivative(ratio, slipping, u0, u1, separated)
             weight = drho_dw[j, c]
             for h in range(P):
                 phi = Phi[j, h]

@@ -8,8 +8,6 @@ plane). States: 0 separated, 1 stick, 2 slip.
 """
 from __future__ import annotations
 
-import numpy as np
-
 from sarfe.hbm.laws import jenkins
 from sarfe.hbm.laws.contract import ContactLaw, NormalForce, Parameter
 from sarfe.hbm.laws.rattle import NORMAL_STIFFNESS, penalty_force, penalty_linearization

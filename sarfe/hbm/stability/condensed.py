@@ -24,6 +24,11 @@ import numpy as np
 import scipy.linalg as la
 import scipy.sparse as sp
 
+from sarfe.hbm.aft import jacobian_matrix
+from sarfe.hbm.dynamic_stiffness import dynamic_stiffness_matrix
+from sarfe.hbm.model import make_linear_model
+from sarfe.hbm.stability.hill import hill_stability
+
 
 def _dense(matrix):
     return matrix.toarray() if sp.issparse(matrix) else np.asarray(matrix)
@@ -81,11 +86,6 @@ def condensed_stability(model, contacts, omega, harmonics, forces, operator=None
 
     forces: the AFT :class:`ContactForces` of the orbit (all harmonic rows); operator: the
     :class:`ContactOperator` (friction memory), or None."""
-    from sarfe.hbm.aft import jacobian_matrix
-    from sarfe.hbm.model import make_linear_model
-    from sarfe.hbm.dynamic_stiffness import dynamic_stiffness_matrix
-    from sarfe.hbm.stability.hill import hill_stability
-
     nr, H = contacts.row_count, int(harmonics)
     base = jacobian_matrix(forces.blocks, nr, H)
     basis = ritz_basis(model, contacts.gap_map, base[:nr, :nr].toarray(), omega, H, max_modes)

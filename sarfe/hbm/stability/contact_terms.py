@@ -69,7 +69,7 @@ def _memory_blocks(s, omega, P_march, n_rho_march, drho, k_t, H, N, chunk=2, set
     P1 door trim, N = 256, 4 sliding contacts, H = 15, 1.3 ms per s at chunk 2 against 2.0 ms at
     8, where the march wrote 24 MB per chunk);
     ``setup``: the s-independent arrays of :func:`_memory_setup` when already computed."""
-    from sarfe.hbm.stability.march import linear_march
+    from sarfe.hbm.stability.march import linear_march   # numba (0.4 s to import): 2-D sliders only
 
     s = np.atleast_1d(np.asarray(s, dtype=complex))
     if setup is None:
@@ -108,7 +108,7 @@ def _memory_setup(omega, P_march, n_rho_march, drho, H, N):
     (N, n, 2, 2), source b_j = (I − P_j) δq_j + n_j dρ_j δn_j (N, n, 2, 3P), products Π_j
     (N, n, 2, 2), the DFT matrix E (2H+1, N), E δq (2H+1, 2, 3P), sample spacing h [s], and
     ``stuck`` (n,): contacts stuck at every sample (P_j = I, b_j = 0: no march needed)."""
-    from sarfe.hbm.stability.march import step_products
+    from sarfe.hbm.stability.march import step_products   # numba (0.4 s to import): 2-D sliders only
 
     P = 2 * H + 1
     E, Phi = hm.fourier_matrices(H, N)

@@ -11,10 +11,11 @@ without it and the verdicts be computed afterwards over the reported points:
     solutions = with_stability(solutions, jobs, results)
 
 :func:`stability_of` evaluates the converged point exactly as ``finalize`` does in place (the full
-residual with the slider start of the solve, then :func:`sarfe.hbm.solve.stability`): same inputs,
-same arithmetic, so the verdicts and exponents are those of the serial path. Jobs may also be
-computed while the sweep goes on (``on_job``: :class:`sarfe.util.workers.Stream`); the verdicts of points
-the sweep then drops (backed-up corners, replaced near-duplicates) are simply not used.
+residual with the slider start of the solve, then :func:`sarfe.hbm.stability.select.stability`):
+same inputs, same arithmetic, so the verdicts and exponents are those of the serial path. Jobs may
+also be computed while the sweep goes on (``on_job``: :class:`sarfe.util.workers.Stream`); the
+verdicts of points the sweep then drops (backed-up corners, replaced near-duplicates) are simply
+not used.
 """
 from __future__ import annotations
 
@@ -22,6 +23,9 @@ from contextlib import contextmanager
 from dataclasses import dataclass, replace
 
 import numpy as np
+
+from sarfe.hbm.residual import full_residual
+from sarfe.hbm.stability.select import stability, stability_method
 
 _JOBS = None     # the StabilityJob list of the active deferred_stability() block (None: in place)
 _ON_JOB = None   # its callback on_job(index, job), or None
@@ -78,9 +82,6 @@ def defer(problem, omega, U, slider, options) -> int | None:
 
 def stability_of(job: StabilityJob):
     """StabilityResult of a recorded point, computed as ``finalize`` computes it in place."""
-    from sarfe.hbm.residual import full_residual
-    from sarfe.hbm.solve import stability, stability_method
-
     with np.errstate(all="ignore"):
         ev = full_residual(job.problem, job.displacement.ravel(), job.omega, job.slider,
                            jacobian=True,

@@ -37,6 +37,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
@@ -120,8 +121,6 @@ def _shift_invert(Mt, Dt, jacobian, sigma):
     contact rows of a Ritz-basis problem couple all harmonics: a sparse LU of the first-order
     pencil took 0.9 s there, a dense one of Q 0.1-0.5 s), else SuperLU. Real for real σ and real
     matrices, else complex."""
-    import scipy.linalg as sla
-
     size = Mt.shape[0]
     dtype = np.result_type(jacobian.dtype, Dt.dtype, Mt.dtype,
                            complex if np.iscomplexobj(sigma) else float)

@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from sarfe.hbm.laws.jenkins_march import _project, _step_derivative
+from sarfe.hbm.laws.jenkins_march import return_map_derivative, return_map_step
 
 
 @njit(cache=True)
@@ -88,9 +88,9 @@ def slider_steps(q, rho, start):
     for c in range(n):
         x0, x1 = start[c, 0], start[c, 1]
         for j in range(N):
-            x0, x1, ratio, slipping, u0, u1, separated = _project(
+            x0, x1, ratio, slipping, u0, u1, separated = return_map_step(
                 x0, x1, q[j, c, 0], q[j, c, 1], rho[j, c])
-            p00, p01, p10, p11, s0, s1 = _step_derivative(ratio, slipping, u0, u1, separated)
+            p00, p01, p10, p11, s0, s1 = return_map_derivative(ratio, slipping, u0, u1, separated)
             step[j, c, 0, 0], step[j, c, 0, 1], step[j, c, 1, 0], step[j, c, 1, 1] = p00, p01, p10, p11
             slope[j, c, 0], slope[j, c, 1] = s0, s1
     return step, slope

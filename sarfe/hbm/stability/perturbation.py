@@ -1,7 +1,7 @@
 r"""Stability of a harmonic-balance orbit checked by time integration: do perturbations of the
 orbit decay or grow over a period?
 
-The period map P of the Newmark integrator (:mod:`sarfe.hbm.time_integration`) takes the state
+The period map P of the Newmark integrator (:mod:`sarfe.hbm.newmark`) takes the state
 x = (u, u̇/ω, sliders) at θ = 0 to the state one period later. Starting from the HBM orbit's state,
 Newton shooting finds the integrator's own periodic state x* = P(x*) (a few steps: the two orbits
 differ only by the truncation and time-step errors), with the Jacobian Φ = ∂P/∂x by finite
@@ -23,8 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sarfe.hbm.time_integration import _ContactLaws, _run, _slider_from_initial, _state_at_zero
 from sarfe.hbm.harmonics import time_samples
+from sarfe.hbm.newmark import ContactLaws, initial_sliders, march_periods, state_at_zero
 
 
 @dataclass(frozen=True)
@@ -51,10 +51,10 @@ def perturbation_check(model, contacts, excitation, solution, steps_per_period=5
     N = int(steps_per_period)
     U = np.asarray(solution.displacement, dtype=float)
     n = U.shape[1]
-    u0, v0 = _state_at_zero(U, omega, N)
-    law = _ContactLaws(contacts) if contacts is not None and contacts.count else None
+    u0, v0 = state_at_zero(U, omega, N)
+    law = ContactLaws(contacts) if contacts is not None and contacts.count else None
     force0 = np.asarray(solution.contact_force_time)[0] if law is not None else None
-    slider0 = _slider_from_initial(law, contacts.gap_map @ u0, force0) if law is not None \
+    slider0 = initial_sliders(law, contacts.gap_map @ u0, force0) if law is not None \
         else np.zeros((0, 2))
     forcing = time_samples(np.asarray(excitation, dtype=float), N)
     shape = slider0.shape
@@ -62,8 +62,8 @@ def perturbation_check(model, contacts, excitation, solution, steps_per_period=5
 
     def period(x):
         runs[0] += 1
-        u, v, w = _run(model, contacts, forcing, omega, N, x[:n], omega * x[n:2 * n],
-                       x[2 * n:].reshape(shape), 1, 0.0, False, None, 0)["final"]
+        u, v, w = march_periods(model, contacts, forcing, omega, N, x[:n], omega * x[n:2 * n],
+                                x[2 * n:].reshape(shape), 1, 0.0, False, None, 0)["final"]
         return np.concatenate((u, v / omega, w.ravel()))
 
     x = np.concatenate((u0, v0 / omega, slider0.ravel()))

@@ -1,1 +1,11 @@
-"""Engineers' model files: Nastran bulk data (pyNastran) and Abaqus input decks."""
+"""Engineers' model files (decks) → :class:`~sarfe.mesh.formats.deck.DeckModel`.
+
+- deck: ``DeckModel`` (nodes, frames, shells, solids, beams, springs, masses, rigid elements,
+  supports, loads, sets) in the file's units, ``UNIT_SYSTEMS``, ``to_si``, ``DeckError``.
+- nastran: Nastran bulk data → DeckModel (``read_nastran``, ``nastran_deck``); nastran_bdf: the file
+  through pyNastran (``load_bdf``) and a card's line for messages (``card_where``);
+  nastran_sections (PSHELL, PCOMP, materials), nastran_sets (SPC, loads, SET1);
+  nastran_writer (a PanelMesh written as a deck).
+- abaqus: Abaqus ``.inp`` → DeckModel (``read_abaqus``, ``section_values``); abaqus_lines (keyword
+  blocks, ``*INCLUDE``); abaqus_model (parts and instances flattened).
+"""

@@ -243,6 +243,12 @@ class DeckModel:
     element_sets          {name: (k,) int}       deck element ids: 'pid_<id>', Abaqus ELSETs
     unsupported           {card: count}          cards present that sarfe does not model
     ignored               {card: count}          cards deliberately not modelled (ignore_cards)
+    coupled_mass          bool                   the deck asks for coupled (consistent) element
+                                                 mass (Nastran PARAM,COUPMASS > 0); otherwise
+                                                 the commercial solvers' default, lumped
+    drilling_penalty      float                  α of the shells' drilling stiffness
+                                                 α C₃₃ ∫ (θz − ω)² dA (Nastran 1e-6·K6ROT,
+                                                 K6ROT = 100 by default)
     notes                 tuple[str]             things a user should know (e.g. MAT1 without
                                                  density read as ρ = 0)
     """
@@ -264,6 +270,8 @@ class DeckModel:
     element_sets: dict = field(default_factory=dict)
     unsupported: dict = field(default_factory=dict)
     ignored: dict = field(default_factory=dict)
+    coupled_mass: bool = False
+    drilling_penalty: float = 1e-4
     notes: tuple = ()
 
     @property

@@ -1,6 +1,6 @@
 """Nastran shell sections and shell elements → `ShellElements` (part of `sarfe.mesh.formats.nastran`).
 
-Functions take the reader (`sarfe.mesh.formats.nastran._Converter`: the cross-referenced pyNastran
+Functions take the reader (`sarfe.mesh.formats.nastran`'s converter: the cross-referenced pyNastran
 model, node indices, CD frames, ``fail`` for one-line DeckErrors, ``notes``).
 
 PSHELL: A = T·Q(MID1), D = 12I/T³ · T³/12 · Q(MID2), transverse shear TS/T · T · G(MID3),

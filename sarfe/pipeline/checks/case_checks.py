@@ -5,7 +5,8 @@ passes ``sarfe validate`` does not fail on its input later.
 
 Errors (CaseError, exit 2, one line naming the key or the element):
   * the case file itself (schema, non-finite numbers, signs, units: :func:`sarfe.case.read.load_case`);
-  * the mesh: readable, groups present, contacts pair (as :func:`sarfe.pipeline.model.linear_stage.check_mesh`);
+  * the mesh: readable, groups present, contacts pair (as :func:`sarfe.pipeline.checks.mesh_checks.check_mesh`),
+    no node pair listed twice in one contact;
   * element quality: zero-area triangles, duplicate triangles (same node set), coincident nodes
     that neither an element nor a contact pair joins (a crack) — :mod:`sarfe.mesh.quality`;
   * thickness plausibility: 1e-4·L < t < 0.1·L for the model size L (the bounding-box diagonal),
@@ -13,8 +14,11 @@ Errors (CaseError, exit 2, one line naming the key or the element):
   * the structure is held: every connected part of the mesh holds at least one fixed node (else
     the stiffness has rigid-body modes and the reduction cannot factorize it); a matrices model's
     K plus the springs of the contacts closed at rest is regular (:func:`check_matrices_held`);
-  * every force acts on a free DOF (a force group all fixed is an error, partly fixed a warning);
-  * the output folder: absent, empty or a sarfe result, and writable (:mod:`sarfe.results.folder`).
+  * something is free to move, every force acts on a free DOF and every contact on a free node
+    (a force group or a contact all held is an error, partly held a warning:
+    :mod:`sarfe.pipeline.checks.held_checks`);
+  * the output folder: absent, empty or a sarfe result, and writable (:mod:`sarfe.results.folder`);
+    never a folder holding a file the case reads (:mod:`sarfe.pipeline.checks.case_inputs`).
 
 Warnings (one line each, printed and written to summary.json ``warnings``) for inputs far outside
 the model's range:
@@ -25,7 +29,10 @@ the model's range:
   * H·f_max above ``reduction.cutoff_hz`` (the harmonics have no modes to live in);
   * an open gap larger than the structure (the contact can never close), or |gap_m| more than
     :data:`GAP_RANGE` × the thickest shell or the contact's tolerance_m (:func:`gap_warnings`);
-  * reduction.mode_count above the interior DOFs; a force group partly fixed.
+  * reduction.mode_count above the interior DOFs; a force group partly fixed; a node pair in two
+    contacts (:func:`~sarfe.pipeline.checks.mesh_checks.shared_pair_warnings`);
+  * values no squeak-and-rattle input has (:func:`sarfe.case.plausibility.plausibility_warnings`):
+    μ > 2, a base acceleration above 50 g, a preload pressing a contact more than 1 mm in.
 """
 from __future__ import annotations
 
@@ -33,12 +40,28 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from sarfe.case.plausibility import THICKNESS_RANGE, plausibility_warnings
 from sarfe.case.read import load_case
+from sarfe.erp import nodal_normals
+from sarfe.hbm.pruning import linearized_stiffness
+from sarfe.mesh import connected_components
+from sarfe.mesh.quality import coincident_nodes, degenerate_elements, duplicate_elements
+from sarfe.pipeline.checks.case_inputs import case_inputs
+from sarfe.pipeline.checks.held_checks import (check_something_free, contact_warnings,
+                                               load_warnings)
+from sarfe.pipeline.checks.mesh_checks import check_deck, shared_pair_warnings
+from sarfe.pipeline.model.case_mesh import load_case_mesh
+from sarfe.pipeline.model.contact_pairs import pair_contact
+from sarfe.pipeline.model.erp_map import surface_triangles
+from sarfe.pipeline.model.groups import fixed_nodes, resolve_node_group, shell_properties
+from sarfe.pipeline.model.linear_stage import build_linear_model
+from sarfe.pipeline.model.nonlinear_model import nonlinear_model
+from sarfe.results.folder import check_output_folder
 
 ELEMENTS_PER_WAVELENGTH = 6
 COINCIDENT_TOLERANCE = 1e-7      # × model size: nodes closer than this are at the same place
 DEGENERATE_TOLERANCE = 1e-8      # area ≤ this × (longest edge)²: a zero-area triangle
-THICKNESS_RANGE = (1e-4, 0.1)    # thickness / model size
+HELD_BY = "model.fe.fixed or on no triangle"
 
 
 @dataclass(frozen=True)
@@ -62,8 +85,6 @@ def _where(mesh, triangle) -> str:
 
 def check_element_quality(case, mesh, joined=()) -> None:
     """Zero-area and duplicate triangles, unjoined coincident nodes → CaseError naming them."""
-    from sarfe.mesh.quality import coincident_nodes, degenerate_elements, duplicate_elements
-
     where = ("model", "fe", "mesh") if case.config.model.fe.source == "mesh" else ("model", "fe",
                                                                                   "generator")
     ids = np.arange(mesh.n_triangles)
@@ -98,7 +119,7 @@ def check_element_quality(case, mesh, joined=()) -> None:
 def check_thickness(case, mesh) -> None:
     size = float(np.linalg.norm(np.ptp(mesh.points, axis=0)))
     low, high = THICKNESS_RANGE
-    for name, t in case.config.model.fe.data["thickness_m"].items():
+    for name, t in case.config.model.fe.thickness_m.items():
         path = ("model", "fe", "thickness_m", name)
         if t > high * size:
             raise case.error(f"thickness {t:g} m is not small against the model size {size:.3g} m "
@@ -110,8 +131,6 @@ def check_thickness(case, mesh) -> None:
 
 def check_held(case, mesh, fixed_nodes) -> None:
     """Every connected part of the shell mesh holds a fixed node (no rigid-body motion left)."""
-    from sarfe.mesh import connected_components
-
     count, labels = connected_components(mesh.n_nodes, mesh.triangles)
     held = np.zeros(count, bool)
     labels_fixed = labels[fixed_nodes]
@@ -127,29 +146,13 @@ def check_held(case, mesh, fixed_nodes) -> None:
                          f"{members[0]}); add a fixed group on it", ("model", "fe", "fixed"))
 
 
-def check_loads_free(case, mesh, fixed_nodes, load_nodes) -> list:
-    """Every force group of an FE case acts on a free DOF (``load_nodes``: the nodes of each
-    ``excitation.forces`` group, in order). The force F of a group is split equally over its n
-    nodes (F/n each) and a fixed node's share goes into the support, so a group whose nodes are
-    all held (fixed, or on no triangle) is a CaseError naming it, and a partly held group gets a
-    warning stating the share lost. Returns the warnings (one line each)."""
+def held_nodes(mesh, fixed_nodes) -> tuple:
+    """(held (n,), used (n,)) bool: a node of ``fixed_nodes`` or on no triangle is held."""
     used = np.zeros(mesh.n_nodes, bool)
     used[mesh.triangles.ravel()] = True
     held = ~used
     held[np.asarray(fixed_nodes, dtype=int)] = True
-    warnings = []
-    for i, (load, nodes) in enumerate(zip(case.config.excitation.forces, load_nodes)):
-        path = ("excitation", "forces", i, "group")
-        count = int(np.count_nonzero(held[nodes]))
-        if count == len(nodes):
-            raise case.error(f"the force on group {load['group']} acts on no free DOF: all of its "
-                             f"DOFs are fixed ({len(nodes)} node(s) held by model.fe.fixed or on "
-                             "no triangle)", path)
-        if count:
-            warnings.append(f"excitation.forces[{i}]: {count} of the {len(nodes)} nodes of group "
-                            f"{load['group']} are fixed: {100 * count / len(nodes):.3g} % of "
-                            f"force_N = {load['force_N']:g} N goes straight into the supports")
-    return warnings
+    return held, used
 
 
 HELD_MATRIX_LIMIT = 3000        # DOFs: a dense eigenvalue check above costs more than it finds
@@ -168,10 +171,6 @@ def check_matrices_held(case) -> None:
     point. K_0 (n, n) [N/m]; its eigenvalues λ ≤ :data:`RIGID_TOLERANCE`·max λ span the rigid-body
     modes. CaseError naming model.matrices.stiffness and the null-space size. Models above
     :data:`HELD_MATRIX_LIMIT` DOFs are not checked (a dense eigenvalue problem)."""
-    from sarfe.hbm.pruning import linearized_stiffness
-    from sarfe.pipeline.model.linear_stage import build_linear_model
-    from sarfe.pipeline.model.nonlinear_model import nonlinear_model
-
     stage = build_linear_model(case)
     n = stage.dof_count
     if n > HELD_MATRIX_LIMIT:
@@ -211,15 +210,10 @@ def bending_resolution_hz(points, triangles, thickness, young, poisson, density)
 def mesh_frequency_limit_hz(case, mesh) -> float:
     """Highest frequency [Hz] the case's mesh resolves: the median over its triangles of
     :func:`bending_resolution_hz` with each triangle's material and thickness."""
-    from sarfe.pipeline.model.linear_stage import _per_triangle
-
-    fe = case.config.model.fe.data
-    materials, thickness = list(fe["materials"].values()), list(fe["thickness_m"].values())
-    m = _per_triangle(case, mesh, fe["materials"], "materials")
-    t = np.asarray(thickness, dtype=float)[_per_triangle(case, mesh, fe["thickness_m"],
-                                                          "thickness_m")]
-    E, nu, rho = (np.array([mat[k] for mat in materials])[m] for k in ("E_Pa", "nu", "rho_kg_m3"))
-    return float(np.median(bending_resolution_hz(mesh.points, mesh.triangles, t, E, nu, rho)))
+    section = shell_properties(case, mesh)
+    return float(np.median(bending_resolution_hz(mesh.points, mesh.triangles, section.thickness,
+                                                 section.young, section.poisson,
+                                                 section.density)))
 
 
 GAP_RANGE = 10.0   # |gap_m| above this × the contact's reference length warns
@@ -233,13 +227,13 @@ def gap_warnings(case, mesh=None) -> list:
     tolerance_m = 0), or an open gap already larger than the structure (:func:`range_warnings`),
     no warning."""
     config = case.config
-    fe = config.model.fe.data if case.is_fe else {}
-    thickest = max((float(t) for t in fe.get("thickness_m", {}).values()), default=0.0)
+    thickness = config.model.fe.thickness_m if config.model.is_fe else {}
+    thickest = max((float(t) for t in thickness.values()), default=0.0)
     size = np.inf if mesh is None else float(np.linalg.norm(np.ptp(mesh.points, axis=0)))
     warnings = []
-    for i, contact in ((c.index, c.params) for c in config.contacts):
-        gap = contact.get("gap_m")
-        tolerance = float(contact.get("tolerance_m", 0.0))
+    for i, contact in enumerate(config.contacts):
+        gap = contact.gap_m
+        tolerance = float(contact.tolerance_m)
         reference = max(thickest, tolerance)
         if gap is None or reference <= 0.0 or abs(gap) <= GAP_RANGE * reference or gap > size:
             continue
@@ -248,16 +242,18 @@ def gap_warnings(case, mesh=None) -> list:
         kind = "an overclosure (the parts pressed" if gap < 0 else "an open gap (the parts"
         detail = (f"{kind} {abs(gap) * 1e3:.4g} mm into each other)" if gap < 0
                   else f"{kind} {gap * 1e3:.4g} mm apart)")
-        warnings.append(f"contacts[{i}] ({contact['name']}): gap_m = {gap:g} m is {detail}, "
+        warnings.append(f"contacts[{i}] ({contact.name}): gap_m = {gap:g} m is {detail}, "
                         f"more than {GAP_RANGE:g} × {what}: gap_m is in metres "
                         "(0.5 mm = 5e-4)")
     return warnings
 
 
 def range_warnings(case, mesh=None) -> list:
-    """One-line warnings for inputs far outside the model's range (module docstring)."""
-    warnings = []
+    """One-line warnings for inputs far outside the model's range (module docstring), and
+    those of :func:`sarfe.case.plausibility.plausibility_warnings` (μ, base acceleration,
+    preload overclosure)."""
     config = case.config
+    warnings = plausibility_warnings(config)
     top = _excitation_top_hz(case)
     H = config.solver.harmonics
     if mesh is not None:
@@ -267,10 +263,10 @@ def range_warnings(case, mesh=None) -> list:
                             f"~{limit:.4g} Hz the mesh resolves ({ELEMENTS_PER_WAVELENGTH} elements "
                             "per bending wavelength): refine the mesh or lower the harmonics")
         size = float(np.linalg.norm(np.ptp(mesh.points, axis=0)))
-        for i, contact in ((c.index, c.params) for c in config.contacts):
-            gap = contact.get("gap_m")
+        for i, contact in enumerate(config.contacts):
+            gap = contact.gap_m
             if gap is not None and gap > size:
-                warnings.append(f"contacts[{i}] ({contact['name']}): gap_m = {gap:g} m is larger "
+                warnings.append(f"contacts[{i}] ({contact.name}): gap_m = {gap:g} m is larger "
                                 f"than the structure ({size:.3g} m): the contact can never close")
     warnings += gap_warnings(case, mesh)
     cutoff = None if config.reduction is None else config.reduction.cutoff_hz
@@ -330,20 +326,15 @@ def reduced_model_warnings(case, stage) -> list:
 
 def output_target(case, output_dir=None, force=False):
     """The checked result folder of a case (``output_dir`` or ``output.directory``): absent, empty
-    or a previous sarfe result (or anything but the current/case folder with ``force``), and
-    writable — else CaseError, before any work (rules: :mod:`sarfe.results.folder`)."""
-    from sarfe.results.folder import check_output_folder
-
+    or a previous sarfe result (or, with ``force``, anything but the current or home folder or a
+    folder holding an input of the case: :func:`sarfe.pipeline.checks.case_inputs.case_inputs`),
+    and writable — else CaseError, before any work (rules: :mod:`sarfe.results.folder`)."""
     target = output_dir if output_dir is not None else case.config.output.directory
-    return check_output_folder(target, force=force, protected=[case.source])
+    return check_output_folder(target, force=force, protected=case_inputs(case))
 
 
 def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True) -> CaseCheck:
     """All checks of the module docstring. Raises CaseError at the first problem."""
-    from sarfe.erp import nodal_normals
-    from sarfe.pipeline.model.linear_stage import (_per_triangle, load_case_mesh, pair_contact,
-                                       resolve_node_group)
-
     case = load_case(case)
     output = output_target(case, output_dir, force) if write else None
     if not mesh_checks:
@@ -353,25 +344,22 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True)
         return CaseCheck({}, tuple(range_warnings(case)), output)
     config = case.config
     if config.model.fe.is_deck:   # a Nastran/Abaqus deck: its own checks, with ids
-        from sarfe.pipeline.model.deck_model import check_deck
         info = check_deck(case)
         return CaseCheck(info, tuple(range_warnings(case)) + tuple(info.pop("warnings")), output)
     mesh = load_case_mesh(case)
-    fe = config.model.fe.data
-    fixed = np.unique(np.concatenate([
-        resolve_node_group(case, mesh, g, ("model", "fe", "fixed", i), allow_elements=False)
-        for i, g in enumerate(fe["fixed"])]))
-    _per_triangle(case, mesh, fe["materials"], "materials")
-    _per_triangle(case, mesh, fe["thickness_m"], "thickness_m")
+    fixed = fixed_nodes(case, mesh)
+    held, used = held_nodes(mesh, fixed)
+    check_something_free(case, held, used)
+    shell_properties(case, mesh)
     check_thickness(case, mesh)
     normals = nodal_normals(mesh.points, mesh.triangles)
     paired = {c.name: pair_contact(case, mesh, c.index, normals) for c in config.contacts}
-    load_nodes = [resolve_node_group(case, mesh, f["group"], ("excitation", "forces", i, "group"))
+    shared = shared_pair_warnings(case, paired, mesh.points)
+    load_nodes = [resolve_node_group(case, mesh, f.group, ("excitation", "forces", i, "group"))
                   for i, f in enumerate(config.excitation.forces)]
-    load_warnings = check_loads_free(case, mesh, fixed, load_nodes)
-    surface = config.erp.surface
-    if surface is not None and surface not in mesh.element_groups:
-        resolve_node_group(case, mesh, surface, ("erp", "surface"))
+    warned = load_warnings(case, held, load_nodes, HELD_BY)
+    warned += contact_warnings(case, paired, held, HELD_BY)
+    surface_triangles(case, mesh)     # erp.surface: an element group, or a node group's triangles
     joined = [(int(a), int(b)) for p in paired.values() for a, b in zip(p[0], p[1])]
     check_element_quality(case, mesh, joined)
     check_held(case, mesh, fixed)
@@ -379,10 +367,12 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True)
             "contact_pairs": {name: len(p[0]) for name, p in paired.items()}}
     interior = interior_dof_count(mesh, fixed, np.concatenate(
         [np.zeros(0, int)] + [np.concatenate([p[0], p[1]]) for p in paired.values()] + load_nodes))
-    return CaseCheck(info, tuple(range_warnings(case, mesh)) + tuple(load_warnings)
+    return CaseCheck(info, tuple(range_warnings(case, mesh)) + tuple(shared)
+                     + tuple(warned)
                      + tuple(mode_count_warnings(case, interior)), output)
 
 
-__all__ = ["CaseCheck", "check_case", "check_loads_free", "check_matrices_held", "output_target", "check_element_quality", "check_held", "check_thickness",
-           "bending_resolution_hz", "mesh_frequency_limit_hz", "range_warnings", "reduced_model_warnings",
+__all__ = ["CaseCheck", "check_case", "held_nodes", "check_matrices_held", "output_target",
+           "check_element_quality", "check_held", "check_thickness", "bending_resolution_hz",
+           "mesh_frequency_limit_hz", "range_warnings", "reduced_model_warnings",
            "interior_dof_count", "mode_count_warnings", "gap_warnings"]

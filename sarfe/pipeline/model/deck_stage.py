@@ -1,7 +1,7 @@
-r"""The linear stage of a deck case: K, M of the prepared deck (:mod:`sarfe.pipeline.model.deck_model`) →
-supports → Craig–Bampton with the contact and force nodes' translations as boundary → contact
-geometry, load vectors and the ERP map, as :func:`sarfe.pipeline.model.linear_stage._build_fe` does for a
-generated mesh. The kept DOFs q of the deck (rigid elements eliminated, CD frames) relate to the
+r"""The linear stage of a deck case: K, M of the prepared deck (:mod:`sarfe.pipeline.model.
+deck_model`) → supports → Craig–Bampton with the contact and force nodes' translations as boundary
+→ contact geometry, load vectors and the ERP map, as :func:`sarfe.pipeline.model.fe_stage.
+build_fe_stage` does for a generated mesh. The kept DOFs q of the deck (rigid elements eliminated, CD frames) relate to the
 global DOFs by u = T q (`DeckSystem.transformation`); the reduced model handed on is expressed on
 all 6n global DOFs (:func:`expanded_reduced_model`) so ERP and VTU recovery see dependent nodes.
 """
@@ -13,16 +13,24 @@ import time
 import numpy as np
 
 from sarfe.case.read import Case
-from sarfe.pipeline.model.deck_model import DECK_KEY, prepare_deck
-from sarfe.pipeline.model.linear_stage import reduced_coordinates
+from sarfe.erp import nodal_normals
+from sarfe.fe.deck_assembly import assemble_deck, load_vector
+from sarfe.mesh.formats.deck import DeckError
+from sarfe.pipeline.model.contact_pairs import ContactGeometry, pair_contact, reduced_coordinates
+from sarfe.pipeline.model.cutoff import stage_cutoff_hz
+from sarfe.pipeline.model.deck_checks import DECK_KEY
+from sarfe.pipeline.model.deck_model import prepare_deck
+from sarfe.pipeline.model.erp_map import deck_surface_triangles, erp_map
+from sarfe.pipeline.model.groups import resolve_node_group
+from sarfe.pipeline.model.stage import next_step
+from sarfe.reduction.craig_bampton import craig_bampton
+from sarfe.reduction.reduced_model import free_dofs_system
+from sarfe.util.progress import bar as progress_bar
 
 _LOADED_BOUNDARY_LIMIT = 60   # load-set DOFs kept physically up to this count (else residuals)
 
 
 def _assemble(case: Case, deck):
-    from sarfe.fe.deck_assembly import assemble_deck
-    from sarfe.mesh.formats.deck import DeckError
-
     try:
         return assemble_deck(deck)
     except DeckError as exc:
@@ -47,9 +55,7 @@ def _kept_translations(case, system, deck, nodes, path):
 
 
 def _load_set_vector(case, system, deck, load, path):
-    from sarfe.fe.deck_assembly import load_vector
-
-    name = str(load["load_set"])
+    name = str(load.load_set)
     if name not in deck.loads:
         raise case.error(f"load set '{name}' not in the deck (available: "
                          f"{', '.join(sorted(deck.loads)) or 'none'})", path)
@@ -75,19 +81,18 @@ def expanded_reduced_model(reduced, transform, free, boundary_global):
                                full_dof_count=total, free_dofs=None, total_dof_count=total)
 
 
-def contact_pairs(prepared) -> dict:
+def contact_pairs(case: Case, prepared) -> dict:
     """{contact name: (nodes a, nodes b (−1 ground), frames (n_p, 3, 3), gaps (n_p,) [m])} of
-    a prepared deck: spring contacts from their elements, the others paired as for a mesh."""
-    from sarfe.erp import nodal_normals
-    from sarfe.pipeline.model.linear_stage import pair_contact
-
+    a prepared deck: spring contacts from their elements, the others paired as for a mesh
+    (their ``pairs`` GRID ids as node indices: ``prepared.pairs``)."""
     deck, mesh = prepared.deck, prepared.mesh
     normals = nodal_normals(mesh.points, mesh.triangles)
     paired = {}
-    for contact in prepared.case.config.contacts:
+    for contact in case.config.contacts:
         e = prepared.element_contacts.get(contact.name)
         if e is None:
-            paired[contact.name] = pair_contact(prepared.case, mesh, contact.index, normals)
+            paired[contact.name] = pair_contact(case, mesh, contact.index, normals,
+                                                prepared.pairs.get(contact.index))
             continue
         distance = np.zeros(len(e.nodes_a))
         b = e.nodes_b >= 0
@@ -95,17 +100,6 @@ def contact_pairs(prepared) -> dict:
                                 deck.points[e.nodes_b[b]] - deck.points[e.nodes_a[b]])
         paired[contact.name] = (e.nodes_a, e.nodes_b, e.frames, distance)
     return paired
-
-
-def radiating_triangles(case: Case, mesh) -> np.ndarray:
-    """Triangles of the ERP surface: every shell, or the element group erp.surface."""
-    surface = case.config.erp.surface
-    if surface is None:
-        return mesh.triangles
-    if surface not in mesh.element_groups:
-        raise case.error(f"element group '{surface}' not in the deck (available: "
-                         f"{', '.join(sorted(mesh.element_groups)[:30])})", ("erp", "surface"))
-    return mesh.triangles[mesh.element_groups[surface]]
 
 
 def held_kept_dofs(case: Case, prepared, system) -> np.ndarray:
@@ -125,13 +119,9 @@ def held_kept_dofs(case: Case, prepared, system) -> np.ndarray:
 
 def _craig_bampton(case: Case, k_ff, m_ff, boundary_positions, residual_loads):
     """(ReducedModel, cutoff) with the case's reduction settings; a solver failure is one line."""
-    from sarfe.pipeline.model.linear_stage import default_cutoff_hz
-    from sarfe.reduction.craig_bampton import craig_bampton
-
     red = case.config.reduction
     use_residuals = red.residual_vectors
-    cutoff = red.cutoff_hz if red.cutoff_hz is not None else (
-        None if red.mode_count is not None else default_cutoff_hz(case.config))
+    cutoff = stage_cutoff_hz(case.config)
     loads = np.stack(residual_loads, axis=1) if residual_loads and use_residuals else None
     try:
         def reduce(mode_count, cutoff_hz):
@@ -150,28 +140,24 @@ def _craig_bampton(case: Case, k_ff, m_ff, boundary_positions, residual_loads):
 
 
 def build_deck_stage(case: Case, progress=False) -> dict:
-    """The linear stage of a deck case (the fields of :class:`sarfe.pipeline.model.linear_stage.LinearStage`)."""
-    from sarfe.erp import nodal_areas, nodal_normals
-    from sarfe.pipeline.model.linear_stage import ContactGeometry, _bar, _step, resolve_node_group
-    from sarfe.reduction.craig_bampton import free_dofs_system
-    from sarfe.reduction.recovery import normal_velocity_basis
-
+    """The linear stage of a deck case (the fields of :class:`sarfe.pipeline.model.stage.
+    LinearStage`)."""
     timings, clock = {}, time.perf_counter()
-    stages = _bar(progress, "linear stage", 4, unit="step")
+    stages = progress_bar(progress, "linear stage", 4, "step")
     prepared = prepare_deck(case)
-    deck, mesh, work = prepared.deck, prepared.mesh, prepared.case
+    deck, mesh = prepared.deck, prepared.mesh
     timings["deck_s"] = time.perf_counter() - clock
 
     # contacts and loads first: the errors a user is most likely to make
-    paired = contact_pairs(prepared)
+    paired = contact_pairs(case, prepared)
     exc = case.config.excitation
     forces = exc.forces
-    group_nodes = [None if "load_set" in f else
-                   resolve_node_group(work, mesh, f["group"], ("excitation", "forces", i, "group"))
+    group_nodes = [None if f.load_set is not None else
+                   resolve_node_group(case, mesh, f.group, ("excitation", "forces", i, "group"))
                    for i, f in enumerate(forces)]
-    radiating = radiating_triangles(case, mesh)
+    radiating = deck_surface_triangles(case, mesh)
 
-    _step(stages, "assembly")
+    next_step(stages, "assembly")
     clock = time.perf_counter()
     system = _assemble(case, deck)
     timings["assembly_s"] = time.perf_counter() - clock
@@ -179,7 +165,7 @@ def build_deck_stage(case: Case, progress=False) -> dict:
     if not mass_kg > 0:
         raise case.error("the deck has no mass (" + ("; ".join(deck.notes) or "no density, "
                          "no point masses") + "): give densities (or materials overrides)", DECK_KEY)
-    _step(stages, "reduction")
+    next_step(stages, "reduction")
     n_kept = system.n_dofs
     fixed = held_kept_dofs(case, prepared, system)
     k_ff, m_ff, free = free_dofs_system(system.stiffness, system.mass, fixed)
@@ -192,7 +178,7 @@ def build_deck_stage(case: Case, progress=False) -> dict:
                                      + [np.zeros(0, np.int64)]).astype(np.int64))
     boundary_kept = _kept_translations(case, system, deck, nodes, ("contacts",)).ravel()
     set_vectors = [(_load_set_vector(case, system, deck, f, ("excitation", "forces", i, "load_set"))
-                    if "load_set" in f else None) for i, f in enumerate(forces)]
+                    if f.load_set is not None else None) for i, f in enumerate(forces)]
     loaded = np.unique(np.concatenate([np.flatnonzero(v) for v in set_vectors if v is not None]
                                       + [np.zeros(0, np.int64)]))
     residual_loads = []
@@ -208,7 +194,7 @@ def build_deck_stage(case: Case, progress=False) -> dict:
 
     base_load = None
     if exc.base_acceleration is not None:   # rigid translation ι in the kept (CD) DOFs; −M ι
-        direction = np.asarray(exc.base_acceleration["direction"], dtype=float)
+        direction = np.asarray(exc.base_acceleration.direction, dtype=float)
         local = np.einsum("nij,j->ni", deck.displacement_frames, direction)
         iota = np.where(system.dof_components < 3,
                         local[system.dof_nodes, np.minimum(system.dof_components, 2)], 0.0)
@@ -218,7 +204,7 @@ def build_deck_stage(case: Case, progress=False) -> dict:
     clock = time.perf_counter()
     reduced, cutoff = _craig_bampton(case, k_ff, m_ff, boundary_positions, residual_loads)
     timings["reduction_s"] = time.perf_counter() - clock
-    _step(stages, "contacts, loads, ERP map")
+    next_step(stages, "contacts, loads, ERP map")
     n_b, n_r = reduced.boundary_count, reduced.reduced_dof_count
     kept_of_boundary = free[reduced.boundary_dofs]
     boundary_global = 6 * system.dof_nodes[kept_of_boundary] + system.dof_components[kept_of_boundary]
@@ -239,7 +225,7 @@ def build_deck_stage(case: Case, progress=False) -> dict:
         c = coords_of(nodes_i)
         for comp in range(3):
             ok = c[:, comp] >= 0
-            np.add.at(loads[i], c[ok, comp], load["direction"][comp] / len(nodes_i))
+            np.add.at(loads[i], c[ok, comp], load.direction[comp] / len(nodes_i))
     base = reduced_load(base_load) if base_load is not None else None
 
     added_damping = None
@@ -258,11 +244,8 @@ def build_deck_stage(case: Case, progress=False) -> dict:
             geometry = dataclasses.replace(geometry, normal_stiffness=e.normal_stiffness,
                                            tangential_stiffness=e.tangential_stiffness)
         contacts[name] = geometry
-    erp_nodes = np.unique(radiating)
-    areas = nodal_areas(mesh.points, radiating)[erp_nodes]
-    normals = nodal_normals(mesh.points, radiating)[erp_nodes]
-    erp_map = normal_velocity_basis(expanded, normals, erp_nodes)
-    _step(stages, None)
+    erp_nodes, areas, surface_map = erp_map(mesh, radiating, expanded)
+    next_step(stages, None)
     info = {"nodes": int(deck.n_nodes), "triangles": int(mesh.n_triangles),
             "total_dofs": int(6 * deck.n_nodes), "kept_dofs": int(n_kept),
             "free_dofs": int(len(free)), "held_dofs": int(len(fixed)),
@@ -274,7 +257,7 @@ def build_deck_stage(case: Case, progress=False) -> dict:
             "total_mass_kg": mass_kg,
             **prepared.notes}
     return dict(kind="fe", mass=reduced.mass, stiffness=reduced.stiffness, damping=None,
-                load_vectors=loads, base_vector=base, contacts=contacts, erp_map=erp_map,
+                load_vectors=loads, base_vector=base, contacts=contacts, erp_map=surface_map,
                 erp_areas=areas, erp_nodes=erp_nodes, mesh=mesh, reduced=expanded,
                 mode_frequencies_hz=reduced.mode_frequencies_hz, info=info, timings=timings,
                 node_ids=deck.node_ids, added_damping=added_damping)
@@ -286,3 +269,6 @@ def _translational_mass(system, deck) -> float:
     iota = np.where(system.dof_components < 3,
                     local[system.dof_nodes, np.minimum(system.dof_components, 2)], 0.0)
     return float(iota @ (system.mass @ iota))
+
+
+__all__ = ["build_deck_stage", "contact_pairs", "expanded_reduced_model", "held_kept_dofs"]

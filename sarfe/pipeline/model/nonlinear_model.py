@@ -14,10 +14,15 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
-from sarfe.case.read import Case, load_case
 from sarfe.case.config import DampingConfig, ExcitationConfig
-from sarfe.pipeline.model.linear_stage import LinearStage
+from sarfe.case.read import Case, load_case
+from sarfe.fe.damping import modal_damping
+from sarfe.hbm import laws
+from sarfe.hbm.contacts import make_contact_set
+from sarfe.hbm.model import make_linear_model
+from sarfe.pipeline.model.stage import LinearStage
 
 
 @dataclass(frozen=True)
@@ -45,26 +50,25 @@ def _case_damping(damping: DampingConfig, stage: LinearStage):
     if stage.damping is not None:
         return stage.damping
     if damping.rayleigh is not None:
-        return damping.rayleigh["alpha_1_s"] * M + damping.rayleigh["beta_s"] * K
-    from sarfe.reduction.damping import reduced_modal_damping
-
+        return damping.rayleigh.alpha_1_s * M + damping.rayleigh.beta_s * K
     n = M.shape[0]
     zeta = 0.0 if damping.modal_zeta is None else damping.modal_zeta
-    if isinstance(zeta, tuple):         # per mode range: ({modes: [first, last], zeta}, …)
-        values = np.full(n, zeta[-1]["zeta"])
+    if isinstance(zeta, tuple):         # per mode range: (ModalZetaRange, …)
+        values = np.full(n, zeta[-1].zeta)
         for entry in zeta:
-            first, last = entry["modes"]
-            values[first - 1:min(last, n)] = entry["zeta"]
+            first, last = entry.modes
+            values[first - 1:min(last, n)] = entry.zeta
         zeta = values
     dense = (lambda A: A.toarray() if sp.issparse(A) else np.asarray(A))
-    return reduced_modal_damping(dense(M), dense(K), zeta)
+    return modal_damping(dense(M), dense(K), zeta)
 
 
 def _dof_row(ref, n):
+    """(n,) row r of a :class:`~sarfe.case.config.DofReference`: r·u = sign (u[dof] − u[relative_to])."""
     row = np.zeros(n)
-    row[ref["dof"]] += ref["sign"]
-    if ref["relative_to"] != "ground":
-        row[ref["relative_to"]] -= ref["sign"]
+    row[ref.dof] += ref.sign
+    if ref.relative_to != "ground":
+        row[ref.relative_to] -= ref.sign
     return row
 
 
@@ -76,9 +80,6 @@ def build_contacts(case: Case, stage: LinearStage):
     ``preload_N`` sets the overclosure from the law's static deflection (normal DOF) or the
     constant normal load (no normal DOF); parameters declared ``from_model`` that the case leaves
     out (the effective mass of a normal row) are computed from the model."""
-    from sarfe.hbm import laws
-    from sarfe.hbm.contacts import make_contact_set
-
     n = stage.dof_count
     rows, kind, normal_row, tangent_rows = [], [], [], []
     gap, names, tolerance, groups = [], [], [], []
@@ -113,9 +114,9 @@ def build_contacts(case: Case, stage: LinearStage):
             has_normal = True
         else:
             pairs = 1
-            has_normal = "normal_dof" in contact
-            normal_row.append(add_row(_dof_row(contact["normal_dof"], n)) if has_normal else -1)
-            t = [add_row(_dof_row(ref, n)) for ref in contact.get("tangential_dofs", [])]
+            has_normal = entry.normal_dof is not None
+            normal_row.append(add_row(_dof_row(entry.normal_dof, n)) if has_normal else -1)
+            t = [add_row(_dof_row(ref, n)) for ref in entry.tangential_dofs]
             tangent_rows.append((t + [-1, -1])[:2])
             share = 1.0
         values = {}
@@ -141,10 +142,10 @@ def build_contacts(case: Case, stage: LinearStage):
                                                               dtype=float)
         if not has_normal:
             g = np.zeros(pairs)
-            values["normal_load"] = contact["preload_N"] * share
-        elif "gap_m" in contact:
-            g = np.full(pairs, float(contact["gap_m"]))
-        elif "preload_N" in contact:    # set by preload_gaps below
+            values["normal_load"] = entry.preload_N * share
+        elif entry.gap_m is not None:
+            g = np.full(pairs, float(entry.gap_m))
+        elif entry.preload_N is not None:    # set by preload_gaps below
             g = np.zeros(pairs)
         else:  # FE default: the geometric gap of each node pair along its normal
             g = np.asarray(stage.contacts[name].distances, dtype=float)
@@ -153,11 +154,11 @@ def build_contacts(case: Case, stage: LinearStage):
         for key in table:
             value = values.get(key, np.nan)
             table[key] += list(per_pair[key]) if key in per_pair else [value] * pairs
-        kind += [contact["type"]] * pairs
+        kind += [entry.kind] * pairs
         gap += list(g)
-        tolerance += [contact["tolerance_m"]] * pairs
+        tolerance += [entry.tolerance_m] * pairs
         names += [name] if pairs == 1 else [f"{name}[{p}]" for p in range(pairs)]
-        groups.append((name, contact["type"], np.arange(start, len(kind))))
+        groups.append((name, entry.kind, np.arange(start, len(kind))))
     G = sp.csr_matrix(np.array(rows).reshape(len(rows), n))
     gap = np.array(gap, dtype=float)
     normal_row = np.array(normal_row, dtype=int)
@@ -169,8 +170,8 @@ def build_contacts(case: Case, stage: LinearStage):
     contacts = make_contact_set(G, np.array(kind, dtype=object), normal_row,
                                 np.array(tangent_rows, dtype=int).reshape(-1, 2), gap,
                                 names=names, parameters=parameters)
-    preloaded = [(idx, c["preload_N"]) for c, (_, _, idx) in zip(case.config.contacts, groups)
-                 if "preload_N" in c.params and "gap_m" not in c.params
+    preloaded = [(idx, c.preload_N) for c, (_, _, idx) in zip(case.config.contacts, groups)
+                 if c.preload_N is not None and c.gap_m is None
                  and np.all(normal_row[idx] >= 0)]
     if preloaded:
         contacts = dataclasses.replace(contacts, gap=preload_gaps(
@@ -200,9 +201,7 @@ def _parameter_table(table, kind):
 def _fill_from_model(parameters, mass, gap_map, normal_row):
     """Parameters declared ``from_model`` and left out (NaN): the effective mass of each normal
     row, 1/m_eff = g M⁻¹ gᵀ [kg] (g: the row of G)."""
-    from sarfe.hbm.laws import all_parameters
-
-    declared = all_parameters()
+    declared = laws.all_parameters()
     for key, values in parameters.items():
         p = declared.get(key)
         if p is None or not p.from_model:
@@ -213,7 +212,6 @@ def _fill_from_model(parameters, mass, gap_map, normal_row):
             continue
         rows = gap_map[normal_row[missing]]
         if sp.issparse(mass):
-            import scipy.sparse.linalg as spla
             solved = spla.spsolve(sp.csc_matrix(mass), rows.T.tocsc())
             solved = solved.toarray() if sp.issparse(solved) else np.asarray(solved)
         else:
@@ -235,8 +233,6 @@ def preload_gaps(stiffness, gap_map, normal_row, gap, contacts, preloaded):
     Only the preloaded contacts are assumed closed (the others open) and all are solved together.
     A singular K (a free-floating matrices model) falls back to g = −δ(λ).
     """
-    from sarfe.hbm import laws
-
     index = np.concatenate([idx for idx, _ in preloaded])
     force = np.concatenate([np.full(len(idx), load / len(idx)) for idx, load in preloaded])
     deflection = np.zeros(len(index))
@@ -263,18 +259,16 @@ def excitation_amplitude(excitation: ExcitationConfig, stage: LinearStage) -> np
     """F̂ (n,) complex [N]: f_e(θ) = Re(F̂ e^{iθ})."""
     amplitude = np.zeros(stage.dof_count, dtype=complex)
     for load, vector in zip(excitation.forces, stage.load_vectors):
-        amplitude += load["force_N"] * np.exp(1j * math.radians(load["phase_deg"])) * vector
+        amplitude += load.force_N * np.exp(1j * math.radians(load.phase_deg)) * vector
     if excitation.base_acceleration is not None:
         base = excitation.base_acceleration
-        amplitude += (base["amplitude_m_s2"] * np.exp(1j * math.radians(base["phase_deg"]))
+        amplitude += (base.amplitude_m_s2 * np.exp(1j * math.radians(base.phase_deg))
                       * stage.base_vector)
     return amplitude
 
 
 def nonlinear_model(case, stage: LinearStage) -> NonlinearModel:
     """LinearModel (with damping), ContactSet and excitation harmonics of a case."""
-    from sarfe.hbm.model import make_linear_model
-
     case = load_case(case)
     model = make_linear_model(stage.mass, damping_matrix(case.config.damping, stage),
                                stage.stiffness)

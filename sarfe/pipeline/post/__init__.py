@@ -1,1 +1,4 @@
-"""Stage 4 of a case: ERP, contact indicators, baseline, estimates and records per point."""
+"""Stage 4 of a case: per point ERP, contact indicators, linear baseline, bands (records), the
+contribution of each contact (contribution_records), impacts, slip and dissipated energy
+(contact_dynamics), the arrays of the result files (result_data), and the per-point work on
+worker processes (point_workers)."""

@@ -18,11 +18,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from sarfe.hbm.harmonics import derivative_matrix, time_samples
+
 
 def _row_work(solution) -> np.ndarray:
     """∮ λ ṙ dt per contact row (n_rows,) [J]."""
-    from sarfe.hbm.harmonics import derivative_matrix
-
     R = np.asarray(solution.contact_displacement, dtype=float)
     L = np.asarray(solution.contact_force, dtype=float)
     H = (R.shape[0] - 1) // 2
@@ -36,8 +36,6 @@ def _row_work(solution) -> np.ndarray:
 def contact_dynamics(solution, nl) -> list[dict]:
     """Per named contact (``nl.groups`` order): impacts_per_period, peak_force_N,
     slip_distance_m (squeak contacts; NaN otherwise), dissipated_energy_J (module docstring)."""
-    from sarfe.hbm.harmonics import time_samples
-
     cs = nl.contacts
     if not cs.count:
         return []

@@ -21,7 +21,11 @@ with Q built once per model: a point costs O(S H n²), whatever the size of the 
 from __future__ import annotations
 
 import numpy as np
+
 from sarfe.case.config import ErpConfig
+from sarfe.erp.contributions import contributions_from_gram, ranking_lines, superposition_stack
+from sarfe.erp import reduced as reduced_erp
+from sarfe.hbm.dynamic_stiffness import condense, to_complex
 
 EXCITATION = "excitation"
 
@@ -43,8 +47,6 @@ def source_displacements(condensation, contact_force, member) -> np.ndarray:
     applied without forming it: :meth:`sarfe.hbm.dynamic_stiffness.Condensation.apply_admittance`);
     contact_force: λ̃ harmonics (2H+1, n_rows) [N] (sarfe convention); member: :func:`contact_rows`.
     """
-    from sarfe.hbm.dynamic_stiffness import to_complex
-
     lam = to_complex(np.asarray(contact_force, dtype=float))[np.asarray(condensation.orders)]
     y = np.asarray(condensation.forced)                                     # (H, n)
     if not member.shape[1]:
@@ -57,9 +59,7 @@ def radiation_gram(stage) -> np.ndarray:
     """Q = Nᵀ diag(A) N (n, n) [m²], N = ``stage.erp_map`` (n_s, n) the radiating-node normal
     displacement per reduced coordinate, A the nodal areas: Σ_i A_i |w_i|² = uᴴ Q u for any
     complex reduced displacement u (:func:`sarfe.erp.reduced.radiation_gram`, once per stage)."""
-    from sarfe.erp.reduced import radiation_gram as gram
-
-    return gram(stage.erp_map, stage.erp_areas)
+    return reduced_erp.radiation_gram(stage.erp_map, stage.erp_areas)
 
 
 def reduced_gram(Q, X, omega) -> np.ndarray:
@@ -77,8 +77,6 @@ def reduced_gram(Q, X, omega) -> np.ndarray:
 def point_condensation(nl, solution):
     """The condensation of orders 1 … H of the excitation at the point's ω
     (:func:`sarfe.hbm.dynamic_stiffness.condense`), or None when a Z_k is singular there."""
-    from sarfe.hbm.dynamic_stiffness import condense
-
     U = np.asarray(solution.displacement, dtype=float)
     H = (U.shape[0] - 1) // 2
     excitation = np.zeros_like(U)
@@ -99,9 +97,6 @@ def point_contributions(erp: ErpConfig, stage, nl, solution, condensation=False)
     Γ_k = (kω)² X_kᴴ Q X_k with Q = Nᵀ diag(A) N (:func:`radiation_gram`, once per model), equal to
     the nodal sums Σ_i A_i v̄ v of :func:`sarfe.erp.contributions.erp_contributions` without
     recovering the radiating-node field of every source at every point."""
-    from sarfe.erp.contributions import contributions_from_gram, superposition_stack
-    from sarfe.hbm.dynamic_stiffness import to_complex
-
     if not nl.contacts.count:
         return None, "no contacts"
     if stage.erp_map.shape[0] == 0:
@@ -131,8 +126,6 @@ def contributions_record(erp: ErpConfig, stage, nl, solution, condensation=False
         result, reason = None, f"{type(error).__name__}: {error}"
     if result is None:
         return {"available": False, "reason": reason}
-    from sarfe.erp.contributions import ranking_lines
-
     record = {"available": True, **result.as_dict()}
     record["ranking"] = ranking_lines(result, float(solution.omega) / (2 * np.pi),
                                       skip=(EXCITATION,))

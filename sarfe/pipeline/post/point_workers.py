@@ -24,9 +24,11 @@ result is that path's.
 """
 from __future__ import annotations
 
-from sarfe.hbm.stability.deferred import pending, stability_of, with_stability
 from sarfe.case.config import CaseConfig, SolverConfig
-from sarfe.util.progress import bar as _bar
+from sarfe.hbm.stability.deferred import pending, stability_of, with_stability
+from sarfe.pipeline.post import records
+from sarfe.pipeline.solve.points import common_samples
+from sarfe.util.progress import bar as progress_bar
 from sarfe.util.workers import Stream, map_points, worker_count
 
 
@@ -47,10 +49,8 @@ def first_estimates(config: CaseConfig, stage, nl, solutions) -> dict:
     estimated_points`), computed in this process: the caches it builds (the coarser Craig–Bampton
     model, the modal bases) are inherited by the workers forked after it, as the serial loop's
     later estimates find them, so every estimate has the serial path's round-off."""
-    from sarfe.pipeline.post.records import estimated_points, point_estimate
-
-    return {i: point_estimate(config, stage, nl, solutions[i])
-            for i in estimated_points(config, nl, solutions)[:1]}
+    return {i: records.point_estimate(config, stage, nl, solutions[i])
+            for i in records.estimated_points(config, nl, solutions)[:1]}
 
 
 def point_work(config: CaseConfig, stage, nl, solutions, jobs, done, first, workers,
@@ -72,24 +72,19 @@ def point_work(config: CaseConfig, stage, nl, solutions, jobs, done, first, work
     serially). The records are filled with the verdicts and estimates afterwards
     (:func:`sarfe.pipeline.post.records.with_verdict`, ``with_estimate``): the same records as the
     serial path's."""
-    from sarfe.pipeline.solve.points import common_samples
-    from sarfe.pipeline.post.records import (error_estimates, estimated_points, point_estimate,
-                                            point_records, record_chunks, with_estimate,
-                                            with_verdict)
-
     indices = pending(solutions) if jobs is not None else []
     done = done or {}
     if any(isinstance(done.get(i), Exception) for i in indices):
         return None
     hill = [i for i in indices if i not in done]
-    estimates = [i for i in estimated_points(config, nl, solutions) if i not in first]
+    estimates = [i for i in records.estimated_points(config, nl, solutions) if i not in first]
     gridded = common_samples(nl, solutions)      # records at one N; estimates at each point's own
     # two pools: the Hill and estimate items first, then the records on freshly forked workers
     # (a worker's heap keeps its high-water mark: Hill's working arrays beside the records sent
     # back to this process put P1's tree PSS at 4.1–4.3 GB in one pool, over its 4 GB budget)
     first_pool = [("stability", i) for i in hill] + [("estimate", i) for i in estimates]
     # records by chunks of points: one product with the ERP map per chunk (postprocess)
-    second_pool = [("records", tuple(chunk)) for chunk in record_chunks(len(gridded))]
+    second_pool = [("records", tuple(chunk)) for chunk in records.record_chunks(len(gridded))]
     tasks = first_pool + second_pool
 
     def run(task):
@@ -100,15 +95,15 @@ def point_work(config: CaseConfig, stage, nl, solutions, jobs, done, first, work
             except Exception as error:      # the serial path's sweep is solved instead
                 return error
         if kind == "estimate":
-            return point_estimate(config, stage, nl, solutions[i])
-        return point_records(config, stage, nl, [(j, gridded[j], None) for j in i])
+            return records.point_estimate(config, stage, nl, solutions[i])
+        return records.point_records(config, stage, nl, [(j, gridded[j], None) for j in i])
 
     n = len(gridded)
     what = (f"{'ERP and error estimates' if config.solver.error_estimate else 'ERP'} "
             f"({n} point{'s' if n != 1 else ''})"
             + (f", Hill stability of the {len(hill)} left" if hill else "")
             + (f" on {workers} processes" if len(tasks) > 1 else ""))
-    bar = _bar(progress, what, len(tasks), unit="item")
+    bar = progress_bar(progress, what, len(tasks), "item")
     tick = None if bar is None else (lambda item: bar.update(1))
     try:
         results = (map_points(run, first_pool, workers, progress=tick)
@@ -123,25 +118,24 @@ def point_work(config: CaseConfig, stage, nl, solutions, jobs, done, first, work
     if indices:
         gridded = with_stability(gridded, indices, [verdicts[i] for i in indices])
     computed = {**first, **{i: by_task["estimate", i] for i in estimates}}
-    per_point = error_estimates(config, stage, nl, solutions, computed=computed)
-    records = [record for _, chunk in second_pool for record in by_task["records", chunk]]
-    for (point, row, _, _), solution, estimate in zip(records, gridded, per_point):
-        with_verdict(point, row, solution)
-        with_estimate(point, row, estimate)
-    return gridded, records
+    per_point = records.error_estimates(config, stage, nl, solutions, computed=computed)
+    done_records = [record for _, chunk in second_pool for record in by_task["records", chunk]]
+    for (point, row, _, _), solution, estimate in zip(done_records, gridded, per_point):
+        records.with_verdict(point, row, solution)
+        records.with_estimate(point, row, estimate)
+    return gridded, done_records
 
 
 def point_records(config: CaseConfig, stage, nl, solutions, estimates, workers,
                   progress=None) -> list:
     """[(point dict, table row, ErpResult, map fields)] per solution (:func:`sarfe.pipeline.
-    postprocess.point_records`, by chunks of points), on ``workers`` processes; ``progress()``
+    post.records.point_records`, by chunks of points), on ``workers`` processes; ``progress()``
     once per point (a chunk's points when it finishes)."""
-    from sarfe.pipeline.post.records import point_records as records_of, record_chunks
-
-    chunks = record_chunks(len(solutions))
+    chunks = records.record_chunks(len(solutions))
 
     def record(chunk):
-        return records_of(config, stage, nl, [(i, solutions[i], estimates[i]) for i in chunk])
+        return records.point_records(config, stage, nl,
+                                     [(i, solutions[i], estimates[i]) for i in chunk])
 
     def tick(chunk):
         for _ in chunk:

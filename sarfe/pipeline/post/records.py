@@ -12,6 +12,7 @@ not unstable point of highest A-weighted ERP; every artefact "at the loudest poi
 """
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 
@@ -19,7 +20,16 @@ import numpy as np
 import scipy.sparse as sp
 
 from sarfe.case.config import CaseConfig, ErpConfig, SolverConfig
+from sarfe.erp import equivalent_radiated_power
+from sarfe.erp.bands import third_octave_levels
+from sarfe.erp.risk import linear_risk_from_contacts
+from sarfe.hbm import laws
+from sarfe.hbm.harmonics import time_samples
 from sarfe.pipeline.model.nonlinear_model import NonlinearModel
+from sarfe.pipeline.post.contact_dynamics import contact_dynamics
+from sarfe.pipeline.post.contribution_records import contributions_record, point_condensation
+from sarfe.pipeline.solve.case_accuracy import stage_error_estimate
+from sarfe.results.vtk import radiating_fields
 from sarfe.util.workers import map_points
 
 
@@ -32,13 +42,11 @@ def radiating_displacement(stage, displacement) -> np.ndarray:
     return np.asarray(displacement) @ stage.erp_map.T
 
 
-def _erp(erp: ErpConfig, stage, displacement, omega, normal_displacement=None):
+def point_erp(erp: ErpConfig, stage, displacement, omega, normal_displacement=None):
     """(ErpResult, W) of displacement harmonics (2H+1, n) at ω (zero power without radiating
     nodes); ``normal_displacement``: W = :func:`radiating_displacement` of them when already
     computed. ``erp``: the case's :class:`ErpConfig` (a Case is also taken, for
-    sarfe.pipeline.solve.verify)."""
-    from sarfe.erp import equivalent_radiated_power
-
+    sarfe.pipeline.verify)."""
     if not isinstance(erp, ErpConfig):
         erp = erp.config.erp
     W = radiating_displacement(stage, displacement) if normal_displacement is None \
@@ -63,8 +71,6 @@ def _erp_dict(result):
 
 def contact_indicators(solution, nl: NonlinearModel) -> list[dict]:
     """Per named contact: max penetration, peak normal/friction force, open/stick/slip fractions."""
-    from sarfe.hbm.harmonics import time_samples
-
     cs = nl.contacts
     R = np.asarray(solution.contact_displacement)
     force = np.asarray(solution.contact_force_time)
@@ -107,8 +113,6 @@ def baseline_rows(contacts):
     overclosure that carries the preload) keeps its normal spring and dashpot; a friction pair
     that carries a static normal force there (closed, or a constant normal load N0 > 0) is stuck
     and keeps k_t on its tangent rows. Open pairs are removed (0)."""
-    from sarfe.hbm import laws
-
     c = contacts
     normal, tangent = laws.linearization(c)
     springs, dashpots = np.zeros(c.row_count), np.zeros(c.row_count)
@@ -211,8 +215,6 @@ def linear_baseline(erp: ErpConfig, stage, nl: NonlinearModel, omega, condensati
     linear risk per named contact. ``response``: Û when computed beforehand; ``normal_
     displacement``: the radiating rows (2, n_s) of its [Re Û, −Im Û] (:func:`radiating_
     displacement`, shared with the point's own harmonics by :func:`point_record`)."""
-    from sarfe.erp.risk import linear_risk_from_contacts
-
     U1 = baseline_response(nl, omega, condensation) if response is None else response
     H = (nl.excitation.shape[0] - 1) // 2
     U = np.zeros((2 * H + 1, stage.dof_count))
@@ -221,7 +223,7 @@ def linear_baseline(erp: ErpConfig, stage, nl: NonlinearModel, omega, condensati
     if normal_displacement is not None:
         W = np.concatenate([np.zeros((1, np.shape(normal_displacement)[1])),
                             normal_displacement])
-    erp, _ = _erp(erp, stage, U[:3], omega, W)
+    erp, _ = point_erp(erp, stage, U[:3], omega, W)
     contacts = []
     if nl.contacts.count:
         R = (nl.contacts.gap_map @ U.T).T
@@ -247,7 +249,7 @@ ESTIMATE_STRIDE = 8     # a sweep's estimate is computed at every 8th converged 
 
 
 def _error_estimate(solver: SolverConfig, stage, nl, solution):
-    """A-posteriori error estimate of a converged point (:mod:`sarfe.accuracy.estimates`): harmonic
+    """A-posteriori error estimate of a converged point (:mod:`sarfe.accuracy.estimate`): harmonic
     truncation (H → H' and N → N' solved by condensed Newton from the point, usually 1–4
     iterations), AFT aliasing (N → 2N, likewise), modal truncation (the same on the cached coarser
     Craig–Bampton model), spectral tails. None when switched off, not converged or without
@@ -256,8 +258,6 @@ def _error_estimate(solver: SolverConfig, stage, nl, solution):
             or not nl.contacts.count:
         return None
     try:
-        from sarfe.pipeline.solve.case_accuracy import stage_error_estimate
-
         return stage_error_estimate(solution, stage, nl).as_dict()
     except Exception as error:  # an estimate must not break a solve
         return {"failed": f"{type(error).__name__}: {error}"}
@@ -358,8 +358,6 @@ def harmonic_set_record(solver: SolverConfig, solution):
 
 def band_record(erp, linear, omega) -> dict:
     """Third-octave bands of the point's ERP harmonics and of the linear baseline (at ω only)."""
-    from sarfe.erp.bands import third_octave_levels
-
     f = omega / (2 * np.pi)
     linear_power = linear.get("erp_power_W", float("nan"))
     linear_power = linear_power if math.isfinite(linear_power) else 0.0
@@ -383,10 +381,6 @@ def map_fields(config: CaseConfig, stage, erp, W, omega):
     as the fields (17 rows at H = 15), instead of as W (2H+1 rows) and the density (H rows): at
     P1 (24,100 radiating nodes, 204 points) 0.7 GB instead of 1.9 GB pickled back and held until
     the maps are written. The ErpResult keeps its powers, levels and ``density_total``."""
-    import dataclasses
-
-    from sarfe.results.vtk import radiating_fields
-
     fields = radiating_fields(erp, W, omega) if writes_maps(config, stage) else None
     return dataclasses.replace(erp, density=None), fields
 
@@ -415,8 +409,6 @@ def point_records(config: CaseConfig, stage, nl, points) -> list:
     RECORD_CHUNK points' 8 × 33 rows runs at the machine's multiply rate where one point's 33
     rows wait on memory (≈ 12 instead of ≈ 20 ms a point at P1). The same numbers as one point at
     a time (each row of a product is computed alone)."""
-    from sarfe.pipeline.post.contribution_records import point_condensation
-
     prepared = []
     for _, solution, _ in points:
         try:    # shared by the contributions and the linear baseline (None: their own paths)
@@ -442,9 +434,6 @@ def _point_record(config, stage, nl, index, solution, error_estimate, condensati
     """:func:`point_record` of a point whose condensation, displacement harmonics U, linear
     baseline Û and radiating displacements W_both (2H+3, n_s: U's rows, then the baseline's
     [Re Û, −Im Û]) :func:`point_records` computed."""
-    from sarfe.pipeline.post.contact_dynamics import contact_dynamics
-    from sarfe.pipeline.post.contribution_records import contributions_record
-
     omega = float(solution.omega)
     contacts = contact_indicators(solution, nl) if nl.contacts.count else []
     for record, dynamics in zip(contacts, contact_dynamics(solution, nl)):
@@ -456,7 +445,7 @@ def _point_record(config, stage, nl, index, solution, error_estimate, condensati
             source = shares.get(record["name"], {})
             record.update({"erp_level_dba": source.get("level_dba", float("nan")),
                            "erp_share_a": source.get("share_a", float("nan"))})
-    erp, W = _erp(config.erp, stage, U, omega, W_both[:U.shape[0]])
+    erp, W = point_erp(config.erp, stage, U, omega, W_both[:U.shape[0]])
     linear = linear_baseline(config.erp, stage, nl, omega, condensation, response=U1,
                              normal_displacement=W_both[U.shape[0]:])
     point = {

@@ -4,14 +4,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from sarfe.erp.bands import band_frequencies, nominal_frequency
+from sarfe.hbm.harmonics import time_samples
+from sarfe.results.vtk import contact_point_values
+
 
 def contact_pair_fields(stage, nl, solution, n_points):
     """(peak force magnitude [N], relative displacement amplitude [m]) of every contact pair at
     both of its nodes, as (n_points,) arrays for the VTU (:func:`sarfe.results.vtk.
     contact_point_values`); (None, None) without contacts."""
-    from sarfe.hbm.harmonics import time_samples
-    from sarfe.results.vtk import contact_point_values
-
     cs = nl.contacts
     if not cs.count or not stage.contacts:
         return None, None
@@ -92,8 +93,6 @@ def result_groups(points, nl) -> dict:
                         slot = np.asarray(b["band"]) - first
                         arr[i, slot] = np.asarray(b[key], dtype=float)
                 table[f"{part}_{key}"] = arr
-        from sarfe.erp.bands import band_frequencies, nominal_frequency
-
         mid, lo, hi = band_frequencies(numbers)
         groups["bands"] = {"band": numbers, "nominal_hz": (np.array([nominal_frequency(b)
                                                                      for b in numbers]), "Hz"),

@@ -1,1 +1,3 @@
-"""Stage 3 of a case: harmonic balance per point or by continuation, pruning, accuracy."""
+"""Stage 3 of a case: harmonic balance per point or by continuation with its fallbacks (points),
+contact pruning (pruned_points), the accuracy target → H, N, cutoff and the per-point error
+estimates (case_accuracy)."""

@@ -3,14 +3,18 @@ stage and nonlinear model (plain arrays), the per-point error estimate and a cas
 → H, N and mode count (:func:`resolve_case_accuracy`)."""
 from __future__ import annotations
 
-import copy
-
 import numpy as np
 
-from sarfe.accuracy.estimates import (EstimateProblem, highest_natural_frequency_hz,
-                                      problem_error_estimate)
-from sarfe.accuracy.resolve import resolve_accuracy
+from sarfe.accuracy.estimate import (EstimateProblem, basis_limited_extension,
+                                     highest_natural_frequency_hz, problem_error_estimate)
+from sarfe.accuracy.harmonic_truncation import RICHARDSON, harmonics_richardson
+from sarfe.accuracy.resolve import LADDER_FACTOR, resolve_accuracy
+from sarfe.accuracy.target import parse_accuracy
 from sarfe.case.config import ExcitationConfig, SolverConfig
+from sarfe.case.read import load_case
+from sarfe.hbm import SolverOptions
+from sarfe.pipeline.model.linear_stage import build_linear_model
+from sarfe.pipeline.model.nonlinear_model import nonlinear_model
 
 
 def stage_modal_coordinates(stage):
@@ -37,7 +41,7 @@ def accuracy_problem(stage, nl) -> EstimateProblem:
 
 
 def stage_error_estimate(solution, stage, nl):
-    """:func:`sarfe.accuracy.estimates.problem_error_estimate` of a case's point."""
+    """:func:`sarfe.accuracy.estimate.problem_error_estimate` of a case's point."""
     return problem_error_estimate(solution, accuracy_problem(stage, nl))
 
 
@@ -59,28 +63,34 @@ def rule_cutoff_hz(case, harmonics) -> float | None:
     rung harmonics have no modes (answered quasi-statically) the ladder climbs irregularly (door
     trim, 10 mm, 67 Hz: on a 335 Hz stage to H = 27, then a 610-mode stage, 126 s against 75 s
     with 1.5; benchmarks/results/audible.md). The sweep reuses the search's last stage."""
-    reduction = case.data.get("reduction") or {}
-    if not case.is_fe or "cutoff_hz" in reduction or "mode_count" in reduction:
+    reduction = case.config.reduction
+    if reduction is None or reduction.cutoff_hz is not None or reduction.mode_count is not None:
         return None
     return float(search_margin(case) * int(harmonics) * case.config.excitation.max_frequency_hz)
 
 
 def search_margin(case) -> float:
     """m of :func:`rule_cutoff_hz`: max(reduction.cutoff_margin, LADDER_FACTOR)."""
-    from sarfe.accuracy.resolve import LADDER_FACTOR
-
     return float(max(case.config.reduction.cutoff_margin, LADDER_FACTOR))
 
 
-def _with_cutoff(case, cutoff_hz):
+def with_cutoff(case, cutoff_hz):
     """The case with reduction.cutoff_hz set (unchanged for None)."""
-    from sarfe.case.read import load_case
+    return case if cutoff_hz is None else case.with_reduction(cutoff_hz=float(cutoff_hz))
 
-    if cutoff_hz is None:
-        return case
-    data = copy.deepcopy(case.data)
-    data.setdefault("reduction", {})["cutoff_hz"] = float(cutoff_hz)
-    return load_case(data, base_dir=case.base_dir)
+
+def resolved_case(case, report):
+    """The case with the resolution :func:`case_resolution` chose (``report``): solver.harmonics,
+    samples_per_period, ``resolution: fixed`` (``accuracy`` stays the run's error budget), and the
+    search's reduction cutoff (or mode count) when it reports one."""
+    case = case.with_solver(harmonics=int(report["harmonics"]),
+                            samples_per_period=int(report["samples_per_period"]),
+                            resolution="fixed")
+    if report.get("cutoff_hz"):      # the search's reduction cutoff (FE; none given by the user)
+        return case.with_reduction(cutoff_hz=float(report["cutoff_hz"]))
+    if report.get("mode_count"):
+        return case.with_reduction(cutoff_hz=None, mode_count=int(report["mode_count"]))
+    return case
 
 
 def case_resolution(case, target, points=8, start_harmonics=3, start_samples=64,
@@ -92,7 +102,7 @@ def case_resolution(case, target, points=8, start_harmonics=3, start_samples=64,
     FE cases whose reduction gives neither cutoff_hz nor mode_count: the Craig–Bampton cutoff is
     the search's rule with the chosen H, c(H) = max(cutoff_margin, 1.5) · H · f_max
     (:func:`rule_cutoff_hz`: modes up to the ladder's next rung; reported as ``cutoff_hz`` and set
-    explicitly by :func:`sarfe.accuracy.resolve.apply_resolution`).
+    explicitly by :func:`resolved_case`).
     The ladder's changes are only trusted on a stage whose modes cover them: a stage with too few
     modes answers the high harmonics quasi-statically, and its ladder stops too early or climbs
     too far (door trim: from a 335 Hz stage, H = 27; from 502 Hz, H = 8; benchmarks/results/
@@ -100,11 +110,6 @@ def case_resolution(case, target, points=8, start_harmonics=3, start_samples=64,
     chosen H needs c(H) above the stage's cutoff, the stage of c(H) is built and the search is
     repeated on it from ``start_harmonics`` at the tuned frequencies (at most ``max_rebuilds``
     times). The last stage is returned: the sweep reuses it (same key as the chosen case)."""
-    from sarfe.hbm import SolverOptions
-    from sarfe.case.read import load_case
-    from sarfe.pipeline.model.linear_stage import build_linear_model
-    from sarfe.pipeline.model.nonlinear_model import nonlinear_model
-
     case = load_case(case)
     solver = case.config.solver
     options = SolverOptions(tolerance=solver.tolerance, max_iterations=solver.max_iterations,
@@ -115,7 +120,7 @@ def case_resolution(case, target, points=8, start_harmonics=3, start_samples=64,
     grid = sweep_grid_hz(case.config.excitation, points)
     history, seconds, stages, stage_seconds = [], 0.0, [], []
     for attempt in range(max_rebuilds + 1):
-        searched = _with_cutoff(case, cutoff)
+        searched = with_cutoff(case, cutoff)
         stage = build_linear_model(searched)
         stages.append(stage.info.get("modes"))
         stage_seconds.append(float(stage.timings.get("linear_stage_s", 0.0)))
@@ -164,9 +169,6 @@ def accuracy_check(solver: SolverConfig, points) -> dict | None:
     (a 5 dB error 60 dB below the headline changes nothing a user reads). The knob to raise is the
     one whose part (Richardson factors included) is largest at the worst point: harmonics →
     solver.harmonics, aliasing → solver.samples_per_period, modal → the reduction cutoff."""
-    from sarfe.accuracy.estimates import (RICHARDSON, basis_limited_extension,
-                                          harmonics_richardson, parse_accuracy)
-
     target = parse_accuracy(solver.accuracy_or_default)
     rated = [p for p in points if p["converged"] and p.get("error_estimate")
              and "failed" not in p["error_estimate"]]
@@ -223,5 +225,5 @@ def accuracy_check(solver: SolverConfig, points) -> dict | None:
             "erp_db": float(e["erp_db"]), "knob": KNOBS[knob], "warning": warning}
 
 
-__all__ = ["accuracy_check", "stage_modal_coordinates", "accuracy_problem", "stage_error_estimate", "sweep_grid_hz",
+__all__ = ["accuracy_check", "resolved_case", "with_cutoff", "stage_modal_coordinates", "accuracy_problem", "stage_error_estimate", "sweep_grid_hz",
            "resolve_case_accuracy", "case_resolution", "rule_cutoff_hz", "search_margin"]

@@ -9,18 +9,21 @@ import math
 
 import numpy as np
 
+from sarfe.accuracy.target import parse_accuracy
 from sarfe.case.config import ContinuationConfig, ExcitationConfig, SolverConfig
-from sarfe.pipeline.model.linear_stage import _bar
+from sarfe.hbm import ContinuationOptions, SolverOptions, continuation, solve_frequency
+from sarfe.hbm.harmonics import harmonic_coefficients
+from sarfe.hbm.residual import nonlinear_force
+from sarfe.hbm.solution import HarmonicSolution
+from sarfe.hbm.time_integration import integrate_time, linear_harmonic_response
 from sarfe.pipeline.model.nonlinear_model import NonlinearModel
+from sarfe.util.progress import bar as progress_bar
 
 
 def solver_options(solver: SolverConfig):
     """(SolverOptions, ContinuationOptions) from the ``solver`` section (:class:`SolverConfig`; a
     Case is also taken, for callers that hold only the case). The tolerance of
     ``harmonic_set: auto`` is the amplitude budget of ``solver.accuracy`` (default 'balanced')."""
-    from sarfe.hbm import ContinuationOptions, SolverOptions
-    from sarfe.accuracy.estimates import parse_accuracy
-
     if not isinstance(solver, SolverConfig):
         solver = solver.config.solver
     options = SolverOptions(tolerance=solver.tolerance, max_iterations=solver.max_iterations,
@@ -41,10 +44,6 @@ def time_integration_point(model, contacts, excitation, omega, harmonics, sample
     """A HarmonicSolution (``method='time integration'``) from time integration: the start guess of a retry
     (``max_periods`` small, the state need not be steady) or the stand-in for a point whose
     engine call raised."""
-    from sarfe.hbm.harmonics import harmonic_coefficients
-    from sarfe.hbm.solution import HarmonicSolution
-    from sarfe.hbm.time_integration import integrate_time
-
     steps = max(int(samples_per_period), 256)
     response = integrate_time(model, contacts, excitation, omega, harmonics,
                               steps_per_period=steps, max_periods=max_periods, initial=initial)
@@ -64,9 +63,6 @@ def time_integration_point(model, contacts, excitation, omega, harmonics, sample
 
 def linear_solution(nl: NonlinearModel, omega, H, N):
     """The exact periodic solution of a model without contacts, as a HarmonicSolution."""
-    from sarfe.hbm.solution import HarmonicSolution
-    from sarfe.hbm.time_integration import linear_harmonic_response
-
     U = linear_harmonic_response(nl.model, nl.excitation, omega)
     rows, count = nl.contacts.row_count, nl.contacts.count
     return HarmonicSolution(
@@ -110,8 +106,6 @@ def solve_point(nl, omega, H, N, options, previous):
     An engine exception or a point that still fails is returned with ``converged=False`` and the
     reason (the time-integration state stands in when the engine raised), never dropped.
     """
-    from sarfe.hbm import solve_frequency
-
     contacts = nl.contacts
     if not contacts.count:
         return linear_solution(nl, omega, H, N)
@@ -245,8 +239,6 @@ def common_samples(nl, solutions):
     which use the N each point was solved with). Points solved with fewer samples get
     their contact time histories (force, state) re-sampled by the AFT at the largest N used
     (harmonics unchanged; the ``reason`` says so)."""
-    from sarfe.hbm.residual import nonlinear_force
-
     largest = max((int(s.samples_per_period) for s in solutions), default=0)
     out = []
     for s in solutions:
@@ -265,8 +257,6 @@ def common_samples(nl, solutions):
 def solve_points(solver: SolverConfig, excitation: ExcitationConfig, nl: NonlinearModel,
                  progress=False):
     """HarmonicSolution per frequency point (listed frequencies in order, or a continuation)."""
-    from sarfe.hbm import continuation
-
     H, N = solver.harmonics, solver.samples_per_period
     options, cont_options = solver_options(solver)
     contacts = nl.contacts
@@ -275,7 +265,7 @@ def solve_points(solver: SolverConfig, excitation: ExcitationConfig, nl: Nonline
         start, end = (2 * np.pi * excitation.sweep.start_hz, 2 * np.pi * excitation.sweep.end_hz)
         if contacts.count:
             # the bar counts percent of the frequency range covered (so tqdm estimates the time left)
-            bar = _bar(progress, "sweep (% of the range)", 100, unit="%")
+            bar = progress_bar(progress, "sweep (% of the range)", 100, "%")
             try:
                 solutions = list(continuation(nl.model, contacts, nl.excitation, start, end, H, N,
                                            options=cont_options,
@@ -294,7 +284,7 @@ def solve_points(solver: SolverConfig, excitation: ExcitationConfig, nl: Nonline
     else:
         omegas = 2 * np.pi * np.asarray(excitation.frequency_hz, dtype=float)
     solutions, previous = [], None
-    bar = _bar(progress, "frequencies", len(omegas), unit="point")
+    bar = progress_bar(progress, "frequencies", len(omegas), "point")
     try:
         for omega in omegas:
             solution = solve_point(nl, float(omega), H, N, options, previous)

@@ -23,24 +23,24 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
+import scipy.linalg
 import scipy.sparse as sp
 
 from sarfe.case.config import ExcitationConfig, SolverConfig
+from sarfe.hbm.pruning import (CLOSED, NONLINEAR, OPEN, check_pruning, linearized_stiffness,
+                               prune_contacts, restore_solution, screen_contacts)
 from sarfe.pipeline.model.nonlinear_model import NonlinearModel
-from sarfe.pipeline.solve.points import TIME_INTEGRATION
+from sarfe.pipeline.solve.points import TIME_INTEGRATION, solve_point, solve_points, solver_options
 
-DEFAULT_MARGIN = 0.5
 SWEEP_GRID_POINTS = 201
 MAX_LISTED = 20          # violations listed in the report (all are counted)
 MAX_DENSE_EIGEN = 3000   # DOFs up to which the linearized natural frequencies are computed (dense)
 
 
 def pruning_options(solver: SolverConfig) -> tuple:
-    """(enabled, margin m) from ``solver.prune_contacts``: true | false | {margin: m}."""
-    value = solver.prune_contacts
-    if isinstance(value, dict):
-        return True, float(value.get("margin", DEFAULT_MARGIN))
-    return bool(value), DEFAULT_MARGIN
+    """(enabled, margin m) from ``solver.prune_contacts`` (true | false | {margin: m}; the margin's
+    default: :class:`sarfe.case.config.SolverConfig` ``prune_margin``)."""
+    return solver.prune_contacts, solver.prune_margin
 
 
 def linearized_natural_frequencies(model, contacts) -> np.ndarray:
@@ -48,10 +48,6 @@ def linearized_natural_frequencies(model, contacts) -> np.ndarray:
     solves with (:func:`sarfe.hbm.pruning.linearized_stiffness`: closed pairs as springs k_n,
     friction tangents stuck, open pairs absent). Empty if M is singular (massless DOFs) or the model
     has more than MAX_DENSE_EIGEN DOFs (then the grid alone)."""
-    import scipy.linalg
-
-    from sarfe.hbm.pruning import linearized_stiffness
-
     if model.dof_count > MAX_DENSE_EIGEN:
         return np.zeros(0)
     dense = (lambda A: A.toarray() if sp.issparse(A) else np.asarray(A, dtype=float))
@@ -85,8 +81,6 @@ def contact_report(decisions, groups) -> list:
     """One entry per named contact: its decision (``nonlinear`` if any of its node pairs is kept,
     else ``open`` / ``closed`` / ``open+closed``), pair counts per decision, the smallest clearance
     and the reason of the deciding pair."""
-    from sarfe.hbm.pruning import CLOSED, NONLINEAR, OPEN
-
     report = []
     for name, kind, index in groups:
         own = [decisions[i] for i in index]
@@ -117,8 +111,6 @@ def _check_samples(N):
 def check_solutions(samples_per_period, nl: NonlinearModel, decisions, solutions) -> tuple:
     """(violations, unsolved): the decisions every converged pruned solution breaks, as
     {contact, frequency_hz, what}, and the indices of the points that did not converge."""
-    from sarfe.hbm.pruning import check_pruning
-
     samples = _check_samples(samples_per_period)
     violations, unsolved = [], []
     for index, solution in enumerate(solutions):
@@ -135,9 +127,6 @@ def restore_solutions(solver: SolverConfig, nl: NonlinearModel, decisions, solut
                       linear) -> list:
     """Pruned solutions re-expressed with the full contact set; a point that did not converge on
     the pruned model is solved again at its ω with all contacts (from the pruned state)."""
-    from sarfe.pipeline.solve.points import solve_point, solver_options
-    from sarfe.hbm.pruning import restore_solution
-
     restored = []
     for index, solution in enumerate(solutions):
         if index in unsolved:
@@ -159,9 +148,6 @@ def solve_points_pruned(solver: SolverConfig, excitation: ExcitationConfig, nl: 
     """(solutions, report): :func:`sarfe.pipeline.solve.points.solve_points` on the pruned model, checked
     and restored to the full contact set (module docstring), or on the full model when pruning is
     off, removes nothing, or a decision fails. ``report`` is summary.json's ``contact_pruning``."""
-    from sarfe.pipeline.solve.points import solve_points
-    from sarfe.hbm.pruning import NONLINEAR, prune_contacts, screen_contacts
-
     enabled, margin = pruning_options(solver)
     report = {"enabled": enabled, "applied": False, "fallback": False, "margin": margin,
               "screened_frequencies": 0, "pairs": int(nl.contacts.count),

@@ -1,1 +1,2 @@
-"""Stage 5 of a case: result files, console table and figures."""
+"""Stage 5 of a case: the result files and the console table (result_files), the PNG figures and
+the report's surface maps (figures)."""

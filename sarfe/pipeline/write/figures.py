@@ -7,6 +7,10 @@ from pathlib import Path
 
 import numpy as np
 
+from sarfe import results
+from sarfe.results import render
+from sarfe.results.vtk import period_samples
+
 
 def _squeak_series(nl, solution):
     """(friction |λ_t| (N, n_sq) [N], state (N, n_sq) int, names) of the contacts with a friction (tangent) element: the
@@ -33,15 +37,13 @@ def _squeak_series(nl, solution):
 def point_figures(config, stage, nl, summary, solutions, erps, directory: Path, loudest) -> dict:
     """Draw the run's PNGs into ``directory``; returns {image key: path} (report keys).
     ``config``: the case's :class:`sarfe.case.config.CaseConfig` (name, output.target_dba)."""
-    from sarfe import results as outputs
-
     directory = Path(directory)
     points = summary["points"]
     target = config.output.target_dba
     images = {}
     frequencies = [p["frequency_hz"] for p in points]
     if len(solutions) > 1:
-        images["erp_sweep"] = outputs.plot_erp_sweep(
+        images["erp_sweep"] = results.plot_erp_sweep(
             directory / "erp_sweep.png", frequencies, [p["erp"]["level_db"] for p in points],
             stable=[p["stable"] for p in points], level_a_db=[p["erp"]["level_dba"] for p in points],
             title=config.name, linear_level_db=[p["linear"]["erp_level_db"] for p in points],
@@ -50,12 +52,12 @@ def point_figures(config, stage, nl, summary, solutions, erps, directory: Path, 
         return images
     j = int(loudest)
     at = f"{frequencies[j]:.1f} Hz"
-    images["erp_spectrum"] = outputs.plot_erp_spectrum(
+    images["erp_spectrum"] = results.plot_erp_spectrum(
         directory / "erp_spectrum.png", erps[j].frequencies_hz, erps[j].level_db,
         erps[j].level_a_db, title=f"{config.name}: ERP per harmonic at {at} (loudest point)")
     bands = points[j].get("bands")
     if bands:
-        images["third_octave"] = outputs.plot_third_octave(
+        images["third_octave"] = results.plot_third_octave(
             directory / "third_octave.png", bands["nonlinear"]["nominal_hz"],
             bands["nonlinear"]["level_dba"], linear_level_dba=bands["linear"]["level_dba"],
             linear_nominal_hz=bands["linear"]["nominal_hz"], target_dba=target,
@@ -65,7 +67,7 @@ def point_figures(config, stage, nl, summary, solutions, erps, directory: Path, 
         sources = sorted(contributions["sources"],
                          key=lambda s: -s["share_a"] if s["share_a"] is not None
                          and np.isfinite(s["share_a"]) else np.inf)[:20]
-        images["contributions"] = outputs.plot_contributions(
+        images["contributions"] = results.plot_contributions(
             directory / "contributions.png", [s["name"] for s in sources],
             [s["level_dba"] for s in sources], [s["share_a"] for s in sources],
             title=f"share of the A-weighted ERP at {at}")
@@ -74,13 +76,13 @@ def point_figures(config, stage, nl, summary, solutions, erps, directory: Path, 
         normal_rows = nl.contacts.normal_row
         totals = [force[:, normal_rows[idx][normal_rows[idx] >= 0]].sum(axis=1)
                   + nl.contacts.normal_load[idx].sum() for _, _, idx in nl.groups]
-        images["contact_forces"] = outputs.plot_contact_forces(
+        images["contact_forces"] = results.plot_contact_forces(
             directory / "contact_forces.png", np.stack(totals, axis=1),
             names=[g[0] for g in nl.groups], omega=solutions[j].omega,
             title=f"normal contact forces at {at} (loudest point)")
         friction, state, names = _squeak_series(nl, solutions[j])
         if names:
-            images["friction"] = outputs.plot_friction(
+            images["friction"] = results.plot_friction(
                 directory / "friction.png", friction, state, names=names,
                 omega=solutions[j].omega, title=f"friction and stick/slip at {at}")
     return images
@@ -88,9 +90,7 @@ def point_figures(config, stage, nl, summary, solutions, erps, directory: Path, 
 
 def finish_surface_maps(run) -> dict:
     """{key: PNG path, 'renderer': text} of the renders :func:`start_surface_maps` started."""
-    from sarfe.results.render import finish_render
-
-    rendered = finish_render(run)
+    rendered = render.finish_render(run)
     maps = {key: path for key, (path, _) in zip(("erp_map", "deflection", "contact_map"),
                                                 rendered)}
     maps["renderer"] = rendered[0][1]
@@ -104,15 +104,13 @@ def start_surface_maps(config, mesh, point_data, translations, point, directory:
     The renders: the ERP map [dB re 1 pW/m²], the deflection at the phase of largest displacement
     (exaggerated warp, colour |u| [mm]) and, when contacts move, their relative displacement [mm],
     named at ``contact_nodes`` {name: mesh node}; :func:`finish_surface_maps` collects them."""
-    from sarfe.results.render import start_render
-    from sarfe.results.vtk import period_samples
-
     directory = Path(directory)
     at = f"{point['frequency_hz']:.1f} Hz"
     level = point_data["erp_level_db_m2"]
     jobs = [dict(path=directory / "erp_map.png", points=mesh.points, triangles=mesh.triangles,
                  values=level, label="ERP density [dB re 1 pW/m2]",
-                 title=f"{config.name}: ERP at {at}", clim=[float(level.min()), float(level.max())])]
+                 title=f"{config.name}: ERP at {at}",
+                 clim=[float(np.nanmin(level)), float(np.nanmax(level))])]   # NaN: off the surface
     frames = period_samples(translations, 24)                              # (24, n, 3)
     frame = frames[int(np.argmax(np.linalg.norm(frames, axis=2).max(axis=1)))]
     magnitude = np.linalg.norm(frame, axis=1)
@@ -130,4 +128,4 @@ def start_surface_maps(config, mesh, point_data, translations, point, directory:
                          title=f"contact motion at {at}", cmap="plasma", spots=True,
                          labels=[(mesh.points[node], name)
                                  for name, node in (contact_nodes or {}).items()]))
-    return start_render(jobs)
+    return render.start_render(jobs)

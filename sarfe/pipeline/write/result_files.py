@@ -1,5 +1,6 @@
-"""Result files of a case (via :mod:`sarfe.results`), the console table, and the atomic move
-of the finished result directory into place (the rules: :mod:`sarfe.results.folder`)."""
+"""Result files of a case (via :mod:`sarfe.results`) and the console table. The caller writes them
+into a temporary folder moved into place at the end (:func:`sarfe.results.folder.
+write_result_folder`)."""
 from __future__ import annotations
 
 import math
@@ -8,7 +9,14 @@ from pathlib import Path
 
 import numpy as np
 
+from sarfe import results
+from sarfe.hbm.laws import table_column
+from sarfe.pipeline.post.point_workers import point_workers
 from sarfe.pipeline.post.result_data import contact_pair_fields, result_groups
+from sarfe.pipeline.write import figures
+from sarfe.reduction.recovery import recover_displacement
+from sarfe.results import render
+from sarfe.results.summary import shown_level
 
 
 def write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, directory: Path):
@@ -28,11 +36,9 @@ def write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, dir
         return _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields,
                               directory, started)
     except BaseException:
-        from sarfe.results.render import cancel_render
-
         for kind, run in started:
             if kind == "render":
-                cancel_render(run)
+                render.cancel_render(run)
             else:
                 run.cancel()
         raise
@@ -40,8 +46,6 @@ def write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, dir
 
 def _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, directory,
                    started):
-    from sarfe import results as outputs
-
     files = config.output.files
     written = {}
     written["summary"] = "summary.json"
@@ -55,10 +59,9 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, di
     loudest = (summary.get("worst") or {}).get("index")
     maps, renders, series = {}, None, None
     if stage.kind == "fe" and ("erp_vtu" in files or "animation" in files or "report" in files):
-        from sarfe.reduction.recovery import recover_displacement
-
         mesh = stage.mesh
-        markers = outputs.contact_markers(mesh.n_nodes, [g.nodes_a for g in stage.contacts.values()])
+        markers = results.contact_markers(mesh.n_nodes, [g.nodes_a for g in stage.contacts.values()])
+        parts = results.part_ids(mesh.n_triangles, mesh.element_groups)
         translations = {}
         every_point = full_field_every_point(stage, solutions)
 
@@ -82,7 +85,7 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, di
             if j in loudest_data:     # the loudest point's arrays serve its map and the report's
                 return loudest_data[j]
             force, motion = contact_pair_fields(stage, nl, solutions[j], mesh.n_nodes)
-            data = outputs.erp_point_data(mesh.n_nodes, erps[j], None,
+            data = results.erp_point_data(mesh.n_nodes, erps[j], None,
                                           float(solutions[j].omega), fields=fields[j],
                                           displacement=nodal_translations(j),
                                           radiating_nodes=stage.erp_nodes,
@@ -96,10 +99,8 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, di
         if loudest is not None and ("erp_vtu" in files or "report" in files):
             point_data(loudest)       # before the VTU workers fork: they inherit it
         if "report" in files and loudest is not None:
-            from sarfe.pipeline.write.figures import start_surface_maps
-
             # the report's renders run in their child process while the other files are written
-            renders = start_surface_maps(config, mesh, point_data(loudest),
+            renders = figures.start_surface_maps(config, mesh, point_data(loudest),
                                          nodal_translations(loudest), summary["points"][loudest],
                                          directory / ".report-figures",
                                          contact_nodes={name: int(g.nodes_a[0])
@@ -109,17 +110,18 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, di
         if "erp_vtu" in files:
             frequencies = [float(s.omega) / (2 * np.pi) for s in solutions]
             if len(solutions) == 1:
-                outputs.write_erp_vtu(directory / "erp.vtu", mesh.points, mesh.triangles,
-                                      point_data(0))
+                results.write_erp_vtu(directory / "erp.vtu", mesh.points, mesh.triangles,
+                                      point_data(0), parts=parts)
                 written["erp_vtu"] = "erp.vtu"
             else:       # on the workers while this process writes the files below
-                series = outputs.start_erp_sweep(directory / "erp", mesh.points, mesh.triangles,
+                series = results.start_erp_sweep(directory / "erp", mesh.points, mesh.triangles,
                                                  point_data, frequencies,
-                                                 workers=map_workers(config, mesh, len(solutions)))
+                                                 workers=map_workers(config, mesh, len(solutions)),
+                                                 parts=parts)
                 started.append(("maps", series))
                 written["erp_vtu"] = "erp/erp.pvd"
         if "animation" in files and loudest is not None:
-            outputs.write_deflection_animation(directory / "animation", mesh.points,
+            results.write_deflection_animation(directory / "animation", mesh.points,
                                                mesh.triangles, nodal_translations(loudest),
                                                omega=float(solutions[loudest].omega),
                                                point_data={"contact_marker": markers} | (
@@ -128,7 +130,7 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, di
                                                    else {}))
             written["animation"] = "animation/deflection.pvd"
     if "response" in files:
-        outputs.write_response_h5(
+        results.write_response_h5(
             directory / "response.h5", solutions, contacts=nl.contacts, excitation=nl.excitation,
             boundary_dofs=getattr(stage.reduced, "boundary_dofs", None),
             mode_frequencies_hz=stage.mode_frequencies_hz, erp=erps,
@@ -138,21 +140,17 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, di
         written["response"] = "response.h5"
     images = {}
     if "plots" in files or "report" in files:
-        from sarfe.pipeline.write.figures import point_figures
-
         plot_dir = directory if "plots" in files else directory / ".report-figures"
-        images = point_figures(config, stage, nl, summary, solutions, erps, plot_dir, loudest)
+        images = figures.point_figures(config, stage, nl, summary, solutions, erps, plot_dir, loudest)
         if "plots" in files:
             written["plots"] = ", ".join(sorted(Path(v).name for v in images.values()))
     if series is not None:
         series.finish()
     if renders is not None:
-        from sarfe.pipeline.write.figures import finish_surface_maps
-
-        maps = finish_surface_maps(renders)
+        maps = figures.finish_surface_maps(renders)
     if "report" in files:
         notes = {"renderer": maps.pop("renderer", None)}
-        outputs.write_report_html(directory / "report.html", summary, {**images, **maps}, notes)
+        results.write_report_html(directory / "report.html", summary, {**images, **maps}, notes)
         written["report"] = "report.html"
     shutil.rmtree(directory / ".report-figures", ignore_errors=True)
     return written
@@ -166,8 +164,6 @@ PARALLEL_MAP_VALUES = 2e6
 
 def map_workers(config, mesh, n_maps) -> int:
     """Processes that write a sweep's ERP maps: the run's point workers for a large series."""
-    from sarfe.pipeline.post.point_workers import point_workers
-
     return point_workers(config.solver) if n_maps * mesh.n_nodes >= PARALLEL_MAP_VALUES else 1
 
 
@@ -193,9 +189,6 @@ def results_table(rows, contact_types=None, max_contacts=6) -> str:
     friction law: the share of the period in slip, 0…1). The ±dB column is the ERP error bound,
     "~" marking a bound interpolated between estimated points. ``contact_types``: {name: law
     name} (default: max penetration)."""
-    from sarfe.hbm.laws import table_column
-    from sarfe.results import console_table
-
     columns = ["frequency_hz", "converged", "stable", "iterations", "erp_db", "erp_dba",
                "linear_erp_db"]
     headers = {"frequency_hz": "f [Hz]", "erp_db": "ERP [dB]", "erp_dba": "ERP [dB(A)]",
@@ -216,8 +209,6 @@ def results_table(rows, contact_types=None, max_contacts=6) -> str:
         columns.append(key)
         headers[key] = header
         formats[key] = fmt
-    from sarfe.results.summary import shown_level
-
     shown = [dict(row) for row in rows]
     for row in shown:  # a motionless surface's level reads "-"
         for key in ("erp_db", "erp_dba", "linear_erp_db"):
@@ -233,7 +224,7 @@ def results_table(rows, contact_types=None, max_contacts=6) -> str:
             key = f"{name}.max_penetration_m"
             if isinstance(row.get(key), float) and math.isfinite(row[key]):
                 row[key] = 1e3 * row[key]
-    table = console_table(shown, columns=columns, formats=formats, headers=headers)
+    table = results.console_table(shown, columns=columns, formats=formats, headers=headers)
     if len(names) > max_contacts:
         table += f"\n({len(names) - max_contacts} more contacts in summary.json)"
     return table
@@ -246,11 +237,3 @@ def _error_cell(row) -> str:
     if value is None or not math.isfinite(value):
         return "-"
     return ("~" if row.get("erp_error_interpolated") else "") + f"{value:.2f}"
-
-
-def replace_directory(temporary: Path, target: Path, force: bool = False):
-    """Move a finished temporary directory onto ``target`` (replacing an older sarfe result only;
-    the previous result is restored if the move fails): :func:`sarfe.results.folder.replace_directory`."""
-    from sarfe.results.folder import replace_directory as replace
-
-    replace(temporary, target, force=force)

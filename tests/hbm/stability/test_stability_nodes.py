@@ -1,11 +1,11 @@
-"""The initial nodes of the contact-row count's contour (sarfe.hbm.stability.rows._upper_contour):
+"""The initial nodes of the contact-row count's contour (sarfe.hbm.stability.contour.upper_contour):
 every step keeps every pole of det F at least half a step away — so a pole turns arg det F by at
 most 2 atan(1) = π/2 over a step — checked against the distance of each pole to each step computed
 by brute force, and the closed-form vertical step against a brute-force search."""
 import numpy as np
 
-from sarfe.hbm.stability.rows import (_left_step, _upper_contour, shifted_exponents,
-                                      structural_exponents, winding_count)
+from sarfe.hbm.stability.contour import _left_step, shifted_exponents, upper_contour, winding_count
+from sarfe.hbm.stability.determinant import structural_exponents
 
 
 def segment_distance(poles, a, b, samples=4001):
@@ -38,7 +38,7 @@ def test_every_contour_step_keeps_the_poles_half_a_step_away():
     omega, epsilon = 100.0, 1e-2
     poles = lightly_damped_poles(omega)
     top, X = 0.505 * omega, 5e4
-    nodes = _upper_contour(epsilon, X, top, poles)
+    nodes = upper_contour(epsilon, X, top, poles)
     assert nodes[0] == X and nodes[1] == X + 1j * top and nodes[-1] == -epsilon
     steps = np.abs(np.diff(nodes))
     left = np.isclose(nodes[:-1].real, -epsilon) & np.isclose(nodes[1:].real, -epsilon)
@@ -69,7 +69,7 @@ def test_the_count_on_these_nodes_finds_the_zeros_between_the_poles():
         return (np.log(s - zeros).sum(axis=1) - np.log(s - far).sum(axis=1)
                 + np.log(s - partners).sum(axis=1) - np.log(s - poles).sum(axis=1))
 
-    nodes = _upper_contour(epsilon, X, top, poles)
+    nodes = upper_contour(epsilon, X, top, poles)
     count, _ = winding_count(log_det, nodes)
     assert abs(count - 2.0) < 1e-6
     fine = np.concatenate([X + 1j * np.linspace(0.0, top, 2001),

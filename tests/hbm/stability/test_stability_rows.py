@@ -11,8 +11,9 @@ from sarfe.hbm.aft import jacobian_matrix
 from sarfe.hbm.modal import modal_basis
 from sarfe.hbm.residual import Problem, full_residual
 from sarfe.hbm.stability.contact_terms import ContactOperator
-from sarfe.hbm.stability.rows import (ContactRowDeterminant, contact_row_stability,
-                                      structural_exponents, winding_count)
+from sarfe.hbm.stability.contour import winding_count
+from sarfe.hbm.stability.determinant import ContactRowDeterminant, structural_exponents
+from sarfe.hbm.stability.rows import contact_row_stability
 from tests.hbm.shipped_points import full_hill, shipped_case_points
 
 
@@ -51,7 +52,7 @@ def test_real_zero_locates_the_single_sign_change(root):
     dynamic range as det F has): located to 10⁻⁹ relative — near 0 (either side), at a fold-like
     2.5 1/s and far out at 3000 1/s — with at most 30 evaluations (the bracket grid it replaces
     took 108); None where the sign does not change between the ends."""
-    from sarfe.hbm.stability.rows import real_zero
+    from sarfe.hbm.stability.zeros import real_zero
 
     calls = []
 
@@ -229,14 +230,14 @@ def test_a_ritz_verdict_that_contradicts_the_count_is_reported_uncertain(sweep03
     names the count. Points of the NLvib 03 sweep with two or more such exponents, with the
     locator of those zeros stubbed to fail (it locates them all there: the hand-over is its last
     resort, tests/hbm/stability/test_stability_zeros.py)."""
-    import sarfe.hbm.solve as solve_module
+    import sarfe.hbm.stability.select as select
     import sarfe.hbm.stability.rows as rows_module
     from sarfe.hbm.stability.hill import StabilityResult
     from sarfe.hbm.stability.rows import contact_row_count
 
     model, contacts, F, sols = sweep03
     stub = StabilityResult(True, -1.0, "", np.array([-1.0 + 0j]))
-    monkeypatch.setattr(solve_module, "condensed_stability", lambda *a, **k: stub)
+    monkeypatch.setattr(select, "condensed_stability", lambda *a, **k: stub)
     monkeypatch.setattr(rows_module, "leading_zeros", lambda *a, **k: None)
     checked = 0
     for s in sols:
@@ -245,8 +246,8 @@ def test_a_ritz_verdict_that_contradicts_the_count_is_reported_uncertain(sweep03
         if result is not None or not zeros:
             continue
         problem = Problem(model, contacts, F, s.harmonics, s.samples_per_period)
-        verdict = solve_module.stability(problem, s.omega, s.displacement, ev,
-                                         SolverOptions(stability_method="contact_rows"))
+        verdict = select.stability(problem, s.omega, s.displacement, ev,
+                                   SolverOptions(stability_method="contact_rows"))
         assert verdict.stable is None and f"finds {zeros} Floquet" in verdict.note
         checked += 1
     assert checked >= 1

@@ -11,7 +11,8 @@ import scipy.sparse as sp
 
 from sarfe.hbm.harmonics import derivative_matrix
 from sarfe.hbm.model import make_linear_model
-from sarfe.hbm.stability.rows import _upper_contour, contact_row_counts, winding_count
+from sarfe.hbm.stability.contour import upper_contour, winding_count
+from sarfe.hbm.stability.rows import contact_row_counts
 from sarfe.hbm.stability.zeros import located_zeros, power_sums, roots_of_power_sums
 from tests.hbm.stability.test_stability_rows import sweep03  # noqa: F401  (the NLvib 03 sweep fixture)
 
@@ -70,7 +71,7 @@ def test_located_zeros_of_an_analytic_determinant(zeros):
         samples.update(zip(np.asarray(s).tolist(), v.tolist()))
         return v
 
-    count, evaluations = winding_count(sampled, _upper_contour(epsilon, X, top, poles))
+    count, evaluations = winding_count(sampled, upper_contour(epsilon, X, top, poles))
     assert count == pytest.approx(z.size, abs=1e-6)
     calls.clear()
     found = located_zeros(log_det, samples, z.size, epsilon, top, X, poles)
@@ -91,7 +92,7 @@ def test_located_zeros_refuses_an_incomplete_set():
         return np.log(s[:, None] - z[None]).sum(axis=1) - np.log(s + 40.0 + 0j)
 
     samples = {}
-    nodes = _upper_contour(epsilon, X, top, np.array([-40.0 + 0j]))
+    nodes = upper_contour(epsilon, X, top, np.array([-40.0 + 0j]))
     samples.update(zip(nodes.tolist(), log_det(nodes).tolist()))
     winding_count(lambda s: _kept(samples, log_det, s), nodes)
     assert located_zeros(log_det, samples, 3, epsilon, top, X) is None

@@ -31,7 +31,7 @@ def test_failed_warm_start_retries_the_cold_start_not_the_time_integration(monke
     def no_time_integration(*args, **kwargs):
         raise AssertionError("the time integration must not be needed")
 
-    monkeypatch.setattr(sarfe.hbm, "solve_frequency", warm_start_fails)
+    monkeypatch.setattr(points, "solve_frequency", warm_start_fails)
     monkeypatch.setattr(points, "time_integration_point", no_time_integration)
     point = points.solve_point(nl, omega, H, N, options, cold)
     assert point.converged and point.method != points.TIME_INTEGRATION

@@ -47,7 +47,7 @@ def test_failed_retry_refines_the_time_integration_from_its_end_state(monkeypatc
         return solution if fine else dataclasses.replace(solution, converged=False,
                                                          reason="stalled (test)")
 
-    monkeypatch.setattr(sarfe.hbm, "solve_frequency", only_from_fine_guess)
+    monkeypatch.setattr(points, "solve_frequency", only_from_fine_guess)
     monkeypatch.setattr(points, "time_integration_point", guess)
     point = points.solve_point(nl, omega, H, N, options, previous)
     assert point.converged, point.reason
