@@ -258,7 +258,7 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
         while 2 * N_fine <= MAX_STALL_FACTOR * samples_per_period:
             N_fine *= 2
             fine = replace(problem, samples_per_period=N_fine)
-            trial = _solve(fine, omega_new, U, so, None)
+            trial = solve_from(fine, omega_new, U, so, None)
             if not trial.converged:
                 break
             point, U = trial, trial.displacement
@@ -430,7 +430,7 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
             # a stiff contact: the corrector's tolerance on the contact rows leaves a full
             # residual ≈ k_n ‖R_c‖ / ‖f̃_e‖ above full_tolerance — tightened at this ω by the
             # fixed-frequency Newton and its polish (sarfe.hbm.solve)
-            polished = _solve(problem, omega_new, U_new, so, state["slider"])
+            polished = solve_from(problem, omega_new, U_new, so, state["slider"])
             if polished.converged:
                 point = replace(polished, iterations=result.iterations + polished.iterations,
                                 reason=f"{polished.reason} (tightened at fixed ω: {point.reason})")
