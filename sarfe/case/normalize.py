@@ -102,10 +102,12 @@ def _normalize_model(case, data):
 
 
 def _normalize_deck(case, fe, p):
-    """model.fe.deck: the file exists and is a deck; units, ignore_cards, fixed defaults."""
+    """model.fe.deck: the file exists and is a deck; ignore_cards, groups defaults."""
     _case_file(case, fe["deck"], DECK_SUFFIXES, "deck", p + ("deck",))
     _not_allowed(case, fe, p, ("mesh_units",), "with model.fe.deck (use 'units')")
-    for key in ("units", "ignore_cards", "node_groups", "element_groups"):
+    # ``units`` stays absent when the case does not give it (DeckConfig's default SI applies):
+    # the deck's units check yields to an explicit ``units:`` only (deck_checks.units_given)
+    for key in ("ignore_cards", "node_groups", "element_groups"):
         fe.setdefault(key, default_of(DeckConfig, key))
 
 

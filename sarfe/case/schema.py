@@ -53,7 +53,7 @@ FE_MODEL = _object({
     # an engineer's own deck (Nastran .bdf/.dat/.nas/.fem, Abaqus .inp), read with its
     # properties, supports and loads (sarfe.pipeline.model.deck_model)
     "deck": NAME,
-    "units": {"enum": ["SI", "mm-t-s", "mm-kg-ms", "mm-kg-s", "in-lbf-s"]},
+    "units": {"enum": ["SI", "mm-t-s", "mm-kg-ms", "mm-kg-s", "in-lbf-s", "ft-lbf-s"]},
     "ignore_cards": {"type": "array", "items": NAME, "uniqueItems": True},
     "supports": {"type": "array", "items": SET_REFERENCE, "minItems": 1},
     "node_groups": {"type": "object", "additionalProperties": {

@@ -88,15 +88,17 @@ class DeckSystem:
 def _element_blocks(deck: DeckModel, drilling_penalty, mass="consistent",
                     membrane=DECK_MEMBRANE):
     """Yield (K_e, M_e, dofs) blocks of every element table (CONM2 never lumped)."""
-    for k, m, dofs in _structural_blocks(deck, drilling_penalty, membrane):
+    for k, m, dofs in _structural_blocks(deck, drilling_penalty, membrane, mass):
         yield k, (lumped_mass(m, dofs) if mass == "lumped" else m), dofs
     if len(deck.point_masses.node):
         m, dofs = point_mass_matrices(deck.point_masses)
         yield np.zeros_like(m), m, dofs
 
 
-def _structural_blocks(deck: DeckModel, drilling_penalty, membrane=DECK_MEMBRANE):
-    """Yield (K_e, M_e, dofs) of shells, solids, beams and springs."""
+def _structural_blocks(deck: DeckModel, drilling_penalty, membrane=DECK_MEMBRANE,
+                       mass="consistent"):
+    """Yield (K_e, M_e, dofs) of shells, solids, beams and springs (``mass`` 'lumped': the
+    beams' torsional inertia as the commercial solver lumps it, `beam_matrices`)."""
     yield from shell_blocks(deck, membrane, drilling_penalty)
     for kind, block in deck.solids.items():
         for start in range(0, len(block.element_ids), _BLOCK // 8):
@@ -112,7 +114,7 @@ def _structural_blocks(deck: DeckModel, drilling_penalty, membrane=DECK_MEMBRANE
             yield k, m, dofs
     if len(deck.beams.element_ids):
         try:
-            yield beam_matrices(deck.points, deck.beams)
+            yield beam_matrices(deck.points, deck.beams, lumped_torsion=mass == "lumped")
         except ValueError as error:
             raise DeckError(f"{deck.source}: {error}") from error
     if len(deck.springs.element_ids):

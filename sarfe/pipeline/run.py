@@ -65,7 +65,8 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     bar = progress_bar(progress and linear_stage is None, "checking the case: mesh, groups, quality", None,
                unit="step")
     try:
-        checked = check_case(case, output_dir, force, write=write, mesh_checks=linear_stage is None)
+        checked = check_case(case, output_dir, force, write=write, mesh_checks=linear_stage is None,
+                             assemble=False)   # the linear stage assembles (a deck) right after
     finally:
         if bar is not None:
             bar.close()
@@ -76,7 +77,10 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     timings = {}
     accuracy = None
     config = case.config
-    if config.solver.resolution == "auto":
+    if config.solver.resolution == "auto" and not config.contacts and warn is not None:
+        warn("no contacts: the response is linear (one modal sum per point), so resolution "
+             f"'auto' searches no H; solved at harmonics = {config.solver.harmonics}")
+    if config.solver.resolution == "auto" and config.contacts:
         # accuracy as an input: choose H, N (the reduction cutoff follows H) by a cheap search
         clock = time.perf_counter()
         report, searched = case_resolution(case, config.solver.accuracy)

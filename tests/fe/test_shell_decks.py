@@ -6,12 +6,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import scipy.linalg as la
 import scipy.sparse.linalg as sla
 
 from sarfe.fe.deck_assembly import (assemble_deck, global_matrices, load_vector, mass_properties,
                                     support_dofs)
 from sarfe.mesh.formats.nastran import read_nastran
+from tests.mesh.test_public_decks import deck_frequencies
 
 HERE = Path(__file__).resolve()
 # beside the checkout (CI), or beside the folder of worktrees (/work/wt/<name> → /work/shared)
@@ -25,15 +25,7 @@ def _reference(name):
     return np.array(json.loads((DECKS / "REFERENCE.json").read_text())[name]["frequencies_hz"])
 
 
-def _frequencies(system, fixed, count):
-    """Lowest natural frequencies [Hz]; M may be singular (massless drilling rotations):
-    M x = μ (K + s M) x, λ = 1/μ − s."""
-    free = np.setdiff1d(np.arange(system.n_dofs), np.asarray(fixed, int))
-    k = system.stiffness[free][:, free].toarray()
-    m = system.mass[free][:, free].toarray()
-    shift = 1e-3 * np.abs(np.diag(k)).max() / np.abs(np.diag(m)).max()
-    mu = np.sort(la.eigh(m, k + shift * m, eigvals_only=True))[::-1][:count]
-    return np.sqrt(np.abs(1.0 / mu - shift)) / (2 * np.pi)
+_frequencies = deck_frequencies   # lowest natural frequencies of a deck (M may be singular)
 
 
 @needs_decks

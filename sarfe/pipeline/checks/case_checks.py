@@ -333,8 +333,11 @@ def output_target(case, output_dir=None, force=False):
     return check_output_folder(target, force=force, protected=case_inputs(case))
 
 
-def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True) -> CaseCheck:
-    """All checks of the module docstring. Raises CaseError at the first problem."""
+def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True,
+               assemble=True) -> CaseCheck:
+    """All checks of the module docstring. Raises CaseError at the first problem. ``assemble``
+    (deck path): also assemble the deck, for what solve refuses there (`solve` passes False:
+    its linear stage assembles right after, with the same lines)."""
     case = load_case(case)
     output = output_target(case, output_dir, force) if write else None
     if not mesh_checks:
@@ -344,7 +347,7 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True)
         return CaseCheck({}, tuple(range_warnings(case)), output)
     config = case.config
     if config.model.fe.is_deck:   # a Nastran/Abaqus deck: its own checks, with ids
-        info = check_deck(case)
+        info = check_deck(case, assemble=assemble)
         return CaseCheck(info, tuple(range_warnings(case)) + tuple(info.pop("warnings")), output)
     mesh = load_case_mesh(case)
     fixed = fixed_nodes(case, mesh)

@@ -20,9 +20,10 @@ from sarfe.pipeline.model.case_mesh import load_case_mesh
 from sarfe.pipeline.model.contact_pairs import pair_contact
 from sarfe.pipeline.checks.held_checks import (check_something_free, contact_warnings,
                                                load_warnings)
-from sarfe.pipeline.model.deck_checks import connected_parts
+from sarfe.pipeline.model.deck_checks import check_boundary_nodes, connected_parts
 from sarfe.pipeline.model.deck_model import prepare_deck
-from sarfe.pipeline.model.deck_stage import contact_pairs
+from sarfe.pipeline.model.deck_stage import (assemble_case_deck, contact_pairs, held_kept_dofs,
+                                             kept_translations)
 from sarfe.pipeline.model.erp_map import deck_surface_triangles, surface_triangles
 from sarfe.pipeline.model.groups import fixed_nodes, resolve_node_group, shell_properties
 from sarfe.pipeline.model.matrices_stage import build_matrices_stage
@@ -114,9 +115,10 @@ def mesh_quality(case, mesh, contact_pairs):
                                                       1e-9 * extent, joined)]
 
 
-def check_deck(case) -> dict:
-    """Validation of a deck case without assembly: cards, groups, quality, supports, pairing,
-    something free to move, forces and contacts on free nodes."""
+def check_deck(case, assemble=True) -> dict:
+    """Validation of a deck case: cards, groups, quality, supports, pairing, something free to
+    move, forces and contacts on free nodes, contact and force nodes independent, and
+    (``assemble``) the assembly — what solve refuses there — without the modal reduction."""
     prepared = prepare_deck(case)
     mesh, deck = prepared.mesh, prepared.deck
     held = prepared.held[:, :3].all(axis=1)
@@ -127,6 +129,10 @@ def check_deck(case) -> dict:
     paired = contact_pairs(case, prepared)
     shared = shared_pair_warnings(case, paired, mesh.points)
     pairs = {name: len(p[0]) for name, p in paired.items()}
+    boundary = []           # (nodes, key) of the contact and force nodes
+    for contact in case.config.contacts:
+        a, b, _, _ = paired[contact.name]
+        boundary.append((np.concatenate([a, b[b >= 0]]), ("contacts", contact.index)))
     load_nodes = []
     for i, f in enumerate(case.config.excitation.forces):
         if f.load_set is not None:
@@ -136,12 +142,22 @@ def check_deck(case) -> dict:
                                  f"{', '.join(sorted(deck.loads)) or 'none'})",
                                  ("excitation", "forces", i, "load_set"))
         else:
-            load_nodes.append(resolve_node_group(case, mesh, f.group,
-                                                 ("excitation", "forces", i, "group")))
+            path = ("excitation", "forces", i, "group")
+            load_nodes.append(resolve_node_group(case, mesh, f.group, path))
+            boundary.append((load_nodes[-1], path))
+    for nodes, path in boundary:
+        check_boundary_nodes(case, deck, nodes, path)
     held_by = "the supports or model.fe.fixed, or on no element"
     shared += load_warnings(case, held, load_nodes, held_by)
     shared += contact_warnings(case, paired, held, held_by, labels=deck.node_ids)
     deck_surface_triangles(case, mesh)
+    # what solve refuses at assembly (degenerate cells, rigid-element chains, force nodes
+    # without stiffness): validate assembles too (no reduction)
+    if assemble:
+        system = assemble_case_deck(case, deck)
+        held_kept_dofs(case, prepared, system)
+        for nodes, path in boundary:
+            kept_translations(case, system, deck, nodes, path)
     return {"nodes": prepared.deck.n_nodes, "triangles": mesh.n_triangles,
             "contact_pairs": pairs, "ignored_cards": prepared.notes["ignored_cards"],
             "coincident_node_pairs": prepared.notes["coincident_node_pairs"],

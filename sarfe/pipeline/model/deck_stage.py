@@ -18,7 +18,7 @@ from sarfe.fe.deck_assembly import assemble_deck, load_vector
 from sarfe.mesh.formats.deck import DeckError
 from sarfe.pipeline.model.contact_pairs import ContactGeometry, pair_contact, reduced_coordinates
 from sarfe.pipeline.model.cutoff import stage_cutoff_hz
-from sarfe.pipeline.model.deck_checks import DECK_KEY
+from sarfe.pipeline.model.deck_checks import DECK_KEY, check_boundary_nodes
 from sarfe.pipeline.model.deck_model import prepare_deck
 from sarfe.pipeline.model.erp_map import deck_surface_triangles, erp_map
 from sarfe.pipeline.model.groups import resolve_node_group
@@ -30,22 +30,19 @@ from sarfe.util.progress import bar as progress_bar
 _LOADED_BOUNDARY_LIMIT = 60   # load-set DOFs kept physically up to this count (else residuals)
 
 
-def _assemble(case: Case, deck):
+def assemble_case_deck(case: Case, deck):
+    """The deck's `DeckSystem`; an assembly refusal (degenerate cell, I12 ≠ 0, an undetermined
+    RBE3, …) is a one-line CaseError on model.fe.deck."""
     try:
         return assemble_deck(deck)
     except DeckError as exc:
         raise case.error(str(exc), DECK_KEY) from None
 
 
-def _kept_translations(case, system, deck, nodes, path):
-    """(len(nodes), 3) kept DOF numbers of the translations of `nodes` (global axes)."""
+def kept_translations(case, system, deck, nodes, path):
+    """(len(nodes), 3) kept DOF numbers of the translations of `nodes` (global axes; rotated CD
+    frames and rigid-element dependents were refused before assembly: `check_boundary_nodes`)."""
     nodes = np.asarray(nodes, dtype=np.int64)
-    rotated = ~np.all(np.isclose(deck.displacement_frames[nodes], np.eye(3), atol=1e-12),
-                      axis=(1, 2))
-    if np.any(rotated):
-        raise case.error(f"GRID {int(deck.node_ids[nodes[np.argmax(rotated)]])} has a rotated "
-                         "displacement frame (CD): contact and force nodes must use the basic "
-                         "frame", path)
     dofs = system.dof_index(nodes[:, None], np.arange(3)[None, :])
     if np.any(dofs < 0):
         bad = nodes[np.argmax((dofs < 0).any(axis=1))]
@@ -156,10 +153,16 @@ def build_deck_stage(case: Case, progress=False) -> dict:
                    resolve_node_group(case, mesh, f.group, ("excitation", "forces", i, "group"))
                    for i, f in enumerate(forces)]
     radiating = deck_surface_triangles(case, mesh)
+    for contact in case.config.contacts:      # as validate: before any assembly
+        a, b, _, _ = paired[contact.name]
+        check_boundary_nodes(case, deck, np.concatenate([a, b[b >= 0]]), ("contacts", contact.index))
+    for i, nodes in enumerate(group_nodes):
+        if nodes is not None:
+            check_boundary_nodes(case, deck, nodes, ("excitation", "forces", i, "group"))
 
     next_step(stages, "assembly")
     clock = time.perf_counter()
-    system = _assemble(case, deck)
+    system = assemble_case_deck(case, deck)
     timings["assembly_s"] = time.perf_counter() - clock
     mass_kg = _translational_mass(system, deck)
     if not mass_kg > 0:
@@ -176,7 +179,14 @@ def build_deck_stage(case: Case, progress=False) -> dict:
     contact_nodes = [np.concatenate([a, b[b >= 0]]) for a, b, _, _ in paired.values()]
     nodes = np.unique(np.concatenate(contact_nodes + [g for g in group_nodes if g is not None]
                                      + [np.zeros(0, np.int64)]).astype(np.int64))
-    boundary_kept = _kept_translations(case, system, deck, nodes, ("contacts",)).ravel()
+    for contact in case.config.contacts:      # each on its own key, as validate
+        a, b, _, _ = paired[contact.name]
+        kept_translations(case, system, deck, np.concatenate([a, b[b >= 0]]),
+                          ("contacts", contact.index))
+    for i, group in enumerate(group_nodes):
+        if group is not None:
+            kept_translations(case, system, deck, group, ("excitation", "forces", i, "group"))
+    boundary_kept = kept_translations(case, system, deck, nodes, ("contacts",)).ravel()
     set_vectors = [(_load_set_vector(case, system, deck, f, ("excitation", "forces", i, "load_set"))
                     if f.load_set is not None else None) for i, f in enumerate(forces)]
     loaded = np.unique(np.concatenate([np.flatnonzero(v) for v in set_vectors if v is not None]
@@ -271,4 +281,5 @@ def _translational_mass(system, deck) -> float:
     return float(iota @ (system.mass @ iota))
 
 
-__all__ = ["build_deck_stage", "contact_pairs", "expanded_reduced_model", "held_kept_dofs"]
+__all__ = ["build_deck_stage", "contact_pairs", "expanded_reduced_model", "held_kept_dofs",
+           "assemble_case_deck", "kept_translations"]
