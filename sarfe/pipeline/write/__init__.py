@@ -1,2 +1,2 @@
-"""Stage 5 of a case: the result files and the console table (result_files), the PNG figures and
-the report's surface maps (figures)."""
+"""Stage 5 of a case: the result files and the full table (result_files), the PNG figures and
+the report's surface maps (figures), sound.wav and sound_with_background.wav (sound_files)."""
