@@ -54,8 +54,10 @@ def verdict_text(summary) -> list:
         text += f": margin {margin:+.1f} dB" + (f" in the {band:g} Hz band" if _finite(band)
                                                 else "")
     loudness = audibility.get("loudness_sone")
+    capped = " (at least: bands beyond ISO 532-1's 120 dB)" if audibility.get("loudness_capped") \
+        else ""
     return [text, f"  at the occupant {level_text(audibility.get('spl_dba'), unit='dB(A)')}"
-            + (f", {loudness:.3g} sone" if _finite(loudness) else "")]
+            + (f", {loudness:.3g} sone{capped}" if _finite(loudness) else "")]
 
 
 def target_text(summary) -> str:
@@ -118,12 +120,13 @@ def best_change_text(summary) -> str:
 
 def points_table(rows) -> str:
     """The per-point table in ≤ 80 columns: frequency, converged, stable, ERP dB(A) with its ±,
-    the linear baseline, the SPL at the occupant, audible (the full table: table.txt)."""
+    the linear baseline [dB(A)], the SPL at the occupant [dB(A)], heard, the audibility margin
+    [dB] (the full table: table.txt)."""
     columns = ["frequency_hz", "converged", "stable", "erp_dba", "erp_error_db",
                "linear_erp_dba", "occupant_spl_dba", "audible", "audibility_margin_db"]
     headers = {"frequency_hz": "f [Hz]", "converged": "conv", "erp_dba": "ERP [dB(A)]",
                "erp_error_db": "±dB", "linear_erp_dba": "linear", "occupant_spl_dba":
-               "SPL [dB(A)]", "audible": "heard", "audibility_margin_db": "margin [dB]"}
+               "SPL [dB(A)]", "audible": "heard", "audibility_margin_db": "margin"}
     formats = {"frequency_hz": ".2f", "erp_dba": ".1f", "erp_error_db": ".2f",
                "linear_erp_dba": ".1f", "occupant_spl_dba": ".1f", "audibility_margin_db": "+.1f"}
     shown = []

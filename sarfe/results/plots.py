@@ -363,8 +363,9 @@ def plot_contributions(path, names, level_dba, share_a, title=None, part_level_d
     ax.barh(y, share, color=colors)
     for yi, s_, lv, pv in zip(y, share, level, part):
         alone = f"{lv:.1f}" if np.isfinite(lv) else "-"
-        text = f" {s_:.0f} %" + (f" = {pv:.1f} dB(A)" if np.isfinite(pv) and round(s_) > 0
-                                 else "") + f" (alone {alone})"
+        percent = int(round(s_))
+        text = f" {percent} %" + (f" = {pv:.1f} dB(A)" if np.isfinite(pv) and percent > 0
+                                  else "") + f" (alone {alone})"
         ax.annotate(text, (max(s_, 0.0), yi), va="center", fontsize="x-small")
     ax.set_yticks(y)
     ax.set_yticklabels(names, fontsize="small")

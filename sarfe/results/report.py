@@ -31,6 +31,8 @@ from sarfe.results.summary import (headline_level, headline_notes, level_text, s
 
 __all__ = ["write_report_html", "render_report_html", "data_uri", "environment"]
 
+PARAMETER_SHORT = {"gap_m": "gap", "normal_stiffness_N_m": "kₙ", "tangential_stiffness_N_m": "kₜ",
+                   "friction_coefficient": "μ", "preload_N": "preload"}
 PARAMETER_LABELS = {"gap_m": "gap", "normal_stiffness_N_m": "normal stiffness",
                     "tangential_stiffness_N_m": "tangential stiffness",
                     "friction_coefficient": "friction coefficient", "preload_N": "preload"}
@@ -155,7 +157,8 @@ def render_report_html(summary: dict, images: dict | None = None, notes: dict | 
     parameters = [k for k in PARAMETER_LABELS if any(k in r["ten_percent"] for r in ranking)]
     template = environment().get_template("report.html.j2")
     return template.render(
-        audio=audio, parameters=parameters, background_label=background_label, parameter_labels=PARAMETER_LABELS,
+        audio=audio, parameters=parameters, background_label=background_label,
+        parameter_short=PARAMETER_SHORT, parameter_labels=PARAMETER_LABELS,
         audibility=worst.get("audibility") or {}, model_of_hearing=summary.get(
             "audibility_model") or {}, target=summary.get("target"),
         s=summary, points=points, worst=worst, loudest=loudest, images=images,
