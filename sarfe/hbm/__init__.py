@@ -21,6 +21,8 @@ Modules (in the order a solve uses them):
     continuation       the sweep: pseudo-arclength continuation in ω through folds
     stability/         is the orbit stable? one entry, stability(...) (Hill, contact-row count, …)
     pruning            contact screening: contacts that never switch solved linearly
+    linear_points      points where every contact stays open/closed/stuck: the linearized
+                       response, checked by the laws' AFT (no Newton, no Hill)
     newmark            the Newmark march with contacts (the time integrator's step and periods)
     time_integration   periodic steady state by time integration: the HBM's independent check
 

@@ -141,7 +141,7 @@ _BLOCK_ENTRIES = 4_000_000
 MODAL_SCREEN_MIN_SOLVES = 8
 
 
-def _modal_row_responses(basis, contacts, excitation, omegas):
+def modal_row_responses(basis, contacts, excitation, omegas):
     r"""(r̃ (n_ω, 2h+1, n_rows) [m], bad (n_ω,) bool): the linearized model's response at the rows
     of G from the modal basis of the model (no solve of model size per ω; h: the excitation's
     highest order), ``bad`` where some Z_k(ω) is singular. See :func:`contact_row_responses`."""
@@ -238,7 +238,7 @@ def contact_row_responses(model, contacts, excitation, omegas, modal=True) -> np
     if basis is None:
         return np.stack([np.asarray(G @ U.T).T
                          for U in linear_responses(model, contacts, F, omegas)])
-    R, bad = _modal_row_responses(basis, contacts, F, omegas)
+    R, bad = modal_row_responses(basis, contacts, F, omegas)
     bad |= ~np.all(np.isfinite(R), axis=(1, 2))
     if np.any(bad):
         R[bad] = np.stack([np.asarray(G @ U.T).T
@@ -476,5 +476,5 @@ def _linear_solution(U, omega, harmonics, samples_per_period):
 __all__ = ["OPEN", "CLOSED", "NONLINEAR", "ContactDecision", "PrunedProblem", "screen_contacts",
            "subset_contacts", "kept_rows", "prune_contacts", "check_pruning", "restore_solution",
            "linearized_stiffness", "linearized_damping", "linear_responses",
-           "contact_row_responses",
+           "contact_row_responses", "modal_row_responses",
            "solve_frequency_pruned"]

@@ -38,7 +38,10 @@ convention (``/`` attribute ``fourier_convention``): index 0 = static term u0, 2
     /erp/power_total_W, level_total_db, level_total_a_db  (n_f,)
     /erp/level_dba, level_total_dba                 the *_a_db datasets again (hard links), named
                                                     by their unit dB(A)
-    /erp/density_total_W_m2         (n_f, n_r) ERP density summed over harmonics [W/m²]
+    /erp/density_total_W_m2         (n_m, n_r) ERP density summed over harmonics [W/m²] at the
+                                    points /erp/density_point_index (n_m,) (all n_f points, or
+                                    the mapped ones of an FE sweep: the record stays ∝ points ×
+                                    contacts × H, not × mesh; format_version 2)
     /erp/density_W_m2               (n_f, H, n_r) per harmonic (only if requested)
     /<group>/<name>                 caller-supplied extra groups (e.g. /linear/... of the linear
                                     baseline), each array with its own ``units`` attribute if given
@@ -57,7 +60,7 @@ from sarfe import __version__
 
 __all__ = ["write_response_h5", "read_response_h5", "FOURIER_CONVENTION", "FORMAT_VERSION"]
 
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2      # 2: /erp/density_total_W_m2 at /erp/density_point_index (issue 30)
 FOURIER_CONVENTION = (
     "u(theta) = u0 + sum_{k=1..H} (u_kc cos k theta + u_ks sin k theta), theta = omega t; "
     "harmonic axis of length 2H+1 stores [u0, u1c, u1s, ..., uHc, uHs] (u0 not halved); "
@@ -109,6 +112,7 @@ def write_response_h5(
     radiating_nodes=None,
     store_displacement: bool = False,
     store_erp_density_per_harmonic: bool = False,
+    density_points=None,
     extra_groups: dict | None = None,
     attributes: dict | None = None,
 ) -> Path:
@@ -128,6 +132,7 @@ def write_response_h5(
     radiating_nodes : (n_r,) mesh point indices the ERP densities refer to.
     store_displacement : also store all kept DOFs' harmonics (can be large).
     store_erp_density_per_harmonic : also store /erp/density_W_m2 (n_f, H, n_r).
+    density_points : indices of the points whose ERP density is stored (default: all).
     extra_groups : {group: {name: array | (array, units)}}, e.g. the linear baseline.
     attributes : extra root attributes (str/number), e.g. {"case": name, "model_key": key}.
     """
@@ -229,7 +234,11 @@ def write_response_h5(
             # the same datasets under names ending in their unit (hard links: one copy of the data;
             # the *_a_db names stay for existing scripts)
             group["level_dba"], group["level_total_dba"] = group["level_a_db"], group["level_total_a_db"]
-            _put(group, "density_total_W_m2", _stack(erp, "density_total"), "W/m^2")
+            chosen = np.arange(len(erp)) if density_points is None else np.asarray(
+                density_points, dtype=np.int64)
+            _put(group, "density_point_index", chosen)
+            _put(group, "density_total_W_m2", _stack([erp[int(j)] for j in chosen],
+                                                     "density_total"), "W/m^2")
             if store_erp_density_per_harmonic:
                 _put(group, "density_W_m2", _stack(erp, "density"), "W/m^2")
 

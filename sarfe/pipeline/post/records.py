@@ -350,11 +350,14 @@ def band_record(erp, linear, omega) -> dict:
 
 
 def writes_maps(config: CaseConfig, stage) -> bool:
-    """True when the run writes ERP maps of its points (``erp_vtu`` or ``report`` in
-    ``output.files`` of an FE model: :mod:`sarfe.pipeline.write.result_files`): :func:`point_record` then
-    returns the map fields of each point."""
+    """True when the run writes an ERP map of every point (``erp_vtu`` in ``output.files`` of an
+    FE model and ``output.maps: {every: 1}``: :mod:`sarfe.pipeline.write.result_files`):
+    :func:`point_record` then returns the map fields of each point. The few maps of the other
+    selections (:mod:`sarfe.pipeline.write.map_points`) are made when written."""
     files = config.output.files
-    return getattr(stage, "kind", None) == "fe" and ("erp_vtu" in files or "report" in files)
+    maps = config.output.maps
+    return (getattr(stage, "kind", None) == "fe" and "erp_vtu" in files
+            and not isinstance(maps, (str, tuple)) and int(maps["every"]) == 1)
 
 
 def map_fields(config: CaseConfig, stage, erp, W, omega):

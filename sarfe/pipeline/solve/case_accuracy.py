@@ -15,6 +15,7 @@ from sarfe.case.read import load_case
 from sarfe.hbm import SolverOptions
 from sarfe.pipeline.model.linear_stage import build_linear_model
 from sarfe.pipeline.model.nonlinear_model import nonlinear_model
+from sarfe.util.progress import bar as progress_bar
 
 
 def stage_modal_coordinates(stage):
@@ -94,7 +95,8 @@ def resolved_case(case, report):
 
 
 def case_resolution(case, target, points=8, start_harmonics=3, start_samples=64,
-                    max_harmonics=64, max_samples=8192, max_points_tuned=3, max_rebuilds=2):
+                    max_harmonics=64, max_samples=8192, max_points_tuned=3, max_rebuilds=2,
+                    progress=False):
     """A case's accuracy target → (report, linear stage): :func:`sarfe.accuracy.resolve_accuracy`
     over ``points`` frequencies of the case (screened at ``start_harmonics``, then an H ladder at
     the loudest point), with the case's Newton tolerance and no stability.
@@ -109,7 +111,9 @@ def case_resolution(case, target, points=8, start_harmonics=3, start_samples=64,
     audible.md). So the search runs first on the stage of the case's H, c(H_case); while the
     chosen H needs c(H) above the stage's cutoff, the stage of c(H) is built and the search is
     repeated on it from ``start_harmonics`` at the tuned frequencies (at most ``max_rebuilds``
-    times). The last stage is returned: the sweep reuses it (same key as the chosen case)."""
+    times). The last stage is returned: the sweep reuses it (same key as the chosen case).
+    ``progress``: each stage of the search is shown (its linear model's own progress, then the
+    H ladder on it) — the search can take minutes."""
     case = load_case(case)
     solver = case.config.solver
     options = SolverOptions(tolerance=solver.tolerance, max_iterations=solver.max_iterations,
@@ -121,9 +125,17 @@ def case_resolution(case, target, points=8, start_harmonics=3, start_samples=64,
     history, seconds, stages, stage_seconds = [], 0.0, [], []
     for attempt in range(max_rebuilds + 1):
         searched = with_cutoff(case, cutoff)
-        stage = build_linear_model(searched)
+        where = "" if cutoff is None else f", cutoff {cutoff:.0f} Hz"
+        bar = progress_bar(progress, f"H search ({target}): linear stage {attempt + 1}{where}")
+        if bar is not None:
+            bar.close()
+        stage = build_linear_model(searched, progress=progress)
         stages.append(stage.info.get("modes"))
         stage_seconds.append(float(stage.timings.get("linear_stage_s", 0.0)))
+        bar = progress_bar(progress, f"H search: the H, N ladder on {stage.info.get('modes')} "
+                                     f"modes at {len(grid)} frequencies")
+        if bar is not None:
+            bar.close()
         report = resolve_accuracy(accuracy_problem(stage, nonlinear_model(searched, stage)),
                                   target, grid, solver.harmonics, solver.samples_per_period,
                                   max_points_tuned=max_points_tuned if attempt == 0 else len(grid),
@@ -146,6 +158,18 @@ def case_resolution(case, target, points=8, start_harmonics=3, start_samples=64,
     return report, stage
 
 
+def resolution_line(report, stage) -> str:
+    """One line of what ``resolution: auto`` chose (:func:`case_resolution`'s ``report`` and the
+    linear ``stage`` the sweep uses): H, N, the reduction cutoff [Hz] and modes, the search's
+    time [s]."""
+    modes = (getattr(stage, "info", None) or {}).get("modes") if stage is not None else None
+    cutoff = report.get("cutoff_hz")
+    return (f"resolution auto: H = {report['harmonics']}, N = {report['samples_per_period']}"
+            + ("" if cutoff is None else f", reduction cutoff {cutoff:.0f} Hz")
+            + ("" if modes is None else f", {modes} modes")
+            + f" (search {report.get('seconds', 0.0):.0f} s)")
+
+
 def resolve_case_accuracy(case, target, points=8, start_harmonics=3, start_samples=64,
                           max_harmonics=64, max_samples=8192, max_points_tuned=3) -> dict:
     """The report of :func:`case_resolution` (the report dict of
@@ -157,7 +181,7 @@ def resolve_case_accuracy(case, target, points=8, start_harmonics=3, start_sampl
 RELEVANT_DB = 30.0     # points quieter than the loudest by more than this do not count (dB(A))
 
 KNOBS = {"harmonics": "solver.harmonics", "aliasing": "solver.samples_per_period",
-         "modal": "reduction.cutoff_hz (or mode_count)"}
+         "modal": "reduction.cutoff_hz (or mode_count)", "mesh": "the mesh resolution (a smaller model.fe.generator.mesh_size_m)"}
 
 
 def accuracy_check(solver: SolverConfig, points) -> dict | None:
@@ -168,7 +192,8 @@ def accuracy_check(solver: SolverConfig, points) -> dict | None:
     Counted: converged points with an estimate whose ERP is within RELEVANT_DB of the loudest
     (a 5 dB error 60 dB below the headline changes nothing a user reads). The knob to raise is the
     one whose part (Richardson factors included) is largest at the worst point: harmonics →
-    solver.harmonics, aliasing → solver.samples_per_period, modal → the reduction cutoff."""
+    solver.harmonics, aliasing → solver.samples_per_period, modal → the reduction cutoff, mesh
+    (``mesh_db``, :mod:`sarfe.pipeline.solve.mesh_error`) → the generator's mesh size."""
     target = parse_accuracy(solver.accuracy_or_default)
     rated = [p for p in points if p["converged"] and p.get("error_estimate")
              and "failed" not in p["error_estimate"]]
@@ -198,7 +223,9 @@ def accuracy_check(solver: SolverConfig, points) -> dict | None:
              "modal": np.nan_to_num(e["modal_rel"])}
     parts_db = {"harmonics": factor * abs(np.nan_to_num(e["harmonics_db"])),
                 "aliasing": RICHARDSON * abs(np.nan_to_num(e["aliasing_db"])),
-                "modal": abs(np.nan_to_num(e["modal_db"]))}
+                "modal": abs(np.nan_to_num(e["modal_db"])),
+                "mesh": abs(np.nan_to_num(e.get("mesh_db", 0.0)))}      # sarfe.pipeline.solve.mesh_error
+    parts["mesh"] = 0.0
     share = {k: max(parts[k] / budget, parts_db[k] / (target.erp_db or 1e300)) for k in parts}
     knob = max(share, key=share.get)
     warning = None
@@ -226,4 +253,5 @@ def accuracy_check(solver: SolverConfig, points) -> dict | None:
 
 
 __all__ = ["accuracy_check", "resolved_case", "with_cutoff", "stage_modal_coordinates", "accuracy_problem", "stage_error_estimate", "sweep_grid_hz",
-           "resolve_case_accuracy", "case_resolution", "rule_cutoff_hz", "search_margin"]
+           "resolve_case_accuracy", "case_resolution", "resolution_line", "rule_cutoff_hz",
+           "search_margin"]

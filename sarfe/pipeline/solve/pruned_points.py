@@ -30,7 +30,8 @@ from sarfe.case.config import ExcitationConfig, SolverConfig
 from sarfe.hbm.pruning import (CLOSED, NONLINEAR, OPEN, check_pruning, linearized_stiffness,
                                prune_contacts, restore_solution, screen_contacts)
 from sarfe.pipeline.model.nonlinear_model import NonlinearModel
-from sarfe.pipeline.solve.points import TIME_INTEGRATION, solve_point, solve_points, solver_options
+from sarfe.pipeline.solve.by_need import points_by_need
+from sarfe.pipeline.solve.points import TIME_INTEGRATION, solve_point, solver_options
 
 SWEEP_GRID_POINTS = 201
 MAX_LISTED = 20          # violations listed in the report (all are counted)
@@ -144,31 +145,42 @@ def restore_solutions(solver: SolverConfig, nl: NonlinearModel, decisions, solut
 
 
 def solve_points_pruned(solver: SolverConfig, excitation: ExcitationConfig, nl: NonlinearModel,
-                        progress=False) -> tuple:
-    """(solutions, report): :func:`sarfe.pipeline.solve.points.solve_points` on the pruned model, checked
-    and restored to the full contact set (module docstring), or on the full model when pruning is
-    off, removes nothing, or a decision fails. ``report`` is summary.json's ``contact_pruning``."""
+                        progress=False, measure=None) -> tuple:
+    """(solutions, report): the points (:func:`sarfe.pipeline.solve.by_need.points_by_need`: a
+    sweep by need, else :func:`sarfe.pipeline.solve.points.solve_points`) on the pruned model,
+    checked and restored to the full contact set (module docstring), or on the full model when
+    pruning is off, removes nothing, or a decision fails. ``measure(ũ, ω)``: the response a sweep
+    by need refines its linear peaks on (None: the contact rows'). ``report`` is summary.json's
+    ``contact_pruning``."""
     enabled, margin = pruning_options(solver)
+
+    def points(solver, excitation, nl, progress):
+        if excitation.sweep is None or not solver.continuation.linear_points:
+            return points_by_need(solver, excitation, nl, None, progress=progress)
+        return points_by_need(solver, excitation, nl, screening_frequencies(excitation, nl),
+                              linearized_natural_frequencies(nl.model, nl.contacts), measure,
+                              progress)
+
     report = {"enabled": enabled, "applied": False, "fallback": False, "margin": margin,
               "screened_frequencies": 0, "pairs": int(nl.contacts.count),
               "nonlinear_pairs": int(nl.contacts.count), "contacts": [], "violations": [],
               "violation_count": 0, "full_model_points_hz": []}
     if not enabled or not nl.contacts.count:
-        return solve_points(solver, excitation, nl, progress=progress), report
+        return points(solver, excitation, nl, progress=progress), report
     omegas = screening_frequencies(excitation, nl)
     decisions = screen_contacts(nl.model, nl.contacts, nl.excitation, omegas, margin=margin)
     kept = sum(d.decision == NONLINEAR for d in decisions)
     report.update(screened_frequencies=int(len(omegas)), nonlinear_pairs=int(kept),
                   contacts=contact_report(decisions, nl.groups))
     if kept == nl.contacts.count:      # nothing to remove
-        return solve_points(solver, excitation, nl, progress=progress), report
+        return points(solver, excitation, nl, progress=progress), report
     pruned = prune_contacts(nl.model, nl.contacts, nl.excitation, decisions)
-    solutions = solve_points(solver, excitation, pruned_model(nl, pruned), progress=progress)
+    solutions = points(solver, excitation, pruned_model(nl, pruned), progress=progress)
     violations, unsolved = check_solutions(solver.samples_per_period, nl, decisions, solutions)
     if violations:                     # a decision does not hold: solve it all again
         report.update(fallback=True, nonlinear_pairs=int(nl.contacts.count),
                       violation_count=len(violations), violations=violations[:MAX_LISTED])
-        return solve_points(solver, excitation, nl, progress=progress), report
+        return points(solver, excitation, nl, progress=progress), report
     report.update(applied=True, full_model_points_hz=[
         float(solutions[i].omega) / (2 * np.pi) for i in unsolved])
     return restore_solutions(solver, nl, decisions, solutions, unsolved,

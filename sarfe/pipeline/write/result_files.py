@@ -12,10 +12,12 @@ import numpy as np
 from sarfe import results
 from sarfe.hbm.laws import table_column
 from sarfe.pipeline.post.point_workers import point_workers
+from sarfe.pipeline.post.records import point_erp
 from sarfe.pipeline.post.result_data import (contact_margin_fields, contact_pair_fields,
                                              result_groups)
 from sarfe.pipeline.write import figures
 from sarfe.pipeline.write.sound_files import SOUND_FILES, write_point_sound
+from sarfe.pipeline.write.map_points import map_indices
 from sarfe.reduction.recovery import recover_displacement
 from sarfe.results import render
 from sarfe.results.summary import shown_level
@@ -53,25 +55,32 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, di
     written["summary"] = "summary.json"
     if "table" in files:
         types = {name: kind for name, kind, _ in nl.groups}
-        (directory / "table.txt").write_text(results_table(rows, types, max_contacts=100) + "\n",
-                                             encoding="utf-8")
+        mesh = (summary.get("mesh_error") or {}).get("line")    # the ± mesh term's line
+        (directory / "table.txt").write_text(results_table(rows, types, max_contacts=100) + "\n"
+                                             + (f"{mesh}\n" if mesh else ""), encoding="utf-8")
         written["table"] = "table.txt"
     if not solutions:
         return written
     loudest = (summary.get("worst") or {}).get("index")
     maps, renders, series = {}, None, None
+    frequencies = [float(s.omega) / (2 * np.pi) for s in solutions]
+    selected = map_indices(config.output.maps, frequencies, [bool(s.converged) for s in solutions],
+                           loudest)       # the points with an ERP map (output.maps)
     if stage.kind == "fe" and ("erp_vtu" in files or "animation" in files or "report" in files):
         mesh = stage.mesh
         markers = results.contact_markers(mesh.n_nodes, [g.nodes_a for g in stage.contacts.values()])
+        parts = results.part_ids(mesh.n_triangles, mesh.element_groups)
         translations = {}
-        every_point = full_field_every_point(stage, solutions)
+        every_point = full_field_every_point(stage, solutions) or (
+            len(selected) < len(solutions)
+            and full_field_every_point(stage, [solutions[j] for j in selected]))
 
         def nodal_translations(j):
             # full-field recovery only because a VTU or a map was asked for: (2H+1, n, 3) [m];
             # kept for the loudest point only (200 points of a 5 mm door trim would hold 5 GB)
             if j in translations:
                 return translations[j]
-            if j != loudest and not every_point:
+            if j != loudest and not (every_point and j in selected):
                 return None
             u = recover_displacement(stage.reduced, np.asarray(solutions[j].displacement),
                                      all_dofs=True)
@@ -86,7 +95,11 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, di
             if j in loudest_data:     # the loudest point's arrays serve its map and the report's
                 return loudest_data[j]
             force, motion = contact_pair_fields(stage, nl, solutions[j], mesh.n_nodes)
-            data = results.erp_point_data(mesh.n_nodes, erps[j], None,
+            erp, W = erps[j], None
+            if fields[j] is None:     # a chosen map (output.maps): its ERP density made now
+                erp, W = point_erp(config.erp, stage, np.asarray(solutions[j].displacement),
+                                   float(solutions[j].omega))
+            data = results.erp_point_data(mesh.n_nodes, erp, W,
                                           float(solutions[j].omega), fields=fields[j],
                                           displacement=nodal_translations(j),
                                           radiating_nodes=stage.erp_nodes,
@@ -111,15 +124,18 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, di
                                                         if len(g.nodes_a)})
             started.append(("render", renders))
         if "erp_vtu" in files:
-            frequencies = [float(s.omega) / (2 * np.pi) for s in solutions]
-            if len(solutions) == 1:
+            if len(selected) == 1:      # one map (the loudest, or the only point): erp.vtu
+                j = selected[0]
                 results.write_erp_vtu(directory / "erp.vtu", mesh.points, mesh.triangles,
-                                      point_data(0))
+                                      point_data(j), field_data={"frequency_hz": frequencies[j],
+                                                                 "point_index": j}, parts=parts)
                 written["erp_vtu"] = "erp.vtu"
             else:       # on the workers while this process writes the files below
                 series = results.start_erp_sweep(directory / "erp", mesh.points, mesh.triangles,
-                                                 point_data, frequencies,
-                                                 workers=map_workers(config, mesh, len(solutions)))
+                                                 lambda i: point_data(selected[i]),
+                                                 [frequencies[j] for j in selected],
+                                                 workers=map_workers(config, mesh, len(selected)),
+                                                 indices=selected, parts=parts)
                 started.append(("maps", series))
                 written["erp_vtu"] = "erp/erp.pvd"
         if "animation" in files and loudest is not None:
@@ -132,8 +148,15 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, di
                                                    else {}))
             written["animation"] = "animation/deflection.pvd"
     if "response" in files:
+        reduced = getattr(stage, "reduced", None)
         results.write_response_h5(
             directory / "response.h5", solutions, contacts=nl.contacts, excitation=nl.excitation,
+            # a base excitation loads every coordinate of a reduced model: its "excitation DOFs"
+            # would be the whole reduced response (∝ modes); the contact rows and the ERP are
+            # the record (∝ points × contacts × H)
+            excitation_dofs=np.zeros(0, dtype=int) if reduced is not None
+            and config.excitation.base_acceleration is not None else None,
+            density_points=selected if stage.kind == "fe" else None,
             boundary_dofs=getattr(stage.reduced, "boundary_dofs", None),
             mode_frequencies_hz=stage.mode_frequencies_hz, erp=erps,
             radiating_nodes=stage.erp_nodes if stage.erp_map.shape[0] else None,
@@ -193,15 +216,53 @@ def full_field_every_point(stage, solutions) -> bool:
     return cost <= FULL_FIELD_BUDGET
 
 
-def results_table(rows, contact_types=None, max_contacts=6) -> str:
-    """table.txt, the full table of the frequency points: convergence, ERP, the SPL at the
-    occupant and whether it is heard (margin [dB]) and, per contact (at most ``max_contacts``),
-    the indicator its law declares (max penetration, or the slip fraction of a friction law: the
-    share of the period in slip, 0…1) and its onset factor (< 1: active at this excitation). The ±dB column is the ERP error bound,
+CONSOLE_WIDTH = 80      # the compact console summary fits this many columns
+CONSOLE_ROWS = 12       # … and shows at most this many points (all of them in table.txt)
+
+
+def console_summary(rows, contact_types=None, full_table=None, width=CONSOLE_WIDTH,
+                    max_rows=CONSOLE_ROWS) -> str:
+    """The end-of-run console summary of the points, at most ``width`` characters a line: the
+    compact :func:`results_table` (f, converged, ERP [dB(A)], ±dB and as many contacts as fit) of
+    all points when there are at most ``max_rows``, else of the band's two ends and ``max_rows``
+    − 2 others, the level's peaks loudest first, then points spread over the sweep (in sweep
+    order), with a line saying so and naming ``full_table`` (the file
+    with every point, e.g. 'table.txt'; None: not written)."""
+    rows = list(rows)
+    shown = list(range(len(rows)))
+    if len(rows) > max_rows:
+        levels = np.array([row.get("erp_dba", float("nan")) for row in rows], dtype=float)
+        levels = np.where(np.isfinite(levels), levels, -np.inf)
+        peak = np.r_[False, (levels[1:-1] > levels[:-2]) & (levels[1:-1] >= levels[2:]), False]
+        peaks = [int(i) for i in np.flatnonzero(peak)[np.argsort(-levels[peak])]]
+        spread = [int(i) for i in np.linspace(0, len(rows) - 1, max_rows).round()]
+        chosen = [0, len(rows) - 1]
+        for i in peaks[:max_rows - 2] + spread:     # the peaks loudest first, then spread
+            if len(chosen) < max_rows and i not in chosen:
+                chosen.append(i)
+        shown = sorted(chosen)
+    count = len([k for k in (rows[0] if rows else {}) if k.endswith(".max_penetration_m")])
+    for contacts in range(count, -1, -1):       # as many contact columns as fit the width
+        table = results_table([rows[i] for i in shown], contact_types, max_contacts=contacts,
+                              compact=True)
+        if max(len(line) for line in table.splitlines()) <= width:
+            break
+    if len(shown) < len(rows):
+        where = f"; all in {full_table}" if full_table else ""
+        table += f"\n({len(shown)} of {len(rows)} points: ends, peaks, spread{where})"
+    return table
+
+
+def results_table(rows, contact_types=None, max_contacts=6, compact=False) -> str:
+    """Console table of the frequency points: convergence, ERP and, per contact (at most
+    ``max_contacts``), the indicator its law declares (max penetration, or the slip fraction of a
+    friction law: the share of the period in slip, 0…1). The ±dB column is the ERP error bound,
     "~" marking a bound interpolated between estimated points. ``contact_types``: {name: law
-    name} (default: max penetration)."""
-    columns = ["frequency_hz", "converged", "stable", "iterations", "erp_db", "erp_dba",
-               "linear_erp_db"]
+    name} (default: max penetration). ``compact``: frequency, convergence and dB(A) only (no
+    stability, iterations, dB and linear dB columns: :func:`console_summary`)."""
+    columns = (["frequency_hz", "converged", "erp_dba"] if compact else
+               ["frequency_hz", "converged", "stable", "iterations", "erp_db", "erp_dba",
+                "linear_erp_db"])
     headers = {"frequency_hz": "f [Hz]", "erp_db": "ERP [dB]", "erp_dba": "ERP [dB(A)]",
                "linear_erp_db": "linear [dB]", "iterations": "iter"}
     formats = {"frequency_hz": ".2f", "erp_db": ".1f", "erp_dba": ".1f", "linear_erp_db": ".1f"}

@@ -22,7 +22,7 @@ def _maps(tmp_path, name, budget, monkeypatch):
     data["excitation"].pop("sweep")
     data["excitation"]["frequency_hz"] = [31.0, 20.0, 26.0]
     data["solver"].update(error_estimate=False, stability=False)
-    data["output"]["files"] = ["summary", "erp_vtu"]
+    data["output"].update(files=["summary", "erp_vtu"], maps={"every": 1})   # a map per point
     result = solve_case(data, output_dir=tmp_path / name)
     files = sorted((tmp_path / name / "erp").glob("erp_*.vtu"))
     return result.summary["worst"]["index"], [pyvista.read(f).point_data for f in files]

@@ -34,8 +34,8 @@ def test_every_artefact_uses_the_loudest_converged_stable_point(lumped_case, tmp
     real = solve_module.solve_points_pruned
     chosen = {}
 
-    def tampered(solver, excitation, nl, progress=False):
-        solutions, report = real(solver, excitation, nl, progress=progress)
+    def tampered(solver, excitation, nl, progress=False, measure=None):
+        solutions, report = real(solver, excitation, nl, progress=progress, measure=measure)
         from sarfe.pipeline.post.records import point_erp as _erp
 
         dba = [_erp(_case[0].config.erp, _stage[0], s.displacement, s.omega)[0]
