@@ -20,7 +20,7 @@ from pathlib import Path
 PACKAGE = Path(__file__).resolve().parents[1] / "sarfe"
 LAYERS = {"util": 0, "linalg": 0, "mesh": 0, "fe": 1, "reduction": 2, "hbm": 3, "erp": 4,
           "accuracy": 5, "case": 5, "results": 5, "pipeline": 6, "tradeoff": 7, "batch": 7,
-          "cli": 7, "__main__": 7}
+          "compare": 7, "cli": 7, "__main__": 7}
 MAX_LINES = 600
 #: basenames several modules may share: each is the same concept in its own package
 SHARED_BASENAMES = {"__init__", "__main__", "cli"}

@@ -50,14 +50,16 @@ def test_ex03_rattle_rig_striker_hits_and_time_integration_agrees():
 
 
 def test_ex04_squeak_rig_level_matches_time_integration():
-    """Squeak rig at 100 Hz (H = 23): the radiated level agrees with time integration within
-    0.2 dB (measured 0.05 dB), the pad's normal motion within 1 %; the pad stays pressed (its
-    normal force peaks above the 2 N preload)."""
+    """Squeak rig at 100 Hz (6 mm, H = 32; friction on the plate's face since issue 29): the
+    radiated level agrees with time integration (1024 steps per period) within 0.2 dB (measured
+    0.12 dB; 2048 steps: 0.05 dB), and matches the case's H = 48 reference (43.99 dB(A)) within
+    0.3 dB. The centred pad's normal motion stays negligible in both solutions (by symmetry, so
+    the normal force stays at the 2 N preload)."""
     p = example("ex04_squeak_rig").squeak_point()
-    assert p.level_dba == pytest.approx(37.2, abs=0.3)
+    assert p.level_dba == pytest.approx(43.99, abs=0.3)
     assert p.level_dba == pytest.approx(p.time_level_dba, abs=0.2)
-    assert p.gap_amplitude_m["rub"] == pytest.approx(p.time_gap_amplitude_m["rub"], rel=1e-2)
-    assert p.peak_normal_force_N["rub"] > 2.0
+    assert p.gap_amplitude_m["rub"] < 1e-9 and p.time_gap_amplitude_m["rub"] < 1e-9
+    assert p.peak_normal_force_N["rub"] == pytest.approx(2.0, rel=1e-2)
 
 
 @pytest.mark.slow

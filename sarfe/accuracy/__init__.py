@@ -13,14 +13,14 @@ Modules:
 - modal_truncation: the Craig–Bampton mode-truncation part (coarser models, two probes, decay);
 - estimate: the per-point estimate combining them (:func:`estimate_errors`,
   :class:`EstimateProblem`, :func:`problem_error_estimate`);
-- resolve: a sweep's accuracy target → H, N (:func:`resolve_accuracy`, :func:`apply_resolution`).
+- resolve: a sweep's accuracy target → H, N (:func:`resolve_accuracy`);
+- mesh_refinement: the mesh term's Richardson extrapolation of a level on h and 2h (stated order).
 """
 from sarfe.accuracy.estimate import (ErrorEstimate, EstimateProblem, estimate_errors,
                                      problem_error_estimate)
 from sarfe.accuracy.measures import resize_harmonics
-from sarfe.accuracy.resolve import apply_resolution, resolve_accuracy
+from sarfe.accuracy.resolve import resolve_accuracy
 from sarfe.accuracy.target import PRESETS, AccuracyTarget, parse_accuracy
 
 __all__ = ["PRESETS", "AccuracyTarget", "parse_accuracy", "ErrorEstimate", "EstimateProblem",
-           "estimate_errors", "problem_error_estimate", "resize_harmonics", "resolve_accuracy",
-           "apply_resolution"]
+           "estimate_errors", "problem_error_estimate", "resize_harmonics", "resolve_accuracy"]

@@ -76,9 +76,15 @@ def coarser_basis(model, excitation, boundary_count, removed, residual=()):
         F = np.asarray(excitation, dtype=float)
         loads = np.column_stack([M[np.ix_(S, boundary)], F[1, S], F[2, S]])
         W0 = np.linalg.solve(K[np.ix_(S, S)], loads)
+        # unit M-norm columns and the rank rule of the reduction's own residual modes
+        # (sarfe.reduction.craig_bampton.residual_modes: relative tolerance 1e-8): a unit
+        # rotational boundary acceleration (rotary inertia ρt³/12) loads far less than a
+        # translational one, and a threshold relative to the largest column dropped its direction
+        norms = np.sqrt(np.einsum("ij,ij->j", W0, M[np.ix_(S, S)] @ W0))
+        W0 = W0[:, norms > 0] / norms[norms > 0]
         gram = W0.T @ M[np.ix_(S, S)] @ W0
         values, vectors = np.linalg.eigh(0.5 * (gram + gram.T))
-        ok = values > 1e-10 * max(values.max(initial=0.0), 1e-300)
+        ok = values > 1e-8 ** 2
         W = np.zeros((n, int(ok.sum())))
         W[S] = W0 @ vectors[:, ok] / np.sqrt(values[ok])
         blocks.append(W)

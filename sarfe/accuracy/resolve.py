@@ -33,7 +33,7 @@ it the A-weighting (−50 dB and falling) turns the weighted level into a measur
 harmonic alone.
 
 Works on plain arrays (:class:`sarfe.accuracy.estimate.EstimateProblem`); the case layer builds
-them (:mod:`sarfe.pipeline.solve.case_accuracy`) and applies the result with :func:`apply_resolution`.
+them (:mod:`sarfe.pipeline.solve.case_accuracy`) and applies the result (:func:`sarfe.pipeline.solve.case_accuracy.resolved_case`).
 """
 from __future__ import annotations
 
@@ -305,24 +305,6 @@ def resolve_accuracy(problem: EstimateProblem, target, frequencies_hz, harmonics
             "seconds": seconds, "text": text}
 
 
-def apply_resolution(case_data: dict, report: dict) -> dict:
-    """Case data (a copy) with solver.harmonics / samples_per_period set, ``resolution: fixed``
-    (chosen; ``accuracy`` stays the run's error budget) and reduction.cutoff_hz (or mode_count)
-    when the report gives one (the case layer's search: the reduction's rule at the chosen H)."""
-    data = copy.deepcopy(case_data)
-    data.setdefault("solver", {})
-    data["solver"]["harmonics"] = int(report["harmonics"])
-    data["solver"]["samples_per_period"] = int(report["samples_per_period"])
-    data["solver"]["resolution"] = "fixed"
-    if report.get("cutoff_hz"):      # the search's reduction cutoff (FE; none given by the user)
-        data.setdefault("reduction", {})["cutoff_hz"] = float(report["cutoff_hz"])
-    elif report.get("mode_count"):
-        red = data.setdefault("reduction", {})
-        red.pop("cutoff_hz", None)
-        red["mode_count"] = int(report["mode_count"])
-    return data
-
-
 __all__ = ["AUDIBLE_TOP_HZ", "screen_grid", "contact_active", "a_weighted_power",
            "representative_points", "ladder_samples", "next_harmonics", "harmonics_cap",
-           "LadderResult", "search_harmonics", "resolve_accuracy", "apply_resolution"]
+           "LadderResult", "search_harmonics", "resolve_accuracy"]

@@ -45,7 +45,9 @@ _CASE_SECTIONS = ("name", "description", "model", "damping", "reduction", "conta
                   "solver", "erp", "output")
 # per-contact columns of CaseResult.rows: "<contact>.<quantity>"; maxima over frequency per variant
 CONTACT_MAXIMA = ("max_penetration_m", "peak_normal_force_N", "peak_friction_force_N")
-RATTLE_COLUMN = "max_penetration_m"  # a contact rattles when it closes: penetration > 0
+RATTLE_COLUMN = "max_penetration_m"  # fallback: a contact rattles when it closes: penetration > 0
+IMPACT_COLUMN = "impacts_per_period"  # a contact rattles when it opens and impacts (> 0 per period)
+SLIP_COLUMN = "slip_fraction"        # a contact squeaks (slips) when part of the period slides
 
 
 def parameter_columns(table) -> list[str]:
@@ -82,11 +84,23 @@ def variant_levels(table: pd.DataFrame) -> pd.DataFrame:
         for contact, column in contact_columns(table, quantity).items():
             values = pd.to_numeric(table[column], errors="coerce")
             levels[column] = values.groupby(table["variant_index"]).max().to_numpy()
+    impacts = contact_columns(table, IMPACT_COLUMN)
     for contact, column in contact_columns(table, RATTLE_COLUMN).items():
-        values = pd.to_numeric(table[column], errors="coerce")
+        if contact in impacts:   # rattle = the contact opens and impacts (any law, preloaded too)
+            values = pd.to_numeric(table[impacts[contact]], errors="coerce")
+        else:                    # records without impact counts: closes at all (penetration > 0)
+            values = pd.to_numeric(table[column], errors="coerce")
         if values.notna().any():  # contacts without a normal direction (pure squeak) have NaN
             levels[f"{contact}.rattles"] = (values.fillna(0) > 0).groupby(table["variant_index"]).any().to_numpy()
+    for contact, column in contact_columns(table, SLIP_COLUMN).items():
+        values = pd.to_numeric(table[column], errors="coerce")
+        if values.notna().any():
+            levels[f"{contact}.slips"] = (values.fillna(0) > 0).groupby(table["variant_index"]).any().to_numpy()
     return levels
+
+
+#: fewer variants than this are drawn as dots (strip plot), not as a histogram
+STRIP_BELOW = 10
 
 
 def _stats(values) -> dict:
@@ -155,12 +169,14 @@ def _short_value(value) -> str:
 
 
 def evaluate_gate(table: pd.DataFrame, fail_above_db: float | None = None,
-                  allow_nonconverged: bool = False) -> GateResult:
-    """CI gate: a variant fails when its max ERP level > ``fail_above_db`` [dB], when it did not
+                  allow_nonconverged: bool = False, weighted: bool = False) -> GateResult:
+    """CI gate: a variant fails when its max ERP level > ``fail_above_db`` [dB, or dB(A) when
+    ``weighted``: the A-weighted level the review speaks], when it did not
     converge (unless ``allow_nonconverged``), or when it failed with an error.
     Exit code of a failed gate: ``GATE_EXIT_CODE`` (4)."""
     levels = variant_levels(table) if len(table) else pd.DataFrame()
     parameters = parameter_columns(table)
+    column, unit = ("max_erp_dba", "dB(A)") if weighted else ("max_erp_db", "dB")
     offenders, lines = [], []
     for _, row in levels.iterrows():
         reason = None
@@ -168,9 +184,9 @@ def evaluate_gate(table: pd.DataFrame, fail_above_db: float | None = None,
             reason = f"failed: {row['error']}"
         elif row["status"] == "nonconverged" and not allow_nonconverged:
             reason = "did not converge (use --allow-nonconverged to accept)"
-        elif fail_above_db is not None and "max_erp_db" in row and row["max_erp_db"] > fail_above_db:
-            at = f" at {row['frequency_at_max_hz']:.6g} Hz" if "frequency_at_max_hz" in row else ""
-            reason = f"ERP {row['max_erp_db']:.2f} dB{at} > {fail_above_db:g} dB"
+        elif fail_above_db is not None and column in row and row[column] > fail_above_db:
+            at = f" at {row['frequency_at_max_hz']:.6g} Hz" if "frequency_at_max_hz" in row and not weighted else ""
+            reason = f"ERP {row[column]:.2f} {unit}{at} > {fail_above_db:g} {unit}"
         if reason is not None:
             offenders.append({"variant_id": row["variant_id"], "variant_index": int(row["variant_index"]),
                               "reason": reason})
@@ -178,12 +194,12 @@ def evaluate_gate(table: pd.DataFrame, fail_above_db: float | None = None,
     total = len(levels)
     if offenders:
         if fail_above_db is not None:
-            head = f"gate failed: {len(offenders)} of {total} variants (threshold {fail_above_db:g} dB)"
+            head = f"gate failed: {len(offenders)} of {total} variants (threshold {fail_above_db:g} {unit})"
         else:
             head = f"{len(offenders)} of {total} variants failed or did not converge"
         message = "\n".join([head + ":"] + lines)
     else:
-        message = f"gate passed: {total} variants" + (f" at or below {fail_above_db:g} dB" if fail_above_db is not None else "")
+        message = f"gate passed: {total} variants" + (f" at or below {fail_above_db:g} {unit}" if fail_above_db is not None else "")
     return GateResult(passed=not offenders, threshold_db=fail_above_db, offenders=offenders, message=message)
 
 
@@ -247,9 +263,14 @@ def _plots(levels: pd.DataFrame, output: pathlib.Path) -> list[str]:
     if "max_erp_db" in levels and levels["max_erp_db"].notna().any():
         figure = Figure(figsize=(6, 4))
         axis = figure.add_subplot()
-        axis.hist(levels["max_erp_db"].dropna(), bins=min(30, max(5, len(levels) // 4)), color="tab:blue")
+        values = levels["max_erp_db"].dropna()
+        if len(values) < STRIP_BELOW:    # too few for a histogram: every variant a dot
+            axis.plot(values, np.zeros(len(values)), "o", color="tab:blue", alpha=0.7)
+            axis.set_yticks([])
+        else:
+            axis.hist(values, bins=min(30, max(5, len(levels) // 4)), color="tab:blue")
+            axis.set_ylabel("variants")
         axis.set_xlabel("max ERP level per variant [dB]")
-        axis.set_ylabel("variants")
         axis.set_title(f"ERP level over {int(levels['max_erp_db'].notna().sum())} variants")
         figure.tight_layout()
         figure.savefig(output / "erp_histogram.png", dpi=110)
@@ -371,8 +392,23 @@ def write_batch_report_html(levels: pd.DataFrame, summary: dict, output: pathlib
     return path
 
 
+def one_sample(levels: pd.DataFrame) -> bool:
+    """True when every variant comes from one source (one study file, e.g. Monte-Carlo variants of
+    one case): only then are their levels one statistical sample. Unrelated case files are not."""
+    return "source" not in levels or levels["source"].nunique() <= 1
+
+
+def per_case_rows(levels: pd.DataFrame) -> list[dict]:
+    """One row per variant of a batch of unrelated cases: source, status, loudest level and where."""
+    keep = [c for c in ("source", "variant_id", "status", "max_erp_dba", "max_erp_db",
+                        "frequency_at_max_hz", "error") if c in levels]
+    return [{k: (None if _missing(row[k]) else row[k]) for k in keep} for _, row in levels.iterrows()]
+
+
 def summarize(table: pd.DataFrame, stats=None) -> dict:
-    """Statistics of a merged batch table (the content of summary.json)."""
+    """Statistics of a merged batch table (the content of summary.json). Variants of one source
+    (a study) are one sample: distribution, confidence intervals, P(rattle). Variants of
+    unrelated case files are not: ``sample: "per case"`` and a per-case table ``cases`` instead."""
     levels = variant_levels(table) if len(table) else pd.DataFrame(columns=["status"])
     counts = levels["status"].value_counts().to_dict() if len(levels) else {}
     summary = {
@@ -384,6 +420,14 @@ def summarize(table: pd.DataFrame, stats=None) -> dict:
         "columns": {"erp_db": erp_column(table), "erp_dba": erp_a_column(table),
                     "frequency": frequency_column(table), "parameters": parameter_columns(table)},
     }
+    summary["sample"] = "one case" if one_sample(levels) else "per case"
+    if summary["sample"] == "per case":
+        summary["cases"] = per_case_rows(levels)
+        summary["failures"] = [{"variant_id": r["variant_id"], "error": r["error"]}
+                               for _, r in levels.iterrows() if r["status"] == "failed"]
+        if stats is not None:
+            summary["run"] = asdict(stats)
+        return summary
     if "max_erp_db" in levels:
         summary["max_erp_db"] = _stats(levels["max_erp_db"])
     if "max_erp_dba" in levels:
@@ -395,6 +439,12 @@ def summarize(table: pd.DataFrame, stats=None) -> dict:
         summary["rattle_probability_ci95"] = {
             f[: -len(".rattles")]: [float(v) for v in wilson_interval(ok[f].sum(), len(ok))]
             for f in flags}
+    slips = [c for c in levels.columns if c.endswith(".slips")]
+    if slips and len(ok):
+        summary["slip_probability"] = {f[: -len(".slips")]: float(ok[f].mean()) for f in slips}
+        summary["slip_probability_ci95"] = {
+            f[: -len(".slips")]: [float(v) for v in wilson_interval(ok[f].sum(), len(ok))]
+            for f in slips}
     for parameter in parameter_columns(table):
         values = pd.to_numeric(levels[parameter], errors="coerce") if parameter in levels else pd.Series([], dtype=float)
         if values.notna().any():
@@ -414,7 +464,7 @@ def write_report(table: pd.DataFrame, output, stats=None) -> dict:
     if len(table):
         levels = variant_levels(table)
         store.atomic_write(output / "variants.csv", levels.to_csv(index=False).encode())
-        summary["plots"] = _plots(levels, output)
+        summary["plots"] = _plots(levels, output) if summary["sample"] == "one case" else []
         write_batch_report_html(levels, summary, output, summary["plots"])
         summary["report"] = "report.html"
     store.atomic_write(output / "summary.json", json.dumps(summary, indent=2, default=str).encode())

@@ -40,6 +40,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--fail-above-db", type=float, default=None, metavar="X",
                         help=f"CI gate: exit 4 if any variant's max ERP level exceeds X dB, "
                              "did not converge, or failed")
+    parser.add_argument("--fail-above-dba", type=float, default=None, metavar="X",
+                        help="CI gate in the review's unit: exit 4 if any variant's max A-weighted "
+                             "ERP level exceeds X dB(A), did not converge, or failed")
     parser.add_argument("--allow-nonconverged", action="store_true",
                         help="non-converged variants do not fail the gate")
     parser.add_argument("--write-variant-outputs", action="store_true",
@@ -69,6 +72,9 @@ def run(args: argparse.Namespace) -> int:
               f"{', '.join(missing)}: install them with pip install 'sarfe[{BATCH_EXTRA}]' "
               f"(from a source tree: pip install -e '.[{BATCH_EXTRA}]')", file=sys.stderr)
         return 2
+    if args.fail_above_db is not None and getattr(args, "fail_above_dba", None) is not None:
+        print("sarfe batch: give one of --fail-above-db and --fail-above-dba", file=sys.stderr)
+        return 2
     if args.workers < 0:
         print("sarfe batch: --workers must be >= 0", file=sys.stderr)
         return 2
@@ -85,10 +91,12 @@ def run(args: argparse.Namespace) -> int:
         return 2
     summary = table.attrs.get("summary", {})
     print(_summary_line(summary, output))
-    gate = batch.evaluate_gate(table, args.fail_above_db, args.allow_nonconverged)
-    if args.fail_above_db is not None or not gate.passed:
+    weighted = getattr(args, "fail_above_dba", None) is not None
+    threshold = args.fail_above_dba if weighted else args.fail_above_db
+    gate = batch.evaluate_gate(table, threshold, args.allow_nonconverged, weighted=weighted)
+    if threshold is not None or not gate.passed:
         print(f"sarfe batch: {gate.message}", file=sys.stderr if not gate.passed else sys.stdout)
-    if args.fail_above_db is not None:
+    if threshold is not None:
         return 0 if gate.passed else batch.GATE_EXIT_CODE
     if summary.get("failed"):
         return EXIT_VARIANTS_FAILED

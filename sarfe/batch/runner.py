@@ -30,6 +30,7 @@ import pandas as pd
 
 from sarfe.batch import batch_report, store
 from sarfe.batch.variants import StudyError, Variant, collect_variants
+from sarfe.pipeline.checks.case_inputs import named_files
 from sarfe.results.folder import check_output_folder, claim_folder, marker_info
 
 PIPELINE = "sarfe.pipeline"
@@ -259,9 +260,12 @@ def default_output_dir(variants: list[Variant]) -> pathlib.Path:
 def claim_output(output, study_or_cases, variants, force=False) -> pathlib.Path:
     """Check the batch folder (module ``sarfe.results.folder``) and mark it as sarfe's."""
     inputs = study_or_cases if isinstance(study_or_cases, (list, tuple)) else [study_or_cases]
-    protected = [item for item in inputs if isinstance(item, (str, os.PathLike))]
-    protected += list(dict.fromkeys(str(pathlib.Path(v.case_dir) / "case") for v in variants
-                                    if getattr(v, "case_dir", None)))
+    protected = {item: "a study or case file" for item in inputs
+                 if isinstance(item, (str, os.PathLike))}
+    for variant in variants:      # the files the variants read (mesh, deck, matrices, curves …)
+        if getattr(variant, "case_dir", None):
+            protected.setdefault(str(pathlib.Path(variant.case_dir) / "case"), "the folder of a case")
+            protected.update(named_files(variant.case, variant.case_dir))
     target = check_output_folder(output, force=force, protected=protected,
                                  what="batch output folder", write_inside=True)
     names = list(dict.fromkeys(v.source for v in variants))

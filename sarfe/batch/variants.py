@@ -34,7 +34,6 @@ import itertools
 import json
 import math
 import pathlib
-import re
 from dataclasses import dataclass, field
 
 import jsonschema
@@ -42,6 +41,8 @@ import numpy as np
 import yaml
 
 from sarfe.batch.paths import PathError, apply_parameters, count_matches, parse_path
+from sarfe.case.errors import CaseError
+from sarfe.case.read import CaseLoader, read_case_text
 
 
 class StudyError(ValueError):
@@ -104,28 +105,13 @@ STUDY_SCHEMA = {
 }
 
 
-class _Loader(yaml.SafeLoader):
-    """SafeLoader that also reads ``1e-4`` (no dot) as a float, as YAML 1.2 does."""
-
-
-_Loader.add_implicit_resolver(
-    "tag:yaml.org,2002:float",
-    re.compile(r"""^(?:[-+]?(?:[0-9][0-9_]*)\.[0-9_]*(?:[eE][-+]?[0-9]+)?
-                   |[-+]?(?:[0-9][0-9_]*)(?:[eE][-+]?[0-9]+)
-                   |\.[0-9_]+(?:[eE][-+][0-9]+)?
-                   |[-+]?\.(?:inf|Inf|INF)
-                   |\.(?:nan|NaN|NAN))$""", re.X),
-    list("-+0123456789."),
-)
-
-
 def read_yaml(path) -> dict:
     """Mapping in a YAML file; StudyError names the file on any problem."""
     path = pathlib.Path(path)
-    try:
-        data = yaml.load(path.read_text(), Loader=_Loader)
-    except OSError as error:
-        raise StudyError(f"{path}: cannot read ({error.strerror})") from None
+    try:     # the case reader's numbers (1e-4 a float) and safety limits (size, aliases, depth)
+        data = yaml.load(read_case_text(path), Loader=CaseLoader)
+    except CaseError as error:
+        raise StudyError(f"{path}: cannot read ({error.message})") from None
     except yaml.YAMLError as error:
         hint = ("; quote parameter paths inside {…} or [...], e.g. {'contacts[0].gap_m': 1.0e-4}"
                 if "flow" in str(error) else "")

@@ -214,11 +214,15 @@ class ContactConfig:
     its own parameters (stiffness, friction …; :mod:`sarfe.hbm.laws`; a plain copy, not to be
     edited).
 
-    FE: ``between`` two node groups (b may be 'ground') paired within ``pairing_tolerance_m`` [m],
-    or explicit ``pairs`` of nodes (a deck's GRID ids), or a deck's springs ``from_elements``
-    (along ``element_axis``); ``normal`` 'auto' (the mesh normal) or a vector. Matrices:
-    ``normal_dof`` and ``tangential_dofs``. Every law: ``gap_m`` [m] (None: an FE pair's geometric
-    gap) or a static ``preload_N`` [N], and the rattle ``tolerance_m`` [m]."""
+    FE (:mod:`sarfe.pipeline.model.contact_pairs`): ``between`` two node groups (b may be
+    'ground'; each node of a is a contact point, its partner the closest point of b's surface
+    within ``pairing_tolerance_m`` [m]), or contact ``points_m`` ((n, 3) [m]) on the element
+    groups ``surfaces`` [a, b], or explicit node ``pairs`` (a deck's GRID ids), or a deck's springs
+    ``from_elements`` (along ``element_axis``); ``normal`` 'auto' (the partner surface's normal,
+    fitted over a patch of radius ``patch_radius_m`` [m]), 'separation' (from a's point to b's)
+    or a vector. Matrices: ``normal_dof`` and ``tangential_dofs``. Every law: ``gap_m`` [m] the
+    clearance between the facing surfaces (None: an FE contact's geometric surface gap) or a
+    static ``preload_N`` [N], and the rattle ``tolerance_m`` [m]."""
 
     index: int
     name: str
@@ -228,8 +232,11 @@ class ContactConfig:
     pairs: tuple | None = None
     from_elements: tuple | None = None
     element_axis: int | None = None
+    points_m: tuple | None = None
+    surfaces: tuple | None = None
     normal: str | tuple = "auto"
     pairing_tolerance_m: float = 1e-3
+    patch_radius_m: float = 2e-3
     normal_dof: DofReference | None = None
     tangential_dofs: tuple = ()
     gap_m: float | None = None
@@ -310,7 +317,9 @@ class SolverConfig:
     'odd' | 'auto' (:mod:`sarfe.hbm.harmonic_set`). ``prune_contacts``: contacts that never switch
     are solved linearly, with the clearance margin ``prune_margin`` (:mod:`sarfe.pipeline.solve.
     pruned_points`). ``workers`` 'auto' | n: processes for the per-point work after Newton
-    (:mod:`sarfe.util.workers`)."""
+    (:mod:`sarfe.util.workers`). ``mesh_error``: the mesh term of the ± ('auto': on for
+    generator meshes, 'not estimated' said for decks and given meshes; true: required; false: off;
+    :mod:`sarfe.pipeline.solve.mesh_error`)."""
 
     harmonics: int = 5
     samples_per_period: int = 128
@@ -324,6 +333,7 @@ class SolverConfig:
     prune_contacts: bool = True
     prune_margin: float = 0.5
     workers: int | str = "auto"
+    mesh_error: bool | str = "auto"     # the ± mesh term: 'auto' on for generator meshes (mesh_error)
     continuation: ContinuationConfig = field(default_factory=ContinuationConfig)
 
     @property
@@ -463,8 +473,9 @@ def _dof_reference(ref) -> DofReference:
 def contact_config(index: int, contact: dict) -> ContactConfig:
     """The typed contacts[index] of its normalized mapping ``contact``."""
     typed = _given(contact, ContactConfig, ("between", "pairs", "from_elements", "element_axis",
-                                            "normal", "pairing_tolerance_m", "gap_m", "preload_N",
-                                            "tolerance_m"))
+                                            "points_m", "surfaces", "normal",
+                                            "pairing_tolerance_m", "patch_radius_m", "gap_m",
+                                            "preload_N", "tolerance_m"))
     if "normal_dof" in contact:
         typed["normal_dof"] = _dof_reference(contact["normal_dof"])
     typed["tangential_dofs"] = tuple(_dof_reference(r) for r in contact.get("tangential_dofs", []))
@@ -497,7 +508,7 @@ def _solver_config(solver) -> SolverConfig:
         stability=solver["stability"], error_estimate=solver["error_estimate"],
         harmonic_set=solver["harmonic_set"],
         prune_contacts=True if isinstance(prune, dict) else bool(prune), **margin,
-        workers=solver["workers"],
+        workers=solver["workers"], mesh_error=solver["mesh_error"],
         continuation=ContinuationConfig(initial_step=cont["initial_step"],
                                         min_step=cont["min_step"], max_step=cont["max_step"],
                                         max_points=cont["max_points"]))

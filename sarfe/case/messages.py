@@ -3,7 +3,8 @@ the JSON schema (:data:`sarfe.case.schema.CASE_SCHEMA`), said in the case's word
 
     validate_schema(data, source=None, lines=None)   raises CaseError: file: key.path: problem (line n)
 
-e.g. ``contacts[0]: unknown key (did you mean 'gap_m'? allowed: …)``, ``solver.harmonics: must be
+e.g. ``contacts[0]: unknown key (did you mean 'gap_m'? allowed: …)`` (close spelling, or another
+word for the key: ``mu`` → ``friction_coefficient``, :data:`KEY_ALIASES`), ``solver.harmonics: must be
 >= 1, got 0``, ``solver.accuracy: must be one of 'fast', 'balanced', 'fine' or a mapping, got 7``.
 """
 from __future__ import annotations
@@ -24,6 +25,49 @@ _PATTERN_HINTS = {
     "^auto$": "must be 'auto' or a vector [x, y, z]",
     "^[A-Za-z0-9_.-]+$": "may contain only letters, digits, '_', '.' and '-'",
 }
+# Other words for a key (textbooks, other solvers' inputs, a first guess) that close spelling
+# cannot find: 'mu' is nothing like 'friction_coefficient'. Keys are compared in lower case; of
+# the candidates, the first one the mapping allows is suggested.
+KEY_ALIASES = {
+    "mu": ("friction_coefficient",), "μ": ("friction_coefficient",),
+    "friction": ("friction_coefficient",), "cof": ("friction_coefficient",),
+    "e": ("E_Pa",), "young": ("E_Pa",), "youngs_modulus": ("E_Pa",), "modulus": ("E_Pa",),
+    "rho": ("rho_kg_m3",), "density": ("rho_kg_m3",), "poisson": ("nu",),
+    "poissons_ratio": ("nu",), "thickness": ("thickness_m",), "t": ("thickness_m",),
+    "gap": ("gap_m",), "clearance": ("gap_m",), "preload": ("preload_N",),
+    "k": ("normal_stiffness_N_m", "stiffness"), "kn": ("normal_stiffness_N_m",),
+    "stiffness": ("normal_stiffness_N_m",), "contact_stiffness": ("normal_stiffness_N_m",),
+    "kt": ("tangential_stiffness_N_m",), "c": ("damping_N_s_m",),
+    "force": ("force_N", "forces"), "amplitude": ("force_N", "amplitude_m_s2"),
+    "acceleration": ("amplitude_m_s2", "base_acceleration"), "phase": ("phase_deg",),
+    "frequency": ("frequency_hz",), "frequencies": ("frequency_hz",), "freq": ("frequency_hz",),
+    "f": ("frequency_hz",), "start": ("start_hz",), "f_start": ("start_hz",),
+    "end": ("end_hz",), "stop": ("end_hz",), "f_end": ("end_hz",),
+    "zeta": ("modal_zeta", "zeta"), "damping_ratio": ("modal_zeta", "zeta"),
+    "h": ("harmonics",), "nh": ("harmonics",), "n_harmonics": ("harmonics",),
+    "n": ("samples_per_period",), "samples": ("samples_per_period",),
+    "nfft": ("samples_per_period",), "n_modes": ("mode_count",), "num_modes": ("mode_count",),
+    "cutoff": ("cutoff_hz",), "fmax": ("cutoff_hz",), "mesh_size": ("mesh_size_m",),
+    "element_size": ("mesh_size_m",), "law": ("type",), "kind": ("type",),
+    "clamped": ("fixed",), "spc": ("fixed", "supports"), "bc": ("fixed", "supports"),
+    "boundary_conditions": ("fixed", "supports"), "output_dir": ("directory",),
+    "outdir": ("directory",), "group_pair": ("between",), "target": ("target_dba",),
+}
+
+
+def suggestion(key, allowed) -> str | None:
+    """The allowed key ``key`` most likely means: another word for it (:data:`KEY_ALIASES`),
+    the same key in another case, or the closest spelling; None if nothing is close."""
+    allowed = list(allowed)
+    text = str(key)
+    for candidate in KEY_ALIASES.get(text.lower(), ()):
+        if candidate in allowed:
+            return candidate
+    by_case = [name for name in allowed if name.lower() == text.lower()]
+    if by_case:
+        return by_case[0]
+    close = difflib.get_close_matches(text, allowed, n=1)
+    return close[0] if close else None
 
 
 def describe(value) -> str:
@@ -42,8 +86,8 @@ def _schema_message(error):
         allowed = sorted(error.schema.get("properties", {}))
         extra = sorted(set(inst) - set(allowed))
         key = extra[0]
-        close = difflib.get_close_matches(str(key), allowed, n=1)
-        hint = f"did you mean '{close[0]}'? " if close else ""
+        close = suggestion(key, allowed)
+        hint = f"did you mean '{close}'? " if close else ""
         return path + (key,), f"unknown key ({hint}allowed: {', '.join(allowed)})"
     if v == "required":
         missing = [k for k in value if k not in inst]
@@ -123,4 +167,4 @@ def _accepted_forms(errors) -> str:
     return ("one of " if any(e.validator == "enum" for e in errors) else "") + " or ".join(forms)
 
 
-__all__ = ["validate_schema", "describe"]
+__all__ = ["validate_schema", "describe", "suggestion", "KEY_ALIASES"]

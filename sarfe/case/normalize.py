@@ -16,6 +16,7 @@ from sarfe.case.config import (DEFAULT_ACCURACY, DEFAULT_ZETA, MATRICES_GAP_M, N
                                GeneratorConfig, ReductionConfig, SolverConfig, default_of,
                                default_output_directory, default_output_files,
                                default_samples_per_period)
+from sarfe.case.errors import format_key_path
 from sarfe.case.plausibility import check_plausible
 from sarfe.erp.backgrounds import BackgroundFileError, background_names, load_background
 from sarfe.erp.cabin import Cabin
@@ -104,10 +105,12 @@ def _normalize_model(case, data):
 
 
 def _normalize_deck(case, fe, p):
-    """model.fe.deck: the file exists and is a deck; units, ignore_cards, fixed defaults."""
+    """model.fe.deck: the file exists and is a deck; ignore_cards, groups defaults."""
     _case_file(case, fe["deck"], DECK_SUFFIXES, "deck", p + ("deck",))
     _not_allowed(case, fe, p, ("mesh_units",), "with model.fe.deck (use 'units')")
-    for key in ("units", "ignore_cards", "node_groups", "element_groups"):
+    # ``units`` stays absent when the case does not give it (DeckConfig's default SI applies):
+    # the deck's units check yields to an explicit ``units:`` only (deck_checks.units_given)
+    for key in ("ignore_cards", "node_groups", "element_groups"):
         fe.setdefault(key, default_of(DeckConfig, key))
 
 
@@ -150,23 +153,39 @@ def _normalize_contacts(case, data):
             if "from_elements" in contact and not deck:
                 raise case.error("needs model.fe.deck (CBUSH/CELAS elements of a deck)",
                                  p + ("from_elements",))
-            if "between" not in contact and "pairs" not in contact and "from_elements" not in contact:
+            if not any(k in contact for k in ("between", "pairs", "from_elements", "points_m")):
                 raise case.error("missing required key (node groups [a, b] or [a, ground], "
-                                 "or explicit node 'pairs', or deck 'from_elements')", p + ("between",))
-            _only_one(case, contact, p, ("between", "pairs", "from_elements"))
+                                 "or explicit node 'pairs', or contact 'points_m' with "
+                                 "'surfaces', or deck 'from_elements')", p + ("between",))
+            _only_one(case, contact, p, ("between", "pairs", "from_elements", "points_m"))
+            if "points_m" in contact and "surfaces" not in contact:
+                raise case.error("missing required key (the element groups [a, b] or "
+                                 "[a, ground] the points_m lie on)", p + ("surfaces",))
+            if "surfaces" in contact and not any(k in contact for k in ("between", "points_m")):
+                raise case.error("only with between or points_m", p + ("surfaces",))
+            if "surfaces" in contact and contact["surfaces"][0] == "ground":
+                raise case.error("the first surface cannot be 'ground'", p + ("surfaces", 0))
+            if "from_elements" in contact:
+                _not_allowed(case, contact, p, ("normal", "patch_radius_m"),
+                             "with from_elements (the spring axis is the normal)")
             if "element_axis" in contact and "from_elements" not in contact:
                 raise case.error("only with from_elements", p + ("element_axis",))
             if "between" in contact and contact["between"][0] == "ground":
                 raise case.error("the first group cannot be 'ground'", p + ("between", 0))
+            if "between" in contact and contact["between"][0] == contact["between"][1]:
+                raise case.error(f"group '{contact['between'][0]}' is on both sides: a contact "
+                                 "joins two different groups (or a group and 'ground')",
+                                 p + ("between", 1))
             for j, pair in enumerate(contact.get("pairs", [])):
                 if pair[0] == pair[1]:
                     raise case.error(f"node {pair[0]} is paired with itself (a pair joins two "
                                      "different nodes, or a node and 'ground')", p + ("pairs", j))
-            for key in ("pairing_tolerance_m", "normal"):
+            for key in ("pairing_tolerance_m", "normal", "patch_radius_m"):
                 contact.setdefault(key, default_of(ContactConfig, key))
             has_normal = True
         else:
-            _not_allowed(case, contact, p, ("between", "pairs", "normal", "pairing_tolerance_m"),
+            _not_allowed(case, contact, p, ("between", "pairs", "normal", "pairing_tolerance_m",
+                                            "points_m", "surfaces", "patch_radius_m"),
                          "with model.matrices (use 'normal_dof' / 'tangential_dofs')")
             has_normal = "normal_dof" in contact
             if law.normal_dof == "required" and not has_normal:
@@ -185,6 +204,7 @@ def _normalize_contacts(case, data):
                     "tangential_dofs", []):
                 for key in ("relative_to", "sign"):
                     ref.setdefault(key, default_of(DofReference, key))
+            _check_contact_dofs(case, contact, p)
         others = sorted(every_key - law.keys(), key=lambda k: list(contact).index(k)
                         if k in contact else 0)
         if law.tangent_dofs == "forbidden":
@@ -224,6 +244,26 @@ def _normalize_contacts(case, data):
         if has_normal and "preload_N" not in contact and not fe:
             contact.setdefault("gap_m", MATRICES_GAP_M)  # FE: the geometric gap of each pair
         contact.setdefault("tolerance_m", default_of(ContactConfig, "tolerance_m"))
+
+
+def _check_contact_dofs(case, contact, p):
+    """A matrices contact's DOFs: none measured against itself (r = u[d] − u[d] ≡ 0), no
+    direction given twice (the same relative displacement as two tangents, or as the normal and
+    a tangent: its force would count twice)."""
+    refs = ([(("normal_dof",), contact["normal_dof"])] if "normal_dof" in contact else []) + [
+        (("tangential_dofs", j), ref) for j, ref in enumerate(contact.get("tangential_dofs", []))]
+    seen = {}
+    for path, ref in refs:
+        if ref["relative_to"] == ref["dof"]:
+            raise case.error(f"DOF {ref['dof']} is measured relative to itself (a relative "
+                             "displacement that is always 0)", p + path + ("relative_to",))
+        key = frozenset((ref["dof"], ref["relative_to"]))     # u0 − u1 and u1 − u0 alike
+        if key in seen:
+            first = format_key_path(p + seen[key])
+            raise case.error(f"DOF {ref['dof']} (relative to {ref['relative_to']}) is already "
+                             f"{first}: each direction of a contact is a different relative "
+                             "displacement", p + path)
+        seen[key] = path
 
 
 def _normalize_excitation(case, data):
@@ -286,8 +326,12 @@ def _normalize_solver(case, data):
         raise case.error(f"must be >= 2H+1 = {2 * H + 1} for harmonics H = {H}, got {N}",
                          ("solver", "samples_per_period"))
     for key in ("tolerance", "max_iterations", "stability", "error_estimate", "harmonic_set",
-                "prune_contacts", "workers"):          # defaults: sarfe.case.config.SolverConfig
+                "prune_contacts", "workers", "mesh_error"):   # defaults: sarfe.case.config.SolverConfig
         solver.setdefault(key, default_of(SolverConfig, key))
+    generated = "generator" in data.get("model", {}).get("fe", {})
+    if solver["mesh_error"] is True and not generated:     # sarfe.pipeline.solve.mesh_error
+        raise case.error("true needs a generated mesh (model.fe.generator) to coarsen; use "
+                         "'auto' or false", ("solver", "mesh_error"))
     cont = solver.setdefault("continuation", {})
     for key in ("initial_step", "min_step", "max_step", "max_points"):
         cont.setdefault(key, default_of(ContinuationConfig, key))

@@ -120,8 +120,59 @@ class Case:
 
 
 # ----------------------------------------------------------------------------------- YAML reading
+# Safety limits of the YAML reader (not performance targets): a case file is a few kB, 6 levels
+# deep, with a few anchors (a shared material); these bounds are far above that and keep a hostile
+# or broken file ("billion laughs": 2 kB of nested aliases that expand to 10⁹ values) from taking
+# minutes and gigabytes. Each refusal is a one-line CaseError naming the file and the limit.
+MAX_CASE_FILE_BYTES = 2 ** 20       # 1 MiB: ≈ 5 s of PyYAML (4 MiB took 19 s); matrices → .npz/.mtx
+MAX_YAML_DEPTH = 32                 # nesting levels (a case has 6; generator params a few more)
+MAX_YAML_ALIASES = 100              # *alias uses in one file
+MAX_ALIAS_EXPANSION = 100_000       # values the aliases add when expanded (a copy per use)
+
+
+class YamlLimitError(yaml.YAMLError):
+    """A case file beyond one of the reader's safety limits; ``line`` (1-based) where seen."""
+
+    def __init__(self, problem: str, mark=None):
+        super().__init__(problem)
+        self.problem = problem
+        self.line = None if mark is None else mark.line + 1
+
+
 class CaseLoader(yaml.SafeLoader):
-    """SafeLoader that also reads 2.1e9 / 1e-3 as numbers (YAML 1.1 wants '2.1e+9', '1.0e-3')."""
+    """SafeLoader that also reads 2.1e9 / 1e-3 as numbers (YAML 1.1 wants '2.1e+9', '1.0e-3'),
+    and refuses documents beyond the safety limits above: nesting deeper than
+    :data:`MAX_YAML_DEPTH`, more than :data:`MAX_YAML_ALIASES` aliases, an alias inside its own
+    anchor, or aliases that expand to more than :data:`MAX_ALIAS_EXPANSION` extra values
+    (counted on the composed node graph, where an alias is a shared node, before anything is
+    expanded). Raises :class:`YamlLimitError`."""
+
+    def __init__(self, stream):
+        super().__init__(stream)
+        self.depth = 0
+        self.alias_count = 0
+
+    def compose_node(self, parent, index):
+        if self.check_event(yaml.AliasEvent):
+            self.alias_count += 1
+            if self.alias_count > MAX_YAML_ALIASES:
+                raise YamlLimitError(f"more than {MAX_YAML_ALIASES} aliases (*name); a case file "
+                                     "needs a few at most", self.peek_event().start_mark)
+            return super().compose_node(parent, index)
+        self.depth += 1
+        if self.depth > MAX_YAML_DEPTH:
+            raise YamlLimitError(f"nested more than {MAX_YAML_DEPTH} levels deep",
+                                 self.peek_event().start_mark)
+        try:
+            return super().compose_node(parent, index)
+        finally:
+            self.depth -= 1
+
+    def compose_document(self):
+        node = super().compose_document()
+        if node is not None:
+            check_alias_expansion(node)
+        return node
 
 
 CaseLoader.add_implicit_resolver(
@@ -132,6 +183,45 @@ CaseLoader.add_implicit_resolver(
                   |[-+]?\.(?:inf|Inf|INF)
                   |\.(?:nan|NaN|NAN))$""", re.X),
     list("-+0123456789."))
+
+
+def _children(node) -> list:
+    if isinstance(node, yaml.MappingNode):
+        return [n for pair in node.value for n in pair]
+    return list(node.value) if isinstance(node, yaml.SequenceNode) else []
+
+
+def check_alias_expansion(root) -> int:
+    """The number of values (nodes) of the composed document ``root`` once every alias is
+    expanded, computed without expanding: size(n) = 1 + Σ size(children), memoized per node, so
+    an alias (a node met again) costs one addition. YamlLimitError when an alias sits inside its
+    own anchor (a recursive document) or the aliases add more than :data:`MAX_ALIAS_EXPANSION`
+    values to the distinct ones."""
+    size, state = {}, {}            # id → expanded size; id → 1 on the path, 2 done
+    stack = [(root, False)]
+    while stack:
+        node, children_done = stack.pop()
+        key = id(node)
+        if children_done:
+            size[key] = 1 + sum(size[id(child)] for child in _children(node))
+            state[key] = 2
+            continue
+        if state.get(key) == 2:
+            continue
+        state[key] = 1
+        stack.append((node, True))
+        for child in _children(node):
+            if state.get(id(child)) == 1:
+                raise YamlLimitError("an alias inside its own anchor (a recursive document)",
+                                     child.start_mark)
+            if state.get(id(child)) != 2:
+                stack.append((child, False))
+    expanded = size[id(root)]
+    if expanded - len(size) > MAX_ALIAS_EXPANSION:
+        raise YamlLimitError(f"aliases expand to {expanded:.3g} values (the file holds "
+                             f"{len(size)}); at most {MAX_ALIAS_EXPANSION:,} more than written "
+                             "are accepted (nested aliases, a 'billion laughs'?)")
+    return expanded
 
 
 def _node_lines(node, path=(), lines=None, source=None):
@@ -154,25 +244,47 @@ def _node_lines(node, path=(), lines=None, source=None):
     return lines
 
 
-def line_of(lines, path):
-    path = tuple(path)
-    while path and path not in lines:
-        path = path[:-1]
-    return lines.get(path) if path else None
+def read_case_text(path) -> str:
+    """The text of the case file ``path``: CaseError (naming it) when it is missing, not a
+    regular file (a folder, a device such as /dev/zero, a pipe), larger than
+    :data:`MAX_CASE_FILE_BYTES`, unreadable or not UTF-8. At most that many bytes are read."""
+    source = str(path)
+    path = Path(path)
+    try:
+        if not path.exists():
+            raise CaseError("case file not found", source=source)
+        if not path.is_file():
+            raise CaseError("the case file is not a regular file (a folder, device or pipe); "
+                            "give a YAML file", source=source)
+        with open(path, "rb") as stream:
+            raw = stream.read(MAX_CASE_FILE_BYTES + 1)
+    except OSError as exc:
+        raise CaseError(f"cannot read case file: {exc.strerror or exc}", source=source) from None
+    if len(raw) > MAX_CASE_FILE_BYTES:
+        raise CaseError(f"the case file is larger than {MAX_CASE_FILE_BYTES // 2 ** 20} MiB, the "
+                        "limit of a case file (a safety limit); give large matrices as .npz, "
+                        ".npy or .mtx files", source=source)
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise CaseError(f"cannot read case file: {exc}", source=source) from None
 
 
 def read_yaml(path):
-    """Parse a YAML case file → (data, lines). Malformed YAML → CaseError with line and column."""
+    """Parse a YAML case file → (data, lines). Malformed YAML, or YAML beyond the reader's
+    safety limits (:class:`CaseLoader`), → CaseError with the line."""
     source = str(path)
+    text = read_case_text(path)
+    loader = CaseLoader(text)
     try:
-        text = Path(path).read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise CaseError("case file not found", source=source) from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise CaseError(f"cannot read case file: {exc}", source=source) from None
-    try:
-        node = yaml.compose(text, Loader=CaseLoader)
-        data = yaml.load(text, Loader=CaseLoader)  # noqa: S506 (a SafeLoader)
+        node = loader.get_single_node()
+        if node is None:
+            raise CaseError("the case file is empty", source=source)
+        lines = _node_lines(node, source=source)   # before merge keys (<<) are flattened into it
+        data = loader.construct_document(node)
+    except YamlLimitError as exc:
+        raise CaseError(f"YAML beyond the reader's safety limits: {exc.problem}", source=source,
+                        line=exc.line) from None
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
@@ -180,9 +292,8 @@ def read_yaml(path):
         raise CaseError(f"malformed YAML{where}: {problem}", source=source) from None
     except yaml.YAMLError as exc:
         raise CaseError(f"malformed YAML: {exc}", source=source) from None
-    if node is None:
-        raise CaseError("the case file is empty", source=source)
-    lines = _node_lines(node, source=source)
+    finally:
+        loader.dispose()
     return data, lines
 
 
@@ -206,4 +317,6 @@ def load_case(path_or_dict, base_dir=None) -> Case:
     return dataclasses.replace(case, config=build_config(case.data))
 
 
-__all__ = ["Case", "CaseLoader", "load_case", "read_yaml"]
+__all__ = ["Case", "CaseLoader", "YamlLimitError", "check_alias_expansion", "load_case",
+           "read_case_text", "read_yaml", "MAX_CASE_FILE_BYTES", "MAX_YAML_DEPTH",
+           "MAX_YAML_ALIASES", "MAX_ALIAS_EXPANSION"]

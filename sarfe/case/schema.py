@@ -7,6 +7,7 @@ two keys, node groups present in the mesh, pairing within tolerance) are checked
 """
 from __future__ import annotations
 
+from sarfe.case.plausibility import POISSON_RANGE
 from sarfe.hbm import laws
 
 
@@ -39,7 +40,8 @@ MATRIX = {"type": ["string", "array"], "minLength": 1, "minItems": 1,
           "items": {"type": "array", "minItems": 1, "items": NUMBER}}
 MATERIAL = _object({
     "E_Pa": POSITIVE,
-    "nu": {"type": "number", "exclusiveMinimum": -1, "exclusiveMaximum": 0.5},
+    "nu": {"type": "number", "exclusiveMinimum": POISSON_RANGE[0],
+           "exclusiveMaximum": POISSON_RANGE[1]},
     "rho_kg_m3": POSITIVE,
 }, required=("E_Pa", "nu", "rho_kg_m3"))
 
@@ -51,7 +53,7 @@ FE_MODEL = _object({
     # an engineer's own deck (Nastran .bdf/.dat/.nas/.fem, Abaqus .inp), read with its
     # properties, supports and loads (sarfe.pipeline.model.deck_model)
     "deck": NAME,
-    "units": {"enum": ["SI", "mm-t-s", "mm-kg-ms", "mm-kg-s", "in-lbf-s"]},
+    "units": {"enum": ["SI", "mm-t-s", "mm-kg-ms", "mm-kg-s", "in-lbf-s", "ft-lbf-s"]},
     "ignore_cards": {"type": "array", "items": NAME, "uniqueItems": True},
     "supports": {"type": "array", "items": SET_REFERENCE, "minItems": 1},
     "node_groups": {"type": "object", "additionalProperties": {
@@ -125,8 +127,13 @@ def contact_schema():
                   "items": {"type": "array", "minItems": 2, "maxItems": 2,
                             "items": {"type": ["integer", "string"], "minimum": 0,
                                       "pattern": "^ground$"}}},
-        "normal": {"type": ["string", "array"], "pattern": "^auto$",
+        # FE models: contact points by coordinates on two element groups (b may be 'ground')
+        "points_m": {"type": "array", "minItems": 1,
+                     "items": {"type": "array", "items": NUMBER, "minItems": 3, "maxItems": 3}},
+        "surfaces": {"type": "array", "items": NAME, "minItems": 2, "maxItems": 2},
+        "normal": {"type": ["string", "array"], "pattern": "^(auto|separation)$",
                    "items": NUMBER, "minItems": 3, "maxItems": 3},
+        "patch_radius_m": POSITIVE,
         # FE decks: CBUSH/CELAS element ids turned into this contact (removed from the linear
         # model; their stiffness along element_axis is the penalty stiffness)
         "from_elements": {"type": "array", "items": {"type": "integer", "minimum": 1},
@@ -188,6 +195,8 @@ SOLVER = _object({
         "margin": {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1}})]},
     # processes for the per-point work after Newton (stability, estimates, records): sarfe.util.workers
     "workers": {"oneOf": [{"enum": ["auto"]}, {"type": "integer", "minimum": 1}]},
+    # the mesh term of the ± (sarfe.pipeline.solve.mesh_error): 'auto' = on for generator meshes
+    "mesh_error": {"oneOf": [{"enum": ["auto"]}, {"type": "boolean"}]},
     "continuation": _object({
         "initial_step": {"type": "number", "exclusiveMinimum": 0, "maximum": 1},
         "min_step": {"type": "number", "exclusiveMinimum": 0, "maximum": 1},

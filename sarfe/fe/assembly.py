@@ -8,7 +8,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-__all__ = ["element_dofs", "assemble", "assemble_pair", "fixed_dofs", "free_dofs", "COMPONENTS"]
+__all__ = ["element_dofs", "assemble", "assemble_pair", "fixed_dofs", "free_dofs", "lumped_mass",
+           "COMPONENTS"]
 
 #: component letters of the 6 nodal DOFs
 COMPONENTS = ("ux", "uy", "uz", "rx", "ry", "rz")
@@ -98,3 +99,29 @@ def free_dofs(n_dof, fixed):
     mask = np.ones(n_dof, dtype=bool)
     mask[np.asarray(fixed, dtype=np.int64)] = False
     return np.flatnonzero(mask)
+
+
+def lumped_mass(mass, dofs):
+    """Lumped element masses (n_el, k, k) from consistent ones (n_el, k, k), global frame.
+
+    Per translation direction c the HRZ diagonal m_ii · (Σ_ij M_ij / Σ_i M_ii) over that
+    direction's DOFs: the element's mass in c, r_cᵀ M r_c, is kept exactly (so is the
+    model's), and every entry is positive (quadratic cells too; a linear triangle's corner gets
+    m''A/3). The rotation–rotation block (rotary inertia) is kept, so M stays definite; the
+    translation–rotation coupling (offset shells, beams) is dropped. dofs (n_el, k): global DOF
+    numbers 6·node + c (only the component dof % 6 is used). A loop over the three directions,
+    vectorized over elements."""
+    component = np.asarray(dofs) % 6
+    n_el, size = component.shape
+    diagonal = np.einsum("eii->ei", mass)
+    lumped = np.zeros_like(mass)
+    index = np.arange(size)
+    for c in range(3):
+        pick = (component == c).astype(float)
+        total = (pick[:, None, :] @ mass @ pick[:, :, None])[:, 0, 0]
+        diag_sum = (diagonal * pick).sum(axis=1)
+        scale = np.divide(total, diag_sum, out=np.zeros(n_el), where=diag_sum > 0)
+        lumped[:, index, index] += diagonal * pick * scale[:, None]
+    rotation = component >= 3
+    lumped += mass * (rotation[:, :, None] & rotation[:, None, :])
+    return lumped

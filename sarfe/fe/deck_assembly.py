@@ -1,9 +1,12 @@
 """`DeckModel` → global sparse K, M on 6 DOF per node, constraints eliminated.
 
 Steps (global DOF g = 6·node + c, c = 0..5 = [ux, uy, uz, rx, ry, rz], global axes):
-1. K, M summed from every element table in one coo → csr pass: section shells
-   (`sarfe.fe.shell_section`), solids (`sarfe.fe.solid_cells`, 3 translations of the
-   same nodes), beams/rods, springs, CONM2 (`sarfe.fe.line_elements`).
+1. K, M summed from every element table in one coo → csr pass: shells (`sarfe.fe.deck_shells`:
+   by default the commercial solver's membranes — incompatible-mode quads, constant-strain
+   triangles, weak drilling penalty — with DKT/DKMT bending), solids (`sarfe.fe.solid_cells`,
+   3 translations of the same nodes), beams/rods, springs, CONM2 (`sarfe.fe.line_elements`).
+   Element masses lumped (:func:`lumped_mass`) unless the deck asks for coupled mass
+   (PARAM,COUPMASS > 0), as the commercial solver.
 2. RBE2/RBE3 eliminated exactly: u = C q (`sarfe.fe.constraints`).
 3. The remaining DOFs expressed in each node's output (CD) frame: u_node = Rᵀ q_cd per
    3-component block, R = ``displacement_frames[node]`` (rows = CD axes).
@@ -27,14 +30,15 @@ import scipy.sparse as sp
 
 from sarfe.mesh.formats.deck import DeckError, DeckModel
 
+from sarfe.fe.assembly import lumped_mass
 from sarfe.fe.constraints import constraint_matrix
+from sarfe.fe.deck_shells import DECK_MEMBRANE, shell_blocks
 from sarfe.fe.line_elements import beam_matrices, point_mass_matrices, spring_matrices
-from sarfe.fe.shell import DRILLING_PENALTY
-from sarfe.fe.shell_section import section_shell_element_matrices
+from sarfe.fe.membrane import DRILLING_PENALTY
 from sarfe.fe.solid_cells import DegenerateCellError, solid_cell_matrices
 
 __all__ = ["DeckSystem", "assemble_deck", "support_dofs", "load_vector", "lumped_mass",
-           "global_matrices", "mass_properties"]
+           "global_matrices", "mass_properties", "deck_mass"]
 
 _BLOCK = 4096
 
@@ -81,59 +85,21 @@ class DeckSystem:
         return (self.transformation @ np.asarray(q)).reshape(self.n_nodes, 6)
 
 
-def lumped_mass(mass, dofs):
-    """Row-lumped element masses (n_el, k, k): per translation direction c, the HRZ diagonal
-    m_ii · (Σ_ij M_ij / Σ_i M_ii) over that direction's DOFs (total mass kept, positive for
-    quadratic cells too); the rotation–rotation block (rotary inertia) is kept, the
-    translation–rotation coupling dropped. dofs (n_el, k) give the component (dof % 6)."""
-    component = np.asarray(dofs) % 6
-    n_el, size = component.shape
-    diagonal = np.einsum("eii->ei", mass)
-    lumped = np.zeros_like(mass)
-    index = np.arange(size)
-    for c in range(3):
-        pick = (component == c).astype(float)
-        total = np.einsum("eij,ei,ej->e", mass, pick, pick)
-        diag_sum = (diagonal * pick).sum(axis=1)
-        scale = np.divide(total, diag_sum, out=np.zeros(n_el), where=diag_sum > 0)
-        lumped[:, index, index] += diagonal * pick * scale[:, None]
-    rotation = component >= 3
-    lumped += mass * (rotation[:, :, None] & rotation[:, None, :])
-    return lumped
-
-
-def _element_blocks(deck: DeckModel, drilling_penalty, mass="consistent"):
+def _element_blocks(deck: DeckModel, drilling_penalty, mass="consistent",
+                    membrane=DECK_MEMBRANE):
     """Yield (K_e, M_e, dofs) blocks of every element table (CONM2 never lumped)."""
-    for k, m, dofs in _structural_blocks(deck, drilling_penalty):
+    for k, m, dofs in _structural_blocks(deck, drilling_penalty, membrane, mass):
         yield k, (lumped_mass(m, dofs) if mass == "lumped" else m), dofs
     if len(deck.point_masses.node):
         m, dofs = point_mass_matrices(deck.point_masses)
         yield np.zeros_like(m), m, dofs
 
 
-def _structural_blocks(deck: DeckModel, drilling_penalty):
-    """Yield (K_e, M_e, dofs) of shells, solids, beams and springs."""
-    shells = deck.shells
-    if shells.n_triangles:
-        x = deck.points[shells.triangles]
-        twice_area = np.linalg.norm(np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]), axis=1)
-        edge = np.linalg.norm(x[:, 1] - x[:, 0], axis=1)
-        bad = np.flatnonzero(twice_area <= 1e-12 * np.maximum(edge, 1e-300) ** 2)
-        if bad.size:
-            eid = int(shells.element_ids[shells.triangle_element[bad[0]]])
-            raise DeckError(f"{deck.source}: shell element {eid} has zero area "
-                            f"({bad.size} degenerate triangle(s))")
-    for start in range(0, shells.n_triangles, _BLOCK):
-        rows = slice(start, start + _BLOCK)
-        offset = shells.offset[rows]
-        mass_area = shells.mass_per_area[rows]
-        k, m = section_shell_element_matrices(
-            deck.points, shells.triangles[rows], shells.membrane[rows], shells.coupling[rows],
-            shells.bending[rows], shells.material_axis[rows], mass_area,
-            shells.rotary_inertia_per_area[rows] + mass_area * offset**2, drilling_penalty,
-            first_moment_per_area=mass_area * offset)
-        tri = shells.triangles[rows]
-        yield k, m, (6 * tri[:, :, None] + np.arange(6)).reshape(len(tri), 18)
+def _structural_blocks(deck: DeckModel, drilling_penalty, membrane=DECK_MEMBRANE,
+                       mass="consistent"):
+    """Yield (K_e, M_e, dofs) of shells, solids, beams and springs (``mass`` 'lumped': the
+    beams' torsional inertia as the commercial solver lumps it, `beam_matrices`)."""
+    yield from shell_blocks(deck, membrane, drilling_penalty)
     for kind, block in deck.solids.items():
         for start in range(0, len(block.element_ids), _BLOCK // 8):
             rows = slice(start, start + _BLOCK // 8)
@@ -148,7 +114,7 @@ def _structural_blocks(deck: DeckModel, drilling_penalty):
             yield k, m, dofs
     if len(deck.beams.element_ids):
         try:
-            yield beam_matrices(deck.points, deck.beams)
+            yield beam_matrices(deck.points, deck.beams, lumped_torsion=mass == "lumped")
         except ValueError as error:
             raise DeckError(f"{deck.source}: {error}") from error
     if len(deck.springs.element_ids):
@@ -210,25 +176,46 @@ def _frame_transform(frames, independent):
     return rows, cols, vals
 
 
-def global_matrices(deck: DeckModel, mass="consistent", drilling_penalty=DRILLING_PENALTY):
-    """K, M (CSR (6n, 6n), global DOFs 6·node + c, global axes) before any constraint:
-    e.g. for mass properties, M's rigid-body quadratic forms."""
+def deck_mass(deck: DeckModel, mass=None) -> str:
+    """The element mass a deck is assembled with: ``mass`` if given ('consistent' | 'lumped'),
+    else the deck's own — 'consistent' for PARAM,COUPMASS > 0 (``deck.coupled_mass``), 'lumped'
+    otherwise, as the commercial solver's default."""
+    if mass is None:
+        return "consistent" if deck.coupled_mass else "lumped"
     if mass not in ("consistent", "lumped"):
         raise ValueError(f"mass must be 'consistent' or 'lumped', got {mass!r}")
-    return _sum_blocks(_element_blocks(deck, drilling_penalty, mass), 6 * deck.n_nodes)
+    return mass
 
 
-def assemble_deck(deck: DeckModel, mass="consistent",
-                  drilling_penalty=DRILLING_PENALTY) -> DeckSystem:
+def _drilling(deck: DeckModel, drilling_penalty, membrane):
+    """α: given, else the deck's (1e-6·K6ROT) — or the Allman penalty for 'allman'."""
+    if drilling_penalty is not None:
+        return drilling_penalty
+    return DRILLING_PENALTY if membrane == "allman" else deck.drilling_penalty
+
+
+def global_matrices(deck: DeckModel, mass=None, drilling_penalty=None,
+                    membrane=DECK_MEMBRANE):
+    """K, M (CSR (6n, 6n), global DOFs 6·node + c, global axes) before any constraint:
+    e.g. for mass properties, M's rigid-body quadratic forms. Arguments as :func:`assemble_deck`."""
+    return _sum_blocks(_element_blocks(deck, _drilling(deck, drilling_penalty, membrane),
+                                       deck_mass(deck, mass), membrane), 6 * deck.n_nodes)
+
+
+def assemble_deck(deck: DeckModel, mass=None, drilling_penalty=None,
+                  membrane=DECK_MEMBRANE) -> DeckSystem:
     """Global K, M of a deck with RBE2/RBE3 eliminated, in CD frames, zero-stiffness DOFs held.
 
-    mass: 'consistent' (sarfe's element masses) or 'lumped' (:func:`lumped_mass`: diagonal
-    translational masses as Nastran's default without PARAM,COUPMASS, rotary inertia kept).
-    See the module docstring for the steps; raises DeckError naming the element or card.
+    mass: None (the deck's: lumped unless PARAM,COUPMASS > 0, :func:`deck_mass`), 'lumped'
+    (:func:`lumped_mass`) or 'consistent' (sarfe's element masses). membrane: the shells'
+    membrane (:mod:`sarfe.fe.deck_shells`; default 'nastran': incompatible-mode quads, constant
+    strain triangles, weak drilling penalty α = ``drilling_penalty``, None = the deck's
+    1e-6·K6ROT). See the module docstring for the steps; raises DeckError naming the element
+    or card.
     """
     n = deck.n_nodes
     n_dof = 6 * n
-    stiffness, mass = global_matrices(deck, mass, drilling_penalty)
+    stiffness, mass = global_matrices(deck, mass, drilling_penalty, membrane)
     structural, viscous = _spring_damping(deck, n_dof)
     try:
         c_matrix, independent = constraint_matrix(deck.points, deck.rbe2, deck.rbe3, n)

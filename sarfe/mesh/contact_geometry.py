@@ -40,6 +40,7 @@ __all__ = [
     "patch_normals",
     "facet_average_normals",
     "facet_normal_spread_deg",
+    "facet_normal_residual_deg",
     "separation_normals",
     "orient_normals",
     "frames_from_normals",
@@ -207,14 +208,15 @@ def _unit_or(vectors, fallback):
     return np.where(length > 0, vectors / np.where(length > 0, length, 1.0), backup)
 
 
-def _quadric_normals(centres, nodes_xyz, owner, node, guess, support):
+def _quadric_fit(centres, nodes_xyz, owner, node, guess, support):
     """One weighted least-squares fit per centre, in the frame [t₁, t₂, n₀] of `guess` with
     ξ, η, ζ scaled by the support radius ρ_s (m,) and weights k(|x − c|/ρ_s), of
 
         ζ = a + bξ + cη + dξ² + eξη + fη²        (≥ 6 nodes, well conditioned), else
-        ζ = a + bξ + cη + d(ξ² + η²)            (≥ 4 nodes), else the guess is kept;
+        ζ = a + bξ + cη + d(ξ² + η²)            (≥ 4 nodes), else ζ = 0 (the guess's plane).
 
-    the normal at the centre is (n₀ − b t₁ − c t₂)/|…| (same side as n₀)."""
+    Returns the frames (m, 3, 3) rows [n₀, t₁, t₂] and the coefficients (m, 6) [a, b, c, d, e, f]
+    (dimensionless: lengths over ρ_s)."""
     frame = frames_from_normals(guess)                              # rows n, t1, t2
     rel = (nodes_xyz[node] - centres[owner]) / support[owner, None]
     local = np.einsum("kji,ki->kj", frame[owner], rel)              # (ζ, ξ, η)
@@ -222,10 +224,14 @@ def _quadric_normals(centres, nodes_xyz, owner, node, guess, support):
     weight = np.clip(1.0 - np.einsum("ki,ki->k", rel, rel), 0.0, None) ** 2
     one = np.ones_like(xi)
     m = len(centres)
-    slope = np.zeros((m, 2))
+    coefficients = np.zeros((m, 6))
     done = np.zeros(m, dtype=bool)
-    for design in (np.stack([one, xi, eta, xi * xi, xi * eta, eta * eta], axis=1),
-                   np.stack([one, xi, eta, xi * xi + eta * eta], axis=1)):
+    # full quadric, then the isotropic one (its d fills d and f, e = 0)
+    for design, spread in ((np.stack([one, xi, eta, xi * xi, xi * eta, eta * eta], axis=1),
+                            np.eye(6)),
+                           (np.stack([one, xi, eta, xi * xi + eta * eta], axis=1),
+                            np.array([[1, 0, 0, 0, 0, 0], [0, 1, 0, 0, 0, 0], [0, 0, 1, 0, 0, 0],
+                                      [0, 0, 0, 1, 0, 1]], dtype=float))):
         k = design.shape[1]
         gram = np.zeros((m, k, k))
         rhs = np.zeros((m, k))
@@ -236,10 +242,38 @@ def _quadric_normals(centres, nodes_xyz, owner, node, guess, support):
         if fit.any():
             fit[fit] = np.linalg.cond(gram[fit]) < _MAX_CONDITION
         if fit.any():
-            slope[fit] = np.linalg.solve(gram[fit], rhs[fit][..., None])[:, 1:3, 0]
+            coefficients[fit] = np.linalg.solve(gram[fit], rhs[fit][..., None])[..., 0] @ spread
             done |= fit
-    normal = frame[:, 0] - slope[:, :1] * frame[:, 1] - slope[:, 1:] * frame[:, 2]
-    return normal / np.linalg.norm(normal, axis=1, keepdims=True)
+    return frame, coefficients
+
+
+def _fitted_normals(frame, coefficients, xi=0.0, eta=0.0):
+    """Unit normal n = (n₀ − ζ_ξ t₁ − ζ_η t₂)/|…| of the fitted quadric (:func:`_quadric_fit`)
+    at the scaled in-plane coordinates (ξ, η) (0: the centre), on n₀'s side; shapes broadcast
+    over the leading axis."""
+    b, c, d, e, f = (coefficients[..., i] for i in range(1, 6))
+    slope_xi = b + 2 * d * xi + e * eta
+    slope_eta = c + e * xi + 2 * f * eta
+    normal = (frame[..., 0, :] - slope_xi[..., None] * frame[..., 1, :]
+              - slope_eta[..., None] * frame[..., 2, :])
+    return normal / np.linalg.norm(normal, axis=-1, keepdims=True)
+
+
+def _patch_fit(c, p, t, radius_m, reference, iterations, min_nodes):
+    """(normals (m, 3), frames, coefficients, support ρ_s (m,)) of :func:`patch_normals`."""
+    used = np.unique(t)
+    tree = cKDTree(p[used])
+    nearest, _ = tree.query(c, k=min(min_nodes, len(used)))
+    support = np.maximum(float(radius_m), 1.25 * np.reshape(nearest, (len(c), -1))[:, -1])
+    normal = facet_average_normals(c, p, t, support, reference)
+    owner, local_node = _candidate_pairs(tree, c, support)
+    node = used[local_node]
+    frame = frames_from_normals(normal)
+    coefficients = np.zeros((len(c), 6))
+    for _ in range(iterations):
+        frame, coefficients = _quadric_fit(c, p, owner, node, normal, support)
+        normal = _fitted_normals(frame, coefficients)
+    return normal, frame, coefficients, support
 
 
 def patch_normals(centres, points, triangles, radius_m, reference=None, iterations: int = 2,
@@ -264,16 +298,7 @@ def patch_normals(centres, points, triangles, radius_m, reference=None, iteratio
     c = np.atleast_2d(np.asarray(centres, dtype=float))
     p = np.asarray(points, dtype=float)
     t = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
-    used = np.unique(t)
-    tree = cKDTree(p[used])
-    nearest, _ = tree.query(c, k=min(min_nodes, len(used)))
-    support = np.maximum(float(radius_m), 1.25 * np.reshape(nearest, (len(c), -1))[:, -1])
-    normal = facet_average_normals(c, p, t, support, reference)
-    owner, local_node = _candidate_pairs(tree, c, support)
-    node = used[local_node]
-    for _ in range(iterations):
-        normal = _quadric_normals(c, p, owner, node, normal, support)
-    return normal
+    return _patch_fit(c, p, t, radius_m, reference, iterations, min_nodes)[0]
 
 
 def facet_normal_spread_deg(centres, points, triangles, radius_m, reference=None) -> np.ndarray:
@@ -293,6 +318,36 @@ def facet_normal_spread_deg(centres, points, triangles, radius_m, reference=None
     spread = np.zeros(len(normal))
     np.maximum.at(spread, owner[inside], np.degrees(np.arccos(cosine[inside])))
     return spread
+
+
+def facet_normal_residual_deg(centres, points, triangles, radius_m, reference=None) -> np.ndarray:
+    """Largest angle [deg] between a facet's normal and the normal of the surface fitted through
+    the patch (:func:`patch_normals`' quadric) at the facet's centroid, over the facets inside
+    the patch (kernel weight > 0, or the nearest one), shape (m,).
+
+    Unlike :func:`facet_normal_spread_deg` this leaves out what the smooth surface explains:
+    on a plane, a sphere or a cylinder it is the faceting error only (0 on a flat plate, ≲ 2–3°
+    on the squeak rig's 12 mm spherical pad at its pole on meshes of 2–12 mm, where the spread is
+    8–16°), while an edge, fold, ridge or T-junction, which no quadric follows, leaves tens of
+    degrees (a rib under a skin: > 40°). A caller warns when it is large: the contact normal
+    there depends on the patch and the mesh, not on a surface.
+    """
+    c = np.atleast_2d(np.asarray(centres, dtype=float))
+    p = np.asarray(points, dtype=float)
+    t = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
+    owner, tri, weight, oriented, ref = _patch_terms(c, p, t, radius_m, reference)
+    normal, frame, coefficients, support = _patch_fit(c, p, t, radius_m, ref, 2, _MIN_FIT_NODES)
+    nearest = project_to_surface(c, p, t).element
+    inside = (weight > 0) | (tri == nearest[owner])
+    owner, tri, oriented = owner[inside], tri[inside], oriented[inside]
+    rel = (p[t[tri]].mean(axis=1) - c[owner]) / support[owner, None]
+    xi = np.einsum("ki,ki->k", frame[owner, 1], rel)
+    eta = np.einsum("ki,ki->k", frame[owner, 2], rel)
+    fitted = _fitted_normals(frame[owner], coefficients[owner], xi, eta)
+    cosine = np.clip(np.einsum("ki,ki->k", oriented, fitted), -1.0, 1.0)
+    residual = np.zeros(len(c))
+    np.maximum.at(residual, owner, np.degrees(np.arccos(cosine)))
+    return residual
 
 
 def separation_normals(points_a, points_b, tolerance_m: float = 1e-9):

@@ -27,6 +27,8 @@ from sarfe.pipeline.post.audibility_records import background_record
 from sarfe.pipeline.post.records import error_estimates, worst_of
 from sarfe.pipeline.post.review import target_check
 from sarfe.pipeline.solve.case_accuracy import accuracy_check, case_resolution, resolved_case
+from sarfe.pipeline.solve.mesh_error import (mesh_checked, mesh_error_term, mesh_line,
+                                             with_mesh_term)
 from sarfe.pipeline.solve.points import common_samples, sweep_status
 from sarfe.pipeline.solve.pruned_points import solve_points_pruned
 from sarfe.pipeline.write.result_files import write_outputs
@@ -68,7 +70,8 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     bar = progress_bar(progress and linear_stage is None, "checking the case: mesh, groups, quality", None,
                unit="step")
     try:
-        checked = check_case(case, output_dir, force, write=write, mesh_checks=linear_stage is None)
+        checked = check_case(case, output_dir, force, write=write, mesh_checks=linear_stage is None,
+                             assemble=False)   # the linear stage assembles (a deck) right after
     finally:
         if bar is not None:
             bar.close()
@@ -79,7 +82,10 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     timings = {}
     accuracy = None
     config = case.config
-    if config.solver.resolution == "auto":
+    if config.solver.resolution == "auto" and not config.contacts and warn is not None:
+        warn("no contacts: the response is linear (one modal sum per point), so resolution "
+             f"'auto' searches no H; solved at harmonics = {config.solver.harmonics}")
+    if config.solver.resolution == "auto" and config.contacts:
         # accuracy as an input: choose H, N (the reduction cutoff follows H) by a cheap search
         clock = time.perf_counter()
         report, searched = case_resolution(case, config.solver.accuracy)
@@ -164,6 +170,13 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         timings["postprocess_s"] = time.perf_counter() - clock
     points, rows, erps, map_fields = (list(column) for column in zip(*records)) if records \
         else ([], [], [], [])
+    # the ± mesh term: the loudest point re-solved on a 2× coarser generated mesh (issue 29 item 4)
+    clock = time.perf_counter()
+    mesh_term = mesh_error_term(case, points, solutions) if config.solver.error_estimate \
+        else {"estimated": False, "reason": "not estimated (solver.error_estimate: false)"}
+    with_mesh_term(points, rows, mesh_term)
+    mesh_term["line"] = mesh_line(mesh_term)
+    timings["mesh_error_s"] = time.perf_counter() - clock
     not_converged = [p["index"] for p in points if not p["converged"]]
     # None entries without a sweep
     sweep = sweep_status(config.excitation, config.solver.continuation, solutions)
@@ -199,7 +212,8 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         "target": target_verdict,                # output.target_dba against the loudest point
         "audibility_model": background_record(config.audibility),   # cabin and background
         "accuracy": accuracy,                    # None unless solver.accuracy was given
-        "accuracy_check": accuracy_check(config.solver, points),   # estimates vs the accuracy budget
+        "accuracy_check": mesh_checked(accuracy_check(config.solver, points), mesh_term, case),
+        "mesh_error": mesh_term,                 # the ± mesh term (sarfe.pipeline.solve.mesh_error)
         "warnings": warnings,                    # inputs far outside the model's range
         "timings_s": timings,
         "workers": parallel,      # processes; Hill points computed during the sweep (of all)

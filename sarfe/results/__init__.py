@@ -11,13 +11,15 @@ response_h5.py (response.h5), vtk.py (VTU/PVD arrays), plots.py (PNGs), console.
                       store_displacement=False, store_erp_density_per_harmonic=False,
                       extra_groups=None, attributes=None) -> Path
     read_response_h5(path) -> dict
-    write_erp_vtu(path, points, triangles, point_data: dict, field_data=None, active_vectors=None) -> Path
+    write_erp_vtu(path, points, triangles, point_data: dict, field_data=None, active_vectors=None,
+                  parts=None) -> Path
+    part_ids(n_triangles, element_groups) -> (ids (n_tri,) int32, names)   (cell data part_id)
     erp_point_data(n_points, erp, normal_displacement, omega, displacement=None,
                    radiating_nodes=None, contact_marker=None) -> dict
     contact_markers(n_points, contact_nodes) -> (n_points,) int32
     write_pvd(path, [(time_or_frequency, vtu_filename), ...]) -> Path
     write_erp_sweep(directory, points, triangles, point_data_per_frequency (list | j → dict),
-                    frequencies_hz, basename="erp", workers=1) -> Path (.pvd)
+                    frequencies_hz, basename="erp", workers=1, parts=None) -> Path (.pvd)
     start_erp_sweep(...same...) -> writer; writer.finish() -> Path (.pvd)   (the maps written on
                     the workers while the caller writes the other files)
     write_deflection_animation(directory, points, triangles, displacement_harmonics (2H+1, n, 3),
@@ -49,14 +51,14 @@ _EXPORTS = {
     "console_table": ".summary", "to_jsonable": ".summary", "write_summary_json": ".summary",
     "contact_markers": ".vtk", "erp_point_data": ".vtk", "period_samples": ".vtk",
     "write_deflection_animation": ".vtk", "write_erp_sweep": ".vtk", "write_erp_vtu": ".vtk",
-    "write_pvd": ".vtk", "start_erp_sweep": ".vtk",
+    "write_pvd": ".vtk", "part_ids": ".vtk", "start_erp_sweep": ".vtk",
 }
 __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
 
 __all__ = [
     "write_summary_json", "console_table", "to_jsonable", "write_response_h5", "read_response_h5",
     "write_erp_vtu", "erp_point_data", "contact_markers", "write_pvd", "write_erp_sweep",
-    "start_erp_sweep",
+    "start_erp_sweep", "part_ids",
     "write_deflection_animation", "period_samples", "plot_erp_sweep", "plot_contact_forces",
     "plot_erp_spectrum", "plot_friction", "plot_third_octave", "plot_contributions",
     "plot_audibility",

@@ -15,6 +15,12 @@ Rules (``sarfe solve --output``, ``sarfe batch --output``, the per-variant folde
   containing one of them (even with ``force``); an existing file is never a result folder.
 * Writability is probed (a file is created and removed) before the solve starts; ``os.access``
   is not enough (root passes it on read-only mounts).
+* A mount point is never a solve's result folder (even with ``force``): the result could not be
+  renamed onto it (EBUSY after the whole solve), and writing into it in place would leave half a
+  result on a failure. A folder inside it is fine. (A batch folder, written in place, may be one.)
+* An OS error met writing (a full disk, a read-only file system, no permission, EBUSY) is one
+  line naming the result folder and the file (:func:`os_error`, exit 2); the temporary folder is
+  removed, an earlier result stays.
 * A result is written into a temporary sibling ``.<name>.tmp-<pid>-<random>`` and moved into
   place at the end under an exclusive lock on the parent folder (``flock``), so concurrent writers
   of the same target never interleave: the last one to finish wins and every result is whole.
@@ -28,6 +34,7 @@ from __future__ import annotations
 
 import contextlib
 import datetime as _dt
+import errno
 import json
 import os
 import re
@@ -275,6 +282,13 @@ def _contains(outer: Path, inner: Path) -> bool:
     return inner == outer or outer in inner.parents
 
 
+def _locations(path) -> set:
+    """Where the file ``path`` lives: its own name (its folder resolved) and, for a symbolic
+    link, the file it points to — a folder containing either holds the input."""
+    path = Path(path).expanduser().absolute()
+    return {path.parent.resolve() / path.name, path.resolve()}
+
+
 def _probe_writable(folder: Path) -> None:
     handle, name = tempfile.mkstemp(prefix=".sarfe-probe-", dir=folder)
     os.close(handle)
@@ -300,16 +314,20 @@ def check_output_folder(target, *, force: bool = False, protected=(), what: str 
     if _contains(target, home):
         raise CaseError(f"the {what} would replace the home directory{'' if target == home else ' (it contains it)'};"
                         " choose a new or dedicated folder, e.g. --output results/NAME", source=given)
-    for path in protected:
-        if path is None:
-            continue
-        folder = Path(path).expanduser().resolve().parent
-        if _contains(target, folder):
-            raise CaseError(f"the {what} would replace the folder of {path}; choose a new or "
-                            "dedicated folder, e.g. --output results/NAME", source=given)
+    labels = protected if isinstance(protected, dict) else dict.fromkeys(protected)
+    for path, label in labels.items():
+        if path is not None and any(_contains(target, p) for p in _locations(path)):
+            named = f"{label}, {path}" if label else str(path)
+            raise CaseError(f"the {what} would replace the folder of an input of the case "
+                            f"({named}); choose a new or dedicated folder, e.g. --output "
+                            "results/NAME (--force never deletes an input)", source=given)
     if target.exists() and not target.is_dir():
         raise CaseError(f"the {what} is an existing file, not a folder; give a folder name",
                         source=given)
+    if not write_inside and target.is_dir() and os.path.ismount(target):
+        raise CaseError(f"the {what} is a mount point: a result is written beside it and renamed "
+                        "into place, which a mount point does not allow (EBUSY); give a folder "
+                        f"inside it, e.g. --output {target / 'results'}", source=given)
     if target.is_dir():
         try:
             entries = sorted(p.name for p in target.iterdir())
@@ -453,15 +471,69 @@ def write_result_folder(target, write, info: dict, force: bool = False) -> Path:
     """``write(folder)`` into a new temporary sibling of ``target``, then move it into place.
     On any failure the temporary folder is removed and ``target`` is left as it was."""
     target = Path(target)
-    temporary = new_temporary(target, info)
+    try:
+        temporary = new_temporary(target, info)
+    except OSError as exc:
+        raise os_error(exc, target) or exc from None
     try:
         write(temporary)
         write_marker(temporary, dict(info, files=written_names(temporary)))
         replace_directory(temporary, target, force=force)
-    except BaseException:
+    except BaseException as exc:
         shutil.rmtree(temporary, ignore_errors=True)
+        error = os_error(exc, target) if isinstance(exc, OSError) else None
+        if error is not None:
+            raise error from None
         raise
     return target
+
+
+# ------------------------------------------------------------------------------- OS errors
+# what an OS error met writing a result means, and what the user can do: {errno: (what, advice)}
+_OS_ERRORS = {
+    errno.ENOSPC: ("the disk is full (no space left on device)",
+                   "free space on it or choose another --output"),
+    errno.EDQUOT: ("the disk quota is exceeded", "free space or choose another --output"),
+    errno.EROFS: ("the file system is read-only", "choose a writable --output"),
+    errno.EACCES: ("permission denied", "choose a folder you may write, or change its permissions"),
+    errno.EPERM: ("operation not permitted", "choose a folder you may write"),
+    errno.EBUSY: ("the folder is busy (a mount point, or in use by another program)",
+                  "choose a folder inside it or another --output"),
+    errno.EXDEV: ("the result cannot be moved across file systems", "choose another --output"),
+    errno.EIO: ("an input/output error of the disk", "check the disk or choose another --output"),
+}
+
+
+def _in_result(path: Path) -> tuple:
+    """(result folder, path inside it) of a path in a temporary sibling ``.<name>.tmp-…`` of a
+    result being written (named by its final name), else (None, None)."""
+    parts = path.parts
+    for i, part in enumerate(parts):
+        match = _TEMP_NAME.match(part)
+        if match:
+            return Path(*parts[:i], match["name"]), Path(*parts[i + 1:]) if parts[i + 1:] else None
+    return None, None
+
+
+def os_error(exc: OSError, target=None) -> CaseError | None:
+    """One line for an OS error met reading or writing (a full disk, a read-only file system,
+    no permission, a busy mount point …): a CaseError (exit 2) naming the path — ``target``
+    (the result folder being written) or the error's own file, a file in a temporary result
+    named by the result's final name — what happened and what to do; None for an errno not
+    listed in ``_OS_ERRORS`` (an internal error)."""
+    if not isinstance(exc, OSError) or exc.errno not in _OS_ERRORS:
+        return None
+    what, advice = _OS_ERRORS[exc.errno]
+    file = Path(exc.filename) if isinstance(exc.filename, (str, os.PathLike)) else None
+    folder, inside = _in_result(file) if file is not None else (None, None)
+    if target is not None:
+        folder = Path(target)
+        inside = inside if inside is not None else file
+    if folder is None:
+        return CaseError(f"{what}; {advice}", source=str(file) if file else None)
+    at = f" (at {inside})" if inside is not None else ""
+    return CaseError(f"cannot write the result: {what}{at}; nothing of it was kept (an earlier "
+                     f"result there is unchanged); {advice}", source=str(folder))
 
 
 def claim_folder(target, info: dict, force: bool = False) -> Path:
@@ -486,6 +558,6 @@ def _existing_parent(path: Path) -> Path:
     return parent
 
 
-__all__ = ["MARKER", "check_output_folder", "clean_stale", "claim_folder", "foreign_entries",
+__all__ = ["MARKER", "check_output_folder", "os_error", "clean_stale", "claim_folder", "foreign_entries",
            "is_sarfe_result", "marker_info", "pid_alive", "read_marker", "refusal", "result_kind",
            "replace_directory", "write_result_folder", "written_names"]

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from matplotlib.tri import Triangulation
 
 __all__ = ["plot_erp_sweep", "plot_contact_forces", "plot_erp_spectrum", "plot_friction",
            "plot_third_octave", "plot_contributions", "plot_surface_map", "branch_ids"]
@@ -430,7 +431,12 @@ def plot_surface_map(path, points, triangles, values, label, title=None, clim=No
     fig = _figure(6.4, 4.4)
     ax = fig.add_subplot()
     v = np.asarray(values, dtype=float)
-    image = ax.tripcolor(P[:, a], P[:, b], T, v, shading="gouraud", cmap=cmap,
+    off = np.isnan(v[T]).any(axis=1)       # NaN: off the map's surface, drawn grey, not coloured
+    if off.any():
+        ax.tripcolor(P[:, a], P[:, b], T[off], facecolors=np.ones(int(off.sum())), cmap="Greys",
+                     vmin=0.0, vmax=3.0)
+    image = ax.tripcolor(Triangulation(P[:, a], P[:, b], T, mask=off), np.nan_to_num(v),
+                         shading="gouraud", cmap=cmap,
                          vmin=None if clim is None else clim[0],
                          vmax=None if clim is None else clim[1])
     fig.colorbar(image, ax=ax, label=label)

@@ -7,7 +7,9 @@ pyvista renders in a child process (``python -m sarfe.results.render DATA.npz OU
 a missing or broken OpenGL stack can never take the solve down with it; VTK picks its off-screen
 context itself (here: no X display, it falls back to its EGL/OSMesa path, which renders). When the
 child fails or times out, :func:`sarfe.results.plots.plot_surface_map` draws the field with
-matplotlib's tripcolor seen along the panel's thickness axis, and ``renderer`` says so.
+matplotlib's tripcolor seen along the panel's thickness axis, and ``renderer`` says so. The child
+ends with the solve that started it, even one killed by SIGKILL
+(:func:`sarfe.util.parent_watch.die_with_parent`).
 """
 from __future__ import annotations
 
@@ -20,10 +22,13 @@ from pathlib import Path
 
 import numpy as np
 
+from sarfe.util.parent_watch import die_with_parent
+
 __all__ = ["render_surface", "render_surfaces", "start_render", "finish_render", "cancel_render",
            "RenderRun"]
 
 TIMEOUT_S = 120
+PARENT_ENV = "SARFE_RENDER_PARENT_PID"    # the solve's PID: the child dies with it
 
 
 def render_surface(path, points, triangles, values, label, title=None, warp=None, clim=None,
@@ -84,7 +89,7 @@ def start_render(jobs, use_pyvista: bool = True) -> RenderRun:
                                          dtype=float).reshape(-1, 3),
                  label_texts=np.asarray([t for _, t in job.get("labels") or []], dtype=str))
         run.data.append(name)
-    env = dict(os.environ, PYVISTA_OFF_SCREEN="true")
+    env = dict(os.environ, PYVISTA_OFF_SCREEN="true", **{PARENT_ENV: str(os.getpid())})
     run.stderr = directory / ".render-stderr.txt"    # a file, not a pipe: the child never blocks
     try:
         with open(run.stderr, "w") as stderr:
@@ -190,5 +195,7 @@ def _render(data_path):
 
 
 if __name__ == "__main__":  # child process of render_surfaces: one .npz per image
+    if os.environ.get(PARENT_ENV):      # ends with the solve, even a solve killed by SIGKILL
+        die_with_parent(int(os.environ[PARENT_ENV]))
     for argument in sys.argv[1:]:
         _render(argument)

@@ -18,9 +18,13 @@ Standard ERP point arrays (:func:`erp_point_data`), n = number of mesh points:
     displacement_amplitude_m        (n, 3) per component max_θ |u(θ) − u0| over one period [m]
                                            (zeros if the caller passes no nodal displacement)
     erp_level_db_m2                 (n,)   10 log10(erp_density / 1 pW/m²) [dB re 1 pW/m²], floored
-                                           at the frame's maximum − 60 dB (non-radiating points and
-                                           silent ones sit on the floor), so ParaView's automatic
-                                           colour range shows the hot spots without tuning
+                                           at the frame's maximum − 60 dB (silent points of the
+                                           surface sit on the floor), so ParaView's automatic
+                                           colour range shows the hot spots without tuning; NaN at
+                                           the points off the ERP surface (ParaView's NaN colour,
+                                           not the colour of silence). The active scalars of the
+                                           file: what ParaView colours by when it opens it
+    radiating                       (n,)   int8: 1 on the ERP surface (``erp.surface``), 0 elsewhere
     contact_marker                  (n,)   int: 0 = no contact, c+1 = node of contact c
                                            (ContactSet order; the last contact wins on shared nodes)
     node_id                         (n,)   int: the deck's GRID / node id of each point (deck
@@ -30,11 +34,19 @@ Standard ERP point arrays (:func:`erp_point_data`), n = number of mesh points:
     contact_relative_displacement_m (n,)   max_θ |r(θ) − r0| of the pair's relative displacement
                                            (normal and tangential rows), 0 elsewhere (only when given)
 
-Non-radiating points get 0 in the ERP arrays. The contact arrays make parts visible that rattle or
-rub without radiating (a clip behind the panel): colour by them, or threshold them.
+Non-radiating points get 0 in the ERP density arrays (no power: the sums stay right) and NaN in
+``erp_level_db_m2``; threshold ``radiating`` to hide them. The contact arrays make parts visible
+that rattle or rub without radiating (a clip behind the panel): colour by them, or threshold them.
+
+Cell data ``part_id`` (n_tri,) int32: 1 + the index of the triangle's part in the field data
+``part_names`` ("part_beam,part_plate"; 0: no part) — :func:`part_ids`: the element groups
+``part_*`` (generated meshes) or ``pid_*`` (decks), else every element group. PVD times are written
+with :data:`PVD_DIGITS` significant digits (30 Hz, not 29.999999999999996), more only where
+that would merge two times.
 """
 from __future__ import annotations
 
+import errno
 import os
 import warnings
 from pathlib import Path
@@ -48,9 +60,26 @@ __all__ = ["write_erp_vtu", "write_pvd", "write_deflection_animation", "write_er
            "start_erp_sweep",
            "erp_point_data", "radiating_fields", "contact_markers", "period_samples",
            "excursion_amplitude",
-           "contact_point_values", "erp_level_db_m2", "DB_MAP_RANGE"]
+           "contact_point_values", "erp_level_db_m2", "DB_MAP_RANGE", "part_ids",
+           "MASKED_ARRAYS", "PVD_DIGITS"]
 
 DB_MAP_RANGE = 60.0  # [dB] span of erp_level_db_m2 below its maximum
+MASKED_ARRAYS = ("erp_level_db_m2",)   # NaN kept where point data "radiating" is 0
+PVD_DIGITS = 10      # significant digits of a PVD time (a frequency [Hz], a time [s])
+DEFAULT_SCALARS = "erp_level_db_m2"   # the array ParaView colours an ERP map by when opened
+
+
+def part_ids(n_triangles: int, element_groups: dict) -> tuple:
+    """(ids (n_tri,) int32, names): the part of every triangle, 1 + its index in ``names``, 0
+    for none. Parts are the element groups ``part_*`` (generated meshes) or ``pid_*`` (a deck's
+    shell properties), else all element groups; sorted by name, a later one wins a triangle in
+    two. ``element_groups`` {name: triangle indices}."""
+    names = sorted(g for g in element_groups if g.startswith(("part_", "pid_"))) or \
+        sorted(element_groups)
+    ids = np.zeros(int(n_triangles), dtype=np.int32)
+    for k, name in enumerate(names):
+        ids[np.asarray(element_groups[name], dtype=int)] = k + 1
+    return ids, tuple(names)
 
 
 def erp_level_db_m2(density_W_m2, reference_W_m2: float = 1e-12,
@@ -174,12 +203,16 @@ def _check_mesh(points, triangles):
 
 
 def write_erp_vtu(path, points, triangles, point_data: dict, field_data: dict | None = None,
-                  active_vectors: str | None = None) -> Path:
+                  active_vectors: str | None = None, parts=None) -> Path:
     """Write one VTU: ``points`` (n, 3) [m], ``triangles`` (n_tri, 3) int, ``point_data``
     {name: (n,) or (n, m) array}. Names are kept as given (see the module docstring for the
     standard ERP names, built by :func:`erp_point_data`). Integer arrays stay integer (int32),
     booleans become int8; non-finite float values (NaN/inf, e.g. of a point that did not
-    converge) are written as 0 with a RuntimeWarning, so files never hold NaN.
+    converge) are written as 0 with a RuntimeWarning, so files never hold NaN — except in the
+    :data:`MASKED_ARRAYS` at points whose ``radiating`` is 0 (off the ERP surface).
+    ``parts`` (ids (n_tri,), names) of :func:`part_ids`: cell data ``part_id`` and field data
+    ``part_names``. ``erp_level_db_m2``, when given, is the active scalars (what ParaView colours
+    by first).
     ``field_data`` {name: scalar | array | str} is stored as VTK field data (e.g. the frequency);
     ``active_vectors`` names a (n, 3) array ParaView offers first (e.g. to Warp By Vector).
     Written by VTK's XML writer, appended raw binary with LZ4 compression. Returns the path.
@@ -189,6 +222,8 @@ def write_erp_vtu(path, points, triangles, point_data: dict, field_data: dict | 
 
     points, triangles = _check_mesh(points, triangles)
     grid = pv.UnstructuredGrid({pv.CellType.TRIANGLE: triangles}, points)
+    off_surface = (np.asarray(point_data["radiating"]) == 0) if "radiating" in point_data \
+        else np.zeros(points.shape[0], bool)
     for name, values in point_data.items():
         arr = np.asarray(values)
         if arr.shape[:1] != (points.shape[0],) or arr.ndim > 2:
@@ -201,11 +236,22 @@ def write_erp_vtu(path, points, triangles, point_data: dict, field_data: dict | 
         else:
             arr = np.asarray(arr, dtype=np.float64)         # (no copy when already float)
             bad = ~np.isfinite(arr)
+            if name in MASKED_ARRAYS:
+                bad &= ~(off_surface & np.isnan(arr))
             if np.any(bad):  # e.g. a point that did not converge: keep the run's files readable
                 warnings.warn(f"point_data[{name!r}]: {int(bad.sum())} non-finite values written as 0",
                               RuntimeWarning, stacklevel=2)
                 arr = np.where(bad, 0.0, arr)
         grid.point_data[str(name)] = arr
+    if parts is not None:
+        ids, names = parts
+        if np.shape(ids) != (triangles.shape[0],):
+            raise ValueError(f"part ids must be (n_tri,) = ({triangles.shape[0]},), got "
+                             f"{np.shape(ids)}")
+        grid.cell_data["part_id"] = np.asarray(ids, dtype=np.int32)
+        grid.field_data["part_names"] = [",".join(names)]
+    if DEFAULT_SCALARS in grid.point_data:
+        grid.point_data.active_scalars_name = DEFAULT_SCALARS
     for name, value in (field_data or {}).items():
         grid.field_data[str(name)] = [value] if isinstance(value, str) else np.atleast_1d(value)
     if active_vectors is not None:
@@ -218,24 +264,62 @@ def write_erp_vtu(path, points, triangles, point_data: dict, field_data: dict | 
     writer.SetDataModeToAppended()
     writer.EncodeAppendedDataOff()          # raw bytes, no base64
     writer.SetCompressorTypeToLZ4()
-    if not writer.Write():
-        raise OSError(f"VTK could not write {path}")
+    if not _write_quietly(writer):
+        raise _write_error(path, writer.GetErrorCode())
     return path
+
+
+def _write_quietly(writer) -> bool:
+    """``writer.Write()`` with VTK's own error output off (its log line and the error window
+    that pyvista forwards to logging: 20 lines for a full disk); the failure is raised by the
+    caller as one OSError."""
+    from vtkmodules.vtkCommonCore import vtkObject
+
+    display = vtkObject.GetGlobalWarningDisplay()
+    vtkObject.GlobalWarningDisplayOff()
+    try:
+        return bool(writer.Write())
+    finally:
+        vtkObject.SetGlobalWarningDisplay(display)
+
+
+def _write_error(path: Path, code: int) -> OSError:
+    """The OSError of a failed VTK write of ``path`` with the errno of its cause: VTK's error
+    code is the system's errno below vtkErrorCode.FirstVTKErrorCode (ENOSPC for a full disk);
+    its own OutOfDiskSpaceError is ENOSPC; else the error that opening the file for appending
+    gives (read-only, permission), else EIO."""
+    from vtkmodules.vtkCommonMisc import vtkErrorCode
+
+    number = code if 0 < code < vtkErrorCode.FirstVTKErrorCode else (
+        errno.ENOSPC if code == vtkErrorCode.OutOfDiskSpaceError else None)
+    if number is None:
+        try:
+            with open(path, "ab"):
+                number = errno.EIO
+        except OSError as exc:
+            number = exc.errno or errno.EIO
+    return OSError(number, os.strerror(number), str(path))
 
 
 def write_pvd(path, entries) -> Path:
     """Write a ParaView collection: ``entries`` = [(time_or_frequency, vtu_filename), …].
 
     Filenames are stored relative to the PVD's directory (they should live in it or below).
-    ParaView shows the value as "time": a phase/time for animations, a frequency [Hz] for sweeps.
+    ParaView shows the value as "time": a phase/time for animations, a frequency [Hz] for sweeps;
+    written with :data:`PVD_DIGITS` significant digits (more only if that would merge two).
     """
     path = Path(path)
+    entries = list(entries)
+    values = [float(value) for value, _ in entries]
+    digits = PVD_DIGITS
+    while digits < 17 and (len({f"{v:.{digits}g}" for v in values}) < len(set(values))):
+        digits += 1
     lines = ['<?xml version="1.0"?>',
              '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">',
              "  <Collection>"]
-    for value, filename in entries:
+    for value, (_, filename) in zip(values, entries):
         rel = os.path.relpath(Path(path.parent, filename), path.parent).replace(os.sep, "/")
-        lines.append(f'    <DataSet timestep="{float(value)!r}" group="" part="0" '
+        lines.append(f'    <DataSet timestep="{value:.{digits}g}" group="" part="0" '
                      f"file={quoteattr(rel)}/>")
     lines += ["  </Collection>", "</VTKFile>", ""]
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -306,9 +390,11 @@ def erp_point_data(n_points: int, erp, normal_displacement, omega: float, displa
     full[:H, nodes] = fields[:H]
     full[H, nodes] = erp.density_total
     full[H + 1:, nodes] = fields[H:]
-    data = {"erp_density_W_m2": full[H],
-            "erp_level_db_m2": erp_level_db_m2(full[H],
-                                               float(getattr(erp, "reference_power", 1e-12)))}
+    radiating = np.zeros(n, dtype=np.int8)
+    radiating[nodes] = 1
+    level = erp_level_db_m2(full[H], float(getattr(erp, "reference_power", 1e-12)))
+    level[radiating == 0] = np.nan          # off the ERP surface: no level, not a silent one
+    data = {"erp_density_W_m2": full[H], "erp_level_db_m2": level, "radiating": radiating}
     for k in range(H):
         data[f"erp_density_h{k + 1}_W_m2"] = full[k]
     data["normal_velocity_amplitude_m_s"] = full[H + 1]
@@ -333,9 +419,10 @@ def erp_point_data(n_points: int, erp, normal_displacement, omega: float, displa
 
 
 def write_erp_sweep(directory, points, triangles, point_data_per_frequency, frequencies_hz,
-                    basename: str = "erp", workers: int = 1) -> Path:
+                    basename: str = "erp", workers: int = 1, parts=None) -> Path:
     """One VTU per frequency point (``<basename>_0000.vtu`` …, in sweep order) plus
-    ``<basename>.pvd``. Each VTU carries field data ``frequency_hz`` and ``point_index``.
+    ``<basename>.pvd``. Each VTU carries field data ``frequency_hz`` and ``point_index`` (and
+    ``parts``, :func:`part_ids`, as cell data ``part_id``).
 
     ``point_data_per_frequency``: the point data of each frequency — a sequence of dicts, or a
     function j → dict called when file j is written (so the arrays of all points never coexist).
@@ -348,7 +435,7 @@ def write_erp_sweep(directory, points, triangles, point_data_per_frequency, freq
     0, 1, … (ParaView sorts and merges equal times). Returns the PVD path.
     """
     return start_erp_sweep(directory, points, triangles, point_data_per_frequency,
-                           frequencies_hz, basename, workers).finish()
+                           frequencies_hz, basename, workers, parts=parts).finish()
 
 
 class ErpSweepWriter:
@@ -367,7 +454,7 @@ class ErpSweepWriter:
 
 
 def start_erp_sweep(directory, points, triangles, point_data_per_frequency, frequencies_hz,
-                    basename: str = "erp", workers: int = 1) -> ErpSweepWriter:
+                    basename: str = "erp", workers: int = 1, parts=None) -> ErpSweepWriter:
     """:func:`write_erp_sweep` started on ``workers`` processes without waiting for them: this
     process writes the run's other files meanwhile and calls ``finish()`` (with ``workers`` ≤ 1
     the maps are written by ``finish()``)."""
@@ -384,7 +471,8 @@ def start_erp_sweep(directory, points, triangles, point_data_per_frequency, freq
 
     def write(j):
         write_erp_vtu(directory / names[j], points, triangles, data_of(j),
-                      field_data={"frequency_hz": float(frequencies[j]), "point_index": j})
+                      field_data={"frequency_hz": float(frequencies[j]), "point_index": j},
+                      parts=parts)
 
     import pyvista  # noqa: F401  (imported here once, inherited by forked workers)
     import vtkmodules.vtkIOXML  # noqa: F401

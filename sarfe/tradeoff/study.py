@@ -5,7 +5,8 @@ Knobs (levels around the case value v; the finest level of each knob is that kno
     harmonics          H ∈ {⌈v/2⌉, v, 2v, 4v}            (N raised to ≥ 4H+1 where needed)
     samples            N ∈ {v/2, v, 2v, 8v}              (each ≥ 4H+1)
     modes              fixed-interface modes {v/2, v, 2v, 4v}  (FE cases; linear stage rebuilt)
-    mesh               element size {2v, v, v/√2, v/2}   (generated meshes; linear stage rebuilt)
+    mesh               element size {2v, v, v/√2, v/2}   (generated meshes; linear stage rebuilt;
+                       the ladder's own Richardson estimate per rung: :func:`mesh_ladder`)
     penalty            k_n, k_t × {0.3, 1, 3, 10}        (contact model sensitivity, not a discretization)
 
 Each variant solves the same frequency grid (``points`` frequencies over the sweep, or the listed
@@ -20,7 +21,6 @@ The linear stage is built once and reused for harmonics / samples / penalty vari
 """
 from __future__ import annotations
 
-import copy
 import csv
 import json
 import math
@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from sarfe.accuracy import resize_harmonics
+from sarfe.accuracy.mesh_refinement import MESH_ORDER, mesh_richardson
 from sarfe.erp import equivalent_radiated_power
 from sarfe.hbm import SolverOptions, solve_frequency
 from sarfe.hbm.time_integration import linear_harmonic_response
@@ -84,31 +85,30 @@ def knob_levels(case, stage, knobs=None) -> dict:
 
 
 def variant_case(case, knob, value):
-    """A new Case with one knob changed (see module docstring): the case's record ``case.data`` is
-    copied, edited and loaded again, so the variant gets its own normalized data and config."""
-    data = copy.deepcopy(case.data)
-    solver = data["solver"]
+    """A new Case with one knob changed (see module docstring), through the typed case API
+    (:meth:`sarfe.case.read.Case.with_solver` …): harmonics (N doubled to at least 4H + 1),
+    samples, penalty (every contact's normal and tangential stiffness × value), modes (a mode
+    count instead of a cutoff, no minimum) or mesh (the generator's mesh size)."""
     if knob == "harmonics":
-        solver["harmonics"] = int(value)
-        N = int(solver["samples_per_period"])
+        N = int(case.config.solver.samples_per_period)
         while N < 4 * value + 1:
             N *= 2
-        solver["samples_per_period"] = N
-    elif knob == "samples":
-        solver["samples_per_period"] = int(value)
-    elif knob == "penalty":
-        for contact in data["contacts"]:
-            for key in ("normal_stiffness_N_m", "tangential_stiffness_N_m"):
-                if key in contact:
-                    contact[key] = contact[key] * value
-    elif knob == "modes":
-        red = data.setdefault("reduction", {})
-        red.pop("cutoff_hz", None)
-        red["mode_count"] = int(value)
-        red["min_mode_count"] = 0
-    elif knob == "mesh":
-        data["model"]["fe"]["generator"]["mesh_size_m"] = float(value)
-    return load_case(data, base_dir=case.base_dir)
+        return case.with_solver(harmonics=int(value), samples_per_period=N)
+    if knob == "samples":
+        return case.with_solver(samples_per_period=int(value))
+    if knob == "penalty":
+        for index, contact in enumerate(case.config.contacts):
+            changes = {key: contact.params[key] * value
+                       for key in ("normal_stiffness_N_m", "tangential_stiffness_N_m")
+                       if key in contact.params}
+            if changes:
+                case = case.with_contact(index, **changes)
+        return case
+    if knob == "modes":
+        return case.with_reduction(cutoff_hz=None, mode_count=int(value), min_mode_count=0)
+    if knob == "mesh":
+        return case.with_generator(mesh_size_m=float(value))
+    return case
 
 
 def frequency_grid(case, points=16) -> np.ndarray:
@@ -349,6 +349,8 @@ def run_study(case, knobs=None, points=12, frequencies_hz=None, output_dir=None,
         for row, pts in zip(knob_rows, knob_points):
             row.update(_errors(pts, reference))
             row["reference"] = values[-1][0]
+        if knob == "mesh":
+            mesh_ladder(knob_rows, knob_points)
         rows += knob_rows
         all_points[knob] = [[{k: v for k, v in p.items() if not k.startswith("_")} for p in pts]
                             for pts in knob_points]
@@ -371,6 +373,30 @@ def run_study(case, knobs=None, points=12, frequencies_hz=None, output_dir=None,
     return result
 
 
+def mesh_ladder(rows, points, order=MESH_ORDER):
+    """The mesh ladder's own error estimate (:mod:`sarfe.accuracy.mesh_refinement`, (1)): each
+    rung but the coarsest against the next coarser one, r = h_coarser / h, at every grid point
+    converged in both (max over points, dB(A) and dB alike) → ``mesh_estimate_db``, and
+    ``mesh_estimate_covers``: whether it is at least the rung's error against the finest rung
+    (``erp_db_error``/``erp_dba_error``, the larger); the finest rung has no error to cover."""
+    for k, row in enumerate(rows):
+        row["mesh_estimate_db"], row["mesh_estimate_covers"] = float("nan"), None
+        if k == 0:
+            continue
+        ratio = float(rows[k - 1]["value"]) / float(row["value"])
+        estimates = [mesh_richardson(p[key], c[key], order, ratio)
+                     for p, c in zip(points[k], points[k - 1]) if p["converged"] and c["converged"]
+                     for key in ("erp_db", "erp_dba")]
+        estimates = [e for e in estimates if np.isfinite(e)]
+        if not estimates:
+            continue
+        row["mesh_estimate_db"] = max(estimates)
+        if k < len(rows) - 1:
+            error = _max([row.get("erp_db_error"), row.get("erp_dba_error")])
+            row["mesh_estimate_covers"] = bool(row["mesh_estimate_db"] >= error) \
+                if np.isfinite(error) else None
+
+
 def _is_baseline(case, stage, knob, value):
     config = case.config
     if knob == "harmonics":
@@ -391,7 +417,7 @@ COLUMNS = ("knob", "level", "harmonics", "samples_per_period", "reduced_dofs", "
            "peak_force_N", "amplitude_m", "erp_db_error", "erp_dba_error", "force_rel_error",
            "amplitude_rel_error", "estimate_amplitude_rel", "estimate_erp_db", "wall_s",
            "linear_stage_s", "newton_iterations", "cold_sweep_erp_db", "cold_converged_points", "peak_memory_MB", "converged_points", "points",
-           "baseline", "reference")
+           "baseline", "reference", "mesh_estimate_db", "mesh_estimate_covers")
 
 
 def study_table(rows) -> str:
@@ -409,6 +435,16 @@ def study_table(rows) -> str:
             f"{r.get('estimate_amplitude_rel', float('nan')):8.2e} {r['wall_s']:7.2f} "
             f"{r['newton_iterations']:5d} {r['peak_memory_MB']:6.1f} "
             f"{r['converged_points']:>2}/{r['points']:<2}")
+    mesh = [r for r in rows if r["knob"] == "mesh" and np.isfinite(r.get("mesh_estimate_db",
+                                                                             float("nan")))]
+    if mesh:   # the mesh ladder's Richardson estimates (mesh_ladder)
+        lines.append(f"mesh ladder (Richardson from the next coarser rung, p = {MESH_ORDER:g} "
+                     "stated): " + "; ".join(
+                         f"{r['level']} ±{r['mesh_estimate_db']:.2f} dB" + (
+                             "" if r["mesh_estimate_covers"] is None else
+                             f" ({'covers' if r['mesh_estimate_covers'] else 'does NOT cover'} "
+                             f"|ΔdB| {_max([r['erp_db_error'], r['erp_dba_error']]):.2f})")
+                         for r in mesh))
     lines.append("errors: against the finest level of the same knob (reference column); "
                  "* = the case's setting; est rel = a-posteriori estimate (max over points)")
     return "\n".join(lines)
@@ -495,5 +531,5 @@ def plot_pareto(rows, path, title=""):
 
 
 __all__ = ["KNOBS", "StudyResult", "knob_levels", "variant_case", "frequency_grid", "solve_grid",
-           "attach_estimates", "erp_levels", "contact_measures", "branch_guesses", "run_variant", "run_study", "study_table", "write_study",
+           "attach_estimates", "mesh_ladder", "erp_levels", "contact_measures", "branch_guesses", "run_variant", "run_study", "study_table", "write_study",
            "plot_pareto"]

@@ -6,7 +6,7 @@ computed by ``workers`` processes forked from this one. Fork shares the parent's
 copy-on-write: ``function`` and ``items`` (a closure over the reduced model, the converged points)
 are never pickled — a worker receives an item's index and pickles back only its result (a
 StabilityResult, a record dict). ``workers`` ≤ 1, or a single item, is the plain loop in this
-process. This module imports nothing from sarfe, so every layer may use it.
+process. This module imports only :mod:`sarfe.util.parent_watch`, so every layer may use it.
 
 - Threads: the pool is forked under ``threadpool_limits(1)`` and every worker keeps one BLAS /
   OpenMP thread (docs/performance.md: oversubscribed BLAS threads on 2 cores cost 75×).
@@ -16,6 +16,9 @@ process. This module imports nothing from sarfe, so every layer may use it.
   loop. A worker that dies (killed, out of memory) leaves its items to the parent, which computes
   them itself: the results are the same, only later.
 - Ctrl-C: the workers ignore SIGINT; the parent receives it, stops its workers and re-raises.
+- A parent killed outright (SIGKILL, out of memory): every worker ends with it, within
+  :data:`sarfe.util.parent_watch.POLL_S` at most (the kernel's parent-death signal on Linux, a
+  watchdog thread elsewhere), instead of waiting on its task pipe for good.
   The workers write no result file, except the ERP map series (``sarfe.results.
   write_erp_sweep``: each map its own file, in the run's temporary directory, at the end).
 - ``progress(item)``: called in the parent once per finished item, with that item (in finishing
@@ -31,6 +34,8 @@ import os
 import signal
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
+
+from sarfe.util.parent_watch import die_with_parent
 
 AUTO_LIMIT = 2          # 'auto' uses at most 2 processes (the P1 machine has 2 cores)
 WORKER_MEMORY_SHARE = 0.5   # 'auto': a worker may add up to half the parent's resident memory
@@ -81,8 +86,11 @@ def worker_count(setting="auto") -> int:
     return max(1, int(setting))
 
 
-def _start_worker():
-    """Initializer of a forked worker: SIGINT to the parent only, one BLAS / OpenMP thread."""
+def _start_worker(parent_pid: int):
+    """Initializer of a forked worker: it dies with the process ``parent_pid`` that forked it
+    (SIGKILL included: :func:`sarfe.util.parent_watch.die_with_parent`), SIGINT goes to the
+    parent only, one BLAS / OpenMP thread."""
+    die_with_parent(parent_pid)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     from threadpoolctl import threadpool_limits
 
@@ -172,7 +180,7 @@ def start_map(function, items, workers) -> PendingMap:
         with threadpool_limits(limits=1):     # fork with one BLAS thread (no pool to inherit)
             pool = ProcessPoolExecutor(max_workers=min(int(workers), len(items)),
                                        mp_context=multiprocessing.get_context("fork"),
-                                       initializer=_start_worker)
+                                       initializer=_start_worker, initargs=(os.getpid(),))
             pending = {pool.submit(_run, i): i for i in range(len(items))}
     except BaseException:
         _stop(pool)
@@ -257,7 +265,8 @@ class Stream:
         parent, child = multiprocessing.get_context("fork").Pipe()
         with threadpool_limits(limits=1):
             process = multiprocessing.get_context("fork").Process(
-                target=_stream_worker, args=(self.function, batch, child), daemon=True)
+                target=_stream_worker, args=(self.function, batch, child, os.getpid()),
+                daemon=True)
             process.start()
         child.close()
         self._process, self._connection = process, parent
@@ -292,10 +301,10 @@ class Stream:
         self._connection = None
 
 
-def _stream_worker(function, batch, connection):
+def _stream_worker(function, batch, connection, parent_pid):
     """Body of a :class:`Stream` worker: the batch in order, each result sent as soon as it is
     computed, until the parent says stop; then the sentinel None."""
-    _start_worker()
+    _start_worker(parent_pid)
     gc.freeze()       # this process's collections leave the inherited objects (and pages) alone
     try:
         for key, item in batch:

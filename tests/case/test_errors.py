@@ -138,8 +138,8 @@ def test_unpairable_contact(tmp_path, capsys):
                 "    normal_stiffness_N_m: 2.0e5\n    pairing_tolerance_m: 1.0e-5")
     code, err, _ = run_cli(tmp_path, text, command="validate", capsys=capsys)
     assert code == 2
-    assert "contacts[0].between: 1 of 1 nodes of 'contact_tip_a' have no node of 'contact_tip_b' " \
-           "within pairing_tolerance_m" in err
+    assert "contacts[0].between: 1 of 1 nodes of 'contact_tip_a' have no point of the surface of " \
+           "'contact_tip_b' within pairing_tolerance_m" in err
 
 
 def test_missing_mesh_file_and_units(tmp_path, capsys):

@@ -23,11 +23,15 @@ def test_demo_estimate_is_inside_the_balanced_budget(tmp_path):
 
     summary = solve_case(load_case(DEMO), output_dir=tmp_path / "demo").summary
     check = summary["accuracy_check"]
-    assert check["met"] is True and check["target"] == "balanced" and not check["unknown_points"]
+    # the ± carries the 14 mm mesh's own error (issue 29 item 4: ±4.3 dB, the 28 mm re-solve at
+    # 67 Hz): the demo is screening grade (its file says why); inside the budget but for it
+    assert check["met"] is False and "mostly from mesh" in check["warning"]
+    assert check["target"] == "balanced" and not check["unknown_points"]
     for point in summary["points"]:
         assert point["converged"]
         estimate = point["error_estimate"]
-        assert estimate["erp_db"] <= 0.5 and estimate["amplitude_rel"] <= 0.01, point["frequency_hz"]
+        assert estimate["erp_db"] - estimate["mesh_db"] <= 0.5 and \
+            estimate["amplitude_rel"] <= 0.01, point["frequency_hz"]
 
 
 @pytest.mark.slow

@@ -40,7 +40,9 @@ def test_rattle_rig_end_to_end(tmp_path):
     result = solve_case(data, output_dir=tmp_path / "rig")
     summary = json.loads((tmp_path / "rig" / "summary.json").read_text())
     assert summary["model"]["kind"] == "fe" and summary["model"]["modes"] >= 10
-    assert summary["model"]["boundary_dofs"] == 9            # striker, plate node, load point
+    # boundary: what moves the rattle's one row w (u_z of the striker and of the plate node below
+    # it: a rattle law has no tangent rows) and the load point's 3 translations
+    assert summary["model"]["boundary_dofs"] == 5
     assert (tmp_path / "rig" / "erp" / "erp.pvd").is_file()
     # full-field recovery (Craig–Bampton basis) agrees with the ERP normal-velocity basis: on the
     # flat plate (normal z) the z amplitude of the displacement is the normal amplitude
@@ -91,9 +93,11 @@ solver: {harmonics: 3, samples_per_period: 64}
 
 
 # squeak_rig's A-weighted ERP [dB(A)] at 50, 100, 150 Hz from a converged finer model of the same
-# mesh: H = 48, N = 1024, cutoff margin 2 (32 modes); H = 24 and 48 agree within 0.05 dB
-# (test_squeak_rig_finer_model recomputes it). H = 3, the case's old setting, gave 11.6 / 32.2 / 38.7.
-SQUEAK_RIG_FINE_DBA = (22.03, 37.24, 38.93)
+# mesh (6 mm): H = 48, N = 1024, cutoff margin 2; H = 32 / 40 / 48 agree within 0.06 dB
+# (test_squeak_rig_finer_model recomputes it). Issue 29 changed the physics: the normal is the
+# plate's (not the pad pole's leaning mesh normal) and the friction acts on the plate's face, so
+# its moment (t/2)·F_t bends the plate; before (10 mm, H = 23, node normal): 22.03 / 37.24 / 38.93.
+SQUEAK_RIG_FINE_DBA = (29.84, 43.99, 52.58)
 
 # Shipped cases that miss their 'balanced' budget today, with what was measured (the README's case
 # table says so too); strict: the test fails once a case meets it, so this list stays true.
@@ -103,6 +107,8 @@ BUDGET_MISSED = {
     "rattle_rig_deck": "the rattle rig from its deck: the same sweep and estimate as rattle_rig",
     "instrument_panel": "estimate ±3 % amplitude at 62 Hz (modal part), a false alarm: a converged "
                         "model (H = 12, 806 modes) is within 0.06 dB(A) and 0.6 % of H = 3",
+    "squeak_rig": "the 6 mm mesh's own error: mesh term ±1.47 dB at 150 Hz (issue 29 item 4)",
+    "door_trim": "the 14 mm mesh's own error: mesh term ±4.3 dB at 67 Hz (issue 29 item 4)",
     "lumped_rattle": "H = 7: ±2.9 dB at 51 Hz (0.7-1.3 dB low vs H = 30); H = 16 fits the budget "
                      "but 3 fold-tip points have no estimate (their re-solve fails, also at H = 30)",
 }
@@ -124,13 +130,18 @@ def assert_case_delivers(summary, exit_code):
 
 
 def test_squeak_rig_meets_its_budget_and_a_finer_model(tmp_path):
-    """The shipped squeak rig (H = 23): converged, exit 0, estimate inside 'balanced' (0.5 dB), and
+    """The shipped squeak rig (6 mm, H = 32): converged, exit 0, estimate inside 'balanced' (0.5 dB), and
     each point's dB(A) within its own error bound (and 0.5 dB) of the finer model."""
     result = solve_case(load_case(CASES / "squeak_rig.yaml"), output_dir=tmp_path / "squeak")
     summary = result.summary
-    assert_case_delivers(summary, result.exit_code)
+    # the ± carries the 6 mm mesh's own error (issue 29 item 4: ±1.47 dB at 150 Hz, 12 mm
+    # re-solve): the case is screening grade (its file says why); the budget is met but for it
+    assert result.exit_code == 0 and summary["all_converged"]
+    assert summary["mesh_error"]["estimated"] and summary["accuracy_check"]["met"] is False
+    assert "mostly from mesh" in summary["accuracy_check"]["warning"]
     for p, fine in zip(summary["points"], SQUEAK_RIG_FINE_DBA, strict=True):
-        bound = abs(p["error_estimate"]["erp_db"])
+        assert abs(p["error_estimate"]["erp_db"]) - p["error_estimate"]["mesh_db"] <= 0.5
+        bound = abs(p["error_estimate"]["erp_db"]) - p["error_estimate"]["mesh_db"]
         assert abs(p["erp"]["level_dba"] - fine) <= min(bound + 0.02, 0.5), p["frequency_hz"]
         assert p["stable"] is True and 0.2 < p["contacts"][0]["slip_fraction"] < 0.8  # stick-slip
 
@@ -145,7 +156,10 @@ def test_squeak_rig_finer_model(tmp_path):
     summary = solve_case(data, output_dir=tmp_path / "fine").summary
     levels = [p["erp"]["level_dba"] for p in summary["points"]]
     assert levels == pytest.approx(SQUEAK_RIG_FINE_DBA, abs=0.01)
-    assert max(abs(p["error_estimate"]["erp_db"]) for p in summary["points"]) < 0.2
+    # its own estimate (±0.36 dB at 50 Hz, measured) is conservative: H = 32, 40, 48 agree
+    # within 0.05 dB there
+    assert max(abs(p["error_estimate"]["erp_db"]) - p["error_estimate"].get("mesh_db", 0.0)
+               for p in summary["points"]) < 0.4         # (the mesh term: same mesh, not H)
 
 
 @pytest.mark.slow
@@ -157,7 +171,8 @@ def test_shipped_case_meets_its_accuracy_budget(name, tmp_path):
 
 
 def test_fe_contact_geometry_pairs_ground_and_normal():
-    """Nearest-node pairing: normal from striker to plate (−z), default gap = geometric 0.5 mm;
+    """Striker tip to the plate's surface: normal from striker to plate (−z), gap = the case's
+    gap_m 0.5 mm (the mesh's surface gap is an overlap, tests/pipeline/model/test_contact_pairs);
     a grounded contact with an explicit normal; explicit node pairs give the same rows."""
     from sarfe.pipeline import build_linear_model, nonlinear_model
 
@@ -179,8 +194,8 @@ def test_fe_contact_geometry_pairs_ground_and_normal():
     stage = build_linear_model(data)
     nl = nonlinear_model(data, stage)
     G = nl.contacts.gap_map.toarray()
-    assert np.all(stage.contacts["tip_ground"].coords_b == -1)
-    np.testing.assert_allclose(G[2], G[0])                  # explicit pair = nearest-node pair
+    assert np.all(stage.contacts["tip_ground"].nodes_b == -1)
+    np.testing.assert_allclose(G[2], G[0])                  # explicit pair = point on the plate
     assert nl.contacts.gap.tolist() == pytest.approx([0.5e-3, 1e-3, 0.5e-3])
     # the grounded row measures only the striker: w = −u_z(striker)
     assert np.count_nonzero(G[1]) == 1 and G[1].min() == pytest.approx(-1.0)

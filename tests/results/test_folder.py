@@ -17,25 +17,12 @@ import pytest
 
 from sarfe.cli import main
 from sarfe.case.errors import CaseError
+from small_cases import TINY
+
 from sarfe.results.folder import (MARKER, check_output_folder, clean_stale, is_sarfe_result,
                                     marker_info, replace_directory, write_result_folder)
 
 ROOT = Path(__file__).resolve().parents[2]
-TINY = """\
-name: tiny
-model:
-  matrices:
-    mass: [[1.0, 0.0], [0.0, 1.0]]
-    stiffness: [[2.0e+4, -1.0e+4], [-1.0e+4, 2.0e+4]]
-contacts:
-  - {name: stop, type: rattle, normal_dof: 0, gap_m: 1.0e-3, normal_stiffness_N_m: 1.0e+5}
-excitation:
-  forces: [{dof: 0, force_N: 1.0}]
-  frequency_hz: [20.0]
-solver: {harmonics: 3, stability: false, error_estimate: false}
-erp: {dofs: [0], areas_m2: [0.01]}
-output: {files: [summary, table]}
-"""
 
 
 @pytest.fixture

@@ -86,13 +86,14 @@ def test_cli_study_and_accuracy(tmp_path, case_file, capsys):
 
 @pytest.mark.timeout(300)
 def test_resolve_case_accuracy_finer_target_needs_more(case_file):
-    from sarfe.accuracy.resolve import apply_resolution
-    from sarfe.pipeline.solve.case_accuracy import resolve_case_accuracy
+    from sarfe.case.read import load_case
+    from sarfe.pipeline.solve.case_accuracy import resolve_case_accuracy, resolved_case
 
     fast = resolve_case_accuracy(case_file, "fast", points=2)
     fine = resolve_case_accuracy(case_file, "fine", points=2)
     assert fast["met"] and fine["met"]
     assert fine["harmonics"] >= fast["harmonics"] and fine["harmonics"] > 3
-    data = apply_resolution(CASE, fine)
-    assert data["solver"]["harmonics"] == fine["harmonics"]
+    case = resolved_case(load_case(case_file), fine)
+    assert case.config.solver.harmonics == fine["harmonics"]
+    assert case.data["solver"]["harmonics"] == fine["harmonics"]
     assert np.isfinite(fine["estimate"]["amplitude_rel"])

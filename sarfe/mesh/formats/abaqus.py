@@ -13,7 +13,10 @@ keyword                      read as
                              MASS; ``ELSET=`` adds the elements to an element set
 ``*NSET`` / ``*ELSET``       ids, names of earlier sets (sets of sets), ``GENERATE``;
                              a repeated name appends; ``INSTANCE=`` in an assembly
-``*SHELL SECTION``           ``ELSET``, ``MATERIAL``, first data value = thickness (no offset)
+``*SHELL SECTION``           ``ELSET``, ``MATERIAL``, first data value = thickness (no offset);
+                             ``NODAL THICKNESS``: each element's thickness = the mean of its
+                             nodes' ``*NODAL THICKNESS`` values (constant per element)
+``*NODAL THICKNESS``         node label or node set, thickness
 ``*MATERIAL``                ``*ELASTIC`` (isotropic E, ν) and ``*DENSITY`` (ρ)
 ``*SPRING``                  stiffness of SPRING1/SPRING2 elements (same DOF at both ends)
 ``*MASS``                    point mass of MASS elements
@@ -71,6 +74,7 @@ class _Scope:
     nsets: dict = field(default_factory=dict)          # NAME → (name, [labels])
     elsets: dict = field(default_factory=dict)
     sections: list = field(default_factory=list)       # (elset, material, thickness, where)
+    nodal_thickness: list = field(default_factory=list)  # (node label or nset, t, where)
     springs: list = field(default_factory=list)        # (elset, dof a, dof b, k, where)
     masses: list = field(default_factory=list)         # (elset, mass, where)
 
@@ -106,11 +110,14 @@ class _Reader:
         self.cloads: list = []             # (load set, reference, component, value, where)
         self.unsupported: dict = {}
         self.ignored: dict = {}
+        self.unsupported_where: dict = {}   # name → "file:line" of its first appearance
 
     # bookkeeping ---------------------------------------------------------------------------
-    def skip(self, name: str, count: int = 1):
+    def skip(self, name: str, count: int = 1, where: str = ""):
         table = self.ignored if name.upper().lstrip("*") in self.ignore else self.unsupported
         table[name] = table.get(name, 0) + count
+        if where:
+            self.unsupported_where.setdefault(name, where)
 
     def run(self):
         for block in keyword_blocks(self.path):
@@ -128,7 +135,7 @@ class _Reader:
                     self.in_assembly = False
                     self.scope = self.model
             else:
-                self.skip("*" + block.keyword)
+                self.skip("*" + block.keyword, where=f"{block.file}:{block.line}")
                 self.material = None if block.keyword in ("MATERIAL",) else self.material
         return self
 
@@ -155,7 +162,8 @@ class _Reader:
     def k_element(self, block):
         kind = str(block.options.get("TYPE", "")).upper()
         if kind not in SHELL_NODES and kind not in POINT_ELEMENT_NODES:
-            self.skip(kind or "*ELEMENT without TYPE", len(block.data))
+            self.skip(kind or "*ELEMENT without TYPE", len(block.data),
+                      where=f"{block.file}:{block.line}")
             return
         size = SHELL_NODES.get(kind) or POINT_ELEMENT_NODES[kind]
         labels = []
@@ -219,19 +227,32 @@ class _Reader:
     # properties ------------------------------------------------------------------------------
     def k_shell_section(self, block):
         for option in block.options:
-            if option not in ("ELSET", "MATERIAL", "SECTION INTEGRATION", "OFFSET", "NAME"):
+            if option not in ("ELSET", "MATERIAL", "SECTION INTEGRATION", "OFFSET", "NAME",
+                              "NODAL THICKNESS"):
                 raise DeckError(f"{block.where()}: option {option} is not supported")
         offset = block.options.get("OFFSET", "0")
         if str(offset).upper() not in ("0", "0.", "0.0", "MIDDLE", "SMID"):
             raise DeckError(f"{block.where()}: OFFSET={offset} (shell offset) is not supported; "
                             "model the mid-surface")
-        if not block.data:
+        line = block.line
+        if "NODAL THICKNESS" in block.options:
+            thickness = None                  # from *NODAL THICKNESS (abaqus_model)
+        elif not block.data:
             raise DeckError(f"{block.where()}: the thickness data line is missing")
-        fields, _, line = block.data[0]
-        thickness = parse_number(trimmed(fields)[0], block, line, "thickness")
+        else:
+            fields, _, line = block.data[0]
+            thickness = parse_number(trimmed(fields)[0], block, line, "thickness")
         self.scope.sections.append((str(block.options.get("ELSET", "")),
                                     str(block.options.get("MATERIAL", "")).upper(),
                                     thickness, block.where(line)))
+
+    def k_nodal_thickness(self, block):
+        for fields, _, line in block.data:
+            fields = trimmed(fields)
+            if len(fields) < 2:
+                raise DeckError(f"{block.where(line)}: needs a node (or node set) and a thickness")
+            self.scope.nodal_thickness.append(
+                (fields[0], parse_number(fields[1], block, line, "thickness"), block.where(line)))
 
     def k_material(self, block):
         name = block.options.get("NAME")
@@ -245,7 +266,7 @@ class _Reader:
             raise DeckError(f"{block.where()}: *ELASTIC outside a *MATERIAL")
         if kind != "ISOTROPIC" or len(block.data) != 1:
             self.skip(f"*ELASTIC, TYPE={kind}" if kind != "ISOTROPIC"
-                      else "*ELASTIC (temperature table)")
+                      else "*ELASTIC (temperature table)", where=f"{block.file}:{block.line}")
             return
         fields, _, line = block.data[0]
         values = [parse_number(v, block, line) for v in trimmed(fields)[:2]]
@@ -398,6 +419,7 @@ def section_values(path) -> list[tuple[str, str, float]]:
         values += [(f"{material['where']}, NAME={name}", key, float(material[key]))
                    for key in ("E", "rho") if key in material]
     for scope in [reader.model, reader.assembly, *reader.parts.values()]:
-        values += [(where, "thickness", float(thickness)) for _, _, thickness, where in scope.sections]
+        values += [(where, "thickness", float(thickness)) for _, _, thickness, where in scope.sections
+                   if thickness is not None]
     return values
 

@@ -3,7 +3,8 @@
 A keyword line ``*KEYWORD, OPTION=value, FLAG`` (continued when it ends in ',') opens a
 :class:`KeywordBlock`; its data lines are split at commas (an ``*ELEMENT`` data line ending in ','
 continues on the next line); ``**`` comment lines and blank lines are skipped;
-``*INCLUDE, INPUT=<file>`` inlines the file (relative to the including one). Every block and data
+``*INCLUDE, INPUT=<file>`` inlines the file (relative to the including one); text lines before the
+first keyword (a preamble such as ``>**``) are skipped, numeric ones refused. Every block and data
 line keeps its file and line number for messages ("plate.inp:47: *SHELL SECTION: …").
 """
 from __future__ import annotations
@@ -79,7 +80,10 @@ def keyword_blocks(path: Path):
             pending = (text, file, number)
         else:
             if block is None:
-                raise DeckError(f"{file}:{number}: data line before any keyword: {text[:40]!r}")
+                if _numeric(text):     # numbers before any keyword: a file cut at its head
+                    raise DeckError(f"{file}:{number}: data line before any keyword: "
+                                    f"{text[:40]!r}")
+                continue               # a preamble line (e.g. '>**' of some writers): no data
             fields = [f.strip() for f in text.split(",")]
             if block.data and block.data[-1][0] and block.data[-1][0][-1] == "" \
                     and block.keyword == "ELEMENT":     # element line continued after ','
@@ -96,6 +100,15 @@ def keyword_blocks(path: Path):
         block = KeywordBlock(" ".join(head.split()).upper(), parse_options(rest), [], file, number)
     if block is not None:
         yield block
+
+
+def _numeric(text: str) -> bool:
+    """Whether a line's first field is a number (a data line, not a preamble)."""
+    try:
+        float(text.split(",")[0].replace("d", "e").replace("D", "E"))
+    except ValueError:
+        return False
+    return True
 
 
 def trimmed(fields):

@@ -126,13 +126,30 @@ def build_deck_model(reader) -> DeckModel:
                 raise DeckError(f"{where}: no element set {elset!r}")
             for label in elsets[elset]:
                 mass_of[label] = mass
+        nodal_t = {}                       # *NODAL THICKNESS: node index → t
+        for ref, t, where in scope.nodal_thickness:
+            if str(ref).rpartition(".")[2].isdigit():
+                targets = [index_of[global_node(ref, scope, offset, where)]]
+            elif str(ref).upper() in scope.nsets:
+                targets = [index_of[global_node(n, scope, offset, where)]
+                           for n in scope.nsets[str(ref).upper()][1]]
+            else:
+                raise DeckError(f"{where}: no node set {ref!r}")
+            nodal_t.update(dict.fromkeys(targets, t))
         for label, kind, refs, where in scope.elements:
             nodes = [index_of[global_node(r, scope, offset, where)] for r in refs]
             element_id = offset + label
             if kind in SHELL_NODES:
                 if label not in section_of:
                     raise DeckError(f"{where}: shell element {label} has no *SHELL SECTION")
-                shell_rows.append((element_id, kind, nodes, section_of[label]))
+                section = section_of[label]
+                if section[3] is None:        # NODAL THICKNESS: the mean of its nodes' values
+                    missing = [n for n in nodes if n not in nodal_t]
+                    if missing:
+                        raise DeckError(f"{where}: element {label}: node {int(node_ids[missing[0]])}"
+                                        " has no *NODAL THICKNESS (its section asks for one)")
+                    section = section[:3] + (float(np.mean([nodal_t[n] for n in nodes])),)
+                shell_rows.append((element_id, kind, nodes, section))
             elif kind == "MASS":
                 if label not in mass_of:
                     raise DeckError(f"{where}: MASS element {label} has no *MASS")
@@ -175,7 +192,8 @@ def build_deck_model(reader) -> DeckModel:
         shells=_shell_table(shell_rows, points), springs=_spring_table(spring_rows),
         point_masses=_mass_table(mass_rows), supports=supports, loads=loads,
         node_sets=node_sets, element_sets=element_sets,
-        unsupported=dict(reader.unsupported), ignored=dict(reader.ignored))
+        unsupported=dict(reader.unsupported), ignored=dict(reader.ignored),
+        unsupported_where=dict(reader.unsupported_where))
 
 
 def _node_reference(ref, node_sets, node_index, where):

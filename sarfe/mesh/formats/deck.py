@@ -243,6 +243,13 @@ class DeckModel:
     element_sets          {name: (k,) int}       deck element ids: 'pid_<id>', Abaqus ELSETs
     unsupported           {card: count}          cards present that sarfe does not model
     ignored               {card: count}          cards deliberately not modelled (ignore_cards)
+    unsupported_where     {card: "file:line"}    where each unsupported card first appears
+    coupled_mass          bool                   the deck asks for coupled (consistent) element
+                                                 mass (Nastran PARAM,COUPMASS > 0); otherwise
+                                                 the commercial solvers' default, lumped
+    drilling_penalty      float                  α of the shells' drilling stiffness
+                                                 α C₃₃ ∫ (θz − ω)² dA (Nastran 1e-6·K6ROT,
+                                                 K6ROT = 100 by default)
     notes                 tuple[str]             things a user should know (e.g. MAT1 without
                                                  density read as ρ = 0)
     """
@@ -264,6 +271,9 @@ class DeckModel:
     element_sets: dict = field(default_factory=dict)
     unsupported: dict = field(default_factory=dict)
     ignored: dict = field(default_factory=dict)
+    unsupported_where: dict = field(default_factory=dict)
+    coupled_mass: bool = False
+    drilling_penalty: float = 1e-4
     notes: tuple = ()
 
     @property
@@ -314,6 +324,7 @@ UNIT_SYSTEMS = {
     "mm-kg-s": UnitSystem("mm-kg-s", 1e-3, 1.0, 1.0),
     "m-kg-s": UnitSystem("m-kg-s", 1.0, 1.0, 1.0),
     "in-lbf-s": UnitSystem("in-lbf-s", _INCH, _LBF / _INCH, 1.0),
+    "ft-lbf-s": UnitSystem("ft-lbf-s", 12 * _INCH, _LBF / (12 * _INCH), 1.0),   # mass unit: slug
 }
 
 # dimension (length, mass, time) of every float field that carries a unit

@@ -22,7 +22,7 @@ import numpy as np
 
 from sarfe.mesh.formats.deck import DeckError
 
-__all__ = ["load_bdf", "bulk_fields", "card_line", "card_where"]
+__all__ = ["load_bdf", "bulk_fields", "card_line", "card_where", "first_lines"]
 
 
 def load_bdf(path: Path):
@@ -172,6 +172,29 @@ def card_line(path, card: str, ident) -> tuple[str, int] | None:
         return None
 
     return scan(Path(path))
+
+
+def first_lines(path, cards) -> dict:
+    """{card: "file:line"} of the first line of each bulk-data card name in ``cards`` in the
+    deck or the files it INCLUDEs (a plain scan, for messages); cards not found are left out."""
+    wanted = {str(c).upper() for c in cards}
+    found, seen = {}, []
+
+    def scan(file: Path):
+        if file in seen or not file.is_file() or len(found) == len(wanted):
+            return
+        seen.append(file)
+        with open(file, errors="replace") as handle:
+            for number, text in enumerate(handle, start=1):
+                name = bulk_fields(text)[0].strip().upper().rstrip("*")
+                if name in wanted and name not in found:
+                    found[name] = f"{file}:{number}"
+                include = _INCLUDE.match(text)
+                if include:
+                    scan(file.parent / include.group(1))
+
+    scan(Path(path))
+    return found
 
 
 def card_where(path, card: str, ident) -> str:

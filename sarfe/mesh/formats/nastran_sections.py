@@ -111,11 +111,15 @@ SUBDIVISION = {
     "CQUAD8": [[0, 4, 7], [4, 1, 5], [5, 2, 6], [6, 3, 7], [4, 5, 6], [4, 6, 7]],
 }
 _CORNERS = {"CTRIA3": 3, "CQUAD4": 4, "CTRIA6": 3, "CQUAD8": 4}
+#: shells read as another card: CTRIAR/CQUADR (drilling stiffness) as CTRIA3/CQUAD4, whose
+#: membranes carry the drilling rotation in sarfe
+ALIASES = {"CTRIAR": "CTRIA3", "CQUADR": "CQUAD4"}
 
 
 def shells(reader) -> ShellElements:
     model = reader.model
-    eids = [e for e, el in sorted(model.elements.items()) if el.type in SUBDIVISION]
+    eids = [e for e, el in sorted(model.elements.items())
+            if ALIASES.get(el.type, el.type) in SUBDIVISION]
     if not eids:
         return ShellElements()
     sections = {}
@@ -128,8 +132,8 @@ def shells(reader) -> ShellElements:
             reader.fail(el.type, eid, "midside nodes partly given: not modelled")
         nodes = [reader.node(n, el.type, eid) for n in el.node_ids]
         nodes_all[row, :len(nodes)] = nodes
-        kinds.append(el.type)
-        nodes = nodes[:_CORNERS[el.type]]
+        kinds.append(ALIASES.get(el.type, el.type))
+        nodes = nodes[:_CORNERS[kinds[-1]]]
         zoffs.append(float(el.zoffset or 0.0))
         prop = el.pid_ref
         if prop.pid not in sections:

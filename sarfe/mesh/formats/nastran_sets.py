@@ -93,11 +93,14 @@ def loads(reader) -> dict:
     for sid, cards in model.load_combinations.items():
         total = np.zeros((n, 6))
         for card in cards:
+            if card.type != "LOAD":   # LSEQ (dynamic loads) etc.: listed in ``unsupported``
+                continue
             for scale, lid in zip(card.scale_factors, card.load_ids):
                 if lid not in base:
                     reader.fail("LOAD", sid, f"load set {lid} does not exist")
                 total += float(card.scale) * float(scale) * base[lid]
-        result[str(sid)] = total
+        if any(card.type == "LOAD" for card in cards):
+            result[str(sid)] = total
     return result
 
 def sets(reader):

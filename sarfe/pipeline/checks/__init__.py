@@ -1,4 +1,6 @@
 """Stage 1 of a case: every input check before any work — case_checks (check_case, the warnings
 for inputs far outside the model's range), mesh_checks (check_mesh / check_deck: groups, pairing,
-quality without assembly). The checks a deck's reading runs are part of building it
+shared node pairs, quality without assembly), held_checks (nothing left to move, a force or a
+contact on held nodes only, for a mesh and a deck alike), case_inputs (every file a case reads: never inside
+an output folder). The checks a deck's reading runs are part of building it
 (:mod:`sarfe.pipeline.model.deck_checks`)."""

@@ -5,7 +5,8 @@ passes ``sarfe validate`` does not fail on its input later.
 
 Errors (CaseError, exit 2, one line naming the key or the element):
   * the case file itself (schema, non-finite numbers, signs, units: :func:`sarfe.case.read.load_case`);
-  * the mesh: readable, groups present, contacts pair (as :func:`sarfe.pipeline.checks.mesh_checks.check_mesh`);
+  * the mesh: readable, groups present, contacts pair (as :func:`sarfe.pipeline.checks.mesh_checks.check_mesh`),
+    no node pair listed twice in one contact;
   * element quality: zero-area triangles, duplicate triangles (same node set), coincident nodes
     that neither an element nor a contact pair joins (a crack) — :mod:`sarfe.mesh.quality`;
   * thickness plausibility: 1e-4·L < t < 0.1·L for the model size L (the bounding-box diagonal),
@@ -13,8 +14,11 @@ Errors (CaseError, exit 2, one line naming the key or the element):
   * the structure is held: every connected part of the mesh holds at least one fixed node (else
     the stiffness has rigid-body modes and the reduction cannot factorize it); a matrices model's
     K plus the springs of the contacts closed at rest is regular (:func:`check_matrices_held`);
-  * every force acts on a free DOF (a force group all fixed is an error, partly fixed a warning);
-  * the output folder: absent, empty or a sarfe result, and writable (:mod:`sarfe.results.folder`).
+  * something is free to move, every force acts on a free DOF and every contact on a free node
+    (a force group or a contact all held is an error, partly held a warning:
+    :mod:`sarfe.pipeline.checks.held_checks`);
+  * the output folder: absent, empty or a sarfe result, and writable (:mod:`sarfe.results.folder`);
+    never a folder holding a file the case reads (:mod:`sarfe.pipeline.checks.case_inputs`).
 
 Warnings (one line each, printed and written to summary.json ``warnings``) for inputs far outside
 the model's range:
@@ -25,7 +29,10 @@ the model's range:
   * H·f_max above ``reduction.cutoff_hz`` (the harmonics have no modes to live in);
   * an open gap larger than the structure (the contact can never close), or |gap_m| more than
     :data:`GAP_RANGE` × the thickest shell or the contact's tolerance_m (:func:`gap_warnings`);
-  * reduction.mode_count above the interior DOFs; a force group partly fixed.
+  * reduction.mode_count above the interior DOFs; a force group partly fixed; a node pair in two
+    contacts (:func:`~sarfe.pipeline.checks.mesh_checks.shared_pair_warnings`);
+  * values no squeak-and-rattle input has (:func:`sarfe.case.plausibility.plausibility_warnings`):
+    μ > 2, a base acceleration above 50 g, a preload pressing a contact more than 1 mm in.
 """
 from __future__ import annotations
 
@@ -33,15 +40,19 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from sarfe.case.plausibility import THICKNESS_RANGE
+from sarfe.case.plausibility import THICKNESS_RANGE, plausibility_warnings
 from sarfe.case.read import load_case
-from sarfe.erp import nodal_normals
 from sarfe.hbm.pruning import linearized_stiffness
 from sarfe.mesh import connected_components
 from sarfe.mesh.quality import coincident_nodes, degenerate_elements, duplicate_elements
-from sarfe.pipeline.checks.mesh_checks import check_deck
+from sarfe.pipeline.checks.case_inputs import case_inputs
+from sarfe.pipeline.checks.held_checks import (check_something_free, contact_warnings,
+                                               load_warnings)
+from sarfe.pipeline.checks.mesh_checks import check_deck, shared_pair_warnings
 from sarfe.pipeline.model.case_mesh import load_case_mesh
-from sarfe.pipeline.model.contact_pairs import pair_contact
+from sarfe.pipeline.model.contact_pairs import boundary_dofs, node_pairs
+from sarfe.pipeline.model.erp_map import surface_triangles
+from sarfe.pipeline.model.fe_stage import resolve_contacts
 from sarfe.pipeline.model.groups import fixed_nodes, resolve_node_group, shell_properties
 from sarfe.pipeline.model.linear_stage import build_linear_model
 from sarfe.pipeline.model.nonlinear_model import nonlinear_model
@@ -50,6 +61,7 @@ from sarfe.results.folder import check_output_folder
 ELEMENTS_PER_WAVELENGTH = 6
 COINCIDENT_TOLERANCE = 1e-7      # × model size: nodes closer than this are at the same place
 DEGENERATE_TOLERANCE = 1e-8      # area ≤ this × (longest edge)²: a zero-area triangle
+HELD_BY = "model.fe.fixed or on no triangle"
 
 
 @dataclass(frozen=True)
@@ -134,29 +146,13 @@ def check_held(case, mesh, fixed_nodes) -> None:
                          f"{members[0]}); add a fixed group on it", ("model", "fe", "fixed"))
 
 
-def check_loads_free(case, mesh, fixed_nodes, load_nodes) -> list:
-    """Every force group of an FE case acts on a free DOF (``load_nodes``: the nodes of each
-    ``excitation.forces`` group, in order). The force F of a group is split equally over its n
-    nodes (F/n each) and a fixed node's share goes into the support, so a group whose nodes are
-    all held (fixed, or on no triangle) is a CaseError naming it, and a partly held group gets a
-    warning stating the share lost. Returns the warnings (one line each)."""
+def held_nodes(mesh, fixed_nodes) -> tuple:
+    """(held (n,), used (n,)) bool: a node of ``fixed_nodes`` or on no triangle is held."""
     used = np.zeros(mesh.n_nodes, bool)
     used[mesh.triangles.ravel()] = True
     held = ~used
     held[np.asarray(fixed_nodes, dtype=int)] = True
-    warnings = []
-    for i, (load, nodes) in enumerate(zip(case.config.excitation.forces, load_nodes)):
-        path = ("excitation", "forces", i, "group")
-        count = int(np.count_nonzero(held[nodes]))
-        if count == len(nodes):
-            raise case.error(f"the force on group {load.group} acts on no free DOF: all of its "
-                             f"DOFs are fixed ({len(nodes)} node(s) held by model.fe.fixed or on "
-                             "no triangle)", path)
-        if count:
-            warnings.append(f"excitation.forces[{i}]: {count} of the {len(nodes)} nodes of group "
-                            f"{load.group} are fixed: {100 * count / len(nodes):.3g} % of "
-                            f"force_N = {load.force_N:g} N goes straight into the supports")
-    return warnings
+    return held, used
 
 
 HELD_MATRIX_LIMIT = 3000        # DOFs: a dense eigenvalue check above costs more than it finds
@@ -253,9 +249,11 @@ def gap_warnings(case, mesh=None) -> list:
 
 
 def range_warnings(case, mesh=None) -> list:
-    """One-line warnings for inputs far outside the model's range (module docstring)."""
-    warnings = []
+    """One-line warnings for inputs far outside the model's range (module docstring), and
+    those of :func:`sarfe.case.plausibility.plausibility_warnings` (μ, base acceleration,
+    preload overclosure)."""
     config = case.config
+    warnings = plausibility_warnings(config)
     top = _excitation_top_hz(case)
     H = config.solver.harmonics
     if mesh is not None:
@@ -278,17 +276,18 @@ def range_warnings(case, mesh=None) -> list:
     return warnings
 
 
-def interior_dof_count(mesh, fixed_nodes, boundary_nodes) -> int:
+def interior_dof_count(mesh, fixed_nodes, boundary_dofs) -> int:
     """Interior DOFs of the Craig–Bampton split, as the linear stage makes it: 6 per node on a
-    triangle that is not fixed, minus the 3 translations of each free contact or load node (the
-    boundary). At most this many fixed-interface modes exist."""
+    triangle that is not fixed, minus the boundary DOFs (global numbers 6·node + component: what
+    the contact rows touch and the load nodes' translations) on such nodes. At most this many
+    fixed-interface modes exist."""
     used = np.zeros(mesh.n_nodes, bool)
     used[mesh.triangles.ravel()] = True
     free = used.copy()
     free[np.asarray(fixed_nodes, dtype=int)] = False
-    boundary = np.unique(np.asarray(boundary_nodes, dtype=int))
-    boundary = boundary[(boundary >= 0) & free[np.maximum(boundary, 0)]]
-    return int(6 * np.count_nonzero(free) - 3 * boundary.size)
+    boundary = np.unique(np.asarray(boundary_dofs, dtype=np.int64))
+    boundary = boundary[(boundary >= 0) & free[np.maximum(boundary, 0) // 6]]
+    return int(6 * np.count_nonzero(free) - boundary.size)
 
 
 def mode_count_warnings(case, interior) -> list:
@@ -328,14 +327,18 @@ def reduced_model_warnings(case, stage) -> list:
 
 def output_target(case, output_dir=None, force=False):
     """The checked result folder of a case (``output_dir`` or ``output.directory``): absent, empty
-    or a previous sarfe result (or anything but the current/case folder with ``force``), and
-    writable — else CaseError, before any work (rules: :mod:`sarfe.results.folder`)."""
+    or a previous sarfe result (or, with ``force``, anything but the current or home folder or a
+    folder holding an input of the case: :func:`sarfe.pipeline.checks.case_inputs.case_inputs`),
+    and writable — else CaseError, before any work (rules: :mod:`sarfe.results.folder`)."""
     target = output_dir if output_dir is not None else case.config.output.directory
-    return check_output_folder(target, force=force, protected=[case.source])
+    return check_output_folder(target, force=force, protected=case_inputs(case))
 
 
-def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True) -> CaseCheck:
-    """All checks of the module docstring. Raises CaseError at the first problem."""
+def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True,
+               assemble=True) -> CaseCheck:
+    """All checks of the module docstring. Raises CaseError at the first problem. ``assemble``
+    (deck path): also assemble the deck, for what solve refuses there (`solve` passes False:
+    its linear stage assembles right after, with the same lines)."""
     case = load_case(case)
     output = output_target(case, output_dir, force) if write else None
     if not mesh_checks:
@@ -345,32 +348,37 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True)
         return CaseCheck({}, tuple(range_warnings(case)), output)
     config = case.config
     if config.model.fe.is_deck:   # a Nastran/Abaqus deck: its own checks, with ids
-        info = check_deck(case)
+        info = check_deck(case, assemble=assemble)
         return CaseCheck(info, tuple(range_warnings(case)) + tuple(info.pop("warnings")), output)
     mesh = load_case_mesh(case)
     fixed = fixed_nodes(case, mesh)
+    held, used = held_nodes(mesh, fixed)
+    check_something_free(case, held, used)
     shell_properties(case, mesh)
     check_thickness(case, mesh)
-    normals = nodal_normals(mesh.points, mesh.triangles)
-    paired = {c.name: pair_contact(case, mesh, c.index, normals) for c in config.contacts}
+    resolved = resolve_contacts(case, mesh)
+    paired = node_pairs(resolved)
+    shared = shared_pair_warnings(case, paired, mesh.points)
     load_nodes = [resolve_node_group(case, mesh, f.group, ("excitation", "forces", i, "group"))
                   for i, f in enumerate(config.excitation.forces)]
-    load_warnings = check_loads_free(case, mesh, fixed, load_nodes)
-    surface = config.erp.surface
-    if surface is not None and surface not in mesh.element_groups:
-        resolve_node_group(case, mesh, surface, ("erp", "surface"))
+    warned = load_warnings(case, held, load_nodes, HELD_BY)
+    warned += contact_warnings(case, paired, held, HELD_BY)
+    surface_triangles(case, mesh)     # erp.surface: an element group, or a node group's triangles
     joined = [(int(a), int(b)) for p in paired.values() for a, b in zip(p[0], p[1])]
     check_element_quality(case, mesh, joined)
     check_held(case, mesh, fixed)
     info = {"nodes": mesh.n_nodes, "triangles": mesh.n_triangles,
             "contact_pairs": {name: len(p[0]) for name, p in paired.items()}}
-    interior = interior_dof_count(mesh, fixed, np.concatenate(
-        [np.zeros(0, int)] + [np.concatenate([p[0], p[1]]) for p in paired.values()] + load_nodes))
-    return CaseCheck(info, tuple(range_warnings(case, mesh)) + tuple(load_warnings)
+    loads = np.concatenate([np.zeros(0, int)] + load_nodes)
+    interior = interior_dof_count(mesh, fixed, np.union1d(
+        boundary_dofs(resolved), (6 * loads[:, None] + np.arange(3)).ravel()))
+    geometry = tuple(w for r in resolved.values() for w in r.warnings)
+    return CaseCheck(info, tuple(range_warnings(case, mesh)) + tuple(shared)
+                     + tuple(warned) + geometry
                      + tuple(mode_count_warnings(case, interior)), output)
 
 
-__all__ = ["CaseCheck", "check_case", "check_loads_free", "check_matrices_held", "output_target",
+__all__ = ["CaseCheck", "check_case", "held_nodes", "check_matrices_held", "output_target",
            "check_element_quality", "check_held", "check_thickness", "bending_resolution_hz",
            "mesh_frequency_limit_hz", "range_warnings", "reduced_model_warnings",
            "interior_dof_count", "mode_count_warnings", "gap_warnings"]

@@ -8,7 +8,9 @@
                        deck_checks: quality, supports, units; deck_springs: springs → contacts)
     case_mesh        the case's mesh (file or generator)
     groups           node groups, fixed nodes, per-triangle shell properties
-    contact_pairs    node pairs, frames, geometric gaps, reduced coordinates
+    contact_pairs    contacts from the geometry: points, partner-surface normals, frames,
+                     surface gaps, rows on the reduced coordinates (issue 29)
+    contact_kinematics  points on the shells' faces by shape functions (±t/2), contact rows
     cutoff           the Craig–Bampton cutoff rule
     erp_map          radiating surface → normal-displacement map N, nodal areas
     nonlinear_model  damping, ContactSet, excitation harmonics on the kept DOFs

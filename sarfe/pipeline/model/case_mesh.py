@@ -8,11 +8,11 @@ taken for a unit mistake (mm read as m, or the reverse) and refused.
 """
 from __future__ import annotations
 
-import difflib
 import importlib
 
 import numpy as np
 
+from sarfe.case.messages import suggestion
 from sarfe.case.plausibility import SPAN_RANGE_M
 from sarfe.mesh import load_mesh
 from sarfe.mesh.cache import cached_mesh
@@ -34,8 +34,8 @@ def check_generator_params(case, generator) -> None:
     valid = parameter_names(generator.name)
     for key in generator.params:
         if key not in valid:
-            close = difflib.get_close_matches(str(key), valid, n=1)
-            hint = f"did you mean '{close[0]}'? " if close else ""
+            close = suggestion(key, valid)
+            hint = f"did you mean '{close}'? " if close else ""
             raise case.error(f"unknown parameter of generator {generator.name} ({hint}valid: "
                              f"{', '.join(valid)})", ("model", "fe", "generator", "params", key))
 

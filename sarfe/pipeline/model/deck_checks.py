@@ -9,7 +9,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from sarfe.case.plausibility import MIN_E_PA, MIN_RHO_KG_M3, SPAN_RANGE_M, THICKNESS_RANGE
+from sarfe.case.plausibility import (MIN_E_PA, MIN_RHO_KG_M3, POISSON_RANGE, SPAN_RANGE_M,
+                                     THICKNESS_RANGE)
 from sarfe.case.read import Case
 from sarfe.mesh import quality
 from sarfe.mesh.formats.abaqus import section_values
@@ -212,6 +213,117 @@ def has_mass(deck) -> bool:
                 or np.any(deck.beams.density > 0) or np.any(deck.beams.mass_per_length > 0))
 
 
+def massless_parts(deck) -> list[str]:
+    """Connected parts (:func:`connected_parts`) none of whose nodes carries mass — their DOFs
+    would have K but no M, and the modal reduction cannot factor M (LinAlgError) — as messages
+    naming the part's GRIDs and the properties without density."""
+    count, part, used = connected_parts(deck)
+    heavy = np.zeros(deck.n_nodes, dtype=bool)
+    shells = deck.shells
+    heavy[shells.triangles[shells.mass_per_area > 0].ravel()] = True
+    for block in deck.solids.values():
+        heavy[block.connectivity[block.density > 0].ravel()] = True
+    beams = deck.beams
+    heavy[beams.nodes[(beams.density > 0) | (beams.mass_per_length > 0)].ravel()] = True
+    heavy[deck.point_masses.node[deck.point_masses.mass > 0]] = True
+    problems = []
+    for p in range(count):
+        nodes = np.flatnonzero((part == p) & used)
+        if nodes.size == 0 or heavy[nodes].any():
+            continue
+        grids = deck.node_ids[nodes]
+        in_part = np.isin(shells.triangles, nodes).any(axis=1)
+        pids = np.unique(shells.property_ids[shells.triangle_element[in_part]])
+        pids = np.concatenate([pids, np.unique(beams.property_ids[np.isin(beams.nodes, nodes)
+                                                                  .any(axis=1)])])
+        for block in deck.solids.values():
+            pids = np.concatenate([pids, block.property_ids[np.isin(block.connectivity, nodes)
+                                                             .any(axis=1)]])
+        shown = ", ".join(str(int(i)) for i in np.unique(pids)[:5] if i > 0)
+        problems.append(f"a part of {len(nodes)} nodes (GRIDs {int(grids.min())}…"
+                        f"{int(grids.max())}) has no mass"
+                        + (f" (property {shown}: its material has no density ρ)" if shown else ""))
+    return problems
+
+
+def check_material_bounds(case: Case, deck) -> None:
+    """E > 0 and −1 < ν < 0.5 for every material of the deck — the bounds the case's own
+    ``materials`` keys have (schema) — as a one-line CaseError on model.fe.deck naming the card;
+    no unit advice (no unit system makes a modulus negative). ν of a shell section is read where
+    the section is isotropic (A₁₁ = A₂₂, A₆₆ = (A₁₁ − A₁₂)/2: ν = A₁₂/A₁₁), of a beam from
+    ν = E/(2G) − 1, of a solid as given."""
+    deck_config = case.config.model.fe.deck
+    path = case.resolve(deck_config.file)
+    a = deck.shells.membrane
+    a11, a22, a12, a66 = a[:, 0, 0], a[:, 1, 1], a[:, 0, 1], a[:, 2, 2]
+    iso = np.isclose(a11, a22, rtol=1e-9) & np.isclose(a66, (a11 - a12) / 2, rtol=1e-9) & (a11 != 0)
+    shell_nu = np.where(iso, np.divide(a12, a11, out=np.zeros_like(a11), where=a11 != 0), 0.0)
+    beams = deck.beams
+    beam_nu = np.divide(beams.young, 2 * beams.shear_modulus, out=np.ones_like(beams.young),
+                        where=beams.shear_modulus != 0) - 1
+    tables = [("shell", _section_moduli(deck.shells), shell_nu), ("beam", beams.young, beam_nu)]
+    tables += [(f"solid:{kind}", b.young, b.poisson) for kind, b in deck.solids.items()]
+    for table, young, nu in tables:
+        bad_e = np.flatnonzero(np.nan_to_num(young, nan=1.0) <= 0)
+        if bad_e.size:
+            row = int(bad_e[0])
+            where = _card_of(path, deck, deck_config.units, "E", table, row, float(young[row]))
+            raise case.error(f"{where}: E = {young[row]:.4g} Pa must be > 0", DECK_KEY)
+        low, high = POISSON_RANGE         # the schema's bounds of materials: nu
+        bad_nu = np.flatnonzero((nu >= high - 1e-12) | (nu <= low))
+        if bad_nu.size:
+            row = int(bad_nu[0])
+            where = _card_of(path, deck, deck_config.units, "E", table, row, float(young[row]))
+            raise case.error(f"{where}: ν = {nu[row]:.4g} is outside {low:g} < ν < {high:g} (the "
+                             "bounds of a case's materials: nu)", DECK_KEY)
+
+
+def dependent_components(deck) -> np.ndarray:
+    """(n, 6) bool: the components a rigid element makes dependent — an RBE2's dependent nodes
+    in its CM components, an RBE3's reference node in its REFC components (the reader refuses
+    partial masks on CD-frame nodes, so global and CD components agree where partial)."""
+    dependent = np.zeros((deck.n_nodes, 6), dtype=bool)
+    rbe2, rbe3 = deck.rbe2, deck.rbe3
+    if len(rbe2.dependent):
+        np.logical_or.at(dependent, rbe2.dependent, rbe2.components[rbe2.dependent_element])
+    if len(rbe3.reference):
+        np.logical_or.at(dependent, rbe3.reference, rbe3.reference_components)
+    return dependent
+
+
+def check_supports_on_dependents(case: Case, deck, held) -> None:
+    """A support on a component a rigid element makes dependent: the one-line CaseError solve
+    gives at assembly (:func:`sarfe.pipeline.model.deck_stage.held_kept_dofs`), before it."""
+    both = held & dependent_components(deck)
+    if np.any(both):
+        node, comp = np.argwhere(both)[0]
+        raise case.error(f"a support holds GRID {int(deck.node_ids[node])} component "
+                         f"{int(comp) + 1}, which a rigid element (RBE2/RBE3) makes dependent",
+                         ("model", "fe", "supports"))
+
+
+def check_boundary_nodes(case: Case, deck, nodes, path) -> None:
+    """Contact and force nodes become physical boundary DOFs (translations, global axes): a
+    node with a rotated CD frame, or whose translations a rigid element makes dependent (an
+    RBE2 dependent node, an RBE3 reference node), is a one-line CaseError at ``path`` — the
+    same check validate and solve make before any assembly (a node without stiffness is found
+    at assembly)."""
+    nodes = np.asarray(nodes, dtype=np.int64)
+    if nodes.size == 0:
+        return
+    rotated = ~np.all(np.isclose(deck.displacement_frames[nodes], np.eye(3), atol=1e-12),
+                      axis=(1, 2))
+    if np.any(rotated):
+        raise case.error(f"GRID {int(deck.node_ids[nodes[np.argmax(rotated)]])} has a rotated "
+                         "displacement frame (CD): contact and force nodes must use the basic "
+                         "frame", path)
+    dependent = dependent_components(deck)[:, :3].any(axis=1)
+    if np.any(dependent[nodes]):
+        bad = nodes[np.argmax(dependent[nodes])]
+        raise case.error(f"GRID {int(deck.node_ids[bad])} is a dependent node of a rigid element "
+                         "(RBE2/RBE3): use an independent node", path)
+
+
 def used_nodes(deck) -> np.ndarray:
     _, _, used = connected_parts(deck)
     return np.flatnonzero(used)
@@ -332,39 +444,62 @@ _SYMBOL = {"E": ("E", "Pa"), "rho": ("ρ", "kg/m³")}
 _DIMENSION = {"E": (-1, 1, -2), "rho": (-3, 1, 0), "thickness": (1, 0, 0)}
 
 
-def check_units(case: Case, deck) -> None:
-    """One-line CaseError on ``model.fe.units`` for the first implausible value of the deck in
-    SI (:func:`unit_findings`), naming the deck card (file:line: MAT1 1, PSHELL 1, …), the
-    value, the rule and, when one fits, the unit system the deck looks like:
+def units_given(case: Case) -> bool:
+    """Whether the case file names model.fe.units itself (not the default SI)."""
+    return "units" in (case.data.get("model", {}).get("fe", {}) or {})
+
+
+def check_units(case: Case, deck) -> list[str]:
+    """The plausibility of the deck's units (:func:`unit_findings`), as one line per finding
+    naming the deck card (file:line: MAT1 1, PSHELL 1, …), the value in SI, the rule and, when
+    one fits, the unit system the deck looks like:
 
         deck.bdf:1473: MAT1 1: E = 2200 Pa with units: SI — implausible for a trim part
         (E < 1e5 Pa); the deck looks like mm-t-s: set model.fe.units: mm-t-s
-    """
+
+    Returns the warnings. E, ρ or span findings are a CaseError on model.fe.units while the case
+    leaves ``units`` at its default (with the system the deck looks like, if one fits); an
+    explicit ``units:`` wins and the finding is a warning (a real structure with near-zero ρ
+    and its mass in CONM2s, e.g. the Goland wing, is kept). Thickness-to-size findings are
+    warnings (no unit system changes a ratio of lengths: a real thin web or thick laminate is
+    kept). What no unit system can make plausible — E ≤ 0, ν outside (−1, 0.5) — is refused by
+    :func:`check_material_bounds`."""
     findings = unit_findings(deck)
     if not findings:
-        return
+        return []
     deck_config = case.config.model.fe.deck
     units, path = deck_config.units, case.resolve(deck_config.file)
-    quantity, table, row, value = findings[0]
     suggestion = suggested_units(deck, units)
-    hint = (f"the deck looks like {suggestion}: set model.fe.units: {suggestion}" if suggestion
-            else "check model.fe.units and the deck's unit system")
-    if quantity == "span":
-        side = f"> {SPAN_RANGE_M[1]:g} m" if value > SPAN_RANGE_M[1] else \
-            f"< {SPAN_RANGE_M[0] * 1e3:g} mm"
-        raise case.error(f"{path}: the GRIDs span {value:.3g} m with units: {units} — "
-                         f"implausible for a trim part ({side}); {hint}", UNITS_KEY)
-    where = _card_of(path, deck, units, quantity, table, row, value)
-    if quantity == "thickness":
-        span = model_span(deck)
-        low, high = THICKNESS_RANGE
-        rule = (f"above {high:g} of the model size {span:.3g} m" if value > high * span
-                else f"below {low:g} of the model size {span:.3g} m")
-        raise case.error(f"{where}: thickness {value:.3g} m with units: {units} — {rule}: the "
-                         "thickness and the GRIDs look like different length units", UNITS_KEY)
-    symbol, unit = _SYMBOL[quantity]
-    raise case.error(f"{where}: {symbol} = {value:.4g} {unit} with units: {units} — implausible "
-                     f"for a trim part ({_RULES[quantity]}); {hint}", UNITS_KEY)
+    explicit = units_given(case)
+    warnings = []
+    for quantity, table, row, value in findings:
+        if quantity == "thickness":
+            span = model_span(deck)
+            low, high = THICKNESS_RANGE
+            rule = (f"above {high:g} of the model size {span:.3g} m" if value > high * span
+                    else f"below {low:g} of the model size {span:.3g} m")
+            where = _card_of(path, deck, units, quantity, table, row, value)
+            warnings.append(f"{where}: thickness {value:.3g} m with units: {units} — {rule}; "
+                            "kept (check that the thickness and the GRIDs share a length unit)")
+            continue
+        if quantity == "span":
+            side = f"> {SPAN_RANGE_M[1]:g} m" if value > SPAN_RANGE_M[1] else \
+                f"< {SPAN_RANGE_M[0] * 1e3:g} mm"
+            text = (f"{path}: the GRIDs span {value:.3g} m with units: {units} — "
+                    f"implausible for a trim part ({side})")
+        else:
+            symbol, unit = _SYMBOL[quantity]
+            where = _card_of(path, deck, units, quantity, table, row, value)
+            text = (f"{where}: {symbol} = {value:.4g} {unit} with units: {units} — implausible "
+                    f"for a trim part ({_RULES[quantity]})")
+        if not explicit:
+            advice = (f"the deck looks like {suggestion}: set model.fe.units: {suggestion}"
+                      if suggestion else "no unit system makes the deck plausible: check the "
+                      "deck's values")
+            raise case.error(f"{text}; {advice} (or units: {units} to keep {units})", UNITS_KEY)
+        warnings.append(f"{text}; kept as model.fe.units: {units} says" +
+                        (f" (the deck would look plausible in {suggestion})" if suggestion else ""))
+    return list(dict.fromkeys(warnings))      # one card found by several tables: once
 
 
 def _card_of(path, deck, units, quantity, table, row, value) -> str:

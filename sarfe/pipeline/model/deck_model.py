@@ -33,8 +33,11 @@ from sarfe.mesh import PanelMesh
 from sarfe.mesh.formats.abaqus import read_abaqus
 from sarfe.mesh.formats.deck import DeckError, to_si
 from sarfe.mesh.formats.nastran import read_nastran
-from sarfe.pipeline.model.deck_checks import (DECK_KEY, card_key, check_quality, check_units,
+from sarfe.pipeline.model.deck_checks import (DECK_KEY, card_key, check_material_bounds,
+                                              check_quality, check_supports_on_dependents,
+                                              check_units,
                                               free_rigid_motions, has_mass, ignored_mass,
+                                              massless_parts,
                                               joined_pairs, support_mask, used_nodes)
 from sarfe.pipeline.model.deck_springs import hysteretic_spring, springs_to_contacts
 
@@ -68,13 +71,18 @@ def apply_ignore_cards(case: Case, deck):
                              f"{_listing(deck.unsupported) or 'none'})",
                              ("model", "fe", "ignore_cards", j))
     if unsupported:
-        raise case.error(f"the deck has cards sarfe does not model: {_listing(unsupported)}; "
-                         "support them or name them in model.fe.ignore_cards", DECK_KEY)
+        raise case.error(f"the deck has {len(unsupported)} card type"
+                         f"{'s' if len(unsupported) > 1 else ''} sarfe does not model: "
+                         f"{_listing(unsupported, deck.unsupported_where)}; support them or name "
+                         "them in model.fe.ignore_cards", DECK_KEY)
     return dataclasses.replace(deck, unsupported={}, ignored=ignored)
 
 
-def _listing(counts: dict) -> str:
-    return ", ".join(f"{card} ({count})" for card, count in sorted(counts.items()))
+def _listing(counts: dict, where=None) -> str:
+    """"CAERO1 (1, first at deck.bdf:12), …" — every card with its count and first line."""
+    where = where or {}
+    return ", ".join(f"{card} ({count}" + (f", first at {where[card]})" if card in where else ")")
+                     for card, count in sorted(counts.items()))
 
 
 def deck_files(path, seen=None) -> list:
@@ -194,7 +202,7 @@ def apply_overrides(case: Case, deck, mesh):
 
 def grid_pairs(case: Case, deck) -> dict:
     """{contact index: [[a, b], …]} of the contacts that list ``pairs``: their GRID ids as deck
-    node indices ('ground' kept), for :func:`sarfe.pipeline.model.contact_pairs.pair_contact`."""
+    node indices ('ground' kept), for :func:`sarfe.pipeline.model.contact_pairs.resolve_contact`."""
     out = {}
     for contact in case.config.contacts:
         i = contact.index
@@ -234,13 +242,18 @@ def prepare_deck(case: Case) -> PreparedDeck:
     if deck.shells.n_triangles == 0:
         raise case.error("the deck has no shell elements (the ERP surface is made of shells)",
                          DECK_KEY)
-    check_units(case, deck)          # the deck's own values, before any YAML override
+    check_material_bounds(case, deck)
+    unit_warnings = check_units(case, deck)   # the deck's own values, before any YAML override
     mesh = deck_panel_mesh(case, deck)
     deck = apply_overrides(case, deck, mesh)
     deck, element_contacts, contact_warnings = springs_to_contacts(case, deck)
     if not has_mass(deck):
         raise case.error("the deck has no mass (" + ("; ".join(deck.notes) or "no density, "
                          "no point masses") + "): give densities (or materials overrides)", DECK_KEY)
+    massless = massless_parts(deck)
+    if massless:
+        raise case.error("; ".join(massless[:3]) + ": give its material a density (or a "
+                         "materials override)", DECK_KEY)
     unjoined_mass = np.setdiff1d(deck.point_masses.node, used_nodes(deck))
     if unjoined_mass.size:
         raise case.error(f"point mass on GRID {int(deck.node_ids[unjoined_mass[0]])} which no "
@@ -248,6 +261,7 @@ def prepare_deck(case: Case) -> PreparedDeck:
     joined = joined_pairs(deck, [(c.nodes_a, c.nodes_b) for c in element_contacts.values()])
     quality = check_quality(case, deck, joined)
     held = support_mask(case, deck, mesh)
+    check_supports_on_dependents(case, deck, held)
     free = free_rigid_motions(case, deck, held)
     if free:
         raise case.error("the structure is not held after the supports: " + "; ".join(free)
@@ -268,7 +282,7 @@ def prepare_deck(case: Case) -> PreparedDeck:
     if len(deck.springs.element_ids) and np.any(deck.springs.viscous_damping):
         notes["spring_damping"] = "the springs' viscous damping B is added to the case's damping"
     return PreparedDeck(deck, mesh, held, element_contacts, grid_pairs(case, deck), notes,
-                        tuple(contact_warnings))
+                        tuple(unit_warnings) + tuple(contact_warnings))
 
 
 __all__ = ["read_case_deck", "apply_ignore_cards", "deck_files", "deck_panel_mesh",

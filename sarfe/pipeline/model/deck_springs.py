@@ -14,7 +14,7 @@ import numpy as np
 
 from sarfe.case.read import Case
 from sarfe.hbm import laws
-from sarfe.pipeline.model.contact_pairs import frame_from_normal
+from sarfe.mesh.contact_geometry import frames_from_normals
 
 
 @dataclasses.dataclass(frozen=True)
@@ -87,7 +87,7 @@ def springs_to_contacts(case: Case, deck):
                             f"(up to {float(k_t[r]):g} N/m, {spring_name(springs, rows[r])}) "
                             "leaves the model; type: squeak keeps it as the stick stiffness")
         contacts[contact.name] = ElementContact(ids, springs.node_a[rows], springs.node_b[rows],
-                                                   frame_from_normal(normal), k_n, k_t)
+                                                   frames_from_normals(normal), k_n, k_t)
     if not remove.any():
         return deck, contacts, warnings
     # a spring's dashpot B stays as a parallel linear damper between its nodes (stiffness 0)

@@ -1,6 +1,6 @@
 r"""The linear stage of a deck case: K, M of the prepared deck (:mod:`sarfe.pipeline.model.
-deck_model`) → supports → Craig–Bampton with the contact and force nodes' translations as boundary
-→ contact geometry, load vectors and the ERP map, as :func:`sarfe.pipeline.model.fe_stage.
+deck_model`) → supports → Craig–Bampton with the DOFs the contact rows touch and the force nodes'
+translations as boundary → contact geometry, load vectors and the ERP map, as :func:`sarfe.pipeline.model.fe_stage.
 build_fe_stage` does for a generated mesh. The kept DOFs q of the deck (rigid elements eliminated, CD frames) relate to the
 global DOFs by u = T q (`DeckSystem.transformation`); the reduced model handed on is expressed on
 all 6n global DOFs (:func:`expanded_reduced_model`) so ERP and VTU recovery see dependent nodes.
@@ -13,12 +13,14 @@ import time
 import numpy as np
 
 from sarfe.case.read import Case
-from sarfe.erp import nodal_normals
 from sarfe.fe.deck_assembly import assemble_deck, load_vector
 from sarfe.mesh.formats.deck import DeckError
-from sarfe.pipeline.model.contact_pairs import ContactGeometry, pair_contact, reduced_coordinates
+from sarfe.pipeline.model.contact_kinematics import ShellSurface
+from sarfe.pipeline.model.contact_pairs import (boundary_dofs, contact_geometry,
+                                                reduced_coordinates, resolve_contact,
+                                                spring_contact)
 from sarfe.pipeline.model.cutoff import stage_cutoff_hz
-from sarfe.pipeline.model.deck_checks import DECK_KEY
+from sarfe.pipeline.model.deck_checks import DECK_KEY, check_boundary_nodes
 from sarfe.pipeline.model.deck_model import prepare_deck
 from sarfe.pipeline.model.erp_map import deck_surface_triangles, erp_map
 from sarfe.pipeline.model.groups import resolve_node_group
@@ -30,27 +32,43 @@ from sarfe.util.progress import bar as progress_bar
 _LOADED_BOUNDARY_LIMIT = 60   # load-set DOFs kept physically up to this count (else residuals)
 
 
-def _assemble(case: Case, deck):
+def assemble_case_deck(case: Case, deck):
+    """The deck's `DeckSystem`; an assembly refusal (degenerate cell, I12 ≠ 0, an undetermined
+    RBE3, …) is a one-line CaseError on model.fe.deck."""
     try:
         return assemble_deck(deck)
     except DeckError as exc:
         raise case.error(str(exc), DECK_KEY) from None
 
 
-def _kept_translations(case, system, deck, nodes, path):
-    """(len(nodes), 3) kept DOF numbers of the translations of `nodes` (global axes)."""
+def kept_translations(case, system, deck, nodes, path):
+    """(len(nodes), 3) kept DOF numbers of the translations of `nodes` (global axes; rotated CD
+    frames and rigid-element dependents were refused before assembly: `check_boundary_nodes`)."""
     nodes = np.asarray(nodes, dtype=np.int64)
-    rotated = ~np.all(np.isclose(deck.displacement_frames[nodes], np.eye(3), atol=1e-12),
-                      axis=(1, 2))
-    if np.any(rotated):
-        raise case.error(f"GRID {int(deck.node_ids[nodes[np.argmax(rotated)]])} has a rotated "
-                         "displacement frame (CD): contact and force nodes must use the basic "
-                         "frame", path)
     dofs = system.dof_index(nodes[:, None], np.arange(3)[None, :])
     if np.any(dofs < 0):
         bad = nodes[np.argmax((dofs < 0).any(axis=1))]
         raise case.error(f"GRID {int(deck.node_ids[bad])} is a dependent node of a rigid element "
                          "(RBE2/RBE3) or has no stiffness: use an independent node", path)
+    return dofs
+
+
+def _kept_dofs(case, system, deck, nodes, components, path, held_ok=False):
+    """Kept DOF numbers (m,) of the global DOFs (node, component 0–5) the contact rows touch
+    (rotated CD frames and rigid-element dependents of the contact nodes were refused before
+    assembly: `check_boundary_nodes`); one without stiffness is a one-line error, or −1 with
+    ``held_ok`` when it was held for lack of stiffness (a contact row through it sees u = 0)."""
+    nodes = np.asarray(nodes, dtype=np.int64)
+    components = np.asarray(components, dtype=np.int64)
+    dofs = system.dof_index(nodes, components)
+    bad = dofs < 0
+    if held_ok and np.any(bad):
+        auto = set(zip(system.auto_held_nodes.tolist(), system.auto_held_components.tolist()))
+        bad &= ~np.array([(int(n), int(c)) in auto for n, c in zip(nodes, components)])
+    if np.any(bad):
+        raise case.error(f"GRID {int(deck.node_ids[nodes[np.argmax(bad)]])} is a dependent node "
+                         "of a rigid element (RBE2/RBE3) or has no stiffness: use an independent "
+                         "node", path)
     return dofs
 
 
@@ -81,25 +99,27 @@ def expanded_reduced_model(reduced, transform, free, boundary_global):
                                full_dof_count=total, free_dofs=None, total_dof_count=total)
 
 
+def deck_shell_surface(prepared) -> ShellSurface:
+    """The deck's shells as the contacts see them: thickness and mid-surface offset (ZOFFS) of
+    each triangle, as read (YAML thickness overrides applied)."""
+    shells = prepared.deck.shells
+    return ShellSurface(prepared.deck.points, shells.triangles, np.asarray(shells.thickness),
+                        np.asarray(shells.offset))
+
+
 def contact_pairs(case: Case, prepared) -> dict:
-    """{contact name: (nodes a, nodes b (−1 ground), frames (n_p, 3, 3), gaps (n_p,) [m])} of
-    a prepared deck: spring contacts from their elements, the others paired as for a mesh
-    (their ``pairs`` GRID ids as node indices: ``prepared.pairs``)."""
-    deck, mesh = prepared.deck, prepared.mesh
-    normals = nodal_normals(mesh.points, mesh.triangles)
-    paired = {}
+    """{contact name: ResolvedContact} of a prepared deck: spring contacts from their elements
+    (:func:`sarfe.pipeline.model.contact_pairs.spring_contact`), the others resolved as for a
+    mesh (their ``pairs`` GRID ids as node indices: ``prepared.pairs``)."""
+    surface = deck_shell_surface(prepared)
+    resolved = {}
     for contact in case.config.contacts:
         e = prepared.element_contacts.get(contact.name)
-        if e is None:
-            paired[contact.name] = pair_contact(case, mesh, contact.index, normals,
-                                                prepared.pairs.get(contact.index))
-            continue
-        distance = np.zeros(len(e.nodes_a))
-        b = e.nodes_b >= 0
-        distance[b] = np.einsum("ij,ij->i", e.frames[b, 0],
-                                deck.points[e.nodes_b[b]] - deck.points[e.nodes_a[b]])
-        paired[contact.name] = (e.nodes_a, e.nodes_b, e.frames, distance)
-    return paired
+        resolved[contact.name] = (
+            spring_contact(contact.name, e, surface) if e is not None else
+            resolve_contact(case, prepared.mesh, contact.index, surface,
+                            prepared.pairs.get(contact.index)))
+    return resolved
 
 
 def held_kept_dofs(case: Case, prepared, system) -> np.ndarray:
@@ -156,10 +176,16 @@ def build_deck_stage(case: Case, progress=False) -> dict:
                    resolve_node_group(case, mesh, f.group, ("excitation", "forces", i, "group"))
                    for i, f in enumerate(forces)]
     radiating = deck_surface_triangles(case, mesh)
+    for contact in case.config.contacts:      # as validate: before any assembly
+        a, b = paired[contact.name].nodes_a, paired[contact.name].nodes_b
+        check_boundary_nodes(case, deck, np.concatenate([a, b[b >= 0]]), ("contacts", contact.index))
+    for i, nodes in enumerate(group_nodes):
+        if nodes is not None:
+            check_boundary_nodes(case, deck, nodes, ("excitation", "forces", i, "group"))
 
     next_step(stages, "assembly")
     clock = time.perf_counter()
-    system = _assemble(case, deck)
+    system = assemble_case_deck(case, deck)
     timings["assembly_s"] = time.perf_counter() - clock
     mass_kg = _translational_mass(system, deck)
     if not mass_kg > 0:
@@ -172,11 +198,22 @@ def build_deck_stage(case: Case, progress=False) -> dict:
     position = np.full(n_kept, -1)
     position[free] = np.arange(len(free))
 
-    # boundary = translations of contact and force nodes (+ loaded DOFs of small load sets)
-    contact_nodes = [np.concatenate([a, b[b >= 0]]) for a, b, _, _ in paired.values()]
-    nodes = np.unique(np.concatenate(contact_nodes + [g for g in group_nodes if g is not None]
+    # boundary = DOFs the contact rows touch, translations of the force nodes (+ loaded DOFs of
+    # small load sets)
+    touched = boundary_dofs(paired)
+    contact_kept = _kept_dofs(case, system, deck, touched // 6, touched % 6, ("contacts",),
+                              held_ok=True)
+    nodes = np.unique(np.concatenate([g for g in group_nodes if g is not None]
                                      + [np.zeros(0, np.int64)]).astype(np.int64))
-    boundary_kept = _kept_translations(case, system, deck, nodes, ("contacts",)).ravel()
+    for contact in case.config.contacts:      # each on its own key, as validate
+        r = paired[contact.name]
+        kept_translations(case, system, deck, np.concatenate([r.nodes_a, r.nodes_b[r.nodes_b >= 0]]),
+                          ("contacts", contact.index))
+    for i, group in enumerate(group_nodes):
+        if group is not None:
+            kept_translations(case, system, deck, group, ("excitation", "forces", i, "group"))
+    boundary_kept = np.union1d(contact_kept[contact_kept >= 0], kept_translations(
+        case, system, deck, nodes, ("excitation", "forces")).ravel())
     set_vectors = [(_load_set_vector(case, system, deck, f, ("excitation", "forces", i, "load_set"))
                     if f.load_set is not None else None) for i, f in enumerate(forces)]
     loaded = np.unique(np.concatenate([np.flatnonzero(v) for v in set_vectors if v is not None]
@@ -236,14 +273,7 @@ def build_deck_stage(case: Case, progress=False) -> dict:
         d_ff = system.viscous_damping[free][:, free]
         added_damping = basis.T @ (d_ff @ basis)
     expanded = expanded_reduced_model(reduced, system.transformation, free, boundary_global)
-    contacts = {}
-    for name, (a, b, frames, distance) in paired.items():
-        geometry = ContactGeometry(name, a, b, frames, coords_of(a), coords_of(b), distance)
-        e = prepared.element_contacts.get(name)
-        if e is not None:   # per-pair stiffness of the springs the contact replaces
-            geometry = dataclasses.replace(geometry, normal_stiffness=e.normal_stiffness,
-                                           tangential_stiffness=e.tangential_stiffness)
-        contacts[name] = geometry
+    contacts = contact_geometry(paired, boundary_global, n_r)
     erp_nodes, areas, surface_map = erp_map(mesh, radiating, expanded)
     next_step(stages, None)
     info = {"nodes": int(deck.n_nodes), "triangles": int(mesh.n_triangles),
@@ -271,4 +301,5 @@ def _translational_mass(system, deck) -> float:
     return float(iota @ (system.mass @ iota))
 
 
-__all__ = ["build_deck_stage", "contact_pairs", "expanded_reduced_model", "held_kept_dofs"]
+__all__ = ["build_deck_stage", "deck_shell_surface", "contact_pairs", "expanded_reduced_model",
+           "held_kept_dofs", "assemble_case_deck", "kept_translations"]

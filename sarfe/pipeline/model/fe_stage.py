@@ -1,11 +1,13 @@
 r"""The linear stage of a mesh or generator FE case: mesh → shell K, M (per-triangle thickness and
-material) → remove the fixed (clip/clamp) DOFs → Craig–Bampton with boundary = translations of the
-contact and excitation nodes:
+material) → remove the fixed (clip/clamp) DOFs → Craig–Bampton with boundary = the DOFs the
+contact rows touch (translations and rotations of the nodes of each contact point's elements) and
+the translations of the excitation nodes:
 
     u = T q,  q = [q_b, q_m],  M_r = Tᵀ M T,  K_r = Tᵀ K T,  f_r = Tᵀ f,
 
-contact rows w = n·(u_a − u_b), q_i = t_i·(u_a − u_b) touch boundary coordinates only, and the
-radiating-surface normal displacement is w_s = N q (:mod:`sarfe.pipeline.model.erp_map`).
+contact rows [w, q₁, q₂]_p = frame_p (u_face,a − u_face,b) (:mod:`sarfe.pipeline.model.
+contact_pairs`) touch boundary coordinates only, and the radiating-surface normal displacement
+is w_s = N q (:mod:`sarfe.pipeline.model.erp_map`).
 One function per step; :func:`build_fe_stage` runs them in order.
 """
 from __future__ import annotations
@@ -15,10 +17,11 @@ import time
 import numpy as np
 from scipy.sparse.linalg import ArpackError, ArpackNoConvergence
 
-from sarfe.erp import nodal_normals
 from sarfe.fe.shell import shell_matrices
 from sarfe.pipeline.model.case_mesh import load_case_mesh
-from sarfe.pipeline.model.contact_pairs import contact_geometry, pair_contact, reduced_coordinates
+from sarfe.pipeline.model.contact_kinematics import ShellSurface
+from sarfe.pipeline.model.contact_pairs import (boundary_dofs, contact_geometry,
+                                                reduced_coordinates, resolve_contact)
 from sarfe.pipeline.model.cutoff import stage_cutoff_hz
 from sarfe.pipeline.model.erp_map import erp_map, surface_triangles
 from sarfe.pipeline.model.groups import fixed_nodes, resolve_node_group, shell_properties
@@ -28,17 +31,29 @@ from sarfe.reduction.reduced_model import free_dofs_system
 from sarfe.util.progress import bar as progress_bar
 
 
+def shell_surface(case, mesh) -> ShellSurface:
+    """The mesh's shells as the contacts see them: per-triangle thickness (``thickness_m``), no
+    offsets (a generated or plain mesh is the mid-surface)."""
+    thickness = shell_properties(case, mesh).thickness
+    return ShellSurface(mesh.points, mesh.triangles, thickness, np.zeros_like(thickness))
+
+
+def resolve_contacts(case, mesh) -> dict:
+    """{name: ResolvedContact} of every contact of a mesh/generator case."""
+    surface = shell_surface(case, mesh)
+    return {c.name: resolve_contact(case, mesh, c.index, surface) for c in case.config.contacts}
+
+
 def mesh_groups(case, mesh) -> tuple:
-    """Step 1 (after the mesh): the node groups the case names — fixed nodes, contact pairs
-    {name: (a, b, frames, distance)}, load nodes per force — and the radiating triangles. Cheap,
-    and the errors a user is most likely to make, so they come first."""
+    """Step 1 (after the mesh): the node groups the case names — fixed nodes, contacts
+    {name: ResolvedContact}, load nodes per force — and the radiating triangles. Cheap, and the
+    errors a user is most likely to make, so they come first."""
     config = case.config
     fixed = fixed_nodes(case, mesh)
-    normals_all = nodal_normals(mesh.points, mesh.triangles)
-    paired = {c.name: pair_contact(case, mesh, c.index, normals_all) for c in config.contacts}
+    resolved = resolve_contacts(case, mesh)
     load_nodes = [resolve_node_group(case, mesh, f.group, ("excitation", "forces", i, "group"))
                   for i, f in enumerate(config.excitation.forces)]
-    return fixed, paired, load_nodes, surface_triangles(case, mesh)
+    return fixed, resolved, load_nodes, surface_triangles(case, mesh)
 
 
 def assemble(case, mesh) -> tuple:
@@ -69,12 +84,13 @@ def supports(mesh, fixed, stiffness, mass) -> tuple:
     return k_ff, m_ff, free, position
 
 
-def boundary_positions(paired, load_nodes, position) -> np.ndarray:
-    """Step 4: the Craig–Bampton boundary — translations of the contact and load nodes — as
-    positions among the free DOFs (fixed ones left out)."""
-    nodes = [g[0] for g in paired.values()] + [g[1][g[1] >= 0] for g in paired.values()]
-    nodes = np.unique(np.concatenate(nodes + load_nodes + [np.zeros(0, int)]))
-    positions = position[(6 * nodes[:, None] + np.arange(3)).ravel()]
+def boundary_positions(resolved, load_nodes, position) -> np.ndarray:
+    """Step 4: the Craig–Bampton boundary — every DOF the contact rows touch
+    (:func:`sarfe.pipeline.model.contact_pairs.boundary_dofs`) and the load nodes' translations —
+    as positions among the free DOFs (fixed ones left out)."""
+    nodes = np.unique(np.concatenate(load_nodes + [np.zeros(0, int)]))
+    dofs = np.union1d(boundary_dofs(resolved), (6 * nodes[:, None] + np.arange(3)).ravel())
+    positions = position[dofs]
     return positions[positions >= 0]
 
 
@@ -171,7 +187,7 @@ def build_fe_stage(case, progress=False) -> dict:
     timings["mesh_s"] = time.perf_counter() - clock
     next_step(stages, "assembly")
     n_nodes = mesh.n_nodes
-    fixed, paired, load_nodes, radiating = mesh_groups(case, mesh)
+    fixed, resolved, load_nodes, radiating = mesh_groups(case, mesh)
 
     clock = time.perf_counter()
     stiffness, mass = assemble(case, mesh)
@@ -180,7 +196,7 @@ def build_fe_stage(case, progress=False) -> dict:
 
     k_ff, m_ff, free, position = supports(mesh, fixed, stiffness, mass)
     del stiffness, mass                  # the free-DOF copies are all the reduction needs
-    boundary = boundary_positions(paired, load_nodes, position)
+    boundary = boundary_positions(resolved, load_nodes, position)
     base = base_load(config.excitation, n_nodes, m_ff, free)
     clock = time.perf_counter()
     reduced, cutoff = reduce_model(case, k_ff, m_ff, boundary, free, n_nodes, base, progress)
@@ -188,8 +204,9 @@ def build_fe_stage(case, progress=False) -> dict:
     next_step(stages, "contacts, loads, ERP map")
     n_b, n_r = reduced.boundary_count, reduced.reduced_dof_count
 
-    coords_of = reduced_coordinates(free[reduced.boundary_dofs], n_nodes)
-    contacts = contact_geometry(paired, coords_of)
+    boundary_global = free[reduced.boundary_dofs]
+    coords_of = reduced_coordinates(boundary_global, n_nodes)
+    contacts = contact_geometry(resolved, boundary_global, n_r)
     loads, reduced_base = load_vectors(config.excitation, load_nodes, coords_of, reduced, base)
     erp_nodes, areas, surface_map = erp_map(mesh, radiating, reduced)
 
@@ -209,5 +226,5 @@ def build_fe_stage(case, progress=False) -> dict:
                 timings=timings)
 
 
-__all__ = ["build_fe_stage", "mesh_groups", "assemble", "supports", "boundary_positions",
+__all__ = ["build_fe_stage", "shell_surface", "resolve_contacts", "mesh_groups", "assemble", "supports", "boundary_positions",
            "base_load", "reduce_model", "reduction_error", "load_vectors", "SINGULAR_WORDS"]

@@ -2,9 +2,10 @@ r"""The nonlinear model of a case on the kept DOFs: damping, contacts, excitatio
 
 Excitation (one harmonic at ω): f_e(θ) = Re(F̂ e^{iθ}), F̂ = Σ_l F_l e^{iφ_l} b_l (+ A e^{iφ} b_base),
 so in sarfe's Fourier convention F[1] = Re F̂ (cos), F[2] = −Im F̂ (sin), all other rows 0.
-Contacts: one ContactSet entry per node pair (FE) or per named contact (matrices), with rows
-w = n·(u_a − u_b), q_i = t_i·(u_a − u_b) of G; stiffness and preload of a named contact are split
-equally over its pairs.
+Contacts: one ContactSet entry per contact point (FE) or per named contact (matrices), with rows
+w = n·(u_a − u_b), q_i = t_i·(u_a − u_b) of G — FE: the stage's rows of the facing shell faces
+(:class:`sarfe.pipeline.model.contact_pairs.ContactGeometry`); stiffness and preload of a named
+contact are split equally over its points.
 """
 from __future__ import annotations
 
@@ -81,35 +82,33 @@ def build_contacts(case: Case, stage: LinearStage):
     constant normal load (no normal DOF); parameters declared ``from_model`` that the case leaves
     out (the effective mass of a normal row) are computed from the model."""
     n = stage.dof_count
-    rows, kind, normal_row, tangent_rows = [], [], [], []
+    kind, normal_row, tangent_rows = [], [], []
     gap, names, tolerance, groups = [], [], [], []
     table = {}
 
+    blocks, n_rows = [], [0]         # sparse row blocks of G and their running count
+
     def add_row(vector):
-        rows.append(vector)
-        return len(rows) - 1
+        blocks.append(sp.csr_matrix(np.asarray(vector, dtype=float).reshape(1, n)))
+        n_rows[0] += 1
+        return n_rows[0] - 1
 
     for entry in case.config.contacts:
         contact = entry.params
         name, law = entry.name, laws.law(entry.kind)
         tangent = laws.uses_tangent(law, contact)
         start = len(kind)
-        if stage.kind == "fe":
+        if stage.kind == "fe":       # rows 3p (w), 3p+1, 3p+2 (q₁, q₂) of each point p
             geometry = stage.contacts[name]
             pairs = len(geometry.nodes_a)
-            for p in range(pairs):
-                directions = geometry.frames[p] if tangent else geometry.frames[p][:1]
-                made = []
-                for e in directions:
-                    vector = np.zeros(n)
-                    for comp in range(3):
-                        if geometry.coords_a[p, comp] >= 0:
-                            vector[geometry.coords_a[p, comp]] += e[comp]
-                        if geometry.coords_b[p, comp] >= 0:
-                            vector[geometry.coords_b[p, comp]] -= e[comp]
-                    made.append(add_row(vector))
-                normal_row.append(made[0])
-                tangent_rows.append(made[1:3] if tangent else [-1, -1])
+            per_point = 3 if tangent else 1
+            take = (3 * np.arange(pairs)[:, None] + np.arange(per_point)).ravel()
+            first = n_rows[0]
+            blocks.append(sp.csr_matrix(geometry.rows)[take])
+            n_rows[0] += len(take)
+            made = first + np.arange(len(take)).reshape(pairs, per_point)
+            normal_row += made[:, 0].tolist()
+            tangent_rows += (made[:, 1:3].tolist() if tangent else [[-1, -1]] * pairs)
             share = 1.0 / pairs
             has_normal = True
         else:
@@ -147,7 +146,7 @@ def build_contacts(case: Case, stage: LinearStage):
             g = np.full(pairs, float(entry.gap_m))
         elif entry.preload_N is not None:    # set by preload_gaps below
             g = np.zeros(pairs)
-        else:  # FE default: the geometric gap of each node pair along its normal
+        else:  # FE default: the geometric surface gap of each point along its normal
             g = np.asarray(stage.contacts[name].distances, dtype=float)
         for key, value in values.items():
             table.setdefault(key, [np.nan] * start)
@@ -159,7 +158,7 @@ def build_contacts(case: Case, stage: LinearStage):
         tolerance += [entry.tolerance_m] * pairs
         names += [name] if pairs == 1 else [f"{name}[{p}]" for p in range(pairs)]
         groups.append((name, entry.kind, np.arange(start, len(kind))))
-    G = sp.csr_matrix(np.array(rows).reshape(len(rows), n))
+    G = sp.vstack(blocks, format="csr") if blocks else sp.csr_matrix((0, n))
     gap = np.array(gap, dtype=float)
     normal_row = np.array(normal_row, dtype=int)
     parameters = _parameter_table(table, kind)

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from sarfe.case.read import load_case
+from sarfe.hbm import laws
 from sarfe.pipeline.model.cutoff import default_cutoff_hz
 from sarfe.pipeline.model.deck_model import deck_files
 from sarfe.util.hashing import file_sha256, sha256_hex
@@ -86,16 +87,21 @@ def linear_model_key(case) -> str:
     parts = {
         "model": model,
         "reduction": _reduction_key(data.get("reduction", {}), case.config) if case.is_fe else None,
-        "contacts": [{k: c.get(k) for k in ("name", "between", "pairs", "pairing_tolerance_m",
-                                            "normal", "normal_dof", "tangential_dofs",
-                                            "from_elements", "element_axis")}
-                     for c in data["contacts"]],
+        "contacts": [{k: c.get(k) for k in ("name", "between", "pairs", "points_m", "surfaces",
+                                            "pairing_tolerance_m", "normal", "patch_radius_m",
+                                            "normal_dof", "tangential_dofs", "from_elements",
+                                            "element_axis")}
+                     # a law without a tangent element keeps only the normal rows (their boundary)
+                     | {"tangent_rows": laws.uses_tangent(laws.law(entry.kind), entry.params)}
+                     for c, entry in zip(data["contacts"], case.config.contacts)],
         "forces": [{k: f.get(k) for k in ("group", "dof", "direction", "load_set")}
                    for f in exc.get("forces", [])],
         "base": {k: v for k, v in exc["base_acceleration"].items() if k in ("direction", "influence")}
         if "base_acceleration" in exc else None,
         "erp": {k: data["erp"].get(k) for k in ("surface", "dofs", "areas_m2")},
-        "sarfe_linear_stage": 1,
+        # 2: contact rows from the geometry (points on the shells' faces, the partner surface's
+        # normal), the boundary = the DOFs they touch (issue 29)
+        "sarfe_linear_stage": 2,
     }
     return sha256_hex(json.dumps(parts, sort_keys=True, default=str))
 

@@ -157,7 +157,7 @@ def resolve_case_accuracy(case, target, points=8, start_harmonics=3, start_sampl
 RELEVANT_DB = 30.0     # points quieter than the loudest by more than this do not count (dB(A))
 
 KNOBS = {"harmonics": "solver.harmonics", "aliasing": "solver.samples_per_period",
-         "modal": "reduction.cutoff_hz (or mode_count)"}
+         "modal": "reduction.cutoff_hz (or mode_count)", "mesh": "the mesh resolution (a smaller model.fe.generator.mesh_size_m)"}
 
 
 def accuracy_check(solver: SolverConfig, points) -> dict | None:
@@ -168,7 +168,8 @@ def accuracy_check(solver: SolverConfig, points) -> dict | None:
     Counted: converged points with an estimate whose ERP is within RELEVANT_DB of the loudest
     (a 5 dB error 60 dB below the headline changes nothing a user reads). The knob to raise is the
     one whose part (Richardson factors included) is largest at the worst point: harmonics →
-    solver.harmonics, aliasing → solver.samples_per_period, modal → the reduction cutoff."""
+    solver.harmonics, aliasing → solver.samples_per_period, modal → the reduction cutoff, mesh
+    (``mesh_db``, :mod:`sarfe.pipeline.solve.mesh_error`) → the generator's mesh size."""
     target = parse_accuracy(solver.accuracy_or_default)
     rated = [p for p in points if p["converged"] and p.get("error_estimate")
              and "failed" not in p["error_estimate"]]
@@ -198,7 +199,9 @@ def accuracy_check(solver: SolverConfig, points) -> dict | None:
              "modal": np.nan_to_num(e["modal_rel"])}
     parts_db = {"harmonics": factor * abs(np.nan_to_num(e["harmonics_db"])),
                 "aliasing": RICHARDSON * abs(np.nan_to_num(e["aliasing_db"])),
-                "modal": abs(np.nan_to_num(e["modal_db"]))}
+                "modal": abs(np.nan_to_num(e["modal_db"])),
+                "mesh": abs(np.nan_to_num(e.get("mesh_db", 0.0)))}      # sarfe.pipeline.solve.mesh_error
+    parts["mesh"] = 0.0
     share = {k: max(parts[k] / budget, parts_db[k] / (target.erp_db or 1e300)) for k in parts}
     knob = max(share, key=share.get)
     warning = None

@@ -118,7 +118,8 @@ def start_surface_maps(config, mesh, point_data, translations, point, directory:
     level = point_data["erp_level_db_m2"]
     jobs = [dict(path=directory / "erp_map.png", points=mesh.points, triangles=mesh.triangles,
                  values=level, label="ERP density [dB re 1 pW/m2]",
-                 title=f"{config.name}: ERP at {at}", clim=[float(level.min()), float(level.max())])]
+                 title=f"{config.name}: ERP at {at}",
+                 clim=[float(np.nanmin(level)), float(np.nanmax(level))])]   # NaN: off the surface
     frames = period_samples(translations, 24)                              # (24, n, 3)
     frame = frames[int(np.argmax(np.linalg.norm(frames, axis=2).max(axis=1)))]
     magnitude = np.linalg.norm(frame, axis=1)

@@ -53,8 +53,9 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, di
     written["summary"] = "summary.json"
     if "table" in files:
         types = {name: kind for name, kind, _ in nl.groups}
-        (directory / "table.txt").write_text(results_table(rows, types, max_contacts=100) + "\n",
-                                             encoding="utf-8")
+        mesh = (summary.get("mesh_error") or {}).get("line")    # the ± mesh term's line
+        (directory / "table.txt").write_text(results_table(rows, types, max_contacts=100) + "\n"
+                                             + (f"{mesh}\n" if mesh else ""), encoding="utf-8")
         written["table"] = "table.txt"
     if not solutions:
         return written
@@ -63,6 +64,7 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, di
     if stage.kind == "fe" and ("erp_vtu" in files or "animation" in files or "report" in files):
         mesh = stage.mesh
         markers = results.contact_markers(mesh.n_nodes, [g.nodes_a for g in stage.contacts.values()])
+        parts = results.part_ids(mesh.n_triangles, mesh.element_groups)
         translations = {}
         every_point = full_field_every_point(stage, solutions)
 
@@ -114,12 +116,13 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, di
             frequencies = [float(s.omega) / (2 * np.pi) for s in solutions]
             if len(solutions) == 1:
                 results.write_erp_vtu(directory / "erp.vtu", mesh.points, mesh.triangles,
-                                      point_data(0))
+                                      point_data(0), parts=parts)
                 written["erp_vtu"] = "erp.vtu"
             else:       # on the workers while this process writes the files below
                 series = results.start_erp_sweep(directory / "erp", mesh.points, mesh.triangles,
                                                  point_data, frequencies,
-                                                 workers=map_workers(config, mesh, len(solutions)))
+                                                 workers=map_workers(config, mesh, len(solutions)),
+                                                 parts=parts)
                 started.append(("maps", series))
                 written["erp_vtu"] = "erp/erp.pvd"
         if "animation" in files and loudest is not None:

@@ -98,8 +98,8 @@ def test_spring_becomes_contact_with_its_stiffness(tmp_path):
 def test_unsupported_keyword_is_refused_then_ignored(tmp_path):
     inp = plate_inp().replace("*HEADING", "*SURFACE, NAME=top\nplate, SPOS\n*HEADING")
     data = write_case(tmp_path, inp)
-    with pytest.raises(CaseError, match=r"model\.fe\.deck: .*cards sarfe does not model: "
-                                        r"\*SURFACE \(1\)"):
+    with pytest.raises(CaseError, match=r"model\.fe\.deck: .*1 card type sarfe does not model: "
+                                        r"\*SURFACE \(1, first at .*plate\.inp:1\)"):
         check_mesh(load_case(data, base_dir=tmp_path))
     data["model"]["fe"]["ignore_cards"] = ["*SURFACE"]
     info = check_mesh(load_case(data, base_dir=tmp_path))
@@ -205,7 +205,8 @@ def test_ignored_cards_and_their_mass_are_recorded(tmp_path):
                            "frequency_hz": 10.0},
             "reduction": {"mode_count": 4}, "solver": {"harmonics": 1, "samples_per_period": 8,
                                                         "error_estimate": False, "stability": False}}
-    with pytest.raises(CaseError, match=r"CSHEAR \(1\), PSHEAR \(1\)"):
+    with pytest.raises(CaseError, match=r"CSHEAR \(1, first at .*shear\.bdf:\d+\), "
+                                        r"PSHEAR \(1, first at .*shear\.bdf:\d+\)"):
         check_mesh(load_case(data, base_dir=tmp_path))
     data["model"]["fe"]["ignore_cards"] = ["CSHEAR", "PSHEAR"]
     result = solve_case(load_case(data, base_dir=tmp_path), write=False)
@@ -236,7 +237,7 @@ def test_validate_cli_lists_ignored_cards_and_errors_in_one_line(tmp_path, capsy
     path.write_text(yaml.safe_dump(data))
     assert cli.main(["validate", str(path)]) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "*SURFACE (1)" in err and "ignore_cards" in err
+    assert len(err.splitlines()) == 1 and "*SURFACE (1, first at " in err and "ignore_cards" in err
     data["model"]["fe"]["ignore_cards"] = ["*SURFACE"]
     path.write_text(yaml.safe_dump(data))
     assert cli.main(["validate", str(path)]) == 0

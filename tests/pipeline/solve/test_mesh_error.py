@@ -1,0 +1,96 @@
+"""The mesh term of the ± (sarfe.pipeline.solve.mesh_error, issue 29 item 4): on cases whose level
+converges with the mesh (contacts from the geometry, issue 29 items 1-3) — the door trim at 67 Hz
+(97.00 / 96.52 / 95.96 / 95.69 / 95.56 dB(A) at 14 / 10 / 7 / 5 / 3.5 mm) and the squeak rig at
+50 Hz — the term estimated on a coarse mesh (one re-solve on twice the element size) covers the
+difference to a converged fine mesh (the stored references of tests/cases/data/
+mesh_convergence_reference.json, how each was made written in it); the ± shown (console,
+table.txt, report, summary.json) includes it; decks and given meshes say "not estimated"."""
+import json
+from pathlib import Path
+
+import pytest
+
+from sarfe.case.errors import CaseError
+from sarfe.cli import main
+from sarfe.pipeline import load_case, solve_case
+from sarfe.pipeline.solve.mesh_error import mesh_error_reason
+from sarfe.results.report import render_report_html
+
+CASES = Path(__file__).resolve().parents[3] / "cases"
+REFERENCE = Path(__file__).resolve().parents[2] / "cases" / "data" / "mesh_convergence_reference.json"
+
+
+def one_point(name, frequency_hz, mesh_size_m=None, **solver):
+    case = load_case(CASES / f"{name}.yaml")
+    if mesh_size_m is not None:
+        case = case.with_generator(mesh_size_m=mesh_size_m)
+    data = case.data
+    data["excitation"].pop("sweep", None)
+    data["excitation"]["frequency_hz"] = [frequency_hz]
+    data["solver"].update(solver)
+    return data
+
+
+@pytest.mark.timeout(300)
+@pytest.mark.parametrize("name, mesh_size_m", [
+    pytest.param("door_trim", 0.014, marks=pytest.mark.slow),      # ≈ 10-20 s
+    ("squeak_rig", 0.012), ("squeak_rig", 0.006)])
+def test_mesh_term_covers_the_error_against_a_converged_mesh(name, mesh_size_m):
+    """Measured (2026-11-28, with kinwire's contacts): door trim 14 mm 97.00 dB(A), term 3.76 dB
+    (28 mm: 100.7) against a true error of 1.44; squeak rig 12 mm 30.83, term 2.03 against 1.49;
+    6 mm 29.88, term 0.95 against 0.54. (Not every mesh: the squeak rig at 9 mm gives 0.65
+    against 0.95, its 18 mm re-solve is not yet in the asymptotic range — the other terms of the
+    ± (1.41 dB in all) still cover it; the door trim at 20 mm 1.76 against 4.2.)"""
+    reference = json.loads(REFERENCE.read_text())[name]
+    result = solve_case(one_point(name, reference["frequency_hz"], mesh_size_m, stability=False),
+                        write=False)
+    term = result.summary["mesh_error"]
+    assert term["estimated"] and term["coarse_mesh_size_m"] == pytest.approx(2 * mesh_size_m)
+    level = result.summary["points"][0]["erp"]["level_dba"]
+    true_error = abs(level - reference["level_dba"])
+    assert true_error > 0.3
+    assert true_error <= term["mesh_db"] <= 4 * true_error  # covers, not absurdly
+    estimate = result.summary["points"][0]["error_estimate"]
+    assert estimate["mesh_db"] == pytest.approx(term["mesh_db"])
+    assert estimate["erp_db"] >= term["mesh_db"]            # the ± includes it
+    assert result.summary["worst"]["erp_error_db"] == pytest.approx(estimate["erp_db"])
+
+
+@pytest.mark.timeout(300)
+def test_the_printed_plus_minus_includes_the_mesh_term(tmp_path, capsys):
+    """Console, table.txt, report and summary.json of a coarse rattle rig (20 mm, one point)."""
+    path = tmp_path / "rig.yaml"
+    data = one_point("rattle_rig", 31.0, 0.02, stability=False)
+    data["model"]["fe"]["generator"].pop("path", None)
+    data["output"]["files"] = ["summary", "table"]
+    import yaml
+    path.write_text(yaml.safe_dump(data))
+    # the generator mesh is relative to nothing: the case lives in tmp_path, outputs there too
+    assert main(["solve", str(path), "--output", str(tmp_path / "out"), "--quiet"]) in (0, 3)
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    term = summary["mesh_error"]
+    assert term["estimated"] and term["mesh_db"] > 0
+    bound = summary["worst"]["erp_error_db"]
+    assert bound >= term["mesh_db"]
+    assert term["line"] in (tmp_path / "out" / "table.txt").read_text()
+    assert f"± {bound:.2f}" in (tmp_path / "out" / "table.txt").read_text() or \
+        f"{bound:.2f}" in (tmp_path / "out" / "table.txt").read_text()
+    assert 'id="mesh-error"' in render_report_html(summary)
+    assert "mesh_db" in render_report_html(summary)
+    capsys.readouterr()
+    assert main(["solve", str(path), "--output", str(tmp_path / "out"), "--force"]) in (0, 3)
+    out = capsys.readouterr().out
+    assert f"± {bound:.2f} dB(A)" in out and "mesh error: ±" in out
+
+
+def test_decks_and_given_meshes_say_not_estimated():
+    deck = load_case(CASES / "rattle_rig_deck.yaml")
+    assert "not estimated" in mesh_error_reason(deck) and "deck" in mesh_error_reason(deck)
+    assert "matrices" in mesh_error_reason(load_case(CASES / "lumped_rattle.yaml"))
+    off = load_case(CASES / "squeak_rig.yaml").with_solver(mesh_error=False)
+    assert "solver.mesh_error: false" in mesh_error_reason(off)
+    assert mesh_error_reason(load_case(CASES / "squeak_rig.yaml")) is None
+    data = load_case(CASES / "rattle_rig_deck.yaml").data
+    data["solver"]["mesh_error"] = True
+    with pytest.raises(CaseError, match="mesh_error"):
+        load_case(data, base_dir=CASES)
