@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import textwrap
 import time
 import traceback
 
@@ -66,7 +67,7 @@ def cmd_solve(args) -> int:
         for line in summary_lines(summary, result.rows):
             print(line)
         if (summary.get("mesh_error") or {}).get("line"):
-            print(summary["mesh_error"]["line"])
+            print(textwrap.fill(summary["mesh_error"]["line"], WIDTH, subsequent_indent="  "))
         files = summary.get("files") or {}
         shown = ", ".join([files[k] for k in ("table", "report") if k in files]
                           + (["sound.wav"] if "sound" in files else []))
