@@ -35,4 +35,6 @@ def test_lumped_rattle_audibility_outputs(tmp_path):
     full = subprocess.run([sys.executable, "-m", "sarfe", "solve", str(case), "--output",
                            str(tmp_path / "lr2"), "--force"], capture_output=True, text=True,
                           cwd=ROOT)
-    assert max(len(line) for line in full.stdout.splitlines()) <= 80
+    wide = [line for line in full.stdout.splitlines()                # the path line holds a path
+            if len(line) > 80 and not line.startswith("results:")]
+    assert wide == []
