@@ -3,10 +3,10 @@
 Exit codes: 0 success; 2 a problem in the case file (one line on stderr naming the key, no
 traceback unless ``--debug``), or of the system met reading or writing (a full disk, a read-only
 file system, no permission, a busy mount point: one line naming the path,
-:func:`sarfe.results.folder.os_error`); 3 the run finished but some frequency point did not
-converge (see summary.json ``non_converged_points``); 4 ``output.target_dba`` exceeded at the
-loudest converged point, 4 before 3 (:mod:`sarfe.case.errors`); 1 an unexpected internal error; 130
-interrupted.
+:func:`sarfe.results.folder.os_error`); 4 ``output.target_dba`` exceeded at the loudest converged
+point; 3 the run finished but some frequency point did not converge (see summary.json
+``non_converged_points``) — 4 before 3 (:mod:`sarfe.case.errors`); 1 an unexpected internal error;
+130 interrupted.
 Subcommands ``study`` (``sarfe.tradeoff.cli``), ``batch`` (``sarfe.batch.cli``) and ``compare``
 (``sarfe.compare.cli``) are added by their
 ``register(subparsers)`` functions.
@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import textwrap
 import time
 import traceback
 from pathlib import Path
@@ -29,8 +30,8 @@ from sarfe.pipeline import build_linear_model, load_case, nonlinear_model, solve
 from sarfe.pipeline.checks.case_checks import check_case, output_target
 from sarfe.pipeline.verify import format_rows, verify_point
 from sarfe.results.console import WIDTH, quiet_line, summary_lines
-from sarfe.results.summary import pruning_line, stability_line
 from sarfe.results.folder import os_error
+from sarfe.results.summary import pruning_line, stability_line
 from sarfe.tradeoff import cli as tradeoff_cli
 
 
@@ -67,7 +68,7 @@ def cmd_solve(args) -> int:
         for line in summary_lines(summary, result.rows):
             print(line)
         if (summary.get("mesh_error") or {}).get("line"):
-            print(summary["mesh_error"]["line"][:WIDTH])
+            print(textwrap.fill(summary["mesh_error"]["line"], WIDTH, subsequent_indent="  "))
         files = summary.get("files") or {}
         shown = ", ".join([files[k] for k in ("table", "report") if k in files]
                           + (["sound.wav"] if "sound" in files else []))

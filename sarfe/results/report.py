@@ -73,8 +73,8 @@ def environment():
     env.filters["mm"] = lambda v: _number(v, ".3f", 1e3)
     env.filters["yesno"] = lambda v: "-" if v is None else ("yes" if v else "no")
     env.filters["share"] = share_text
-    env.filters["signed"] = lambda v, fmt=".1f": "-" if v is None or not math.isfinite(v) \
-        else format(v, "+" + fmt)
+    env.filters["signed"] = lambda v, fmt=".1f": (   # None/Undefined/NaN → "-"
+        format(v, "+" + fmt) if isinstance(v, (int, float)) and math.isfinite(v) else "-")
     return env
 
 
