@@ -18,7 +18,6 @@ import sys
 import textwrap
 import time
 import traceback
-from pathlib import Path
 
 import numpy as np
 
