@@ -3,9 +3,10 @@
 Exit codes: 0 success; 2 a problem in the case file (one line on stderr naming the key, no
 traceback unless ``--debug``), or of the system met reading or writing (a full disk, a read-only
 file system, no permission, a busy mount point: one line naming the path,
-:func:`sarfe.results.folder.os_error`); 3 the run finished but some frequency point did not
-converge (see summary.json ``non_converged_points``); 1 an unexpected internal error; 130
-interrupted.
+:func:`sarfe.results.folder.os_error`); 4 ``output.target_dba`` exceeded at the loudest converged
+point; 3 the run finished but some frequency point did not converge (see summary.json
+``non_converged_points``) — 4 before 3 (:mod:`sarfe.case.errors`); 1 an unexpected internal error;
+130 interrupted.
 Subcommands ``study`` (``sarfe.tradeoff.cli``), ``batch`` (``sarfe.batch.cli``) and ``compare``
 (``sarfe.compare.cli``) are added by their
 ``register(subparsers)`` functions.
@@ -14,9 +15,9 @@ from __future__ import annotations
 
 import argparse
 import sys
+import textwrap
 import time
 import traceback
-from pathlib import Path
 
 import numpy as np
 
@@ -27,9 +28,9 @@ from sarfe.compare import cli as compare_cli
 from sarfe.pipeline import build_linear_model, load_case, nonlinear_model, solve_case
 from sarfe.pipeline.checks.case_checks import check_case, output_target
 from sarfe.pipeline.verify import format_rows, verify_point
-from sarfe.pipeline.write.result_files import console_summary
+from sarfe.results.console import WIDTH, quiet_line, summary_lines
 from sarfe.results.folder import os_error
-from sarfe.results.summary import loudest_lines, pruning_line, stability_line
+from sarfe.results.summary import pruning_line, stability_line
 from sarfe.tradeoff import cli as tradeoff_cli
 
 
@@ -50,26 +51,29 @@ def cmd_solve(args) -> int:
     result = solve_case(case, output_dir=args.output, progress=not args.quiet, force=args.force,
                         warn=_warn)
     summary = result.summary
-    if not args.quiet:
+    if args.quiet:      # one result line and the path
+        print(quiet_line(summary))
+        print(f"results: {result.output_dir}")
+    else:
         model = summary["model"]
         if model.get("kind") == "fe":
             residual = model.get("residual_vectors") or 0     # reduced = boundary + modes + these
-            print(f"model: {model['nodes']} nodes, {model['free_dofs']} free DOFs → "
-                  f"{model['reduced_dofs']} reduced ({model['boundary_dofs']} boundary + "
-                  f"{model['modes']} modes"
-                  + (f" + {residual} residual vectors)" if residual else ")"))
+            print(f"model: {model['nodes']} nodes, {model['free_dofs']} DOFs → "
+                  f"{model['reduced_dofs']} ({model['boundary_dofs']} boundary + "
+                  f"{model['modes']} modes" + (f" + {residual} residual)" if residual else ")"))
         pruning = pruning_line(summary.get("contact_pruning"))
         if pruning:
-            print(pruning)
-        types = {c["name"]: c["type"] for c in summary["contacts"]}
-        table = Path(result.output_dir) / "table.txt" if result.output_dir else None
-        print(console_summary(result.rows, types,   # every point in table.txt (issue 30)
-                              "table.txt" if table is not None and table.exists() else None))
-        for line in loudest_lines(summary.get("worst")):
+            print(pruning[:WIDTH])
+        for line in summary_lines(summary, result.rows):
             print(line)
         if (summary.get("mesh_error") or {}).get("line"):
-            print(summary["mesh_error"]["line"])
+            print(textwrap.fill(summary["mesh_error"]["line"], WIDTH, subsequent_indent="  "))
+        files = summary.get("files") or {}
+        shown = ", ".join([files[k] for k in ("table", "report") if k in files]
+                          + (["sound.wav"] if "sound" in files else []))
         print(f"results: {result.output_dir}  ({time.perf_counter() - clock:.1f} s)")
+        if shown:
+            print(f"  full table and every contact: {shown}")
     if summary["non_converged_points"]:
         print(f"sarfe: {len(summary['non_converged_points'])} point(s) did not converge: "
               f"{summary['non_converged_points']} (see summary.json)", file=sys.stderr)
@@ -143,15 +147,17 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="sarfe", description="Squeak & rattle noise of car interior panels: FE + "
         "Craig–Bampton + harmonic balance with contact + equivalent radiated power.",
-        epilog="exit codes: 0 ok, 2 case-file error, 3 a point did not converge or an incomplete "
-               "sweep left part of its band without converged points, 1 internal error")
+        epilog="exit codes: 0 ok, 2 case-file error, 4 output.target_dba exceeded at the loudest "
+               "point, 3 a point did not converge or an incomplete sweep left part of its band "
+               "without converged points (4 before 3), 1 internal error")
     parser.add_argument("--version", action="version", version=f"sarfe {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
 
     def common(p):
         p.add_argument("case", metavar="CASE.yaml", help="case file")
         p.add_argument("--debug", action="store_true", help="show tracebacks")
-        p.add_argument("--quiet", action="store_true", help="no progress bars or table")
+        p.add_argument("--quiet", action="store_true", help="no progress bars or table; solve "
+                       "prints one result line and the result path")
 
     p = sub.add_parser("solve", help="solve a case and write results")
     common(p)

@@ -244,7 +244,7 @@ def main():
     # the whole-process runs first: a child forked from a grown parent reports its RSS in ru_maxrss
     res["balanced"] = balanced()
     # (a run with reduction.cutoff_margin 1.0 is now the same run: the search keeps
-    # max(cutoff_margin, 1.5) · H · f_max, sarfe.pipeline.solve.case_accuracy.rule_cutoff_hz)
+    # its Newton cutoff max(1 kHz, 1.5 · 5 · f_max), sarfe.pipeline.solve.case_accuracy.rule_cutoff_hz)
     res["cutoffs"] = cutoff_study()
     res["wall_s"] = time.perf_counter() - t0
     write(res)

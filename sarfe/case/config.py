@@ -29,13 +29,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
 
+from sarfe.erp.cabin import PASSENGER_CAR
 from sarfe.erp.erp import AIR_DENSITY, REFERENCE_POWER, SOUND_SPEED
 
 DEFAULT_ZETA = 0.02                 # modal damping ratio when the case gives no damping
 CONTINUATION_MAX_STEP = 0.1         # see the module docstring (0.1 vs the engine's 0.25)
 MATRICES_GAP_M = 0.0                # gap of a matrices contact with a normal DOF and no preload
 RESULTS_DIRECTORY = "results"       # output.directory default: results/<case name>
-OUTPUT_FILES = ("summary", "response", "plots", "table", "report")   # output.files default
+OUTPUT_FILES = ("summary", "response", "plots", "table", "report", "sound")  # output.files default
 FE_OUTPUT_FILES = ("erp_vtu", "animation")                           # … and with model.fe
 
 
@@ -363,6 +364,42 @@ class ErpConfig:
     reference_power_W: float = REFERENCE_POWER
 
 
+# ------------------------------------------------------------------------------------- audibility
+NO_BACKGROUND = "none"              # audibility.background: the threshold in quiet only
+DEFAULT_BACKGROUND = "ev_80kmh"     # a quiet battery-electric cabin at 80 km/h, 61 dB(A)
+
+
+@dataclass(frozen=True)
+class CabinConfig:
+    """audibility.cabin: the diffuse-field cabin from the ERP to the occupant's ear
+    (:class:`sarfe.erp.cabin.Cabin`; defaults: :data:`sarfe.erp.cabin.PASSENGER_CAR`, a saloon
+    with cloth seats, docs/audibility.md). ``absorption``: ᾱ, one value or one per
+    ``absorption_band_hz`` centre."""
+
+    distance_m: float = PASSENGER_CAR.distance_m
+    volume_m3: float = PASSENGER_CAR.volume_m3
+    surface_m2: float = PASSENGER_CAR.surface_m2
+    absorption: float | tuple = PASSENGER_CAR.absorption[0]
+    absorption_band_hz: tuple = ()
+    directivity: float = PASSENGER_CAR.directivity
+
+
+@dataclass(frozen=True)
+class AudibilityConfig:
+    """audibility: will the occupant hear it (:mod:`sarfe.pipeline.post.audibility_records`).
+    ``background``: a shipped cabin spectrum by name (:func:`sarfe.erp.backgrounds.
+    background_names`), a third-octave CSV file (resolved against the case file's folder by the
+    case layer) or 'none' (the threshold in quiet only). Default :data:`DEFAULT_BACKGROUND`: the
+    quietest realistic driving condition shipped (an EV has no engine noise to mask a rattle),
+    so a verdict 'not audible' holds in louder cabins too. ``loudness_field``: the ISO 532-1
+    field, 'diffuse' (the occupant hears the reverberant cabin from all sides) or 'free'; ``sound_duration_s``: the length of sound.wav."""
+
+    background: str = DEFAULT_BACKGROUND
+    loudness_field: str = "diffuse"
+    sound_duration_s: float = 3.0
+    cabin: CabinConfig = field(default_factory=CabinConfig)
+
+
 # ----------------------------------------------------------------------------------------- output
 @dataclass(frozen=True)
 class OutputConfig:
@@ -398,6 +435,7 @@ class CaseConfig:
     solver: SolverConfig
     erp: ErpConfig
     output: OutputConfig
+    audibility: AudibilityConfig = field(default_factory=AudibilityConfig)
 
 
 # ------------------------------------------------------------------ the normalized mapping → typed
@@ -508,14 +546,26 @@ def build_config(data: dict) -> CaseConfig:
                       reference_power_W=erp["reference_power_W"]),
         output=OutputConfig(directory=out["directory"], files=tuple(out["files"]),
                             target_dba=out.get("target_dba"),
-                            maps=_frozen(out["maps"])))
+                            maps=_frozen(out["maps"])),
+        audibility=_audibility_config(data.get("audibility") or {}))
+
+
+def _audibility_config(section) -> AudibilityConfig:
+    cabin = dict(section.get("cabin") or {})
+    if isinstance(cabin.get("absorption"), list):
+        cabin["absorption"] = tuple(cabin["absorption"])
+    if "absorption_band_hz" in cabin:
+        cabin["absorption_band_hz"] = tuple(cabin["absorption_band_hz"])
+    return AudibilityConfig(cabin=CabinConfig(**cabin), **_given(
+        section, AudibilityConfig, ("background", "loudness_field", "sound_duration_s"), lambda v: v))
 
 
 __all__ = ["CaseConfig", "ModelConfig", "FeConfig", "GeneratorConfig", "DeckConfig",
            "MaterialConfig", "MatricesConfig", "DampingConfig", "ModalZetaRange",
            "RayleighConfig", "ReductionConfig", "ContactConfig", "DofReference", "ForceConfig",
            "BaseAccelerationConfig", "ExcitationConfig", "SweepConfig", "SolverConfig",
-           "ContinuationConfig", "ErpConfig", "OutputConfig", "build_config", "contact_config",
+           "ContinuationConfig", "ErpConfig", "OutputConfig", "AudibilityConfig", "CabinConfig",
+           "NO_BACKGROUND", "DEFAULT_BACKGROUND", "build_config", "contact_config",
            "default_of", "default_output_directory", "default_output_files",
            "DEFAULT_ZETA", "DEFAULT_ACCURACY", "CONTINUATION_MAX_STEP", "MATRICES_GAP_M",
            "default_samples_per_period"]

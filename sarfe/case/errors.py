@@ -8,6 +8,11 @@ from __future__ import annotations
 
 EXIT_CASE_ERROR = 2
 EXIT_NOT_CONVERGED = 3
+# output.target_dba exceeded at the loudest converged point (as the batch gate's 4). Precedence of
+# `sarfe solve`: 1 internal and 2 input errors first (nothing solved); then 4 — an exceeded target
+# is established by converged points, and a point that did not converge could only be louder; then
+# 3 — an incomplete run cannot declare a target met; else 0.
+EXIT_TARGET_EXCEEDED = 4
 
 
 def format_key_path(path) -> str:

@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import math
 
-from sarfe.case.config import (DEFAULT_ACCURACY, DEFAULT_ZETA, MATRICES_GAP_M,
+from sarfe.case.config import (DEFAULT_ACCURACY, DEFAULT_ZETA, MATRICES_GAP_M, NO_BACKGROUND,
+                               AudibilityConfig, CabinConfig,
                                BaseAccelerationConfig, ContactConfig, ContinuationConfig,
                                DeckConfig, DofReference, ErpConfig, FeConfig, ForceConfig,
                                GeneratorConfig, OutputConfig, ReductionConfig, SolverConfig,
@@ -18,6 +19,8 @@ from sarfe.case.config import (DEFAULT_ACCURACY, DEFAULT_ZETA, MATRICES_GAP_M,
                                default_samples_per_period)
 from sarfe.case.errors import format_key_path
 from sarfe.case.plausibility import check_plausible
+from sarfe.erp.backgrounds import BackgroundFileError, background_names, load_background
+from sarfe.erp.cabin import Cabin
 from sarfe.hbm import laws
 
 MESH_SUFFIXES = (".msh", ".bdf", ".nas", ".dat", ".inp")
@@ -374,6 +377,47 @@ def _normalize_output(case, data):
         out["files"] = ["summary"] + list(out["files"])
 
 
+def _normalize_audibility(case, data):
+    """audibility: defaults (sarfe.case.config.AudibilityConfig, CabinConfig); the background is
+    read here, so `validate` finds a bad file: a shipped name stays a name, a file is resolved
+    against the case file's folder (the normalized case holds its absolute path); the cabin must
+    make a valid :class:`sarfe.erp.cabin.Cabin` (one absorption per band centre, increasing)."""
+    section = data.setdefault("audibility", {})
+    p = ("audibility",)
+    for key in ("background", "loudness_field", "sound_duration_s"):
+        section.setdefault(key, default_of(AudibilityConfig, key))
+    cabin = section.setdefault("cabin", {})
+    for key in ("distance_m", "volume_m3", "surface_m2", "absorption", "directivity"):
+        cabin.setdefault(key, default_of(CabinConfig, key))
+    background = section["background"]
+    if background != NO_BACKGROUND:
+        shipped = background in background_names()
+        if not shipped:
+            file = case.resolve(background)
+            if not file.is_file():
+                raise case.error(f"background {background!r}: neither a shipped spectrum "
+                                 f"({', '.join(background_names())}), 'none' nor a file "
+                                 f"(looked for {file})", p + ("background",))
+            section["background"] = background = str(file)
+        try:
+            load_background(background)
+        except BackgroundFileError as error:
+            raise case.error(f"background: {error}", p + ("background",)) from None
+    absorption = cabin["absorption"]
+    bands = cabin.get("absorption_band_hz")
+    if isinstance(absorption, list) and bands is None and len(absorption) > 1:
+        raise case.error("a list of absorption coefficients needs 'absorption_band_hz' (one "
+                         "band centre per value)", p + ("cabin", "absorption"))
+    try:
+        Cabin(volume_m3=cabin["volume_m3"], surface_m2=cabin["surface_m2"],
+              absorption=absorption, absorption_band_hz=bands or (),
+              directivity=cabin["directivity"], distance_m=cabin["distance_m"])
+    except ValueError as error:
+        key = "absorption_band_hz" if "band" in str(error) else "absorption"
+        raise case.error(str(error).replace("Cabin.", "audibility.cabin."),
+                         p + ("cabin", key)) from None
+
+
 def normalize(case):
     """Cross-key rules and defaults; returns a Case whose ``data`` has every key filled in."""
     data = case.data
@@ -385,6 +429,7 @@ def normalize(case):
     _normalize_reduction(case, data)
     _normalize_erp(case, data)
     _normalize_output(case, data)
+    _normalize_audibility(case, data)
     check_plausible(case, data)
     return case
 

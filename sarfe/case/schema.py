@@ -217,7 +217,7 @@ ERP = _object({
     "reference_power_W": POSITIVE,
 })
 
-OUTPUT_FILES = ["summary", "response", "erp_vtu", "animation", "plots", "table", "report"]
+OUTPUT_FILES = ["summary", "response", "erp_vtu", "animation", "plots", "table", "report", "sound"]
 OUTPUT = _object({
     "directory": NAME,
     "target_dba": NUMBER,   # optional target level [dB(A)]: a line in the plots and the report
@@ -227,6 +227,24 @@ OUTPUT = _object({
     "maps": {"oneOf": [{"enum": ["loudest"]}, _object({"every": {"type": "integer", "minimum": 1}},
                                                       required=("every",)),
                        {"type": "array", "items": POSITIVE, "minItems": 1}]},
+})
+
+# will the occupant hear it (sarfe.case.config.AudibilityConfig, docs/audibility.md): the cabin
+# from the ERP to the ear, the background noise it must be heard over, the loudness field
+ABSORPTION = {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1}
+AUDIBILITY = _object({
+    "background": NAME,         # a shipped spectrum's name, a CSV file, or 'none'
+    "loudness_field": {"enum": ["diffuse", "free"]},
+    "sound_duration_s": {"type": "number", "exclusiveMinimum": 0, "maximum": 60},
+    "cabin": _object({
+        "distance_m": POSITIVE,
+        "volume_m3": POSITIVE,
+        "surface_m2": POSITIVE,
+        "absorption": {"oneOf": [ABSORPTION, {"type": "array", "items": ABSORPTION,
+                                              "minItems": 1}]},
+        "absorption_band_hz": {"type": "array", "items": POSITIVE, "minItems": 1},
+        "directivity": POSITIVE,
+    }),
 })
 
 CASE_SCHEMA = {
@@ -245,5 +263,6 @@ CASE_SCHEMA = {
         "solver": SOLVER,
         "erp": ERP,
         "output": OUTPUT,
+        "audibility": AUDIBILITY,
     }, required=("name", "model", "excitation")),
 }

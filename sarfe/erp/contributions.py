@@ -21,7 +21,14 @@ Shares over the period's harmonics, unweighted and A-weighted (α_k = 10^(A(f_k)
     share_s   = Σ_k Q_s,k / Σ_k P_k,          share_A,s = Σ_k α_k Q_s,k / Σ_k α_k P_k,
 
 so Σ_s share_s = Σ_s share_A,s = 1 exactly. The ranking orders the sources by share_A (the total is
-judged in dB(A)). A motionless surface (total below ``MOTIONLESS_LEVEL_DB`` = −100 dB re 1 pW,
+judged in dB(A)). Two levels go with a source, and the ranking prints both, named:
+
+    its part of the total   L_part,A = 10 lg(Σ_k α_k Q_s,k / P_ref) = L_A,total + 10 lg share_A,s
+                            (only for share_A > 0: a source with a negative share cancels sound),
+                            monotone with the share printed beside it;
+    alone                   L_A,s = 10 lg(Σ_k α_k P_s,k / P_ref), what s radiates by itself —
+                            not monotone with the share: a source in phase with the total may have
+                            a large share and a small level alone, one out of phase the reverse. A motionless surface (total below ``MOTIONLESS_LEVEL_DB`` = −100 dB re 1 pW,
 round-off radiates about −180 dB) has no sound to split: its shares and its superposition error
 are NaN.
 """
@@ -35,7 +42,7 @@ from sarfe.erp.erp import AIR_DENSITY, REFERENCE_POWER, SOUND_SPEED, power_level
 from sarfe.erp.weighting import a_weighting_db
 
 __all__ = ["ErpContributions", "erp_contributions", "contributions_from_gram",
-           "superposition_stack", "ranking_lines", "normal_velocity", "MOTIONLESS_LEVEL_DB"]
+           "superposition_stack", "ranking_lines", "ranking_line", "share_text", "normal_velocity", "MOTIONLESS_LEVEL_DB"]
 
 MOTIONLESS_LEVEL_DB = -100.0  # [dB re P_ref] below this total the surface counts as motionless
 
@@ -61,6 +68,8 @@ class ErpContributions:
     partial_level_dba: np.ndarray  # (S,) A-weighted [dB(A)]
     share: np.ndarray            # (S,) Σ_k Q_s,k / Σ_k P_k [-]
     share_a: np.ndarray          # (S,) A-weighted share [-]
+    part_level_db: np.ndarray    # (S,) 10 lg(Σ_k Q_s,k / P_ref) [dB re 1 pW], NaN where ≤ 0
+    part_level_dba: np.ndarray   # (S,) its part of the A-weighted total [dB(A)], NaN where ≤ 0
     superposition_error: float   # ‖Σ_s v_s − v‖ / ‖v‖ (area-weighted), or NaN without a given total
 
     def order(self) -> np.ndarray:
@@ -75,6 +84,8 @@ class ErpContributions:
                              "level_db": float(self.partial_level_db[s]),
                              "level_dba": float(self.partial_level_dba[s]),
                              "share": float(self.share[s]), "share_a": float(self.share_a[s]),
+                             "part_level_db": float(self.part_level_db[s]),
+                             "part_level_dba": float(self.part_level_dba[s]),
                              "harmonics_power_W": self.partial_power_W[s].tolist(),
                              "harmonics_coherent_power_W": self.coherent_power_W[s].tolist()}
                             for s, name in enumerate(self.names)]}
@@ -153,27 +164,55 @@ def contributions_from_gram(names, gram, omega: float, has_total: bool = True,
     if not P.sum() >= reference_power * 10.0 ** (MOTIONLESS_LEVEL_DB / 10.0):
         share, share_a = np.full(S, np.nan), np.full(S, np.nan)
         error = float("nan")
+    part, part_a = coherent.sum(axis=1), coherent @ alpha
+    with np.errstate(invalid="ignore", divide="ignore"):
+        part_db = np.where(share > 0, power_level_db(np.clip(part, 0.0, None), reference_power),
+                           np.nan)
+        part_dba = np.where(share_a > 0, power_level_db(np.clip(part_a, 0.0, None),
+                                                        reference_power), np.nan)
     return ErpContributions(
         names=tuple(str(n) for n in names), frequencies_hz=f, partial_power_W=partial,
         coherent_power_W=coherent, total_power_W=P, partial_total_W=partial.sum(axis=1),
         partial_level_db=power_level_db(partial.sum(axis=1), reference_power),
         partial_level_dba=power_level_db(partial @ alpha, reference_power),
-        share=share, share_a=share_a, superposition_error=error)
+        share=share, share_a=share_a, part_level_db=part_db, part_level_dba=part_dba,
+        superposition_error=error)
+
+
+def share_text(share) -> str:
+    """'24 %' of a share (0…1); a share that rounds to 0 % reads '0 %' (never '-0 %'), a negative
+    one '-3 %', NaN '- %'."""
+    if share is None or not np.isfinite(share):
+        return "- %"
+    percent = int(round(100.0 * float(share)))
+    return f"{percent} %"
+
+
+def ranking_line(name, share_a, part_level_dba, level_dba, frequency_hz=None) -> str:
+    """One ranking line, the share with the level it is monotone with and the level alone named:
+    'upper_1: 24 % of the total = 90.7 dB(A) (alone 90.2 dB(A)) at 67 Hz'; a source that
+    rounds to 0 % or cancels sound has no part level: 'lower_1: 0 % of the total (alone 57.8
+    dB(A))', 'x: -3 % of the total (cancels) (alone 80.1 dB(A))'."""
+    def level(value):
+        return f"{value:.1f} dB(A)" if value is not None and np.isfinite(value) else "- dB(A)"
+    percent = round(100 * share_a) if share_a is not None and np.isfinite(share_a) else 0
+    part = f" = {level(part_level_dba)}" if percent > 0 and part_level_dba is not None \
+        and np.isfinite(part_level_dba) else ""
+    cancels = " (cancels)" if percent < 0 else ""
+    at = "" if frequency_hz is None else f" at {frequency_hz:.4g} Hz"
+    return (f"{name}: {share_text(share_a)} of the total{part}{cancels} (alone "
+            f"{level(level_dba)}){at}")
 
 
 def ranking_lines(contributions: ErpContributions, frequency_hz: float, count: int | None = None,
                   skip=()) -> list[str]:
-    """'side_left: 93.1 dB(A), 71 % of the total at 67 Hz' per source, by decreasing A-weighted
-    share (the first ``count``; sources named in ``skip`` left out). A source with no sound reads
-    '-' for its level."""
+    """:func:`ranking_line` per source, by decreasing A-weighted share (the first ``count``;
+    sources named in ``skip`` left out)."""
     lines = []
     for s in contributions.order():
         name = contributions.names[s]
         if name in skip:
             continue
-        level = contributions.partial_level_dba[s]
-        share = contributions.share_a[s]
-        level_text = f"{level:.1f} dB(A)" if np.isfinite(level) else "- dB(A)"
-        share_text = f"{100 * share:.0f} %" if np.isfinite(share) else "- %"
-        lines.append(f"{name}: {level_text}, {share_text} of the total at {frequency_hz:.4g} Hz")
+        lines.append(ranking_line(name, contributions.share_a[s], contributions.part_level_dba[s],
+                                  contributions.partial_level_dba[s], frequency_hz))
     return lines if count is None else lines[:count]

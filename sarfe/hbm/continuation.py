@@ -32,6 +32,31 @@ gradually) — and, once a sweep has met one corner, at every turn of ω — the
 on with 2N; a turn within ``FOLD_DISTANCE`` of the band of a checked one is taken as a fold. A new point closer than ``REPORT_DISTANCE`` (scaled) to the
 last one replaces it rather than adding a near-duplicate row.
 
+Extremes (hard contacts k_n ≥ 10⁹ N/m, stick springs k_t ≥ 10⁹ N/m, tiny gaps or damping; measured
+on cases/lumped_rattle.yaml with one parameter changed, docs/hbm.md "At the extremes"):
+
+- A re-solve with 2N reorients along the secant of the two points before it *with the old N*
+  (across N the jump of x can outweigh the step: with k_t = 10⁹ N/m the sweep ran back down its
+  own branch from 63.9 Hz to the band start).
+- Physical corners. Where the panel first touches (grazing) a hard contact turns the branch at
+  ~110° within a length no N resolves (10⁹ N/m: 111° at N = 512 … 16384). A stall within
+  ``FOLD_DISTANCE`` of a point where N was already raised steps past the corner
+  (:func:`_corner_step`, the point's ``reason`` says so) instead of raising N again; so does a
+  stall once N is at ``MAX_STALL_FACTOR`` × N. From then on the tangent is oriented along the
+  last secant (at a corner crossed within one step, t_i oriented like t_{i−1} points back).
+- Unresolved contact forces. Each accepted point's residual with 2N samples is measured (one AFT
+  evaluation); above ``ALIASING_LIMIT`` the point is re-solved with 2N, 4N, … until it is below
+  ``ALIASING_TARGET`` (≤ ``MAX_STALL_FACTOR`` × N) and the sweep goes on with that N (measured
+  largest values along the shipped sweeps: 2.6·10⁻³ lumped_rattle, 6.3·10⁻³ rattle_rig; 0.075
+  with k_n = 10⁹ N/m at N = 256). Stalls (and, once a corner was stepped past or N raised for
+  this, turns) raise N up to ``MAX_STALL_FACTOR`` × N.
+- Stiff contacts: a point whose full residual misses ``full_tolerance`` (≈ k_n ‖R_c‖ / ‖f̃_e‖) is
+  tightened at its ω by the fixed-frequency Newton and its polish (:mod:`sarfe.hbm.solve`).
+- Stops that name the knob: more than ``CORNER_LIMIT`` corners within ``FOLD_DISTANCE`` (raise
+  solver.samples_per_period), or a new point within ``RETRACE_SHARE`` of its step of the path
+  through the earlier points (a closed loop of solutions, or a wrong turn running back along the
+  branch: raise solver.harmonics; at ``MAX_STALL_FACTOR`` × N: the contact is not resolved).
+
 Band edge. A branch that turns back past ω_start is stopped there: the last point is solved at
 exactly ω_start and its ``reason`` says why (no points outside the band).
 
@@ -57,10 +82,17 @@ from sarfe.hbm.solve import (check_omega, finalize, initial_slider, linearized_g
                              wants_condensation)
 
 REPORT_DISTANCE = 1e-4   # scaled arclength below which a new point replaces the last one reported
-MAX_SAMPLES_FACTOR = 16  # N may be raised to 16× the requested one at corners (docstring)
+MAX_SAMPLES_FACTOR = 16  # N may be raised to 16× the requested one at turns of ω (docstring)
+MAX_STALL_FACTOR = 64    # … and to 64× at stalled steps and unresolved contact forces
 BACKUP = 3               # points dropped before re-solving with 2N at a corner or turn
 FOLD_DISTANCE = 0.05     # a turn of ω this close (share of the band) to a checked one is a fold
 COS_CORNER = 0.2         # ω turns with consecutive secants at more than ~80°: a corner, checked
+COS_BEHIND = -0.9        # a corner step's point at more than ~154° from t_i: the old piece behind
+CORNER_LIMIT = 12        # corners stepped past within FOLD_DISTANCE of each other: a crawl, stop
+RETRACE_SKIP = 3         # a new point near the path of the earlier points but these: came back
+RETRACE_SHARE = 0.1      # … within this share of its step
+ALIASING_LIMIT = 2e-2    # residual of a point with 2N samples above which N is doubled (docstring)
+ALIASING_TARGET = 5e-3   # … until it is below this (a margin: the contact hardens along the branch)
 
 
 DENSE_BELOW = 500        # a sparse J of fewer rows is bordered and factorized dense (sp.bmat and
@@ -166,12 +198,15 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
 
     inner = {}
     refined_at = []                 # ω where a turn was checked with 2N
+    physical = False                # a corner stayed after raising N: orientation by secants
+    extreme = False                 # a corner was stepped past or N raised for aliasing
+    corners_at = []                 # ω of the corners stepped past
 
-    def refine_samples():
+    def refine_samples(factor=MAX_SAMPLES_FACTOR):
         """(k, point k re-solved with 2N — 4N, … when that fails) after backing up BACKUP points
-        (or none), or (0, None) when no re-solve up to MAX_SAMPLES_FACTOR × N converges."""
+        (or none), or (0, None) when no re-solve up to ``factor`` × the requested N converges."""
         N_fine = 2 * problem.samples_per_period
-        while N_fine <= MAX_SAMPLES_FACTOR * samples_per_period:
+        while N_fine <= factor * samples_per_period:
             fine = replace(problem, samples_per_period=N_fine)
             for k in dict.fromkeys((max(0, len(solutions) - 1 - BACKUP), len(solutions) - 1)):
                 point = solve_from(fine, solutions[k].omega, solutions[k].displacement, so, None)
@@ -185,6 +220,104 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
         if jacobian:
             inner["z"], inner["ev"] = zz, e
         return e
+
+    def pass_corner(t):
+        """:func:`_corner_step` at z, travelling along the secant from the point before (t_i at
+        the first point: at a corner crossed within a step, t_i oriented like t_{i−1} may point
+        back), with spheres of radius ≤ that secant's length."""
+        direction_z, radius = t, options.initial_step
+        if len(solutions) > 1:
+            before = solutions[-2]
+            secant = z - np.append(to_x(before.displacement) / x_scale, before.omega / span)
+            size = np.linalg.norm(secant)
+            if size > 0:
+                direction_z, radius = secant / size, min(radius, size)
+        for r in (options.initial_step, 4 * options.initial_step):   # across a sawtooth
+            result = _corrector(evaluate_z, z, z + r * direction_z, direction_z, r, x_scale, span,
+                                corrector, accept)
+            if result is not None:
+                d = result.x - z
+                return result, float(d @ direction_z / np.linalg.norm(d))
+        return _corner_step(evaluate_z, z, direction_z, radius, x_scale, span, corrector, accept)
+
+    fine_evaluator = {}
+
+    def aliasing(N, zz):
+        """‖R(x)‖ / reference of the point zz (solved with N AFT samples) evaluated with 2N
+        samples: how far the contact forces move when the sampling is refined."""
+        N_fine = 2 * N
+        if fine_evaluator.get("key") != (N_fine, condensed, id(problem)):
+            fine_evaluator["key"] = (N_fine, condensed, id(problem))
+            fine_evaluator["evaluate"] = make_evaluator(
+                replace(problem, samples_per_period=N_fine), condensed, False)[0]
+        with np.errstate(all="ignore"):
+            e = fine_evaluator["evaluate"](zz[:-1] * x_scale, zz[-1] * span, False,
+                                           state["slider"])
+        return float(np.linalg.norm(e.residual) / e.reference)
+
+    def resolve_aliasing(result):
+        """The accepted point re-solved with 2N, 4N, … (≤ MAX_SAMPLES_FACTOR × the requested N)
+        until its residual with twice its N is ≤ ALIASING_TARGET (or the cap), or None."""
+        omega_new = result.x[-1] * span
+        U = to_displacement(result.x[:-1] * x_scale, omega_new, result.evaluation)
+        N_fine, point = problem.samples_per_period, None
+        while 2 * N_fine <= MAX_STALL_FACTOR * samples_per_period:
+            N_fine *= 2
+            fine = replace(problem, samples_per_period=N_fine)
+            trial = solve_from(fine, omega_new, U, so, None)
+            if not trial.converged:
+                break
+            point, U = trial, trial.displacement
+            zz = np.append(to_x(U) / x_scale, omega_new / span)
+            if (2 * N_fine > MAX_STALL_FACTOR * samples_per_period
+                    or aliasing(N_fine, zz) <= ALIASING_TARGET):
+                break
+        return point
+
+    trail = {}
+
+    def retraces(zz, length):
+        """Does zz lie within RETRACE_SHARE × the step ``length`` of the path through the reported
+        points before the last RETRACE_SKIP ones: the sweep came back onto its own branch (a
+        closed loop, or a wrong turn at a corner that runs back along it)?"""
+        earlier = solutions[:-RETRACE_SKIP]
+        if len(earlier) < 2 or length <= 0:
+            return False
+        key = (x_scale, condensed)
+        if trail.get("key") != key:
+            trail.clear()
+            trail["key"] = key
+        Z = np.array([trail.setdefault(id(s), np.append(to_x(s.displacement) / x_scale,
+                                                         s.omega / span)) for s in earlier])
+        a, b = Z[:-1], Z[1:]
+        ab = b - a
+        share = np.clip(np.einsum("ij,ij->i", zz - a, ab)
+                        / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300), 0.0, 1.0)
+        gap = np.linalg.norm(a + share[:, None] * ab - zz, axis=1)
+        return bool(gap.min() < RETRACE_SHARE * length)
+
+    def came_back(omega):
+        """The stop reason of a sweep that came back onto its own branch, naming the knob."""
+        N, H = problem.samples_per_period, problem.harmonics
+        if 2 * N > MAX_STALL_FACTOR * samples_per_period:
+            return (f"the branch came back onto itself near {omega / (2 * np.pi):.5g} Hz at "
+                    f"N = {N}, the most samples the sweep raises N to ({MAX_STALL_FACTOR} × "
+                    "solver.samples_per_period): the contact forces are not resolved — raise "
+                    "solver.samples_per_period, or soften the contact (its stiffness)")
+        return (f"the branch came back onto itself near {omega / (2 * np.pi):.5g} Hz (a closed "
+                f"loop of solutions at H = {H}, N = {N}): raise solver.harmonics")
+
+    def crawling(omega):
+        """The stop reason of a sweep that meets a corner every few steps, naming the knob."""
+        N = problem.samples_per_period
+        capped = 2 * N > MAX_STALL_FACTOR * samples_per_period
+        return (f"more than {CORNER_LIMIT} corners of the branch within "
+                f"{FOLD_DISTANCE * span / (2 * np.pi):.3g} Hz of {omega / (2 * np.pi):.5g} Hz "
+                f"at N = {N}" + (f", the most samples the sweep raises N to ({MAX_STALL_FACTOR} × "
+                                 "solver.samples_per_period)" if capped else "")
+                + " (the sampled contact forces switch a sample at a time): raise "
+                "solver.samples_per_period" + (", or soften the contact (its stiffness)"
+                                               if capped else ""))
 
     def stop(reason):
         last = solutions[-1]
@@ -205,6 +338,7 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
                 continue
             return stop("singular bordered Jacobian (tangent)")
         refined = None                 # point k re-solved with 2N (stalled step or turn of ω)
+        corner = None                  # cosine of a corner stepped past (_corner_step)
         while True:
             predicted = z + step * t
             result = _corrector(evaluate_z, z, predicted, t, step, x_scale, span, corrector, accept)
@@ -217,13 +351,30 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
                 break
             step *= 0.5
             if step < options.min_step:
-                refined_at.append(z[-1] * span)
-                k, refined = refine_samples()
-                if refined is None:
+                omega_i = z[-1] * span
+                persists = any(abs(omega_i - w) < FOLD_DISTANCE * span for w in refined_at)
+                physical = physical or persists
+                passed = None
+                if persists:   # 2N did not remove a corner here: a corner of the branch itself
+                    passed = pass_corner(t)
+                if passed is None:
+                    refined_at.append(omega_i)
+                    k, refined = refine_samples(MAX_STALL_FACTOR)
+                    if refined is None and not persists:
+                        passed = pass_corner(t)
+                if passed is not None:
+                    (result, corner), refined = passed, None
+                    step = np.linalg.norm(result.x - z)
+                    extreme = True
+                    corners_at.append(omega_i)
+                    if sum(abs(omega_i - w) < FOLD_DISTANCE * span for w in corners_at) > \
+                            CORNER_LIMIT:
+                        return stop(crawling(omega_i))
+                elif refined is None:
                     return stop(f"step below min_step {options.min_step:g} near ω = "
-                                f"{z[-1] * span:.6g} (N = {problem.samples_per_period})")
+                                f"{omega_i:.6g} (N = {problem.samples_per_period})")
                 break
-        if refined is None and len(solutions) > 1:
+        if refined is None and corner is None and len(solutions) > 1:
             omega_i = z[-1] * span
             z_prev = np.append(to_x(solutions[-2].displacement) / x_scale,
                                solutions[-2].omega / span)
@@ -232,20 +383,32 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
             turned = behind[-1] * ahead[-1] < 0 and (sharp or refined_at)
             if turned and not any(abs(omega_i - w) < FOLD_DISTANCE * span for w in refined_at):
                 refined_at.append(omega_i)      # ω turns at a corner: checked with 2N
-                k, refined = refine_samples()
+                k, refined = refine_samples(MAX_STALL_FACTOR if extreme else MAX_SAMPLES_FACTOR)
+        why = "a stalled step or a turn of ω, checked with finer AFT sampling"
+        if refined is None and problem.samples_per_period < MAX_STALL_FACTOR * samples_per_period:
+            aliased = aliasing(problem.samples_per_period, result.x)
+            if aliased > ALIASING_LIMIT:    # the contact forces are not resolved by N samples
+                refined = resolve_aliasing(result)
+                if refined is not None:
+                    k, extreme = len(solutions), True
+                    why = (f"with {problem.samples_per_period} samples the residual of this point "
+                           f"at twice as many was {aliased:.2g} > {ALIASING_LIMIT:g}: the contact "
+                           "forces were not resolved")
         if refined is not None:        # continue with 2N from the re-solved point k
             problem = replace(problem, samples_per_period=refined.samples_per_period)
             full_problem = replace(full_problem, samples_per_period=refined.samples_per_period)
             evaluate, to_x, to_displacement = make_evaluator(problem, condensed)
             state["slider"] = initial_slider(problem, refined.displacement)
+            replaced = (np.append(to_x(solutions[k].displacement) / x_scale,
+                                  solutions[k].omega / span) if k < len(solutions) else result.x)
             del solutions[k:]
             solutions.append(replace(refined, reason=f"{refined.reason} (N raised to "
-                                     f"{refined.samples_per_period} here: a stalled step or a turn "
-                                     f"of ω, checked with finer AFT sampling)"))
+                                     f"{refined.samples_per_period} here: {why})"))
             z = np.append(to_x(refined.displacement) / x_scale, refined.omega / span)
-            if k > 0:               # orientation: the secant from the point before
-                before = solutions[k - 1]
-                previous = z - np.append(to_x(before.displacement) / x_scale, before.omega / span)
+            if k > 0:               # orientation: the secant from the point before, both
+                before = solutions[k - 1]      # with the old N (across N, the change of x with
+                previous = replaced - np.append(to_x(before.displacement) / x_scale,  # N can
+                                                before.omega / span)                  # dominate)
                 previous /= max(np.linalg.norm(previous), 1e-300)
             else:
                 previous = np.zeros_like(z)
@@ -255,6 +418,8 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
             continue
         z_new = result.x
         omega_new = z_new[-1] * span
+        if retraces(z_new, np.linalg.norm(z_new - z)):
+            return stop(came_back(omega_new))
         U_new = to_displacement(z_new[:-1] * x_scale, omega_new, result.evaluation)
         if direction * (omega_new - omega_end) >= 0:      # passed the end: solve at ω_end exactly
             fraction = (omega_end - z[-1] * span) / (omega_new - z[-1] * span)
@@ -267,6 +432,20 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
             return solutions
         point = finalize(problem, omega_new, U_new, True, "converged", result.iterations,
                          state["slider"], so)
+        if not point.converged and "above full_tolerance" in point.reason:
+            # a stiff contact: the corrector's tolerance on the contact rows leaves a full
+            # residual ≈ k_n ‖R_c‖ / ‖f̃_e‖ above full_tolerance — tightened at this ω by the
+            # fixed-frequency Newton and its polish (sarfe.hbm.solve)
+            polished = solve_from(problem, omega_new, U_new, so, state["slider"])
+            if polished.converged:
+                point = replace(polished, iterations=result.iterations + polished.iterations,
+                                reason=f"{polished.reason} (tightened at fixed ω: {point.reason})")
+                U_new = polished.displacement
+                z_new = np.append(to_x(U_new) / x_scale, omega_new / span)
+        if corner is not None:
+            point = replace(point, reason=f"{point.reason} (a corner of the branch passed by a "
+                            f"sphere step: the piece ahead at {np.degrees(np.arccos(corner)):.0f}° "
+                            f"from the tangent, N = {problem.samples_per_period})")
         full = escalate(point, U_new)
         if full is not None:           # continue with all orders from the re-solved point
             if not full.converged:
@@ -299,6 +478,8 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
             return solutions
         if len(solutions) >= options.max_points:
             return stop(f"max_points {options.max_points} reached")
+        if (physical or extreme) and full is None:
+            t = (z_new - z) / np.linalg.norm(z_new - z)    # orientation past corners: the secant
         previous, z = t, z_new
         if result.iterations <= options.target_iterations:
             step = min(step * options.step_growth, options.max_step)
@@ -319,9 +500,11 @@ def _band_edge(problem, solutions, point, omega_start, options, slider):
     return solutions
 
 
-def _corrector(evaluate_z, z, predicted, t, step, x_scale, span, options, accept):
+def _corrector(evaluate_z, z, predicted, t, step, x_scale, span, options, accept, travel=None,
+               cos_min=0.0):
     """Newton on R(z) = 0 with t·(z − z_p) = 0 (hyperplane), or ‖z − z_i‖² = Δs² when t is None
-    (sphere). Returns the converged NewtonResult within 3 Δs of z_i, or None."""
+    (sphere). Returns the converged NewtonResult within 3 Δs of z_i, or None. A sphere point must
+    lie ahead: cos(z − z_i, d) > ``cos_min`` with d = ``travel`` (default z_p − z_i)."""
     def augmented(zz, jacobian):
         e = evaluate_z(zz, jacobian)
         if t is not None:
@@ -340,7 +523,46 @@ def _corrector(evaluate_z, z, predicted, t, step, x_scale, span, options, accept
     except SingularJacobian:
         return None
     if result.converged and np.linalg.norm(result.x - z) <= 3 * step:
-        if t is None and (result.x - z) @ (predicted - z) <= 0:
+        ahead = predicted - z if travel is None else travel
+        if t is None and (result.x - z) @ ahead <= cos_min * np.linalg.norm(
+                result.x - z) * np.linalg.norm(ahead):
             return None          # the sphere's backward intersection
         return result
+    return None
+
+
+def _corner_step(evaluate_z, z, t, radius, x_scale, span, options, accept):
+    r"""A step past a corner of the branch just ahead of z_i, where the correctors stall: the
+    piece ahead leaves at an angle to t_i (the direction of travel: the secant from z_{i−1}) that
+    no hyperplane t_iᵀ(z − z_p) = 0 meets near z_i, and whose sphere point the plain sphere
+    corrector rejects as lying 'behind' (more than 90° from t_i).
+
+    A sphere ‖z − z_i‖ = r meets the branch twice: on the piece behind z_i and on the piece
+    ahead. The point behind is found first (Newton on the sphere from z_i − r t_i); the piece
+    ahead is then sought from z_i + r t_B, z_i − r t_B and z_i + r t_i, where t_B is the tangent at
+    z_i + (r/8) t_i (past the corner: the contact state of the piece ahead holds there), and the
+    first converged point that is not the point behind (farther than 10⁻³ r from it; where the
+    point behind was not found: cos(z − z_i, t_i) > ``COS_BEHIND``) is taken, for r = ``radius``,
+    r/8, r/64. The test by position, not angle, also passes a fold at a corner, whose piece ahead
+    returns almost antiparallel to t_i. Measured on cases/lumped_rattle.yaml with k_n = 10⁹ N/m,
+    where the panel first touches the bracket (42.4 Hz): the piece ahead at 110° from t_i, found
+    from z_i − r t_B in 5 Newton iterations for r = 10⁻³ … 0.02.
+    Returns (NewtonResult, cosine of z − z_i with t_i) or None."""
+    for r in (radius, radius / 8, radius / 64):
+        behind = _corrector(evaluate_z, z, z - r * t, None, r, x_scale, span, options, accept,
+                            cos_min=-2.0)
+        try:
+            beyond = tangent(evaluate_z(z + r / 8 * t, True), x_scale, span, t)
+        except SingularJacobian:
+            beyond = t
+        for start in (z + r * beyond, z - r * beyond, z + r * t):
+            result = _corrector(evaluate_z, z, start, None, r, x_scale, span, options, accept,
+                                cos_min=-2.0)
+            if result is None:
+                continue
+            d = result.x - z
+            cosine = float(d @ t / np.linalg.norm(d))
+            if (np.linalg.norm(result.x - behind.x) > 1e-3 * r if behind is not None
+                    else cosine > COS_BEHIND):
+                return result, cosine
     return None

@@ -79,9 +79,10 @@ import numpy as np
 
 from sarfe.hbm import laws
 from sarfe.hbm.harmonics import derivative_matrix, time_samples
-from sarfe.hbm.solve import linearized_guess, make_problem
+from sarfe.hbm.solve import linearized_guess, linearized_rows, make_problem
 
-__all__ = ["OnsetFactors", "RestResponse", "rest_response", "onset_factors",
+__all__ = ["OnsetFactors", "RestResponse", "rest_contacts", "rest_rows", "rest_response",
+           "onset_factors",
            "excitation_onset", "ONSET_SAMPLES"]
 
 ONSET_SAMPLES = 512     # samples of the period on which s(θ) is minimized (then refined)
@@ -118,11 +119,14 @@ class OnsetFactors:
             return 20.0 * np.log10(self.factor)
 
 
-def _rest_contacts(contacts, slid=None):
-    """The set whose law linearization (:func:`sarfe.hbm.laws.linearization`) is the rest state:
-    the tangent spring k_t only where the contact carries a static normal force (λ_n(0) > 0),
-    like the pipeline's linear baseline, and not where it ``slid`` (n_c,) bool. For
-    :func:`linearized_guess` only (k_t = 0 is not a valid Jenkins element)."""
+def rest_contacts(contacts, slid=None):
+    """The contact set whose law linearization (:func:`sarfe.hbm.laws.linearization`) is the rest
+    state — the ONE definition shared by the onset factor and the pipeline's linear baseline
+    (:func:`rest_rows`): every normal row closed at u = 0 keeps its law's spring and dashpot (a
+    preloaded pair; open pairs carry nothing), and the tangent spring k_t stays only where the
+    contact carries a static normal force (λ_n(0) > 0: stuck) and not where it ``slid`` (n_c,)
+    bool. For :func:`sarfe.hbm.solve.linearized_guess` and :func:`rest_rows` only (k_t = 0 is not
+    a valid Jenkins element for a solve)."""
     normal, _ = laws.linearization(contacts)
     keep = normal.preload > 0
     if slid is not None:
@@ -131,6 +135,13 @@ def _rest_contacts(contacts, slid=None):
     if "tangential_stiffness" in table:
         table["tangential_stiffness"] = np.where(keep, table["tangential_stiffness"], 0.0)
     return replace(contacts, parameters=table)
+
+
+def rest_rows(contacts):
+    """(spring [N/m], dashpot [N s/m], preload [N]) per row of G in the rest state
+    (:func:`rest_contacts`, :func:`sarfe.hbm.solve.linearized_rows`): the matrices
+    K + Gᵀ diag(spring) G and D + Gᵀ diag(dashpot) G of the linear rest structure."""
+    return linearized_rows(rest_contacts(contacts))
 
 
 @dataclass(frozen=True)
@@ -172,7 +183,7 @@ def rest_response(model, contacts, excitation, omega) -> RestResponse:
     (a few passes; 2-D: the direction of the first stuck trial force is kept). Its dynamic
     response stays the stuck spring's (small motions about the slid position stick)."""
     F = np.asarray(excitation, dtype=float)
-    U = _linear_solve(model, _rest_contacts(contacts), F, omega)
+    U = _linear_solve(model, rest_contacts(contacts), F, omega)
     normal, spring_t = laws.linearization(contacts)
     G = contacts.gap_map
     closed = (contacts.normal_row >= 0) & normal.closed
@@ -206,7 +217,7 @@ def rest_response(model, contacts, excitation, omega) -> RestResponse:
         load = np.zeros(contacts.row_count)
         np.add.at(load, rows_t[on], force[on])
         static[0] = F[0] - np.asarray(G.T @ load)
-        u0 = _linear_solve(model, _rest_contacts(contacts, slid), static, omega)[0]
+        u0 = _linear_solve(model, rest_contacts(contacts, slid), static, omega)[0]
         N0, trial, limit = static_forces(u0)
     tangential = np.where(slid[:, None], limit[:, None] * direction, trial) * friction[:, None]
     displacement = U.copy()

@@ -10,8 +10,10 @@ solve use model; post uses solve; write uses post; run.py and verify.py sit on t
     solve/    points (HBM per frequency or continuation, fallbacks), pruned_points,
               case_accuracy (accuracy target → H, N, cutoff; per-point estimates)
     post/     records (ERP, contact indicators, linear baseline, bands), contribution_records,
-              contact_dynamics, result_data, point_workers (the per-point work on processes)
-    write/    result_files (summary, response.h5, VTU, report; console table), figures
+              contact_dynamics, audibility_records (heard at the occupant), margin_records
+              (onset factor, level sensitivities), review (loudest point's answers, target),
+              result_data, point_workers (the per-point work on processes)
+    write/    result_files (summary, response.h5, VTU, report; table.txt), figures, sound_files
     run.py    solve_case: check → model → solve → post → write
     verify.py verify_point: one point, harmonic balance against time integration
 
@@ -21,7 +23,7 @@ solve use model; post uses solve; write uses post; run.py and verify.py sit on t
     nonlinear_model(case, stage) -> NonlinearModel          damping, contacts, excitation
     solve_case(case, linear_stage=None, output_dir=None, progress=False) -> CaseResult
 """
-from sarfe.case.errors import EXIT_CASE_ERROR, EXIT_NOT_CONVERGED, CaseError
+from sarfe.case.errors import EXIT_CASE_ERROR, EXIT_NOT_CONVERGED, EXIT_TARGET_EXCEEDED, CaseError
 from sarfe.case.read import Case, load_case
 from sarfe.pipeline.checks.mesh_checks import check_mesh
 from sarfe.pipeline.model.contact_pairs import ContactGeometry
@@ -33,4 +35,5 @@ from sarfe.pipeline.write.result_files import results_table
 
 __all__ = ["Case", "CaseError", "CaseResult", "ContactGeometry", "LinearStage", "load_case",
            "linear_model_key", "build_linear_model", "check_mesh", "solve_case",
-           "nonlinear_model", "results_table", "EXIT_CASE_ERROR", "EXIT_NOT_CONVERGED"]
+           "nonlinear_model", "results_table", "EXIT_CASE_ERROR", "EXIT_NOT_CONVERGED",
+           "EXIT_TARGET_EXCEEDED"]

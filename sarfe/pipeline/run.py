@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from sarfe import __version__
-from sarfe.case.errors import EXIT_NOT_CONVERGED
+from sarfe.case.errors import EXIT_NOT_CONVERGED, EXIT_TARGET_EXCEEDED
 from sarfe.case.read import load_case
 from sarfe.hbm.stability.deferred import deferred_stability, pending
 from sarfe.pipeline.checks.case_checks import check_case, reduced_model_warnings
@@ -24,7 +24,9 @@ from sarfe.pipeline.model.nonlinear_model import nonlinear_model
 from sarfe.pipeline.model.stage import linear_model_key
 from sarfe.pipeline.post.point_workers import (first_estimates, point_records, point_work,
                                                point_workers, stability_stream)
+from sarfe.pipeline.post.audibility_records import background_record
 from sarfe.pipeline.post.records import error_estimates, worst_of
+from sarfe.pipeline.post.review import target_check
 from sarfe.pipeline.solve.by_need import erp_measure
 from sarfe.pipeline.solve.case_accuracy import (accuracy_check, case_resolution, resolution_line,
                                                 resolved_case)
@@ -42,7 +44,8 @@ from sarfe.util.progress import bar as progress_bar
 class CaseResult:
     """Result of :func:`solve_case`: ``summary`` (= summary.json), ``rows`` (one flat dict per
     frequency point), ``exit_code`` (0 all converged, 3 some point did not converge or an
-    incomplete sweep left part of its band without converged points),
+    incomplete sweep left part of its band without converged points, 4 ``output.target_dba``
+    exceeded at the loudest point — before 3, :data:`sarfe.case.errors.EXIT_TARGET_EXCEEDED`),
     ``solutions`` (HarmonicSolution per point), ``output_dir`` (None if nothing was written)."""
 
     summary: dict
@@ -186,6 +189,10 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     # without the band still being covered by converged points (docs/hbm.md, exit codes)
     exit_code = EXIT_NOT_CONVERGED if (not_converged or not points or (
         sweep["complete"] is False and not sweep["covered"])) else 0
+    worst = worst_of(points)
+    target_verdict = target_check(config.output.target_dba, worst)
+    if target_verdict is not None and target_verdict["exceeded"]:   # 4 before 3 (case.errors)
+        exit_code = EXIT_TARGET_EXCEEDED
     summary = {
         "sarfe_version": __version__,
         "case": case.name,
@@ -206,7 +213,9 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
                           **_node_pairs(stage, name)) for name, kind, idx in nl.groups],
         "contact_pruning": pruning,              # per contact: open / closed / nonlinear
         "points": points,
-        "worst": worst_of(points),
+        "worst": worst,
+        "target": target_verdict,                # output.target_dba against the loudest point
+        "audibility_model": background_record(config.audibility),   # cabin and background
         "accuracy": accuracy,                    # None unless solver.accuracy was given
         "accuracy_check": mesh_checked(accuracy_check(config.solver, points), mesh_term, case),
         "mesh_error": mesh_term,                 # the ± mesh term (sarfe.pipeline.solve.mesh_error)

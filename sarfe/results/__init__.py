@@ -1,7 +1,8 @@
 """sarfe.results — result writers; each a plain function writing into a given path/directory.
 
 File layouts and array names are documented in the modules: summary.py (summary.json),
-response_h5.py (response.h5), vtk.py (VTU/PVD arrays), plots.py (PNGs).
+response_h5.py (response.h5), vtk.py (VTU/PVD arrays), plots.py (PNGs), console.py (what
+``sarfe solve`` prints: the 80-column summary and the --quiet line).
 
     write_summary_json(path, summary: dict) -> Path            strict JSON, NaN/inf → null + note
     console_table(rows: list[dict], columns=None, formats=None, headers=None, max_rows=None) -> str
@@ -29,7 +30,9 @@ response_h5.py (response.h5), vtk.py (VTU/PVD arrays), plots.py (PNGs).
     plot_erp_spectrum(path, frequencies_hz (H,), level_db (H,), level_a_db=None, title=None) -> Path
     plot_friction(path, friction_time (N, n), state (N, n), names=None, omega=None) -> Path
     plot_third_octave(path, nominal_hz, level_dba, linear_level_dba=None, ...) -> Path
-    plot_contributions(path, names, level_dba, share_a) -> Path
+    plot_contributions(path, names, level_dba, share_a, title=None, part_level_dba=None) -> Path
+    plot_audibility(path, band_hz, spl_db, background_db, threshold_in_quiet_db,
+                    masked_threshold_db, title=None) -> Path
     write_report_html(path, summary, images={key: png}, notes=None) -> Path   (report.py, jinja2)
     render_surface(path, points, triangles, values, label, ...) -> (Path, renderer)  (render.py;
     start_render(jobs) / finish_render(run) render in a child while the caller goes on)
@@ -42,6 +45,7 @@ from sarfe.util.lazy import lazy_exports
 _EXPORTS = {
     "plot_contact_forces": ".plots", "plot_contributions": ".plots", "plot_erp_spectrum": ".plots",
     "plot_erp_sweep": ".plots", "plot_friction": ".plots", "plot_third_octave": ".plots",
+    "plot_audibility": ".plots",
     "write_report_html": ".report",
     "read_response_h5": ".response_h5", "write_response_h5": ".response_h5",
     "console_table": ".summary", "to_jsonable": ".summary", "write_summary_json": ".summary",
@@ -57,5 +61,6 @@ __all__ = [
     "start_erp_sweep", "part_ids",
     "write_deflection_animation", "period_samples", "plot_erp_sweep", "plot_contact_forces",
     "plot_erp_spectrum", "plot_friction", "plot_third_octave", "plot_contributions",
+    "plot_audibility",
     "write_report_html",
 ]

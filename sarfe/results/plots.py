@@ -348,26 +348,73 @@ def plot_third_octave(path, nominal_hz, level_dba, linear_level_dba=None, linear
     return _save(fig, path)
 
 
-def plot_contributions(path, names, level_dba, share_a, title=None) -> Path:
+def plot_contributions(path, names, level_dba, share_a, title=None, part_level_dba=None) -> Path:
     """Horizontal bars of the coherent A-weighted share [%] of each source (ranked as given),
-    annotated with its partial ERP [dB(A)] ('-' for a source with no sound)."""
+    annotated with the level of its part of the total (``part_level_dba``, monotone with the
+    bar) and its level alone (``level_dba``: what it radiates by itself; '-' for no sound)."""
     names = [str(v) for v in names]
     share = 100.0 * np.nan_to_num(np.asarray(share_a, dtype=float))
     level = np.asarray(level_dba, dtype=float)
+    part = np.full(len(names), np.nan) if part_level_dba is None \
+        else np.array([np.nan if v is None else v for v in part_level_dba], dtype=float)
     fig = _figure(7.0, 1.2 + 0.35 * len(names))
     ax = fig.add_subplot()
     y = np.arange(len(names))[::-1]
     colors = ["C3" if v >= 0 else "C0" for v in share]
     ax.barh(y, share, color=colors)
-    for yi, s_, lv in zip(y, share, level):
-        text = f"{lv:.1f} dB(A)" if np.isfinite(lv) else "- dB(A)"
-        ax.annotate(f" {s_:.0f} %, {text}", (max(s_, 0.0), yi), va="center", fontsize="x-small")
+    for yi, s_, lv, pv in zip(y, share, level, part):
+        alone = f"{lv:.1f}" if np.isfinite(lv) else "-"
+        percent = int(round(s_))
+        text = f" {percent} %" + (f" = {pv:.1f} dB(A)" if np.isfinite(pv) and percent > 0
+                                  else "") + f" (alone {alone})"
+        ax.annotate(text, (max(s_, 0.0), yi), va="center", fontsize="x-small")
     ax.set_yticks(y)
     ax.set_yticklabels(names, fontsize="small")
     ax.set_xlabel("coherent share of the A-weighted ERP [%]")
     ax.axvline(0.0, color="k", linewidth=0.6)
-    ax.set_xlim(min(0.0, share.min(initial=0.0)) - 5, max(100.0, share.max(initial=0.0)) + 35)
+    ax.set_xlim(min(0.0, share.min(initial=0.0)) - 5, max(100.0, share.max(initial=0.0)) + 55)
     ax.grid(True, axis="x", alpha=0.3)
+    if title:
+        ax.set_title(title)
+    return _save(fig, path)
+
+
+def plot_audibility(path, band_hz, spl_db, background_db, threshold_in_quiet_db,
+                    masked_threshold_db, title=None) -> Path:
+    """Third-octave SPL at the occupant [dB re 20 µPa] as bars (ISO 532-1 bands 25 Hz … 12.5 kHz)
+    against the background bands, the masked threshold and the threshold in quiet: a bar above
+    both thresholds is audible (its margin annotated)."""
+    f = np.asarray(band_hz, dtype=float)
+    spl, back = np.asarray(spl_db, dtype=float), np.asarray(background_db, dtype=float)
+    quiet = np.asarray(threshold_in_quiet_db, dtype=float)
+    masked = np.asarray(masked_threshold_db, dtype=float)
+    threshold = np.fmax(quiet, np.where(np.isfinite(masked), masked, -np.inf))
+    x = np.arange(f.size)
+    values = np.concatenate([v[np.isfinite(v)] for v in (spl, back, threshold)])
+    floor = float(np.floor(min(values.min(initial=0.0), 0.0) / 10.0) * 10.0)
+    top = float(values.max(initial=60.0)) + 8.0
+    fig = _figure(7.0, 3.8)
+    ax = fig.add_subplot()
+    ax.bar(x, np.where(np.isfinite(spl), spl - floor, 0.0).clip(0.0), 0.7, bottom=floor,
+           color="C1", label="prediction at the occupant")
+    if np.isfinite(back).any():
+        ax.plot(x, np.where(np.isfinite(back), back, np.nan), "s", color="0.55", markersize=3,
+                label="background")
+        ax.plot(x, np.where(np.isfinite(masked), masked, np.nan), "-", color="C0",
+                label="masked threshold")
+    ax.plot(x, quiet, "--", color="k", linewidth=1.0, label="threshold in quiet (ISO 226)")
+    for xi, level, limit in zip(x, spl, threshold):
+        if np.isfinite(level) and level > limit:
+            ax.annotate(f"+{level - limit:.0f}", (xi, level), ha="center", va="bottom",
+                        fontsize="xx-small", color="C3")
+    step = 2
+    ax.set_xticks(x[::step])
+    ax.set_xticklabels([f"{v:g}" for v in f[::step]], rotation=45, fontsize="small")
+    ax.set_xlabel("third-octave band, nominal mid-band frequency [Hz]")
+    ax.set_ylabel("SPL [dB re 20 µPa]")
+    ax.set_ylim(floor, top)
+    ax.grid(True, axis="y", alpha=0.3)
+    ax.legend(fontsize="x-small", loc="upper right")
     if title:
         ax.set_title(title)
     return _save(fig, path)

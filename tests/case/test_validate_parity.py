@@ -87,6 +87,9 @@ MUTATIONS = [
     ("panel-zeta-modes-reversed", "instrument_panel",
      put(("damping", "modal_zeta"), [{"modes": [5, 2], "zeta": 0.02}]),
      ["damping.modal_zeta[0].modes", "first <= last"]),
+    # instrument_panel_sweep (a sweep with output.maps)
+    ("panel-sweep-maps-every-zero", "instrument_panel_sweep",
+     put(("output", "maps"), {"every": 0}), ["output.maps.every", ">= 1"]),
     # squeak_rig (friction)
     ("squeak-no-friction", "squeak_rig", drop(("contacts", 0, "friction_coefficient")),
      ["contacts[0].friction_coefficient", "missing required key"]),

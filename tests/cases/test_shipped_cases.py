@@ -37,6 +37,7 @@ def test_rattle_rig_end_to_end(tmp_path):
     data["excitation"].pop("sweep")
     data["excitation"]["frequency_hz"] = [31.0, 20.0]
     data["output"]["files"] = ["summary", "response", "erp_vtu", "table"]
+    data["output"]["maps"] = {"every": 1}        # a map per point (default: the loudest only)
     result = solve_case(data, output_dir=tmp_path / "rig")
     summary = json.loads((tmp_path / "rig" / "summary.json").read_text())
     assert summary["model"]["kind"] == "fe" and summary["model"]["modes"] >= 10

@@ -112,8 +112,12 @@ def test_ranking_names_the_contact_that_drives_the_panel():
     assert abs(share["stop"]) < 1e-9 and abs(share["excitation"]) < 1e-9
     assert not np.isfinite(result.partial_level_db[result.names.index("stop")])
     lines = ranking_lines(result, 25.0, skip=("excitation",))
-    assert lines[0].startswith("link: ") and "100 % of the total at 25 Hz" in lines[0]
-    assert lines[1] == "stop: - dB(A), 0 % of the total at 25 Hz"
+    link = result.names.index("link")
+    assert lines[0] == (f"link: 100 % of the total = {result.part_level_dba[link]:.1f} dB(A) "
+                        f"(alone {result.partial_level_dba[link]:.1f} dB(A)) at 25 Hz")
+    # all of the sound: its part of the total is the whole, and equal to it alone
+    assert result.part_level_dba[link] == pytest.approx(result.partial_level_dba[link], abs=1e-6)
+    assert lines[1] == "stop: 0 % of the total (alone - dB(A)) at 25 Hz"
 
 
 def test_shares_of_disjoint_fields_are_their_power_fractions():

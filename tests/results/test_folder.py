@@ -354,7 +354,7 @@ def fe_case(folder: Path) -> Path:
     data["excitation"].pop("sweep")
     data["excitation"]["frequency_hz"] = [31.0, 26.0]
     data["solver"].update(harmonics=3, error_estimate=False, stability=False)
-    data["output"] = {"files": ["summary", "table", "erp_vtu", "animation"]}
+    data["output"] = {"files": ["summary", "table", "erp_vtu", "animation"], "maps": {"every": 1}}
     folder.mkdir()
     path = folder / "rig.yaml"
     path.write_text(yaml.safe_dump(data))

@@ -87,6 +87,7 @@ def test_a_failing_writer_stops_the_report_render(tmp_path, monkeypatch):
     data["excitation"]["frequency_hz"] = [31.0, 26.0]
     data["solver"].update(error_estimate=False, stability=False, workers=1)
     data["output"]["files"] = ["summary", "erp_vtu", "report"]
+    data["output"]["maps"] = {"every": 1}     # a series of maps: written on the map workers
     with pytest.raises(RuntimeError, match="disk full"):
         solve_case(data, output_dir=tmp_path / "run")
     assert len(started) == 1

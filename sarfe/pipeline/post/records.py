@@ -3,7 +3,8 @@ third-octave bands, the contribution of each contact, and the loudest point of a
 
 ERP: w_s = N ũ (radiating-node normal displacement harmonics) → :func:`sarfe.erp.
 equivalent_radiated_power`. Linear baseline: (K + Gᵀ diag(k) G − ω² M + iω D) Û = F̂ with the
-contacts at their static state (preloaded pairs as springs, open ones removed) →
+contacts at their static state (preloaded pairs as springs, open ones removed: the rest state
+of :func:`sarfe.hbm.onset.rest_rows`, the same as the onset factor's) →
 :func:`sarfe.erp.risk.linear_risk_from_contacts` and its ERP. Bands: :func:`sarfe.erp.bands.
 third_octave_levels` of the harmonic powers (the linear baseline radiates at ω only).
 Contributions: :mod:`sarfe.pipeline.post.contribution_records`; per-period contact dynamics:
@@ -23,11 +24,14 @@ from sarfe.case.config import CaseConfig, ErpConfig, SolverConfig
 from sarfe.erp import equivalent_radiated_power
 from sarfe.erp.bands import third_octave_levels
 from sarfe.erp.risk import linear_risk_from_contacts
-from sarfe.hbm import laws
+from sarfe.hbm.onset import rest_rows
 from sarfe.hbm.harmonics import time_samples
 from sarfe.pipeline.model.nonlinear_model import NonlinearModel
+from sarfe.pipeline.post.audibility_records import point_audibility
 from sarfe.pipeline.post.contact_dynamics import contact_dynamics
 from sarfe.pipeline.post.contribution_records import contributions_record, point_condensation
+from sarfe.pipeline.post.margin_records import point_margins
+from sarfe.pipeline.post.review import loudest_review
 from sarfe.pipeline.solve.case_accuracy import stage_error_estimate
 from sarfe.results.vtk import radiating_fields
 from sarfe.util.workers import map_points
@@ -106,32 +110,12 @@ def contact_indicators(solution, nl: NonlinearModel) -> list[dict]:
     return out
 
 
-def baseline_rows(contacts):
-    """(spring [N/m], dashpot [N s/m]) of every row of G in the linear baseline: the contacts at
-    their static state (no static load: the rest position, u = 0; each law's linearization,
-    :func:`sarfe.hbm.laws.linearization`). A pair closed there (g ≤ 0: a preloaded pair, g = the
-    overclosure that carries the preload) keeps its normal spring and dashpot; a friction pair
-    that carries a static normal force there (closed, or a constant normal load N0 > 0) is stuck
-    and keeps k_t on its tangent rows. Open pairs are removed (0)."""
-    c = contacts
-    normal, tangent = laws.linearization(c)
-    springs, dashpots = np.zeros(c.row_count), np.zeros(c.row_count)
-    closed = (c.normal_row >= 0) & normal.closed
-    springs[c.normal_row[closed]] = normal.spring[closed]
-    dashpots[c.normal_row[closed]] = normal.dashpot[closed]
-    stuck = normal.preload > 0
-    for col in range(2):
-        present = (c.tangent_rows[:, col] >= 0) & stuck
-        springs[c.tangent_rows[present, col]] = tangent[present]
-    return springs, dashpots
-
-
 _BASELINE = {}     # the matrices of the last model: every point of a run shares them
 
 
 def baseline_matrices(nl: NonlinearModel):
-    """Dense (K + Gᵀ diag(k) G, M, D + Gᵀ diag(c) G) of the linear baseline (:func:`baseline_rows`),
-    built once per model (not per frequency point)."""
+    """Dense (K + Gᵀ diag(k) G, M, D + Gᵀ diag(c) G) of the linear baseline (the rest state,
+    :func:`sarfe.hbm.onset.rest_rows`), built once per model (not per frequency point)."""
     hit = _BASELINE.get(id(nl))
     if hit is not None and hit[0] is nl:
         return hit[1]
@@ -139,7 +123,7 @@ def baseline_matrices(nl: NonlinearModel):
     K, M, D = dense(nl.model.stiffness), dense(nl.model.mass), dense(nl.model.damping)
     if nl.contacts.count:
         G = sp.csr_matrix(nl.contacts.gap_map)
-        k, c = baseline_rows(nl.contacts)
+        k, c, _ = rest_rows(nl.contacts)
         K = K + (G.T @ sp.diags(k) @ G).toarray()
         D = D + (G.T @ sp.diags(c) @ G).toarray()
     _BASELINE.clear()
@@ -149,7 +133,7 @@ def baseline_matrices(nl: NonlinearModel):
 
 def baseline_response(nl: NonlinearModel, omega, condensation=None) -> np.ndarray:
     """Û (n,) complex [m] of (K + Gᵀ diag(k) G − ω² M + iω (D + Gᵀ diag(c) G)) Û = F̂
-    (:func:`baseline_rows`).
+    (:func:`sarfe.hbm.onset.rest_rows`).
 
     With the point's condensation (:func:`sarfe.pipeline.post.contribution_records.point_condensation`, order
     1 kept) no matrix of model size is factorized: with y = Z₁⁻¹F̂, Y = Z₁⁻¹Gᵀ, C = G Z₁⁻¹ Gᵀ and
@@ -160,7 +144,7 @@ def baseline_response(nl: NonlinearModel, omega, condensation=None) -> np.ndarra
     Otherwise (or when that system is singular) one dense LU of the matrix (least squares only for
     a singular one: an undamped free-floating part)."""
     if condensation is not None and nl.contacts.count and 1 in np.asarray(condensation.orders):
-        springs, dashpots = baseline_rows(nl.contacts)
+        springs, dashpots, _ = rest_rows(nl.contacts)
         s = springs + 1j * omega * dashpots
         active = np.flatnonzero(s != 0)
         order = int(np.flatnonzero(np.asarray(condensation.orders) == 1)[0])
@@ -207,7 +191,7 @@ def linear_baseline(erp: ErpConfig, stage, nl: NonlinearModel, omega, condensati
                     response=None, normal_displacement=None):
     """Linear response at ω of the structure with its contacts at their static state: preloaded
     (closed) pairs as their linearized spring k_n (and dashpot c_n), stuck friction pairs as k_t,
-    open pairs removed (:func:`baseline_rows`):
+    open pairs removed (:func:`sarfe.hbm.onset.rest_rows`):
 
         (K + Gᵀ diag(k) G − ω² M + iω (D + Gᵀ diag(c) G)) Û = F̂   [m],
 
@@ -451,6 +435,13 @@ def _point_record(config, stage, nl, index, solution, error_estimate, condensati
     erp, W = point_erp(config.erp, stage, U, omega, W_both[:U.shape[0]])
     linear = linear_baseline(config.erp, stage, nl, omega, condensation, response=U1,
                              normal_displacement=W_both[U.shape[0]:])
+    for record, margin in zip(contacts, point_margins(config, stage, nl, solution)):
+        record.update(margin)           # onset factor and level sensitivities (what would fix it)
+    areas = stage.erp_areas if W.shape[1] == np.size(stage.erp_areas) else np.zeros(W.shape[1])
+    audibility = point_audibility(config, erp, W, areas, contributions)
+    alone = {source["name"]: source for source in audibility["sources"]}
+    for record in contacts:
+        record["audibility"] = alone.get(record["name"])
     point = {
         "index": index, "frequency_hz": omega / (2 * np.pi), "omega_rad_s": omega,
         "converged": bool(solution.converged), "stable": None, "stability_note": "",
@@ -463,13 +454,16 @@ def _point_record(config, stage, nl, index, solution, error_estimate, condensati
         "harmonic_set": harmonic_set_record(config.solver, solution),
         "bands": band_record(erp, linear, omega),
         "contributions": contributions,
+        "audibility": audibility,
     }
     row = {"case": config.name, "point": index, "frequency_hz": point["frequency_hz"],
            "converged": point["converged"], "stable": None,
            "iterations": point["iterations"], "erp_W": erp.power_total,
            "erp_db": erp.level_total_db, "erp_dba": erp.level_total_a_db,
            "linear_erp_db": linear["erp_level_db"], "linear_erp_dba": linear["erp_level_dba"],
-           "erp_error_db": float("nan")}
+           "erp_error_db": float("nan"), "occupant_spl_dba": audibility["spl_dba"],
+           "loudness_sone": audibility["loudness_sone"], "audible": audibility["audible"],
+           "audibility_margin_db": audibility["margin_db"]}
     with_verdict(point, row, solution)
     with_estimate(point, row, _error_estimate(config.solver, stage, nl, solution)
                   if error_estimate is False else error_estimate)
@@ -480,6 +474,9 @@ def _point_record(config, stage, nl, index, solution, error_estimate, condensati
                 row[f"{c['name']}.{key}"] = c[key]
     for c in linear["contacts"]:
         row[f"{c['name']}.linear_rattle_risk"] = c["rattle_risk"]
+        row[f"{c['name']}.dynamic_tolerance_m"] = c["dynamic_tolerance_m"]
+    for c in contacts:
+        row[f"{c['name']}.onset_factor"] = (c.get("onset") or {}).get("factor", float("nan"))
     return (point, row) + map_fields(config, stage, erp, W, omega)
 
 
@@ -544,7 +541,7 @@ def worst_of(points):
                  "ranking": contributions.get("ranking", []),
                  "excitation": None if excitation is None else {
                      "level_dba": excitation["level_dba"], "share_a": excitation["share_a"]},
-                 "bands": p.get("bands"), "contacts": {}}
+                 "bands": p.get("bands"), "contacts": {}, **loudest_review(p)}
     for c_index, c in enumerate(points[0]["contacts"]):
         pen = [p["contacts"][c_index]["max_penetration_m"] for p in points]
         force = [p["contacts"][c_index]["peak_normal_force_N"] for p in points]

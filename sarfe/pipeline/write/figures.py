@@ -1,5 +1,5 @@
 """The PNG figures of a run (``erp_sweep.png``, ``erp_spectrum.png``, ``third_octave.png``,
-``contributions.png``, ``contact_forces.png``, ``friction.png``) and the report's surface maps,
+``contributions.png``, ``audibility.png``, ``contact_forces.png``, ``friction.png``) and the report's surface maps,
 all "at the loudest point" drawn at the one point ``summary["worst"]["index"]``."""
 from __future__ import annotations
 
@@ -70,7 +70,16 @@ def point_figures(config, stage, nl, summary, solutions, erps, directory: Path, 
         images["contributions"] = results.plot_contributions(
             directory / "contributions.png", [s["name"] for s in sources],
             [s["level_dba"] for s in sources], [s["share_a"] for s in sources],
-            title=f"share of the A-weighted ERP at {at}")
+            title=f"share of the A-weighted ERP at {at}",
+            part_level_dba=[s.get("part_level_dba") for s in sources])
+    audibility = points[j].get("audibility") or {}
+    if audibility.get("bands"):
+        b = audibility["bands"]
+        images["audibility"] = results.plot_audibility(
+            directory / "audibility.png", b["band_hz"], b["spl_db"], b["background_db"],
+            b["threshold_in_quiet_db"], b["masked_threshold_db"],
+            title=f"{config.name}: at the occupant at {at} "
+            f"(background {Path(config.audibility.background).stem})")
     if nl.contacts.count:
         force = np.asarray(solutions[j].contact_force_time)
         normal_rows = nl.contacts.normal_row

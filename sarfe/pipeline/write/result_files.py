@@ -13,8 +13,10 @@ from sarfe import results
 from sarfe.hbm.laws import table_column
 from sarfe.pipeline.post.point_workers import point_workers
 from sarfe.pipeline.post.records import point_erp
-from sarfe.pipeline.post.result_data import contact_pair_fields, result_groups
+from sarfe.pipeline.post.result_data import (contact_margin_fields, contact_pair_fields,
+                                             result_groups)
 from sarfe.pipeline.write import figures
+from sarfe.pipeline.write.sound_files import SOUND_FILES, write_point_sound
 from sarfe.pipeline.write.map_points import map_indices
 from sarfe.reduction.recovery import recover_displacement
 from sarfe.results import render
@@ -104,6 +106,8 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, di
                                           contact_marker=markers, contact_force=force,
                                           contact_displacement=motion,
                                           node_ids=getattr(stage, "node_ids", None))
+            # onset factor, dynamic tolerance, sensitivity at the contact nodes (what would fix it)
+            data.update(contact_margin_fields(stage, nl, summary["points"][j], mesh.n_nodes))
             if j == loudest:
                 loudest_data[j] = data
             return data
@@ -165,13 +169,21 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, di
         images = figures.point_figures(config, stage, nl, summary, solutions, erps, plot_dir, loudest)
         if "plots" in files:
             written["plots"] = ", ".join(sorted(Path(v).name for v in images.values()))
+    sounds = {}
+    if ("sound" in files or "report" in files) and loudest is not None:
+        sound_dir = directory if "sound" in files else directory / ".report-figures"
+        summary["sound"] = write_point_sound(config, summary["points"][loudest], sound_dir)
+        sounds = {name: sound_dir / name for name in (summary["sound"] or {}).get("files", {})}
+        if "sound" in files and sounds:
+            written["sound"] = ", ".join(name for name in SOUND_FILES if name in sounds)
     if series is not None:
         series.finish()
     if renders is not None:
         maps = figures.finish_surface_maps(renders)
     if "report" in files:
         notes = {"renderer": maps.pop("renderer", None)}
-        results.write_report_html(directory / "report.html", summary, {**images, **maps}, notes)
+        results.write_report_html(directory / "report.html", summary, {**images, **maps}, notes,
+                                  sounds=sounds)
         written["report"] = "report.html"
     shutil.rmtree(directory / ".report-figures", ignore_errors=True)
     return written
@@ -258,6 +270,11 @@ def results_table(rows, contact_types=None, max_contacts=6, compact=False) -> st
         # the error estimate of the ERP level (summary.json points[].error_estimate.erp_db)
         columns.insert(columns.index("erp_dba") + 1, "erp_error_db")
         headers["erp_error_db"], formats["erp_error_db"] = "±dB", ".2f"
+    if rows and "occupant_spl_dba" in rows[0]:     # heard at the occupant (audibility)
+        columns += ["occupant_spl_dba", "audible", "audibility_margin_db"]
+        headers.update(occupant_spl_dba="SPL [dB(A)]", audible="heard",
+                       audibility_margin_db="margin [dB]")
+        formats.update(occupant_spl_dba=".1f", audibility_margin_db="+.1f")
     names = [k[: -len(".max_penetration_m")] for k in (rows[0] if rows else {})
              if k.endswith(".max_penetration_m")]
     for name in names[:max_contacts]:
@@ -269,9 +286,13 @@ def results_table(rows, contact_types=None, max_contacts=6, compact=False) -> st
         columns.append(key)
         headers[key] = header
         formats[key] = fmt
+        if f"{name}.onset_factor" in rows[0]:   # onset factor s* of the excitation (< 1: active)
+            columns.append(f"{name}.onset_factor")
+            headers[f"{name}.onset_factor"] = f"{name} onset"
+            formats[f"{name}.onset_factor"] = ".3g"
     shown = [dict(row) for row in rows]
     for row in shown:  # a motionless surface's level reads "-"
-        for key in ("erp_db", "erp_dba", "linear_erp_db"):
+        for key in ("erp_db", "erp_dba", "linear_erp_db", "occupant_spl_dba"):
             if key in row:
                 row[key] = shown_level(row[key])
     if "erp_error_db" in columns:  # "~": interpolated between estimated points (not estimated)

@@ -61,8 +61,9 @@ def test_report_is_self_contained_with_every_section(report):
     page = Page()
     page.feed(path.read_text(encoding="utf-8"))
     assert page.external == []                                    # no network, no other file
-    assert page.sections == ["headline", "case", "accuracy", "erp", "ranking", "bands",
-                             "contacts", "maps", "points"]
+    # first screen: verdict, then who makes it (issue 31 item 5); audibility when computed
+    assert [s for s in page.sections if s != "audibility"] == [
+        "headline", "ranking", "case", "accuracy", "erp", "bands", "contacts", "maps", "points"]
     for table in ("ranking-table", "band-table", "points-table"):
         assert table in page.tables
     # five listed frequencies: the level-vs-frequency plot and every plot at the loudest point

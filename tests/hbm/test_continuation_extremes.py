@@ -1,0 +1,149 @@
+"""Continuation at the extremes (issue 29 item 5): cases/lumped_rattle.yaml with one parameter
+pushed — a hard contact (k_n = 10⁹, 10¹⁰ N/m), a tiny gap (10⁻⁷ m), light damping (ζ = 10⁻⁴), a
+stiff stick spring on the seal (k_t = 10⁹ N/m) — is swept 30 → 90 Hz by continuation to the end
+of the band (``sweep_complete``), or stops with one line naming the knob to turn.
+
+The continued branch is checked against the independent Newmark time integration
+(:func:`sarfe.hbm.time_integration.integrate_time`) at k_n = 10¹⁰ N/m: a few points of the sweep,
+each integrated from its HBM solution until periodic, must keep their first harmonic (the physics,
+not the code's own earlier output).
+
+The full sweeps take 1-3 min each (``@pytest.mark.slow``; times and points in
+benchmarks/results/extremes.md, benchmarks/engine/bench_extremes.py).
+"""
+from __future__ import annotations
+
+import importlib
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sarfe.case.read import load_case
+from sarfe.hbm.time_integration import integrate_time
+from sarfe.pipeline import solve_case
+from sarfe.pipeline.model.linear_stage import build_linear_model
+from sarfe.pipeline.model.nonlinear_model import nonlinear_model
+from sarfe.pipeline.solve.points import solver_options
+
+continuation_module = importlib.import_module("sarfe.hbm.continuation")   # the package re-exports
+CASE = Path(__file__).resolve().parents[2] / "cases" / "lumped_rattle.yaml"   # the function
+
+EXTREMES = {        # one parameter of lumped_rattle changed: (where, key, value)
+    "k_n = 1e9 N/m": ("contacts", 0, "normal_stiffness_N_m", 1e9),
+    "k_n = 1e10 N/m": ("contacts", 0, "normal_stiffness_N_m", 1e10),
+    "gap = 1e-7 m": ("contacts", 0, "gap_m", 1e-7),
+    "zeta = 1e-4": ("damping", None, "modal_zeta", 1e-4),
+    "k_t = 1e9 N/m": ("contacts", 1, "tangential_stiffness_N_m", 1e9),
+}
+
+
+def extreme_case(name, **solver):
+    """The case data of lumped_rattle with the extreme ``name`` (a key of EXTREMES, or None)."""
+    data = load_case(CASE).data
+    if name is not None:
+        section, index, key, value = EXTREMES[name]
+        (data[section][index] if index is not None else data[section])[key] = value
+    data["solver"].update(solver)
+    return data
+
+
+def _solve(data):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return solve_case(data, write=False)
+
+
+def _continue(data, start_hz, end_hz):
+    """The continuation of the case's nonlinear model alone (no point-by-point fallback, no
+    post-processing) → list of HarmonicSolution."""
+    case = load_case(data, base_dir=CASE.parent)
+    model = nonlinear_model(case, build_linear_model(case))
+    _, options = solver_options(case.config.solver)
+    return continuation_module.continuation(
+        model.model, model.contacts, model.excitation, 2 * np.pi * start_hz, 2 * np.pi * end_hz,
+        case.config.solver.harmonics, case.config.solver.samples_per_period, options=options)
+
+
+@pytest.mark.timeout(300)
+def test_a_corner_it_may_not_pass_stops_with_one_line_naming_the_knob(monkeypatch):
+    """k_n = 10⁹ N/m: where the panel first touches the bracket (42.4 Hz) the branch turns by ~110°
+    within a length no N resolves; the sweep steps past such corners with a sphere step, but a
+    sweep that meets more than CORNER_LIMIT of them within FOLD_DISTANCE crawls and must stop
+    there, saying which knob to turn. With CORNER_LIMIT = 0 the first corner is one too many."""
+    monkeypatch.setattr(continuation_module, "CORNER_LIMIT", 0)
+    points = _continue(extreme_case("k_n = 1e9 N/m", stability=False), 30.0, 44.0)
+    reason = points[-1].reason
+    assert "sweep stopped" in reason and "corners of the branch" in reason
+    assert "raise solver.samples_per_period" in reason and "\n" not in reason
+    assert 42.0 < points[-1].omega / (2 * np.pi) < 43.0
+
+
+PASSING = ("k_n = 1e9 N/m", "k_n = 1e10 N/m", "k_t = 1e9 N/m")   # measured: complete at H = 7
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(1800)
+@pytest.mark.parametrize("name", sorted(EXTREMES))
+def test_extreme_sweeps_complete_or_stop_naming_the_knob(name):
+    """Each extreme of lumped_rattle swept 30 → 90 Hz at the case's H = 7 (before: k_n = 10⁹ and
+    10¹⁰ N/m stopped at 42.4 Hz, ζ = 10⁻⁴ at 55 Hz, gap 10⁻⁷ m and k_t = 10⁹ N/m turned back past
+    30 Hz). The hard contacts and the stiff stick spring complete by continuation
+    (``sweep_complete``, every point in the band, the last at 90 Hz). The tiny gap and the light
+    damping were measured to come back onto their own branch at H = 7 (31.2 Hz, 54.3 Hz: a closed
+    loop of solutions); they must complete or stop with one line naming solver.harmonics
+    (gap 10⁻⁷ m completed at H = 15 with an earlier state of this branch)."""
+    result = _solve(extreme_case(name, error_estimate=False, stability=False))
+    summary = result.summary
+    f = np.array([p["frequency_hz"] for p in summary["points"]])
+    assert f.min() >= 30.0 - 1e-9 and f.max() <= 90.0 + 1e-9
+    if name in PASSING or summary["sweep_complete"]:
+        assert summary["sweep_complete"] is True, summary["sweep_stop_reason"]
+        assert summary["sweep_stop_reason"] is None
+        return
+    reason = summary["sweep_stop_reason"]
+    assert "\n" not in reason and "raise solver." in reason
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(1800)
+def test_stiffest_contact_stops_with_one_line_naming_the_knob():
+    """k_n = 10¹¹ N/m (beyond the item's 10¹⁰): the branch past the first impact is resolved to
+    N = 64 × 256 samples and then still crawls from corner to corner; the sweep must say so in one
+    line naming solver.samples_per_period (before: exit code 3, 11 points not converged)."""
+    data = extreme_case(None, error_estimate=False, stability=False)
+    data["contacts"][0]["normal_stiffness_N_m"] = 1e11
+    result = _solve(data)
+    summary = result.summary
+    if summary["sweep_complete"]:
+        return                                  # passing is allowed too
+    reason = summary["sweep_stop_reason"]
+    assert "\n" not in reason and "solver." in reason
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(1800)
+def test_hard_contact_branch_matches_time_integration():
+    """k_n = 10¹⁰ N/m, the continued branch at three frequencies on its upper (impacting) part and
+    past the jump: each point's first harmonic on all DOFs agrees with an independent Newmark
+    integration (2048 steps per period, Richardson) started from it and run to a periodic state
+    within 2 % (H = 7 truncation of a hard impact: the integrator resolves all harmonics)."""
+    data = extreme_case("k_n = 1e10 N/m", stability=False)
+    points = _continue(data, 30.0, 90.0)
+    assert points[-1].omega / (2 * np.pi) == pytest.approx(90.0)
+    case = load_case(data, base_dir=CASE.parent)
+    model = nonlinear_model(case, build_linear_model(case))
+    f = np.array([p.omega / (2 * np.pi) for p in points])
+    amplitude = np.array([np.hypot(*p.displacement[1:3, 0]) for p in points])
+    impacting = np.flatnonzero(amplitude > 1e-4)           # closes the 0.1 mm gap
+    chosen = [impacting[len(impacting) // 4], impacting[len(impacting) // 2], len(points) - 1]
+    for k in chosen:
+        point = points[k]
+        H = point.displacement.shape[0] // 2
+        reference = integrate_time(model.model, model.contacts, model.excitation, point.omega, H,
+                                   steps_per_period=2048, richardson=True, initial=point)
+        a = point.displacement[1] - 1j * point.displacement[2]
+        b = reference.displacement_harmonics[1] - 1j * reference.displacement_harmonics[2]
+        error = np.abs(a - b).max() / np.abs(b).max()
+        assert error < 2e-2, (f[k], error)
