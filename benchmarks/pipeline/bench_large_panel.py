@@ -185,6 +185,7 @@ def run(dofs: float, timeout_s: float, max_gb: float, profile: bool, root: pathl
     for r in readers:
         r.join(timeout=5)
     code = proc.returncode
+    (work / "console.txt").write_text("\n".join(lines) + "\n")
     if code == 124 and stopped is None:
         stopped = f"timeout {timeout_s:.0f} s"
     rec = {"target_dofs": dofs, "mesh_size_m": mesh_m, "exit": code, "stopped": stopped,
@@ -213,7 +214,7 @@ def run(dofs: float, timeout_s: float, max_gb: float, profile: bool, root: pathl
     if rec["stage_s"]:
         rec["dominant_stage"] = max(rec["stage_s"], key=rec["stage_s"].get)
     if profile and (work / "profile.json").exists():
-        rec["hot_functions"] = hot_functions(work / "profile.out")
+        rec["hot_functions"] = hot_functions(work / "profile.json")
     return rec
 
 
