@@ -85,6 +85,7 @@ def test_estimate_brackets_lumped_rattle_case():
             assert true_db <= e.erp_db <= 5 * true_db, (H, s.omega, true_db, e)
 
 
+@pytest.mark.slow   # default suite under 10 min on 2 cores (682 s measured): a long study, run by make bench / make test-all
 @pytest.mark.timeout(600)
 def test_estimate_brackets_squeak_rig_at_low_harmonics():
     """FE squeak rig (stick–slip) at its 100 Hz point, H = 1 and 2: against a reference with

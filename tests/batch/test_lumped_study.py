@@ -70,6 +70,7 @@ def test_table_outputs(in_process):
         __import__("math").log10).to_numpy()).max() < 0.05
 
 
+@pytest.mark.slow   # default suite under 10 min on 2 cores (682 s measured): a long study, run by make bench / make test-all
 def test_same_table_on_one_and_two_workers(in_process, tmp_path, dask_client):
     table, _, _ = in_process
     two = run_study(STUDY, client=dask_client, output_dir=tmp_path / "two")

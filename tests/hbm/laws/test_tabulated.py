@@ -129,7 +129,7 @@ def first_harmonic(U):
     return U[1] - 1j * U[2]
 
 
-@pytest.mark.parametrize("frequency", [12.0, 20.0])
+@pytest.mark.parametrize("frequency", [12.0, pytest.param(20.0, marks=pytest.mark.slow)])
 def test_hbm_matches_time_integration_and_hill(frequency):
     """HBM at H = 15 within 0.5 % of Newmark (1024 steps, Richardson, from the H = 30 solution);
     Hill says stable and Newmark stays on the orbit; the contact slips part of the period."""

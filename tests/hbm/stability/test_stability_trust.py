@@ -74,6 +74,7 @@ def rattle_rig():
     return nonlinear_model(case, build_linear_model(case, progress=False))
 
 
+@pytest.mark.slow   # default suite under 10 min on 2 cores (682 s measured): a long study, run by make bench / make test-all
 def test_rattle_rig_edge_eigenvalue_is_not_an_instability(rattle_rig):
     """cases/rattle_rig.yaml (H = 10, N = 256) at 31.2 Hz: the full Hill method's leading exponent
     is an edge eigenvalue far outside the strip |Im s| ≤ ω/2 (a structural mode above Hω that

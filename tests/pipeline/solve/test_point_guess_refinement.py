@@ -22,6 +22,7 @@ def test_guess_steps_cover_the_harmonics():
         assert steps >= max(points.GUESS_STEPS, 2 * H + 1) and steps & (steps - 1) == 0
 
 
+@pytest.mark.slow   # default suite under 10 min on 2 cores (682 s measured): a long study, run by make bench / make test-all
 def test_failed_retry_refines_the_time_integration_from_its_end_state(monkeypatch):
     """Every Newton start fails except one from a guess of 8 × guess_steps(H): the point is that
     Newton's solution, and the refined integration started where the coarse one ended."""
