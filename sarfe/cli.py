@@ -84,6 +84,8 @@ def cmd_solve(args) -> int:
         print(f"sarfe: {summary['accuracy_check']['warning']}", file=sys.stderr)
     if summary.get("sweep_complete") is False:
         print(f"sarfe: {summary['sweep_stop_reason']}", file=sys.stderr)
+    if summary.get("sweep_note"):
+        print(f"sarfe: note: {summary['sweep_note']}", file=sys.stderr)
     return result.exit_code
 
 

@@ -52,10 +52,14 @@ on cases/lumped_rattle.yaml with one parameter changed, docs/hbm.md "At the extr
   this, turns) raise N up to ``MAX_STALL_FACTOR`` × N.
 - Stiff contacts: a point whose full residual misses ``full_tolerance`` (≈ k_n ‖R_c‖ / ‖f̃_e‖) is
   tightened at its ω by the fixed-frequency Newton and its polish (:mod:`sarfe.hbm.solve`).
+- Closed loops: a new point within ``RETRACE_SHARE`` of its step of the path through the earlier
+  points. Gap 10⁻⁷ m (31.2 Hz), ζ = 10⁻⁴ (54.3 Hz): unchecked, the sweep circles one loop of H = 7
+  solutions again and again (the time integration is not periodic there). The sweep leaves it
+  (≤ ``LOOP_LIMIT`` times) by a new continuation from fixed ω past the farthest ω reached
+  (:func:`continuation`'s ``leave_loop``); that point's ``reason`` says so (``LEFT_LOOP``).
 - Stops that name the knob: more than ``CORNER_LIMIT`` corners within ``FOLD_DISTANCE`` (raise
-  solver.samples_per_period), or a new point within ``RETRACE_SHARE`` of its step of the path
-  through the earlier points (a closed loop of solutions, or a wrong turn running back along the
-  branch: raise solver.harmonics; at ``MAX_STALL_FACTOR`` × N: the contact is not resolved).
+  solver.samples_per_period), or a loop that cannot be left (raise solver.harmonics; at
+  ``MAX_STALL_FACTOR`` × N: the contact is not resolved).
 
 Band edge. A branch that turns back past ω_start is stopped there: the last point is solved at
 exactly ω_start and its ``reason`` says why (no points outside the band).
@@ -91,6 +95,9 @@ COS_BEHIND = -0.9        # a corner step's point at more than ~154° from t_i: t
 CORNER_LIMIT = 12        # corners stepped past within FOLD_DISTANCE of each other: a crawl, stop
 RETRACE_SKIP = 3         # a new point near the path of the earlier points but these: came back
 RETRACE_SHARE = 0.1      # … within this share of its step
+LOOP_LIMIT = 3           # closed loops the sweep leaves by a new start past them (docstring)
+LOOP_EXIT = (0.25, 0.5, 1.0, 2.0)   # … at these shares of initial_step past the loop's farthest ω
+LEFT_LOOP = "left a closed loop of solutions"   # in the reason of the new start past a loop
 ALIASING_LIMIT = 2e-2    # residual of a point with 2N samples above which N is doubled (docstring)
 ALIASING_TARGET = 5e-3   # … until it is below this (a margin: the contact hardens along the branch)
 
@@ -136,7 +143,7 @@ def _switch_set(tangent_z, rows_from, harmonics, width, x_scale_from, x_scale_to
 
 def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
                  samples_per_period, options=None, progress=None, harmonic_set=None,
-                 stop_when=None, band_start=None):
+                 stop_when=None, band_start=None, loops_left=LOOP_LIMIT, guess=None):
     """Sweep ω from ω_start to ω_end [rad/s] (either direction) → list of HarmonicSolution.
 
     progress(done, total): called after each point with done = covered fraction of the range
@@ -147,7 +154,9 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
     sweep there, as complete (a sweep by need stops a branch that is linear again:
     :mod:`sarfe.pipeline.solve.by_need`). band_start [rad/s]: where a branch turning back is
     stopped (default ω_start; a sweep by need starts inside the band and follows a fold back
-    past its own start).
+    past its own start). loops_left: closed loops the sweep may still leave (module docstring); guess
+    (2H+1, n_dof) [m]: the first point's Newton start (None: the linearized guess; either way
+    with the homotopies of :func:`sarfe.hbm.solve.solve_from` when it fails).
     A failed sweep returns the points found so far; the last one's ``reason`` says why it stopped.
     """
     options = options or ContinuationOptions()
@@ -166,9 +175,9 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
     direction = np.sign(omega_end - omega_start)
     span = abs(omega_end - omega_start)
     state = {"slider": None}
-    first = (solve_auto(full_problem, omega_start, None, so) if auto else
-             solve_from(full_problem, omega_start, linearized_guess(full_problem, omega_start), so,
-                        homotopy=True))
+    first = (solve_auto(full_problem, omega_start, guess, so) if auto else
+             solve_from(full_problem, omega_start, linearized_guess(full_problem, omega_start)
+                        if guess is None else guess, so, homotopy=True))
     solutions = [first]
     if not first.converged:
         return solutions
@@ -319,6 +328,29 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
                 "solver.samples_per_period" + (", or soften the contact (its stiffness)"
                                                if capped else ""))
 
+    def leave_loop(omega_back):
+        """A new continuation to ω_end from fixed ω LOOP_EXIT × initial_step past the farthest ω
+        reached (Newton from that point), appended with a reason saying so; or None."""
+        far = max(solutions, key=lambda s: direction * s.omega)
+        for share in LOOP_EXIT if loops_left > 0 else ():
+            omega_r = far.omega + direction * share * options.initial_step * span
+            done = float(direction * (omega_r - omega_start) / span)
+            if done >= 1.0:
+                return None
+            onward = continuation(
+                model, contacts, excitation, omega_r, omega_end, harmonics, samples_per_period,
+                replace(options, max_points=options.max_points - len(solutions)), progress and
+                (lambda d, t: progress(done + (1 - done) * d, 1.0)), harmonic_set, stop_when,
+                omega_start if band_start is None else band_start, loops_left - 1, far.displacement)
+            if onward[0].converged:
+                onward[0] = replace(onward[0], reason=(
+                    f"{onward[0].reason} ({LEFT_LOOP} at H = {problem.harmonics}, N = "
+                    f"{problem.samples_per_period}: the branch came back onto itself near "
+                    f"{omega_back / (2 * np.pi):.5g} Hz; the sweep went on from here, solved at "
+                    f"fixed ω past the loop's farthest {far.omega / (2 * np.pi):.5g} Hz)"))
+                return solutions + onward
+        return None
+
     def stop(reason):
         last = solutions[-1]
         solutions[-1] = replace(last, reason=f"{last.reason}; sweep stopped: {reason}")
@@ -419,7 +451,7 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
         z_new = result.x
         omega_new = z_new[-1] * span
         if retraces(z_new, np.linalg.norm(z_new - z)):
-            return stop(came_back(omega_new))
+            return leave_loop(omega_new) or stop(came_back(omega_new))
         U_new = to_displacement(z_new[:-1] * x_scale, omega_new, result.evaluation)
         if direction * (omega_new - omega_end) >= 0:      # passed the end: solve at ω_end exactly
             fraction = (omega_end - z[-1] * span) / (omega_new - z[-1] * span)

@@ -204,6 +204,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         "sweep_complete": sweep["complete"],     # None without a sweep; False: see the reason
         "sweep_stop_reason": sweep["reason"],
         "sweep_covered": sweep["covered"],       # False with an incomplete sweep → exit code 3
+        "sweep_note": sweep["note"],             # closed loops the continuation left, or None
         "engine": "harmonic balance",
         "linear_model_key": stage.key,
         "model": dict(stage.info, kind=stage.kind, kept_dofs=int(stage.dof_count),

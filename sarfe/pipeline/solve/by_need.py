@@ -181,10 +181,11 @@ def sweep_by_need(nl, start, end, H, N, options, cont_options, grid, margin, nat
                     and linear_with_margin(contacts, point.contact_displacement,
                                            point.samples_per_period, point.omega, margin))
         branch = list(continuation(model, contacts, F, begin, end, H, N, options=cont_options,
-                                   stop_when=stop_when, band_start=start))
+                                   stop_when=stop_when, band_start=start, loops_left=0))
         if any(STOPPED in str(p.reason) for p in branch):
-            return None     # a stretch's branch stopped (e.g. turned back out of the band): the
-            #                 whole-band continuation, which starts where the plain sweep does
+            return None     # a stretch's branch stopped (e.g. turned back out of the band, or
+            #                 came back onto itself: not left here): the whole-band continuation,
+            #                 which starts where the plain sweep does
         if solutions and branch and abs(branch[0].omega - solutions[-1].omega) <= 1e-12 * span:
             branch = branch[1:]              # the walk's last point again
         reached = branch[-1].omega if branch else begin

@@ -12,6 +12,7 @@ import numpy as np
 from sarfe.accuracy.target import parse_accuracy
 from sarfe.case.config import ContinuationConfig, ExcitationConfig, SolverConfig
 from sarfe.hbm import ContinuationOptions, SolverOptions, continuation, solve_frequency
+from sarfe.hbm.continuation import LEFT_LOOP
 from sarfe.hbm.harmonics import harmonic_coefficients
 from sarfe.hbm.residual import nonlinear_force
 from sarfe.hbm.solution import HarmonicSolution
@@ -164,15 +165,16 @@ def in_band(solutions, start, end):
 
 def sweep_status(excitation: ExcitationConfig, continuation: ContinuationConfig,
                  solutions) -> dict:
-    """How a sweep was solved → {'complete', 'reason', 'covered'} (all None without a sweep).
+    """How a sweep was solved → {'complete', 'reason', 'covered', 'note'} (None without a sweep).
 
     complete: one continuation from start to end, no stop and no point-by-point fallback.
     covered: the band is still covered by converged points — the lowest and highest converged
     frequencies are the band's ends (10⁻³ of its width) and no gap between neighbouring converged
     frequencies is wider than the continuation's largest step (``max_step`` of the band).
-    reason: one line saying what happened (None when complete)."""
+    reason: one line saying what happened (None when complete).
+    note: one line naming the closed loops of solutions the continuation left (None if none)."""
     if excitation.sweep is None:
-        return {"complete": None, "reason": None, "covered": None}
+        return {"complete": None, "reason": None, "covered": None, "note": None}
     start, end = excitation.sweep.start_hz, excitation.sweep.end_hz
     lo, hi = sorted((start, end))
     span = hi - lo
@@ -184,8 +186,12 @@ def sweep_status(excitation: ExcitationConfig, continuation: ContinuationConfig,
     stopped = next((i for i, r in enumerate(reasons) if STOPPED in r), None)
     fallback = sum(POINT_BY_POINT in r or CONTINUATION_FAILED in r for r in reasons)
     reached = bool(solutions) and abs(float(solutions[-1].omega) / (2 * np.pi) - end) <= 1e-3 * span
+    left = [f"{float(s.omega) / (2 * np.pi):.2f}" for s in solutions if LEFT_LOOP in str(s.reason)]
+    note = (f"the continuation {LEFT_LOOP} (H = {solutions[0].harmonics} truncation) "
+            f"{len(left)} time(s) and went on from a point solved at fixed frequency past it, at "
+            f"{', '.join(left)} Hz (see those points' reason)") if left else None
     if stopped is None and not fallback and reached:
-        return {"complete": True, "reason": None, "covered": covered}
+        return {"complete": True, "reason": None, "covered": covered, "note": note}
     if any(CONTINUATION_FAILED in r for r in reasons):
         what = reasons[0].split(CONTINUATION_FAILED, 1)[1].strip(" ()")
         text = f"the continuation failed ({what}); {fallback} point(s) solved point by point"
@@ -199,7 +205,7 @@ def sweep_status(excitation: ExcitationConfig, continuation: ContinuationConfig,
     text = (f"sweep not complete: {text}; "
             + ("the band is still covered by converged points" if covered
                else "the band is NOT covered by converged points (exit code 3)"))
-    return {"complete": False, "reason": text, "covered": covered}
+    return {"complete": False, "reason": text, "covered": covered, "note": note}
 
 
 def finish_sweep(nl, solutions, start, end, H, N, options, step):
