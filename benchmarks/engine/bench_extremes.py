@@ -5,7 +5,8 @@ cases/lumped_rattle.yaml with one parameter pushed — k_n = 10⁹ and 10¹⁰ N
 ``sarfe solve`` (error estimate and stability off: they do not change the sweep). Reported per
 extreme: whether the sweep completed by continuation (summary.json ``sweep_complete``), its stop
 reason, the points, wall and CPU seconds of the whole process, the exit code, the points where
-N was raised and the corners passed by a sphere step (their ``reason``), and the "before" row (the fork base of branch
+N was raised, the corners passed by a sphere step and the closed loops left (their ``reason``;
+rows measured before loops were left have none), and the "before" row (the fork base of branch
 'extremes', measured at the defaults on the same machine, see BEFORE).
 
 Run: OPENBLAS_NUM_THREADS=1 python benchmarks/engine/bench_extremes.py [name ...]
@@ -56,7 +57,8 @@ def sweep(name, directory):
             "wall_s": round(wall, 1), "cpu_s": round(cpu, 1),
             "n_raised": sum("N raised" in (p.get("reason") or "") for p in points),
             "corner_steps": sum("corner of the branch passed" in (p.get("reason") or "")
-                                for p in points)}
+                                for p in points),
+            "loops_left": sum("left a closed loop" in (p.get("reason") or "") for p in points)}
 
 
 def main(names):
@@ -70,13 +72,15 @@ def main(names):
     lines = ["# Continuation at the extremes (lumped_rattle, one parameter changed)", "",
              machine_line(), "",
              "| extreme | before: complete, points, wall s | after: complete | points | wall s "
-             "| CPU s | N raised | corner steps | stop reason |", "|---|---|---|---|---|---|---|---|---|"]
+             "| CPU s | N raised | corner steps | loops left | stop reason |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
     rows = {name: rows[name] for name in EXTREMES if name in rows}
     for name, row in rows.items():
         before = BEFORE[name]
         lines.append(f"| {name} | {before[0]}, {before[1]}, {before[2]} ({before[3]}) | "
                      f"{row['sweep_complete']} | {row['points']} | {row['wall_s']} | "
                      f"{row['cpu_s']} | {row['n_raised']} | {row['corner_steps']} | "
+                     f"{row.get('loops_left', 0)} | "
                      f"{row['stop_reason'] or '—'} |")
     write_results("extremes", {"machine": machine(), "after": rows,
                                "before": {k: dict(zip(("sweep_complete", "points", "wall_s",

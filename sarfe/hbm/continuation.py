@@ -143,7 +143,7 @@ def _switch_set(tangent_z, rows_from, harmonics, width, x_scale_from, x_scale_to
 
 def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
                  samples_per_period, options=None, progress=None, harmonic_set=None,
-                 stop_when=None, band_start=None, loops_left=LOOP_LIMIT, guess=None):
+                 stop_when=None, band_start=None, loops_left=None, guess=None):
     """Sweep ω from ω_start to ω_end [rad/s] (either direction) → list of HarmonicSolution.
 
     progress(done, total): called after each point with done = covered fraction of the range
@@ -154,12 +154,13 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
     sweep there, as complete (a sweep by need stops a branch that is linear again:
     :mod:`sarfe.pipeline.solve.by_need`). band_start [rad/s]: where a branch turning back is
     stopped (default ω_start; a sweep by need starts inside the band and follows a fold back
-    past its own start). loops_left: closed loops the sweep may still leave (module docstring); guess
+    past its own start). loops_left: closed loops the sweep may leave (None: LOOP_LIMIT); guess
     (2H+1, n_dof) [m]: the first point's Newton start (None: the linearized guess; either way
     with the homotopies of :func:`sarfe.hbm.solve.solve_from` when it fails).
     A failed sweep returns the points found so far; the last one's ``reason`` says why it stopped.
     """
     options = options or ContinuationOptions()
+    loops_left = LOOP_LIMIT if loops_left is None else loops_left
     so = options.solver
     if harmonic_set is not None:
         so = replace(so, harmonic_set=harmonic_set)
@@ -329,8 +330,7 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
                                                if capped else ""))
 
     def leave_loop(omega_back):
-        """A new continuation to ω_end from fixed ω LOOP_EXIT × initial_step past the farthest ω
-        reached (Newton from that point), appended with a reason saying so; or None."""
+        """The sweep went on from fixed ω past the loop (module docstring), or None."""
         far = max(solutions, key=lambda s: direction * s.omega)
         for share in LOOP_EXIT if loops_left > 0 else ():
             omega_r = far.omega + direction * share * options.initial_step * span
