@@ -109,8 +109,8 @@ def test_extreme_sweeps_complete_or_stop_naming_the_knob(name):
     """Each extreme of lumped_rattle swept 30 → 90 Hz at the case's H = 7 (before: k_n = 10⁹ and
     10¹⁰ N/m stopped at 42.4 Hz, ζ = 10⁻⁴ at 55 Hz, gap 10⁻⁷ m and k_t = 10⁹ N/m turned back past
     30 Hz). The hard contacts, the stiff stick spring and the tiny gap complete by continuation
-    (``sweep_complete``, every point in the band, the last at 90 Hz; the gap leaves 3 closed
-    loops of H = 7 solutions, at 31.2, 44.8 and 46.7 Hz, said in ``sweep_note``). The light
+    (``sweep_complete``, every point in the band, the last at 90 Hz; the gap leaves closed loops
+    of H = 7 solutions, 2 in this sweep, said in ``sweep_note``). The light
     damping leaves 3 loops (54.3, 55.4, 55.4 Hz) and meets a 4th at 79.2 Hz (measured; past it
     a new start climbs a resonance of metres): it must complete or stop with one line naming
     solver.harmonics."""
@@ -143,6 +143,18 @@ def test_stiffest_contact_stops_with_one_line_naming_the_knob():
     assert "\n" not in reason and "solver." in reason
 
 
+def _swept(name):
+    """The extreme ``name`` continued 30 → 90 Hz (asserted to reach 90 Hz) → (points, its
+    NonlinearModel, frequencies [Hz])."""
+    data = extreme_case(name, stability=False)
+    points = _continue(data, 30.0, 90.0)
+    assert points[-1].omega / (2 * np.pi) == pytest.approx(90.0)
+    case = load_case(data, base_dir=CASE.parent)
+    model = nonlinear_model(case, build_linear_model(case))
+    f = np.array([p.omega / (2 * np.pi) for p in points])
+    return points, model, f
+
+
 @pytest.mark.slow
 @pytest.mark.timeout(1800)
 def test_hard_contact_branch_matches_time_integration():
@@ -150,12 +162,7 @@ def test_hard_contact_branch_matches_time_integration():
     past the jump: each point's first harmonic on all DOFs agrees with an independent Newmark
     integration (2048 steps per period, Richardson) started from it and run to a periodic state
     within 2 % (H = 7 truncation of a hard impact: the integrator resolves all harmonics)."""
-    data = extreme_case("k_n = 1e10 N/m", stability=False)
-    points = _continue(data, 30.0, 90.0)
-    assert points[-1].omega / (2 * np.pi) == pytest.approx(90.0)
-    case = load_case(data, base_dir=CASE.parent)
-    model = nonlinear_model(case, build_linear_model(case))
-    f = np.array([p.omega / (2 * np.pi) for p in points])
+    points, model, f = _swept("k_n = 1e10 N/m")
     amplitude = np.array([np.hypot(*p.displacement[1:3, 0]) for p in points])
     impacting = np.flatnonzero(amplitude > 1e-4)           # closes the 0.1 mm gap
     chosen = [impacting[len(impacting) // 4], impacting[len(impacting) // 2], len(points) - 1]
@@ -180,12 +187,7 @@ def test_tiny_gap_branch_past_its_loops_matches_time_integration():
     it crosses the frequency, agrees within the H = 7 truncation error measured there (4.6 %,
     4.6 %, 0.3 %; a Newton solve at H = 15 from the integration's state agrees to 0.2 %, 0.03 %,
     0.005 %)."""
-    data = extreme_case("gap = 1e-7 m", stability=False)
-    points = _continue(data, 30.0, 90.0)
-    assert points[-1].omega / (2 * np.pi) == pytest.approx(90.0)
-    case = load_case(data, base_dir=CASE.parent)
-    model = nonlinear_model(case, build_linear_model(case))
-    f = np.array([p.omega / (2 * np.pi) for p in points])
+    points, model, f = _swept("gap = 1e-7 m")
     first = np.array([p.displacement[1] - 1j * p.displacement[2] for p in points])
     for frequency, bound in ((50.0, 0.06), (80.0, 0.06), (88.0, 0.01)):
         reference = integrate_time(model.model, model.contacts, model.excitation,
