@@ -26,7 +26,11 @@ factorization path.
 When is D modal-diagonal? Dropping an off-diagonal Δ_ij = v_iᵀ D v_j perturbs Z_k in modal
 coordinates by kω Δ_ij against diagonal terms |1 − a_kj| ≥ kω δ_j, i.e. relatively by at most
 |Δ_ij| / √(δ_i δ_j) at any k and ω (first order). The basis is accepted when every
-|Δ_ij| ≤ tolerance · √(δ_i δ_j) (+ 10⁻¹⁴ max δ for round-off of undamped modes); otherwise
+|Δ_ij| ≤ tolerance · √(δ_i δ_j) (+ 10⁻¹⁴ max δ for round-off of undamped modes), tolerance =
+10⁻⁸: a modal ζ built on the modes of K φ = ω² M φ and projected on those of M v = μ K v keeps
+off-diagonal round-off of ~10⁻¹⁰ √(δ_i δ_j) on Craig–Bampton models (9.2e-11 on the test plate,
+1.1e-10 on the 15 mm instrument panel, which a 10⁻¹⁰ bound sent to the per-harmonic LU at 5× the
+sweep's cost), and a relative perturbation of 10⁻⁸ of Z_k is far below every reported ±; otherwise
 :func:`modal_basis` returns None and the caller keeps the per-harmonic factorization. Only models
 with n ≤ ``max_dofs`` are decomposed (dense LAPACK).
 """
@@ -40,7 +44,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 MODAL_MAX_DOFS = 3000        # dense eigh above this costs more than it saves on a sweep
-MODAL_DAMPING_TOLERANCE = 1e-10
+MODAL_DAMPING_TOLERANCE = 1e-8
 
 
 @dataclass(frozen=True, eq=False)
