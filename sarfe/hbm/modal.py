@@ -123,6 +123,31 @@ class ModalBasis:
         return bool(np.any(np.abs(1.0 - a) <= 1e-13 * np.maximum(1.0, np.abs(a))))
 
 
+def updated_solve(basis: ModalBasis, gap_map: np.ndarray, row_stiffness: np.ndarray,
+                  row_damping: np.ndarray, orders, omega: float, loads: np.ndarray) -> np.ndarray:
+    """z_k = (Z_k + Gᵀ A_k G)⁻¹ f_k for the orders k (m,) and complex loads f_k (m, n): the model
+    with springs k_r and dashpots c_r on the rows of G (n_rows, n dense), A_k = diag(k_r + i kω c_r)
+    (a linearized contact), by Woodbury on Z_k⁻¹ = K⁻¹ + V diag(q_k) Vᵀ:
+
+        y_k = Z_k⁻¹ f_k,  C_k = G Z_k⁻¹ Gᵀ,  λ_k = (I + A_k C_k)⁻¹ A_k G y_k,  z_k = y_k − Z_k⁻¹ Gᵀ λ_k,
+
+    O(n n_modes) per order instead of a dense O(n³) solve. Raises LinAlgError if I + A_k C_k is
+    singular."""
+    orders = np.asarray(orders, dtype=float)
+    G = np.asarray(gap_map, dtype=float)
+    gap_modes, static, static_compliance = basis.gap_projection(G)
+    q = basis.dynamic_receptance(orders, omega)                            # (m, n_modes)
+    y = basis.static_solve(np.asarray(loads).T).T + real_product(
+        q * real_product(loads, basis.modes), basis.modes.T)
+    C = static_compliance[None] + ((gap_modes[None] * q.real[:, None, :]) @ gap_modes.T
+                                   + 1j * (gap_modes[None] * q.imag[:, None, :]) @ gap_modes.T)
+    A = row_stiffness[None, :] + 1j * (orders * omega)[:, None] * row_damping[None, :]
+    system = np.eye(G.shape[0])[None] + A[:, :, None] * C
+    lam = np.linalg.solve(system, (A * (y @ G.T))[..., None])[..., 0]     # (m, n_rows)
+    return y - (real_product(lam, static.T)
+                + real_product(q * real_product(lam, gap_modes), basis.modes.T))
+
+
 def real_product(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     """A B for a complex (or real) A and a real B, as two real products (no complex copy of B)."""
     if not np.iscomplexobj(A):

@@ -265,3 +265,27 @@ def test_shipped_cases_unchanged(name, monkeypatch):
             [c.get("normal_amplitude_m") or 0.0 for c in p["contacts"]], dtype=float))
             for p in (a, b))
         assert np.abs(amplitude_a - amplitude_b).max() <= 1e-4 * max(np.abs(amplitude_b).max(), 1e-30)
+
+
+def test_low_rank_update_equals_the_dense_solve():
+    """(Z_k + Gᵀ diag(k_r + i kω c_r) G)⁻¹ f_k by Woodbury on the modal Z_k⁻¹ (the linearized
+    contacts of a Newton start and of the onset's rest state) equals the dense solve of the
+    updated matrices, at the mean and at harmonics across resonances."""
+    from sarfe.hbm.modal import updated_solve
+
+    model = plate_reduced("modal")
+    basis = modal_basis(model)
+    n = model.dof_count
+    G = np.eye(3, n)
+    rng = np.random.default_rng(4)
+    k_rows, c_rows = np.array([2e4, 0.0, 5e3]), np.array([0.0, 3.0, 1.0])
+    orders = np.array([0, 1, 2, 5])
+    omega = 2 * np.pi * 41.0
+    loads = rng.normal(size=(orders.size, n)) + 1j * rng.normal(size=(orders.size, n))
+    z = updated_solve(basis, G, k_rows, c_rows, orders, omega, loads)
+    K = model.stiffness + G.T @ np.diag(k_rows) @ G
+    D = model.damping + G.T @ np.diag(c_rows) @ G
+    for i, k in enumerate(orders):
+        w = k * omega
+        direct = np.linalg.solve(K - w * w * model.mass + 1j * w * D, loads[i])
+        assert relative(z[i], direct) < 1e-10
