@@ -176,18 +176,20 @@ def _linearized_guess_dense(problem, omega, rows_k, rows_c, preload):
     kept = np.ones(2 * H + 1, bool) if rows is None else np.isin(np.arange(2 * H + 1), rows)
     U = np.zeros((2 * H + 1, n))
     basis = cached_modal_basis(problem.model)
-    if basis is not None:       # the modal Z_k⁻¹ and a low-rank update: no dense solve
-        rhs = to_complex(F)
-        orders = np.flatnonzero(kept[np.r_[0, 2 * np.arange(1, H + 1) - 1]]
-                                & np.any(rhs != 0, axis=1))
+    rhs = to_complex(F)
+    orders = np.flatnonzero(kept[np.r_[0, 2 * np.arange(1, H + 1) - 1]] & np.any(rhs != 0, axis=1))
+    if basis is not None and not basis.singular(orders, float(omega)):
+        # the modal Z_k⁻¹ and a low-rank update: no dense solve (an undamped resonance of the
+        # model without its contacts — Z_k singular — takes the dense solve below)
         try:
             z = np.zeros((H + 1, n), dtype=complex)
-            z[orders] = updated_solve(basis, G.toarray(), rows_k, rows_c, orders, float(omega),
-                                      rhs[orders])
-            U = from_complex(z)
+            with np.errstate(all="ignore"):
+                z[orders] = updated_solve(basis, G.toarray(), rows_k, rows_c, orders,
+                                          float(omega), rhs[orders])
+            if np.all(np.isfinite(z)):
+                return from_complex(z)
         except np.linalg.LinAlgError:
-            return np.zeros((2 * H + 1, n))
-        return U if np.all(np.isfinite(U)) else np.zeros((2 * H + 1, n))
+            pass
     try:
         if kept[0] and np.any(F[0]):
             U[0] = np.linalg.solve(K, F[0])
