@@ -21,6 +21,7 @@ from sarfe.fe.deck_assembly import assemble_deck, mass_properties, support_dofs
 from sarfe.mesh.formats.abaqus import read_abaqus
 from sarfe.mesh.formats.deck import DeckError
 from sarfe.mesh.formats.nastran import nastran_deck
+from tests.fe.test_deck_assembly import hex20_deck
 
 DECKS = Path(__file__).resolve().parents[1] / "data" / "decks"
 REFERENCE = json.loads((DECKS / "REFERENCE.json").read_text())
@@ -162,30 +163,13 @@ def test_huang_closed_form_has_the_euler_bernoulli_limit():
 def _hex20_pipe(outer, wall, length, counts, young, poisson, density):
     """A DeckModel of a straight pipe along z of hex20 cells (counts = cells through the wall,
     around, along), curved edges on the exact circles; node indices of the end z = length."""
-    from sarfe.fe.solid_cells import _HEX_CORNERS, _HEX_EDGES
-    from sarfe.mesh.formats.deck import DeckModel, SolidElements
-
     nr, nt, nz = counts
     shape = (2 * nr + 1, 2 * nt, 2 * nz + 1)
-    grid = np.arange(np.prod(shape)).reshape(shape)
     r, theta, z = np.meshgrid(np.linspace(outer - wall, outer, shape[0]),
                               np.arange(shape[1]) * np.pi / nt, np.linspace(0, length, shape[2]),
                               indexing="ij")
     points = np.column_stack([(r * np.cos(theta)).ravel(), (r * np.sin(theta)).ravel(), z.ravel()])
-    corners = (_HEX_CORNERS + 1).astype(int)
-    local = np.vstack([corners, (corners[_HEX_EDGES[:, 0]] + corners[_HEX_EDGES[:, 1]]) // 2])
-    i, j, k = (a.ravel() for a in np.meshgrid(np.arange(nr), np.arange(nt), np.arange(nz),
-                                             indexing="ij"))
-    c = np.stack([2 * i, 2 * j, 2 * k], 1)[:, None, :] + local[None]
-    cells = grid[c[..., 0], c[..., 1] % shape[1], c[..., 2]]
-    used = np.unique(cells)
-    remap = np.full(len(points), -1)
-    remap[used] = np.arange(len(used))
-    m = len(cells)
-    block = SolidElements("hex20", np.arange(1, m + 1), np.ones(m, int), remap[cells],
-                          np.full(m, young), np.full(m, poisson), np.full(m, density))
-    deck = DeckModel("hex20 pipe", np.arange(1, len(used) + 1), points[used],
-                     np.tile(np.eye(3), (len(used), 1, 1)), solids={"hex20": block})
+    deck = hex20_deck(points, shape, counts, young, poisson, density, "hex20 pipe", wrap_y=True)
     return deck, np.flatnonzero(np.isclose(deck.points[:, 2], length))
 
 
