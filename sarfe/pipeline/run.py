@@ -28,6 +28,7 @@ from sarfe.pipeline.post.point_workers import (first_estimates, point_records, p
 from sarfe.pipeline.post.audibility_records import background_record
 from sarfe.pipeline.post.records import error_estimates, worst_of
 from sarfe.pipeline.post.review import target_check
+from sarfe.pipeline.post.stability_need import stability_stride
 from sarfe.pipeline.solve.by_need import erp_measure
 from sarfe.pipeline.solve.case_accuracy import (accuracy_check, case_resolution, resolution_line,
                                                 resolved_case)
@@ -131,13 +132,15 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     deferring = bool(config.solver.stability)
     parallel, work = {"processes": workers}, None
     streaming = deferring and workers > 1
+    stride = stability_stride(config.excitation)
     with stability_stream() if streaming else contextlib.nullcontext() as stream:
         with deferred_stability(enabled=deferring,
-                                on_job=None if stream is None else stream_submit(stream)) as jobs:
+                                on_job=None if stream is None
+                                else stream_submit(stream, stride)) as jobs:
             solutions, pruning = solve_points_pruned(config.solver, config.excitation, nl,
                                                      progress=progress, measure=erp_measure(stage))
         if workers == 1 and jobs is not None:
-            solutions = serial_stability(solutions, jobs)
+            solutions = serial_stability(solutions, jobs, stride)
         timings["hbm_s"] = time.perf_counter() - clock
         if workers > 1:
             # the first estimate in this process (it builds the caches the others share) while
@@ -163,7 +166,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
                 solutions, pruning = solve_points_pruned(config.solver, config.excitation, nl,
                                                          progress=progress,
                                                          measure=erp_measure(stage))
-            solutions = serial_stability(solutions, jobs)
+            solutions = serial_stability(solutions, jobs, stride)
             timings["hbm_s"] += time.perf_counter() - clock
     clock = time.perf_counter()
     if work is not None:

@@ -31,7 +31,7 @@ from sarfe.hbm.stability import deferred
 from sarfe.hbm.stability.hill import StabilityResult
 from sarfe.hbm.stability.deferred import pending, stability_of, with_stability
 from sarfe.pipeline.post import records
-from sarfe.pipeline.post.stability_need import STABILITY_STRIDE, seed_jobs, stability_by_need
+from sarfe.pipeline.post.stability_need import seed_jobs, stability_by_need, stability_stride
 from sarfe.pipeline.solve.points import common_samples
 from sarfe.util.progress import bar as progress_bar
 from sarfe.util.workers import Stream, map_points, worker_count
@@ -58,17 +58,17 @@ def stability_stream() -> Stream:
     return Stream(stability_of)
 
 
-def stream_submit(stream: Stream):
+def stream_submit(stream: Stream, stride: int):
     """on_job(index, job) for :func:`sarfe.hbm.stability.deferred.deferred_stability`: every
-    STABILITY_STRIDE-th recorded job goes to the stream (the seeds of the stability by need;
-    the others are computed after the sweep where a verdict changes)."""
+    ``stride``-th recorded job goes to the stream (the seeds of the stability by need; the others
+    are computed after the sweep where a verdict changes)."""
     def submit(index, job):
-        if index % STABILITY_STRIDE == 0:
+        if index % stride == 0:
             stream.submit(index, job)
     return submit
 
 
-def serial_stability(solutions, jobs) -> list:
+def serial_stability(solutions, jobs, stride: int) -> list:
     """The solutions of a serial sweep (``workers`` = 1) with their deferred stability by need
     (:mod:`sarfe.pipeline.post.stability_need`) computed in this process; a failing computation
     gives verdict None with its error in the note."""
@@ -77,7 +77,7 @@ def serial_stability(solutions, jobs) -> list:
         return solutions
     verdicts = stability_by_need(solutions, jobs,
                                  lambda todo: [_stability_or_error(j, deferred.stability_of)
-                                               for j in todo])
+                                               for j in todo], stride=stride)
     results = [StabilityResult(None, float("nan"), f"stability failed: {type(r).__name__}: {r}",
                                np.zeros(0, complex)) if isinstance(r, Exception) else r
                for r in (verdicts[i] for i in indices)]
@@ -118,7 +118,8 @@ def point_work(config: CaseConfig, stage, nl, solutions, jobs, done, first, work
         return None
     # the seeds of the stability by need first (sarfe.pipeline.post.stability_need), with the
     # estimates; the crossings between differing verdicts after them
-    hill = [i for i in seed_jobs(solutions) if i not in done] if indices else []
+    stride = stability_stride(config.excitation)
+    hill = [i for i in seed_jobs(solutions, stride) if i not in done] if indices else []
     estimates = [i for i in records.estimated_points(config, nl, solutions) if i not in first]
     gridded = common_samples(nl, solutions)      # records at one N; estimates at each point's own
     # two pools: the Hill and estimate items first, then the records on freshly forked workers
@@ -155,7 +156,7 @@ def point_work(config: CaseConfig, stage, nl, solutions, jobs, done, first, work
     if indices:
         verdicts = stability_by_need(
             solutions, jobs, lambda todo: map_points(_stability_or_error, todo, workers),
-            done=verdicts)
+            done=verdicts, stride=stride)
     if any(isinstance(verdicts[i], Exception) for i in indices):
         return None
     if indices:

@@ -30,6 +30,12 @@ INFERRED = ("inferred: computed neighbours in the sweep have this verdict (stabi
             "every {stride}th point, folds and changes computed)")
 
 
+def stability_stride(excitation) -> int:
+    """STABILITY_STRIDE for a sweep (``excitation.sweep``: its points follow one branch), 1 for a
+    list of frequencies (separate points: every verdict computed)."""
+    return STABILITY_STRIDE if getattr(excitation, "sweep", None) is not None else 1
+
+
 def ordered_jobs(solutions) -> tuple[list, np.ndarray]:
     """(job indices in sweep order, their ω [rad/s]) of the solutions with a deferred stability."""
     pairs = [(s.stability_job, s.omega) for s in solutions if s.stability_job is not None]

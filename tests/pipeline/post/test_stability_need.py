@@ -58,3 +58,13 @@ def test_a_window_narrower_than_the_stride_between_seeds_is_missed_as_documented
     verdicts = stability_by_need(points, list(range(len(points))), lambda todo: [
         StabilityResult(bool(truth[j]), 0.0, "", np.zeros(0)) for j in todo])
     assert verdicts[45].stable is True and verdicts[45].note.startswith("inferred")
+
+
+def test_a_list_of_frequencies_computes_every_verdict():
+    """Separate frequencies are not one branch: stride 1, every point a seed."""
+    from sarfe.pipeline.post.stability_need import stability_stride
+
+    assert stability_stride(SimpleNamespace(sweep=None, frequency_hz=(50.0, 100.0))) == 1
+    assert stability_stride(SimpleNamespace(sweep=object())) == 4
+    points = [SimpleNamespace(omega=w, stability_job=i) for i, w in enumerate((50.0, 100.0, 150.0))]
+    assert seed_jobs(points, 1) == [0, 1, 2]
