@@ -116,7 +116,8 @@ def tables(rows: list) -> list:
                          f"| {r['other_db']:.2f} | {r['error_db']:.2f} | "
                          f"{'yes' if r['covered'] else '**no**'} | {coarse} | "
                          f"{t.get('convergence') or t.get('method') or 'stated'} "
-                         f"{t.get('order', float('nan')):.2f} | {r['mesh_error_s']:.1f} | "
+                         f"{t.get('order') if t.get('order') is not None else float('nan'):.2f} "
+                         f"| {r['mesh_error_s']:.1f} | "
                          f"{r['total_s']:.1f} | {r['cpu_s']:.0f} | {load} | {r['commit']} |")
         lines += [""] + [f"- {m * 1e3:g} mm: {found[m]['line']}" for m in ladder if m in found] + [""]
     return lines

@@ -3,7 +3,7 @@ meshes of √2 and 2 times the element size, the three levels L_h, L_√2h, L_2h
 into a grid convergence index (:func:`sarfe.accuracy.mesh_refinement.mesh_gci`, (2) there):
 
     monotone, observed p = ln(ε₃₂/ε₂₁)/ln √2 in [1, 2]:  mesh_db = 1.25·|L_√2h − L_h| / (√2^p − 1)
-    monotone, p > 2: p = 2;   p < 1 (pre-asymptotic): 1.25·ΔM;   oscillatory: 3·ΔM
+    monotone, p outside [1, 2] (pre-asymptotic): 1.25·ΔM;       oscillatory: 3·ΔM
 
 (ΔM the range of the three levels; Roache's Fs = 1.25 for three meshes, Eça & Hoekstra's 3·ΔM
 where the levels oscillate; the larger of the dB and dB(A) estimates). Where the middle mesh
@@ -215,11 +215,10 @@ def mesh_line(term: dict | None) -> str | None:
         how = (f"Richardson from the {1e3 * term['coarse_mesh_size_m']:.3g} mm mesh with p = "
                f"{term['order']:g} (stated; the middle mesh: {term.get('middle_reason')})")
     elif kind == "monotone":
-        capped = " (capped)" if term["order_used"] < term["order"] else ""
-        how = (f"GCI, monotone, observed p = {term['order']:.2f}{capped}, Fs = "
-               f"{term['safety_factor']:g}")
+        how = f"GCI, monotone, observed p = {term['order']:.2f}, Fs = {term['safety_factor']:g}"
     elif kind == "pre-asymptotic":
-        how = (f"GCI, monotone but observed p = {term['order']:.2f} < 1 (pre-asymptotic): "
+        how = (f"GCI, monotone but observed p = {term['order']:.2f} not in [1, 2] "
+               "(pre-asymptotic): "
                f"Fs = {term['safety_factor']:g} × the levels' range {term['range_db']:.2f} dB")
     elif kind == "oscillatory":
         how = (f"GCI, the levels oscillate: Fs = {term['safety_factor']:g} × their range "
