@@ -39,6 +39,7 @@ from sarfe.hbm.time_integration import linear_harmonic_response
 from sarfe.pipeline.model.linear_stage import build_linear_model
 from sarfe.pipeline.model.nonlinear_model import nonlinear_model
 from sarfe.pipeline.post.records import loudest_point, point_erp
+from sarfe.util.workers import map_points, worker_count
 
 
 def mesh_error_reason(case) -> str | None:
@@ -121,14 +122,21 @@ def mesh_error_term(case, points, solutions, ratio=MESH_GCI_RATIO) -> dict:
     h = float(case.config.model.fe.generator.mesh_size_m)
     out.update(mesh_size_m=h, frequency_hz=points[j]["frequency_hz"],
                level_db=points[j]["erp"]["level_db"], level_dba=points[j]["erp"]["level_dba"])
-    runs = {}
-    for size in (ratio ** 2 * h, ratio * h):          # the coarsest (2h) first: it decides
+    def run(size):
         try:
-            runs[size] = resolve_coarser(case, fine, size)
+            return resolve_coarser(case, fine, size)
         except Exception as error:  # an estimate must not break a solve
-            runs[size] = {"mesh_size_m": size, "failed": f"{type(error).__name__}: {error}"}
-        if "failed" in runs[size] or not runs[size]["converged"]:
-            break                                     # (the middle mesh is not needed then)
+            return {"mesh_size_m": size, "failed": f"{type(error).__name__}: {error}"}
+
+    # the two coarser meshes at once on the case's workers (the coarsest, 2h, decides whether
+    # the middle one is used); one process: the coarsest first, the middle only if it converged
+    sizes = (ratio ** 2 * h, ratio * h)
+    workers = min(worker_count(case.config.solver.workers), len(sizes))
+    runs = dict(zip(sizes, map_points(run, sizes, workers))) if workers > 1 else {}
+    if not runs:
+        runs[sizes[0]] = run(sizes[0])
+        if "failed" not in runs[sizes[0]] and runs[sizes[0]]["converged"]:
+            runs[sizes[1]] = run(sizes[1])
     coarsest = runs[ratio ** 2 * h]
     middle = runs.get(ratio * h, {"mesh_size_m": ratio * h, "failed": "not solved"})
     runs = [middle, coarsest]
