@@ -150,7 +150,7 @@ def check_deck(case, assemble=True) -> dict:
     held_by = "the supports or model.fe.fixed, or on no element"
     shared += load_warnings(case, held, load_nodes, held_by)
     shared += contact_warnings(case, paired, held, held_by, labels=deck.node_ids)
-    deck_surface_triangles(case, mesh)
+    radiating = np.unique(deck_surface_triangles(case, mesh)).size
     # what solve refuses at assembly (degenerate cells, rigid-element chains, force nodes
     # without stiffness): validate assembles too (no reduction)
     if assemble:
@@ -162,6 +162,7 @@ def check_deck(case, assemble=True) -> dict:
             "contact_pairs": pairs, "ignored_cards": prepared.notes["ignored_cards"],
             "coincident_node_pairs": prepared.notes["coincident_node_pairs"],
             "coincident_nodes": prepared.notes["coincident_nodes"],
+            "free_nodes": int(np.count_nonzero(~held)), "radiating_nodes": int(radiating),
             "warnings": list(prepared.warnings) + shared
                         + [w for r in resolved.values() for w in r.warnings]}
 
