@@ -8,8 +8,9 @@ of the result folder per file kind, the points. The table says whether the measu
 bytes fall in the estimated range, and the central disk estimate's ratio (the estimate's low end
 for listed frequencies, where low = high).
 
-``python benchmarks/pipeline/bench_estimate.py [case …]`` (default: the small shipped cases);
-writes benchmarks/results/estimate.{json,md}.
+``python benchmarks/pipeline/bench_estimate.py [case …]`` (default: the small shipped cases;
+door_trim_p1 and instrument_panel_sweep take minutes); writes benchmarks/results/estimate.{json,md},
+replacing the rows of the cases run and keeping the others (each row with its load average).
 """
 import json
 import os
@@ -18,7 +19,8 @@ import sys
 import tempfile
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
-from benchlib import ROOT, machine, machine_line, run_timed, write_results  # noqa: E402
+from benchlib import (ROOT, machine, machine_line, read_results, run_timed,  # noqa: E402
+                      write_results)
 
 CASES = ["squeak_rig", "door_trim", "instrument_panel", "lumped_rattle", "rattle_rig",
          "rattle_rig_deck"]
@@ -70,14 +72,15 @@ def run(case: str, scratch: pathlib.Path) -> dict:
 def markdown(rows, load_start, load_end) -> list:
     lines = ["# The cost said before the run vs the run (issue 30 item 4)", "",
              machine_line(), "",
-             f"Load average at the start {load_start:.2f}, at the end {load_end:.2f}. CPU s = "
+             f"Last run: load average at the start {load_start:.2f}, at the end {load_end:.2f} "
+             "(per case: the load column, start–end of its bench run). CPU s = "
              "user + system of the `sarfe solve` process and its workers. The estimate is the "
              "line `sarfe validate` and `sarfe solve` print (summary.json `cost_estimate`): a "
              "range; MB written is the result folder. Ratio = estimate / measured (low end; "
              "high end for a sweep in brackets).", "",
-             "| case | points est. (run) | CPU s est. | CPU s run | wall s | in range | "
+             "| case | points est. (run) | CPU s est. | CPU s run | wall s | load | in range | "
              "MB est. | MB run | ratio | modes est. (run) |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         e = r["estimate"]
         lo, hi = e["bytes"]
@@ -87,6 +90,7 @@ def markdown(rows, load_start, load_end) -> list:
         pts = "–".join(str(p) for p in sorted(set(e["points"])))
         lines.append(f"| {r['case']} | {pts} ({r['points']}) | {e['cpu_s'][0]:.0f}–"
                      f"{e['cpu_s'][1]:.0f} | {r['cpu_s']:.1f} | {r['wall_s']:.1f} | "
+                     f"{'–'.join(f'{v:.1f}' for v in r.get('load_average', []))} | "
                      f"{'yes' if r['cpu_in_range'] else 'NO'} | {mb} | "
                      f"{r['written_bytes'] / 1e6:.2f} | {ratio} | {e['modes']} "
                      f"({r.get('modes_run')}) |")
@@ -117,6 +121,12 @@ def main(argv) -> None:
             print(f"{case}: CPU {row['cpu_s']:.1f} s (est. {row['estimate']['cpu_s']}), "
                   f"{row['written_bytes'] / 1e6:.2f} MB (est. "
                   f"{[round(b / 1e6, 2) for b in row['estimate']['bytes']]})", flush=True)
+    for row in rows:
+        row["load_average"] = [load_start, os.getloadavg()[0]]
+    done = {row["case"] for row in rows}
+    kept = [row for row in (read_results("estimate") or {}).get("rows", [])
+            if row["case"] not in done]
+    rows = kept + rows
     write_results("estimate", {"machine": machine(), "rows": rows},
                   markdown(rows, load_start, os.getloadavg()[0]))
 

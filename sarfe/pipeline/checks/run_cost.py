@@ -10,7 +10,8 @@ solving (the mesh or matrices, the contacts' node pairs, the case's options).
 **Modes.** The fixed-interface modes below the cutoff f_c, by the leading (Weyl) term of a thin
 plate's eigenvalue count, summed over the triangles (area A_e, D_e = E t³ / (12 (1 − ν²))):
 
-    N(f_c) ≈ Σ_e A_e k_e² / (4π),  k_e² = 2π f_c √(ρ t / D_e)   ⇒   N = f_c Σ_e (A_e / 2) √(ρ t / D)_e
+    N(f_c) ≈ Σ_e A_e k_e² / (4π),  k_e² = 2π f_c √(ρ t / D_e)
+           = f_c Σ_e (A_e / 2) √(ρ t / D)_e
 
 Against the reduction's count it is ×1.16 (squeak rig, 4.8 kHz: 25 vs 22), ×1.41 (door trim,
 800 Hz: 298 vs 212), ×2.1 (instrument panel, 186 Hz: 54 vs 26) and ×0.43 (rattle rig, 400 Hz:
@@ -41,13 +42,14 @@ over 1.5 with the point workers), stage by stage with constants measured on this
     start + outputs      T_START + T_OUTPUT (FE: + the report's renders)
     mesh and assembly    c_a · n_dof
     Craig–Bampton        c_cb · n_dof · modes^0.71        (block Lanczos with shift-invert)
-    H search (auto)      one linear stage + 14 points
+    H search (auto)      14 points at the low H (on the sweep's own linear stage)
     points               n_points · (c_0 + c_1 · (rows (2H+1))^0.55) · (2 for listed frequencies:
                          a cold start each) — Newton, error estimate, Hill stability, records
     mesh term            a quarter of the linear stage and a point (generated meshes)
 
-given as a range ×½ … ×2 around that (and the sweep's point range): an order of magnitude,
-never a promise (benchmarks/benchmarks/accuracy/bench_estimate.py compares it with measured CPU s).
+given as a range ×½ … ×2 around that (a sweep: ×1/√2 … ×√2 around its point range's ends):
+an order of magnitude, never a promise (benchmarks/pipeline/bench_estimate.py compares it with
+measured CPU s: benchmarks/results/estimate.md).
 """
 from __future__ import annotations
 
@@ -76,7 +78,8 @@ PNG_BYTES = 300e3                # the plots (7 PNGs, 264–348 kB measured)
 RENDER_BYTES = 300e3             # the report's surface renders (FE; 80–520 kB measured)
 REPORT_BASE = 100e3              # report.html without its embedded files
 SUMMARY_BASE = 15e3              # summary.json without the points
-SUMMARY_POINT = (9.5e3, 1.4e3, 0.35e3)   # bytes per point: a + b · contacts + c · H (fitted)
+SUMMARY_POINT = (11.6e3, 2.3e3, 0.29e3)  # bytes per point: a + b · contacts + c · H (fitted
+#                                         on the 6 shipped cases of estimate.md: 0.94–1.06)
 TABLE_POINT = (120.0, 60.0)      # table.txt bytes per point: a + b · contacts
 WAV_HEADER = 138                 # bytes of a sound.wav header; 16-bit mono samples follow
 SAMPLE_RATE_HZ = 44100
@@ -86,12 +89,13 @@ T_START = 2.5                    # interpreter, imports, the case checks
 T_OUTPUT = 3.5                   # summary, table, response.h5, plots, sound, report
 T_OUTPUT_FE = 3.0                # … plus the report's renders and the VTU files
 ASSEMBLY_S_PER_DOF = 5e-5        # mesh, checks, assembly (large_panel.md: ≈ 1e-4 at 1 M DOF)
-CB_S = 8.9e-6                    # c_cb: Craig–Bampton s per DOF per mode^0.71
+CB_S = 6e-6                      # c_cb: Craig–Bampton s per DOF per (Weyl) mode^0.71
 CB_MODE_EXPONENT = 0.71
 POINT_S = (0.08, 0.01, 0.55)     # c_0, c_1, exponent of one point's cost
 LISTED_POINT_FACTOR = 2.0        # listed frequencies start cold (no predictor)
 SEARCH_POINTS = 14               # points of the H search: 8 screened, a ladder at the loudest
-RANGE = 2.0                      # the CPU range: central / RANGE … central × RANGE
+RANGE = 2.0                      # the CPU range: central / RANGE … central × RANGE (a sweep:
+#                                  √RANGE around its point range's ends)
 
 
 @dataclass(frozen=True)
@@ -289,7 +293,8 @@ def run_cost(case, size: ModelSize) -> RunCost:
         t = fixed + n * point_seconds(size.contact_rows, h, listed)
         if mesh_term:
             t += 0.25 * stage + point_seconds(size.contact_rows, h, True)
-        cpu.append(t / RANGE if i == 0 else t * RANGE)
+        spread = RANGE if listed else math.sqrt(RANGE)   # a sweep's points carry the rest
+        cpu.append(t / spread if i == 0 else t * spread)
         sizes = file_bytes(config, size, n, h, samples)
         written.append(sum(sizes.values()))
         for name, value in sizes.items():
