@@ -49,7 +49,8 @@ from sarfe.pipeline.checks.case_inputs import case_inputs
 from sarfe.pipeline.checks.held_checks import (check_something_free, contact_warnings,
                                                load_warnings)
 from sarfe.pipeline.checks.mesh_checks import check_deck, shared_pair_warnings
-from sarfe.pipeline.checks.run_cost import ModelSize, contact_rows, weyl_mode_density
+from sarfe.pipeline.checks.run_cost import (ModelSize, contact_rows, plate_bending,
+                                            weyl_mode_density)
 from sarfe.pipeline.model.case_mesh import load_case_mesh
 from sarfe.pipeline.model.contact_pairs import boundary_dofs, node_pairs
 from sarfe.pipeline.model.erp_map import surface_triangles
@@ -361,7 +362,8 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True,
         size = ModelSize(dofs=6 * info.pop("free_nodes"), nodes=info["nodes"],
                          triangles=info["triangles"], radiating_nodes=info.pop("radiating_nodes"),
                          contacts=len(config.contacts),
-                         contact_rows=contact_rows(config, info["contact_pairs"]), fe=True)
+                         contact_rows=contact_rows(config, info["contact_pairs"]),
+                         mode_density_per_hz=info.pop("mode_density_per_hz"), fe=True)
         return CaseCheck(info, tuple(range_warnings(case)) + tuple(info.pop("warnings")), output,
                          size)
     mesh = load_case_mesh(case)
@@ -393,8 +395,8 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True,
                      contacts=len(config.contacts),
                      contact_rows=contact_rows(config, info["contact_pairs"]),
                      mode_density_per_hz=weyl_mode_density(
-                         mesh.points, mesh.triangles, section.thickness, section.young,
-                         section.poisson, section.density),
+                         mesh.points, mesh.triangles, section.density * section.thickness,
+                         plate_bending(section.thickness, section.young, section.poisson)),
                      fe=True, generated=config.model.fe.source == "generator")
     return CaseCheck(info, tuple(range_warnings(case, mesh)) + tuple(shared)
                      + tuple(warned) + geometry

@@ -19,8 +19,9 @@ Against the reduction's count it is ×1.16 (squeak rig, 4.8 kHz: 25 vs 22), ×1.
 either way. The clamped-edge term − Σ L_e k_e / 2π (the exact count of a plate with clamped
 edges) was tried and does not help these models (the rattle rig's count goes below zero); the
 leading term alone is exact to 3 % against a simply supported plate's spectrum once the edge
-term of that boundary is taken off (tests/pipeline/checks/test_run_cost.py). A deck or a
-matrices model states no mode count.
+term of that boundary is taken off (tests/pipeline/checks/test_run_cost.py). A deck's shells
+count with their own ρ t + NSM and √(D₁₁ D₂₂) (the rattle rig's deck gives its generator's
+density); a matrices model states no mode count.
 
 **Points.** A list of frequencies: its length. A sweep (arc-length continuation): between
 :data:`SWEEP_POINTS_PER_BAND` / max_step (a smooth branch: the door trim, 105 at max_step 0.1,
@@ -145,14 +146,20 @@ class RunCost:
                 "files": {k: [int(a), int(b)] for k, (a, b) in self.files.items()}}
 
 
-def weyl_mode_density(points, triangles, thickness, young, poisson, density) -> float:
+def weyl_mode_density(points, triangles, mass_per_area, bending) -> float:
     """Σ_e (A_e / 2) √(ρ t / D)_e [modes/Hz] (module docstring): points (n, 3) [m], triangles
-    (n_e, 3), the section per triangle (scalars or (n_e,)) [m, Pa, –, kg/m³]."""
+    (n_e, 3), per triangle (scalars or (n_e,)) the mass per area ρ t [kg/m²] and the bending
+    stiffness D [N·m] (an orthotropic section: √(D₁₁ D₂₂))."""
     p = np.asarray(points, dtype=float)[np.asarray(triangles)]
     area = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+    return float(np.sum(area / 2 * np.sqrt(np.asarray(mass_per_area, dtype=float)
+                                           / np.asarray(bending, dtype=float))))
+
+
+def plate_bending(thickness, young, poisson):
+    """D = E t³ / (12 (1 − ν²)) [N·m] of an isotropic shell (arrays broadcast)."""
     t = np.asarray(thickness, dtype=float)
-    bending = np.asarray(young, dtype=float) * t ** 3 / (12 * (1 - np.asarray(poisson) ** 2))
-    return float(np.sum(area / 2 * np.sqrt(np.asarray(density, dtype=float) * t / bending)))
+    return np.asarray(young, dtype=float) * t ** 3 / (12 * (1 - np.asarray(poisson) ** 2))
 
 
 def contact_rows(config, pairs: dict | None) -> int:
@@ -340,6 +347,6 @@ def cost_lines(cost: RunCost) -> list:
     return ["cost: " + ", ".join(model), "  " + ", ".join(run)]
 
 
-__all__ = ["ModelSize", "RunCost", "run_cost", "cost_lines", "weyl_mode_density",
+__all__ = ["ModelSize", "RunCost", "run_cost", "cost_lines", "weyl_mode_density", "plate_bending",
            "contact_rows", "sweep_points", "file_bytes", "map_count", "point_seconds",
            "stage_seconds"]

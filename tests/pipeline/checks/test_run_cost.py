@@ -13,7 +13,8 @@ from sarfe import cli
 from sarfe.case.read import load_case
 from sarfe.pipeline import solve_case
 from sarfe.pipeline.checks.case_checks import check_case
-from sarfe.pipeline.checks.run_cost import (ModelSize, cost_lines, run_cost, weyl_mode_density)
+from sarfe.pipeline.checks.run_cost import (ModelSize, cost_lines, plate_bending, run_cost,
+                                            weyl_mode_density)
 from tests.small_cases import TINY, coarse_rig
 
 CASES = Path(__file__).resolve().parents[3] / "cases"
@@ -30,8 +31,8 @@ def test_weyl_density_counts_a_simply_supported_plate():
     index = np.arange(x.size).reshape(x.shape)
     q = np.stack([index[:-1, :-1], index[1:, :-1], index[1:, 1:], index[:-1, 1:]], -1).reshape(-1, 4)
     triangles = np.vstack([q[:, [0, 1, 2]], q[:, [0, 2, 3]]])
-    density = weyl_mode_density(points, triangles, t, E, nu, rho)
     D = E * t ** 3 / (12 * (1 - nu ** 2))
+    density = weyl_mode_density(points, triangles, rho * t, plate_bending(t, E, nu))
     assert density == pytest.approx(a * b / 2 * np.sqrt(rho * t / D), rel=1e-12)
     m = np.arange(1, 400)
     f = np.pi / 2 * np.sqrt(D / (rho * t)) * ((m[:, None] / a) ** 2 + (m[None, :] / b) ** 2)
@@ -140,3 +141,15 @@ def test_validate_and_solve_print_the_cost(tmp_path, capsys):
     assert err.count("sarfe: cost: H 3, N ") == 1
     assert cli.main(["solve", str(path), "-o", str(tmp_path / "q"), "--quiet"]) == 0
     assert "cost:" not in capsys.readouterr().err
+
+
+def test_deck_and_generator_state_the_same_model_size():
+    """The rattle rig read from its Nastran deck (mm-t-s, PSHELL/MAT1 → ρ t and D per triangle)
+    and generated from its YAML (SI) are one model: the same free DOFs, radiating nodes and
+    Weyl modal density."""
+    generated, deck = (check_case(load_case(CASES / f"{name}.yaml"), write=False).size
+                       for name in ("rattle_rig", "rattle_rig_deck"))
+    assert deck.dofs == generated.dofs and deck.contact_rows == generated.contact_rows == 1
+    assert deck.radiating_nodes == generated.radiating_nodes
+    assert deck.mode_density_per_hz == pytest.approx(generated.mode_density_per_hz, rel=1e-6)
+    assert generated.generated and not deck.generated
