@@ -86,9 +86,9 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     # the cost before it is paid (issue 30 item 4): H, N, cutoff, modes, CPU s, bytes written
     cost = None if checked.size is None else run_cost(case, checked.size)
     if cost is not None and progress:
-        for line in cost_lines(cost):
-            print(f"sarfe: {line}" if line.startswith("cost") else f"      {line}",
-                  file=sys.stderr, flush=True)
+        for i, line in enumerate(cost_lines(cost, width=80 - len("sarfe: "))):
+            print(("sarfe: " if i == 0 else " " * len("sarfe: ")) + line, file=sys.stderr,
+                  flush=True)
     timings = {}
     accuracy = None
     config = case.config

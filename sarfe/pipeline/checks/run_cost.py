@@ -325,11 +325,12 @@ def _megabytes(b) -> str:
     return f"{mb:.2g}" if mb < 100 else f"{mb:.0f}"
 
 
-def cost_lines(cost: RunCost) -> list:
-    """The validate/solve line (≤ 80 columns; two lines when one does not hold it), e.g.
+def cost_lines(cost: RunCost, width: int = 80) -> list:
+    """The validate/solve line, wrapped at ``width`` columns between its items (continuation
+    lines indented by two), e.g.
 
         cost: H 10, N 64, cutoff 800 Hz, ≈ 298 modes, 31332 DOFs
-          4 points, ≈ 17–67 s CPU, ≈ 14 MB written
+          4 points, ≈ 14–54 s CPU, ≈ 14 MB written
     """
     H = _span(*cost.harmonics, str) + (" (auto)" if cost.auto else "")
     model = [f"H {H}", f"N {_span(*cost.samples, str)}"]
@@ -342,9 +343,16 @@ def cost_lines(cost: RunCost) -> list:
     run = [f"{_span(*cost.points, str)} points", f"≈ {_span(*cost.cpu_s, _seconds)} s CPU",
            f"≈ {_span(*cost.bytes, _megabytes)} MB written"]
     one = "cost: " + ", ".join(model + run)
-    if len(one) <= 80:
+    if len(one) <= width:
         return [one]
-    return ["cost: " + ", ".join(model), "  " + ", ".join(run)]
+    lines = ["cost: " + model[0]]
+    for item in model[1:] + run:
+        if item is run[0] or len(lines[-1]) + 2 + len(item) + 1 > width:   # + its comma
+            lines[-1] += ","
+            lines.append("  " + item)      # the run's items start a line of their own
+        else:
+            lines[-1] += ", " + item
+    return lines
 
 
 __all__ = ["ModelSize", "RunCost", "run_cost", "cost_lines", "weyl_mode_density", "plate_bending",

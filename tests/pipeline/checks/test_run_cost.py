@@ -13,8 +13,8 @@ from sarfe import cli
 from sarfe.case.read import load_case
 from sarfe.pipeline import solve_case
 from sarfe.pipeline.checks.case_checks import check_case
-from sarfe.pipeline.checks.run_cost import (ModelSize, cost_lines, plate_bending, run_cost,
-                                            weyl_mode_density)
+from sarfe.pipeline.checks.run_cost import (ModelSize, RunCost, cost_lines, plate_bending,
+                                            run_cost, weyl_mode_density)
 from tests.small_cases import TINY, coarse_rig
 
 CASES = Path(__file__).resolve().parents[3] / "cases"
@@ -153,3 +153,16 @@ def test_deck_and_generator_state_the_same_model_size():
     assert deck.radiating_nodes == generated.radiating_nodes
     assert deck.mode_density_per_hz == pytest.approx(generated.mode_density_per_hz, rel=1e-6)
     assert generated.generated and not deck.generated
+
+
+def test_cost_line_wraps_within_its_width():
+    """A 1 M DOF auto sweep: every line within the width (solve gives 73: after 'sarfe: '),
+    each item whole, the run's items on a line of their own."""
+    cost = RunCost((8, 24), (128, 512), 1500.0, 437, (100, 360), (34, 177), (14e6, 37e6),
+                   auto=True, dofs=1140102)
+    for width in (40, 73, 80):
+        lines = cost_lines(cost, width)
+        assert all(len(line) <= width for line in lines)
+        assert lines[0].startswith("cost: H 8–24 (auto), N 128–512")
+        assert any(line.startswith("  100–360 points") for line in lines)
+        assert "1140102 DOFs" in "".join(lines) and "≈ 14–37 MB written" in lines[-1]
