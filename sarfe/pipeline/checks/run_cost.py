@@ -26,7 +26,7 @@ density); a matrices model states no mode count.
 **Points.** A list of frequencies: its length. A sweep (arc-length continuation): between
 :data:`SWEEP_POINTS_PER_BAND` / max_step (a smooth branch: the door trim, 105 at max_step 0.1,
 204 at 0.05) and :data:`SWEEP_FOLD_FACTOR` × that (folds and contact switches: lumped rattle 234,
-rattle rig 363 at 0.1). ``resolution: auto``: H between :data:`AUTO_HARMONICS` (the shipped
+rattle rig 363, instrument panel sweep 400 at 0.1). ``resolution: auto``: H between :data:`AUTO_HARMONICS` (the shipped
 searches chose 14 and 18; the search may go from 3 to 64) and N = max(64, 2^⌈log₂ 16 H⌉).
 
 **Disk** (bytes, the files of ``output.files``): each file from its layout, with the compression
@@ -64,7 +64,7 @@ from sarfe.pipeline.model.cutoff import stage_cutoff_hz
 from sarfe.pipeline.solve.case_accuracy import rule_cutoff_hz
 
 SWEEP_POINTS_PER_BAND = 10.0     # points × max_step of a smooth continuation (door trim)
-SWEEP_FOLD_FACTOR = 3.6          # … × this with folds and contact switches (rattle rig)
+SWEEP_FOLD_FACTOR = 4.0          # … × this with folds and contact switches (IP sweep: 400)
 AUTO_HARMONICS = (8, 24)         # the H range the cost of resolution: auto is given for
 SWEEP_SAMPLES_FACTOR = 16        # sarfe.hbm.continuation.MAX_SAMPLES_FACTOR
 
