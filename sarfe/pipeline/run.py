@@ -19,6 +19,7 @@ from sarfe.case.errors import EXIT_NOT_CONVERGED, EXIT_TARGET_EXCEEDED
 from sarfe.case.read import load_case
 from sarfe.hbm.stability.deferred import deferred_stability, pending
 from sarfe.pipeline.checks.case_checks import check_case, reduced_model_warnings
+from sarfe.pipeline.checks.run_cost import cost_lines, run_cost
 from sarfe.pipeline.model.linear_stage import build_linear_model
 from sarfe.pipeline.model.nonlinear_model import nonlinear_model
 from sarfe.pipeline.model.stage import linear_model_key
@@ -84,6 +85,12 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     for line in warnings:
         if warn is not None:
             warn(line)
+    # the cost before it is paid (issue 30 item 4): H, N, cutoff, modes, CPU s, bytes written
+    cost = None if checked.size is None else run_cost(case, checked.size)
+    if cost is not None and progress:
+        for i, line in enumerate(cost_lines(cost, width=80 - len("sarfe: "))):
+            print(("sarfe: " if i == 0 else " " * len("sarfe: ")) + line, file=sys.stderr,
+                  flush=True)
     timings = {}
     accuracy = None
     config = case.config
@@ -234,6 +241,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         "mesh_error": mesh_term,                 # the ± mesh term (sarfe.pipeline.solve.mesh_error)
         "warnings": warnings,                    # inputs far outside the model's range
         "timings_s": timings,
+        "cost_estimate": None if cost is None else cost.as_dict(),   # said before the run
         "workers": parallel,      # processes; Hill points computed during the sweep (of all)
         "case_data": case.data,                  # the case with every default filled in
     }
