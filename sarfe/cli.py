@@ -27,6 +27,7 @@ from sarfe.case.errors import EXIT_CASE_ERROR, EXIT_NOT_CONVERGED, CaseError
 from sarfe.compare import cli as compare_cli
 from sarfe.pipeline import build_linear_model, load_case, nonlinear_model, solve_case
 from sarfe.pipeline.checks.case_checks import check_case, output_target
+from sarfe.pipeline.checks.run_cost import cost_lines, run_cost
 from sarfe.pipeline.verify import format_rows, verify_point
 from sarfe.results.console import WIDTH, quiet_line, summary_lines
 from sarfe.results.folder import os_error
@@ -107,6 +108,8 @@ def cmd_validate(args) -> int:
             shown = ", ".join(f"{a}={b}" for a, b in info["coincident_nodes"][:10])
             text += (f"\n  note: {info['coincident_node_pairs']} pair(s) of coincident nodes that "
                      f"no element joins (node ids): {shown}")
+    if checked.size is not None:      # what solve will cost (issue 30 item 4)
+        text += "\n" + "\n".join(cost_lines(run_cost(case, checked.size)))
     _say(args, text)
     return 0
 

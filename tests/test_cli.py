@@ -31,7 +31,8 @@ def test_console_script_and_module_entry_point():
     proc = subprocess.run(command + ["validate", str(CASES / "lumped_rattle.yaml")],
                           capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr
-    assert proc.stdout.strip().endswith("valid")
+    assert proc.stdout.splitlines()[0].strip().endswith("valid")
+    assert proc.stdout.splitlines()[1].startswith("cost: H 7, N 256")
 
 
 def test_study_and_batch_subcommands_are_registered(capsys):

@@ -26,7 +26,11 @@ factorization path.
 When is D modal-diagonal? Dropping an off-diagonal Δ_ij = v_iᵀ D v_j perturbs Z_k in modal
 coordinates by kω Δ_ij against diagonal terms |1 − a_kj| ≥ kω δ_j, i.e. relatively by at most
 |Δ_ij| / √(δ_i δ_j) at any k and ω (first order). The basis is accepted when every
-|Δ_ij| ≤ tolerance · √(δ_i δ_j) (+ 10⁻¹⁴ max δ for round-off of undamped modes); otherwise
+|Δ_ij| ≤ tolerance · √(δ_i δ_j) (+ 10⁻¹⁴ max δ for round-off of undamped modes), tolerance =
+10⁻⁸: a modal ζ built on the modes of K φ = ω² M φ and projected on those of M v = μ K v keeps
+off-diagonal round-off of ~10⁻¹⁰ √(δ_i δ_j) on Craig–Bampton models (9.2e-11 on the test plate,
+1.1e-10 on the 15 mm instrument panel, which a 10⁻¹⁰ bound sent to the per-harmonic LU at 5× the
+sweep's cost), and a relative perturbation of 10⁻⁸ of Z_k is far below every reported ±; otherwise
 :func:`modal_basis` returns None and the caller keeps the per-harmonic factorization. Only models
 with n ≤ ``max_dofs`` are decomposed (dense LAPACK).
 """
@@ -40,7 +44,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 MODAL_MAX_DOFS = 3000        # dense eigh above this costs more than it saves on a sweep
-MODAL_DAMPING_TOLERANCE = 1e-10
+MODAL_DAMPING_TOLERANCE = 1e-8
 
 
 @dataclass(frozen=True, eq=False)
@@ -117,6 +121,31 @@ class ModalBasis:
         (an undamped resonance (kω)² = ω_j²)."""
         a = self._a(orders, omega)
         return bool(np.any(np.abs(1.0 - a) <= 1e-13 * np.maximum(1.0, np.abs(a))))
+
+
+def updated_solve(basis: ModalBasis, gap_map: np.ndarray, row_stiffness: np.ndarray,
+                  row_damping: np.ndarray, orders, omega: float, loads: np.ndarray) -> np.ndarray:
+    """z_k = (Z_k + Gᵀ A_k G)⁻¹ f_k for the orders k (m,) and complex loads f_k (m, n): the model
+    with springs k_r and dashpots c_r on the rows of G (n_rows, n dense), A_k = diag(k_r + i kω c_r)
+    (a linearized contact), by Woodbury on Z_k⁻¹ = K⁻¹ + V diag(q_k) Vᵀ:
+
+        y_k = Z_k⁻¹ f_k,  C_k = G Z_k⁻¹ Gᵀ,  λ_k = (I + A_k C_k)⁻¹ A_k G y_k,  z_k = y_k − Z_k⁻¹ Gᵀ λ_k,
+
+    O(n n_modes) per order instead of a dense O(n³) solve. Raises LinAlgError if I + A_k C_k is
+    singular."""
+    orders = np.asarray(orders, dtype=float)
+    G = np.asarray(gap_map, dtype=float)
+    gap_modes, static, static_compliance = basis.gap_projection(G)
+    q = basis.dynamic_receptance(orders, omega)                            # (m, n_modes)
+    y = basis.static_solve(np.asarray(loads).T).T + real_product(
+        q * real_product(loads, basis.modes), basis.modes.T)
+    C = static_compliance[None] + ((gap_modes[None] * q.real[:, None, :]) @ gap_modes.T
+                                   + 1j * (gap_modes[None] * q.imag[:, None, :]) @ gap_modes.T)
+    A = row_stiffness[None, :] + 1j * (orders * omega)[:, None] * row_damping[None, :]
+    system = np.eye(G.shape[0])[None] + A[:, :, None] * C
+    lam = np.linalg.solve(system, (A * (y @ G.T))[..., None])[..., 0]     # (m, n_rows)
+    return y - (real_product(lam, static.T)
+                + real_product(q * real_product(lam, gap_modes), basis.modes.T))
 
 
 def real_product(A: np.ndarray, B: np.ndarray) -> np.ndarray:

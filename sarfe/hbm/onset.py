@@ -259,15 +259,17 @@ def _steady_slip(a_dyn, normal_dyn, static_limit, two_d, samples, directions=DIR
     (N, n, 2) [N] with μN_dyn = ``normal_dyn`` (N, n) and μN0 = ``static_limit`` (n,): along
     e = (1, 0) (one direction); where ``two_d``, the smallest over the directions e (refined by a
     parabola)."""
-    def along(e):
-        x = a_dyn @ e
-        swing = _largest(x - normal_dyn, samples) + _largest(-x - normal_dyn, samples)
-        return _ratio(2.0 * static_limit, swing)
-    result = along(np.array([1.0, 0.0]))
-    if np.any(two_d):
-        angles = np.pi * np.arange(directions) / directions
-        both = np.stack([along(np.array([np.cos(t), np.sin(t)])) for t in angles])   # (m, n)
-        result = np.where(two_d, _smallest(both, directions)[0], result)
+    angles = np.pi * np.arange(directions) / directions if np.any(two_d) else np.zeros(0)
+    e = np.column_stack([[1.0, 0.0], np.stack([np.cos(angles), np.sin(angles)])])  # (2, 1 + m)
+    x = a_dyn @ e                                              # (N, n, 1 + m): all directions
+    N, n, m = x.shape
+    dyn = normal_dyn[:, :, None]
+    swing = (_largest((x - dyn).reshape(N, n * m), samples)
+             + _largest((-x - dyn).reshape(N, n * m), samples)).reshape(n, m)
+    ratio = _ratio(2.0 * static_limit[:, None], swing)          # (n, 1 + m)
+    result = ratio[:, 0]
+    if angles.size:
+        result = np.where(two_d, _smallest(ratio[:, 1:].T, directions)[0], result)
     return result
 
 

@@ -32,10 +32,12 @@ import scipy.sparse as sp
 
 from sarfe.hbm import laws
 from sarfe.hbm.aft import default_slider_start
-from sarfe.hbm.dynamic_stiffness import condense, dynamic_stiffness_matrix, recover_displacement
+from sarfe.hbm.dynamic_stiffness import (condense, dynamic_stiffness_matrix, from_complex,
+                                         recover_displacement, to_complex)
 from sarfe.hbm.harmonic_set import (AUTO_CANDIDATE, coefficient_rows, dropped_content, expand_rows,
                                     harmonic_set_orders)
 from sarfe.hbm.harmonics import check_harmonics, derivative_matrix, time_samples
+from sarfe.hbm.modal import cached_modal_basis, updated_solve
 from sarfe.hbm.newton import SingularJacobian, newton, solve_linear
 from sarfe.hbm.residual import Problem, condensed_residual, full_residual, kept_rows
 from sarfe.hbm.solution import HarmonicSolution, SolverOptions
@@ -173,6 +175,21 @@ def _linearized_guess_dense(problem, omega, rows_k, rows_c, preload):
     rows = kept_rows(problem)
     kept = np.ones(2 * H + 1, bool) if rows is None else np.isin(np.arange(2 * H + 1), rows)
     U = np.zeros((2 * H + 1, n))
+    basis = cached_modal_basis(problem.model)
+    rhs = to_complex(F)
+    orders = np.flatnonzero(kept[np.r_[0, 2 * np.arange(1, H + 1) - 1]] & np.any(rhs != 0, axis=1))
+    if basis is not None and not basis.singular(orders, float(omega)):
+        # the modal Z_k⁻¹ and a low-rank update: no dense solve (an undamped resonance of the
+        # model without its contacts — Z_k singular — takes the dense solve below)
+        try:
+            z = np.zeros((H + 1, n), dtype=complex)
+            with np.errstate(all="ignore"):
+                z[orders] = updated_solve(basis, G.toarray(), rows_k, rows_c, orders,
+                                          float(omega), rhs[orders])
+            if np.all(np.isfinite(z)):
+                return from_complex(z)
+        except np.linalg.LinAlgError:
+            pass
     try:
         if kept[0] and np.any(F[0]):
             U[0] = np.linalg.solve(K, F[0])

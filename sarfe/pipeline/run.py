@@ -19,14 +19,17 @@ from sarfe.case.errors import EXIT_NOT_CONVERGED, EXIT_TARGET_EXCEEDED
 from sarfe.case.read import load_case
 from sarfe.hbm.stability.deferred import deferred_stability, pending
 from sarfe.pipeline.checks.case_checks import check_case, reduced_model_warnings
+from sarfe.pipeline.checks.run_cost import cost_lines, run_cost
 from sarfe.pipeline.model.linear_stage import build_linear_model
 from sarfe.pipeline.model.nonlinear_model import nonlinear_model
 from sarfe.pipeline.model.stage import linear_model_key
 from sarfe.pipeline.post.point_workers import (first_estimates, point_records, point_work,
-                                               point_workers, stability_stream)
+                                               point_workers, serial_stability,
+                                               stability_stream, stream_submit)
 from sarfe.pipeline.post.audibility_records import background_record
 from sarfe.pipeline.post.records import error_estimates, worst_of
 from sarfe.pipeline.post.review import target_check
+from sarfe.pipeline.post.stability_need import stability_stride
 from sarfe.pipeline.solve.by_need import erp_measure
 from sarfe.pipeline.solve.case_accuracy import (accuracy_check, case_resolution, resolution_line,
                                                 resolved_case)
@@ -82,6 +85,12 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     for line in warnings:
         if warn is not None:
             warn(line)
+    # the cost before it is paid (issue 30 item 4): H, N, cutoff, modes, CPU s, bytes written
+    cost = None if checked.size is None else run_cost(case, checked.size)
+    if cost is not None and progress:
+        for i, line in enumerate(cost_lines(cost, width=80 - len("sarfe: "))):
+            print(("sarfe: " if i == 0 else " " * len("sarfe: ")) + line, file=sys.stderr,
+                  flush=True)
     timings = {}
     accuracy = None
     config = case.config
@@ -124,13 +133,21 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     # with workers, Hill stability is recorded during the sweep and computed on one worker while
     # the sweep goes on (the stream); after it the points' stability left, their error estimates
     # and records go to all workers at once (sarfe.pipeline.post.point_workers)
-    deferring = workers > 1 and config.solver.stability
+    # Hill stability by need (sarfe.pipeline.post.stability_need): recorded during the sweep,
+    # computed at the seeds (with workers: on the stream while the sweep goes on) and where a
+    # verdict changes, inferred between equal verdicts — the same on both paths
+    deferring = bool(config.solver.stability)
     parallel, work = {"processes": workers}, None
-    with stability_stream() if deferring else contextlib.nullcontext() as stream:
+    streaming = deferring and workers > 1
+    stride = stability_stride(config.excitation)
+    with stability_stream() if streaming else contextlib.nullcontext() as stream:
         with deferred_stability(enabled=deferring,
-                                on_job=None if stream is None else stream.submit) as jobs:
+                                on_job=None if stream is None
+                                else stream_submit(stream, stride)) as jobs:
             solutions, pruning = solve_points_pruned(config.solver, config.excitation, nl,
                                                      progress=progress, measure=erp_measure(stage))
+        if workers == 1 and jobs is not None:
+            solutions = serial_stability(solutions, jobs, stride)
         timings["hbm_s"] = time.perf_counter() - clock
         if workers > 1:
             # the first estimate in this process (it builds the caches the others share) while
@@ -152,8 +169,11 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
             parallel = {"processes": workers, "stability": "in place: a deferred stability "
                         "raised, the sweep was solved again serially"}
             clock = time.perf_counter()
-            solutions, pruning = solve_points_pruned(config.solver, config.excitation, nl,
-                                                     progress=progress, measure=erp_measure(stage))
+            with deferred_stability() as jobs:
+                solutions, pruning = solve_points_pruned(config.solver, config.excitation, nl,
+                                                         progress=progress,
+                                                         measure=erp_measure(stage))
+            solutions = serial_stability(solutions, jobs, stride)
             timings["hbm_s"] += time.perf_counter() - clock
     clock = time.perf_counter()
     if work is not None:
@@ -222,6 +242,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         "mesh_error": mesh_term,                 # the ± mesh term (sarfe.pipeline.solve.mesh_error)
         "warnings": warnings,                    # inputs far outside the model's range
         "timings_s": timings,
+        "cost_estimate": None if cost is None else cost.as_dict(),   # said before the run
         "workers": parallel,      # processes; Hill points computed during the sweep (of all)
         "case_data": case.data,                  # the case with every default filled in
     }

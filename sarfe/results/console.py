@@ -11,12 +11,16 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import numpy as np
+
 from sarfe.erp.contributions import share_text
 from sarfe.results.summary import console_table, headline_level, headline_notes, level_text
 
-__all__ = ["WIDTH", "summary_lines", "quiet_line", "verdict_text", "points_table"]
+__all__ = ["WIDTH", "summary_lines", "quiet_line", "verdict_text", "points_table",
+           "shown_points"]
 
 WIDTH = 80
+MAX_ROWS = 12       # points in the console table of a sweep (all of them in table.txt)
 PARAMETER_LABELS = {"gap_m": "gap", "normal_stiffness_N_m": "normal stiffness",
                     "tangential_stiffness_N_m": "tangential stiffness",
                     "friction_coefficient": "friction coefficient", "preload_N": "preload"}
@@ -118,10 +122,31 @@ def best_change_text(summary) -> str:
                 f"{best['level_change_dba']:+.1f} dB(A) (linear estimate)")
 
 
-def points_table(rows) -> str:
+def shown_points(rows, max_rows: int = MAX_ROWS) -> list:
+    """Indices of the points the console shows: all when there are at most ``max_rows``, else the
+    band's two ends and ``max_rows`` − 2 others — the level's peaks loudest first, then points
+    spread over the sweep — in sweep order (every point is in table.txt)."""
+    n = len(rows)
+    if n <= max_rows:
+        return list(range(n))
+    levels = np.array([row.get("erp_dba") if _finite(row.get("erp_dba")) else -np.inf
+                       for row in rows], dtype=float)
+    peak = np.r_[False, (levels[1:-1] > levels[:-2]) & (levels[1:-1] >= levels[2:]), False]
+    peaks = [int(i) for i in np.flatnonzero(peak)[np.argsort(-levels[peak], kind="stable")]]
+    spread = [int(i) for i in np.linspace(0, n - 1, max_rows).round()]
+    chosen = [0, n - 1]
+    for i in peaks[:max_rows - 2] + spread:
+        if len(chosen) < max_rows and i not in chosen:
+            chosen.append(i)
+    return sorted(chosen)
+
+
+def points_table(rows, max_rows: int = MAX_ROWS) -> str:
     """The per-point table in ≤ 80 columns: frequency, converged, stable, ERP dB(A) with its ±,
     the linear baseline [dB(A)], the SPL at the occupant [dB(A)], heard, the audibility margin
-    [dB] (the full table: table.txt)."""
+    [dB]; a long sweep shows :func:`shown_points` and a line naming table.txt (every point)."""
+    count = len(rows)
+    rows = [rows[i] for i in shown_points(rows, max_rows)]
     columns = ["frequency_hz", "converged", "stable", "erp_dba", "erp_error_db",
                "linear_erp_dba", "occupant_spl_dba", "audible", "audibility_margin_db"]
     headers = {"frequency_hz": "f [Hz]", "converged": "conv", "erp_dba": "ERP [dB(A)]",
@@ -144,7 +169,10 @@ def points_table(rows) -> str:
         shown.append(r)
     if not any(r.get("erp_error_db") is not None for r in shown):
         columns.remove("erp_error_db")
-    return console_table(shown, columns=columns, formats=formats, headers=headers)
+    table = console_table(shown, columns=columns, formats=formats, headers=headers)
+    if len(shown) < count:
+        table += f"\n({len(shown)} of {count} points: ends, peaks, spread; all in table.txt)"
+    return table
 
 
 def summary_lines(summary, rows) -> list:

@@ -305,30 +305,35 @@ def test_units_give_the_same_frequencies(tmp_path):
     assert np.allclose(f_mm, f_si, rtol=1e-6)
 
 
-def _hex20_plate(lx, ly, thickness, counts, young, poisson, density):
-    """A DeckModel of a plate of hex20 cells (counts = cells along x, y, z)."""
+def hex20_deck(points, shape, counts, young, poisson, density, name, wrap_y=False):
+    """A DeckModel of hex20 cells on a structured grid of points (shape = 2·counts + 1 nodes
+    per axis, the second axis 2·counts when it wraps around, as a pipe's circumference)."""
     from sarfe.fe.solid_cells import _HEX_CORNERS, _HEX_EDGES
     from sarfe.mesh.formats.deck import DeckModel, SolidElements
 
-    nx, ny, nz = counts
-    grid = np.arange((2 * nx + 1) * (2 * ny + 1) * (2 * nz + 1)).reshape(2 * nx + 1, 2 * ny + 1, -1)
-    x, y, z = np.meshgrid(np.linspace(0, lx, 2 * nx + 1), np.linspace(0, ly, 2 * ny + 1),
-                          np.linspace(-thickness / 2, thickness / 2, 2 * nz + 1), indexing="ij")
-    points = np.column_stack([x.ravel(), y.ravel(), z.ravel()])
+    grid = np.arange(np.prod(shape)).reshape(shape)
     corners = (_HEX_CORNERS + 1).astype(int)
     local = np.vstack([corners, (corners[_HEX_EDGES[:, 0]] + corners[_HEX_EDGES[:, 1]]) // 2])
-    i, j, k = (a.ravel() for a in np.meshgrid(np.arange(nx), np.arange(ny), np.arange(nz),
-                                             indexing="ij"))
+    i, j, k = (a.ravel() for a in np.meshgrid(*map(np.arange, counts), indexing="ij"))
     c = np.stack([2 * i, 2 * j, 2 * k], 1)[:, None, :] + local[None]
-    cells = grid[c[..., 0], c[..., 1], c[..., 2]]
+    cells = grid[c[..., 0], c[..., 1] % shape[1] if wrap_y else c[..., 1], c[..., 2]]
     used = np.unique(cells)
     remap = np.full(len(points), -1)
     remap[used] = np.arange(len(used))
     m = len(cells)
     block = SolidElements("hex20", np.arange(1, m + 1), np.ones(m, int), remap[cells],
                           np.full(m, young), np.full(m, poisson), np.full(m, density))
-    return DeckModel("hex20 plate", np.arange(1, len(used) + 1), points[used],
+    return DeckModel(name, np.arange(1, len(used) + 1), points[used],
                      np.tile(np.eye(3), (len(used), 1, 1)), solids={"hex20": block})
+
+
+def _hex20_plate(lx, ly, thickness, counts, young, poisson, density):
+    """A DeckModel of a plate of hex20 cells (counts = cells along x, y, z)."""
+    nx, ny, nz = counts
+    x, y, z = np.meshgrid(np.linspace(0, lx, 2 * nx + 1), np.linspace(0, ly, 2 * ny + 1),
+                          np.linspace(-thickness / 2, thickness / 2, 2 * nz + 1), indexing="ij")
+    points = np.column_stack([x.ravel(), y.ravel(), z.ravel()])
+    return hex20_deck(points, x.shape, counts, young, poisson, density, "hex20 plate")
 
 
 def _shell_plate(lx, ly, thickness, counts, young, poisson, density):

@@ -8,5 +8,6 @@
   beam_library (PBARL/PBEAML shapes → A, I1, I2, J by closed forms);
   nastran_writer (a PanelMesh written as a deck).
 - abaqus: Abaqus ``.inp`` → DeckModel (``read_abaqus``, ``section_values``); abaqus_lines (keyword
-  blocks, ``*INCLUDE``); abaqus_model (parts and instances flattened).
+  blocks, ``*INCLUDE``); abaqus_model (parts and instances flattened); abaqus_beams (B31/B32/B32R
+  with ``*BEAM SECTION`` RECT, CIRC, PIPE → Timoshenko beams).
 """

@@ -9,7 +9,8 @@ keyword                      read as
 =========================== ===============================================================
 ``*NODE`` (repeated)         nodes (``NSET=`` adds them to a node set); ``SYSTEM=R`` only
 ``*ELEMENT``                 S3, S4, S4R, S8R shells (S8R: split into six linear triangles on
-                             its corner and midside nodes, no node dropped); SPRING1/SPRING2;
+                             its corner and midside nodes, no node dropped); B31, B32, B32R
+                             beams (:mod:`~sarfe.mesh.formats.abaqus_beams`); SPRING1/SPRING2;
                              MASS; ``ELSET=`` adds the elements to an element set
 ``*NSET`` / ``*ELSET``       ids, names of earlier sets (sets of sets), ``GENERATE``;
                              a repeated name appends; ``INSTANCE=`` in an assembly
@@ -17,6 +18,8 @@ keyword                      read as
                              ``NODAL THICKNESS``: each element's thickness = the mean of its
                              nodes' ``*NODAL THICKNESS`` values (constant per element)
 ``*NODAL THICKNESS``         node label or node set, thickness
+``*BEAM SECTION``            ``ELSET``, ``MATERIAL``, ``SECTION`` = RECT, CIRC, PIPE: dimensions,
+                             then the local 1-direction (default (0, 0, −1)); no offsets
 ``*MATERIAL``                ``*ELASTIC`` (isotropic E, ν) and ``*DENSITY`` (ρ)
 ``*SPRING``                  stiffness of SPRING1/SPRING2 elements (same DOF at both ends)
 ``*MASS``                    point mass of MASS elements
@@ -49,6 +52,7 @@ from pathlib import Path
 
 import numpy as np
 
+from sarfe.mesh.formats.abaqus_beams import BEAM_NODES, DEFAULT_DIRECTION_1
 from sarfe.mesh.formats.abaqus_lines import keyword_blocks, parse_label, parse_number, trimmed
 from sarfe.mesh.formats.abaqus_model import POINT_ELEMENT_NODES, SHELL_NODES, build_deck_model
 from sarfe.mesh.formats.deck import DeckError, DeckModel
@@ -74,6 +78,7 @@ class _Scope:
     nsets: dict = field(default_factory=dict)          # NAME → (name, [labels])
     elsets: dict = field(default_factory=dict)
     sections: list = field(default_factory=list)       # (elset, material, thickness, where)
+    beam_sections: list = field(default_factory=list)  # (elset, material, kind, dims, n1, where)
     nodal_thickness: list = field(default_factory=list)  # (node label or nset, t, where)
     springs: list = field(default_factory=list)        # (elset, dof a, dof b, k, where)
     masses: list = field(default_factory=list)         # (elset, mass, where)
@@ -161,11 +166,11 @@ class _Reader:
 
     def k_element(self, block):
         kind = str(block.options.get("TYPE", "")).upper()
-        if kind not in SHELL_NODES and kind not in POINT_ELEMENT_NODES:
+        size = SHELL_NODES.get(kind) or BEAM_NODES.get(kind) or POINT_ELEMENT_NODES.get(kind)
+        if size is None:
             self.skip(kind or "*ELEMENT without TYPE", len(block.data),
                       where=f"{block.file}:{block.line}")
             return
-        size = SHELL_NODES.get(kind) or POINT_ELEMENT_NODES[kind]
         labels = []
         for fields, _, line in block.data:
             fields = trimmed(fields)
@@ -245,6 +250,30 @@ class _Reader:
         self.scope.sections.append((str(block.options.get("ELSET", "")),
                                     str(block.options.get("MATERIAL", "")).upper(),
                                     thickness, block.where(line)))
+
+    def k_beam_section(self, block):
+        for option in block.options:
+            if option not in ("ELSET", "MATERIAL", "SECTION", "OFFSET1", "OFFSET2"):
+                raise DeckError(f"{block.where()}: option {option} is not supported")
+        for option in ("OFFSET1", "OFFSET2"):
+            if option in block.options and parse_number(block.options[option], block,
+                                                        block.line) != 0.0:
+                raise DeckError(f"{block.where()}: {option}={block.options[option]} (beam "
+                                "offset) is not supported; model the beam axis")
+        if not all(isinstance(block.options.get(k), str) for k in ("ELSET", "MATERIAL", "SECTION")):
+            raise DeckError(f"{block.where()}: needs ELSET=, MATERIAL= and SECTION=")
+        if not block.data:
+            raise DeckError(f"{block.where()}: the section dimensions line is missing")
+        fields, _, line = block.data[0]
+        dims = [parse_number(v, block, line, "dimension") for v in trimmed(fields)]
+        direction = DEFAULT_DIRECTION_1
+        if len(block.data) > 1:
+            fields, _, dline = block.data[1]
+            direction = tuple(([parse_number(v, block, dline, "direction")
+                                for v in trimmed(fields)] + [0.0] * 3)[:3])
+        self.scope.beam_sections.append((block.options["ELSET"], block.options["MATERIAL"].upper(),
+                                         block.options["SECTION"].upper(), dims, direction,
+                                         block.where(line)))
 
     def k_nodal_thickness(self, block):
         for fields, _, line in block.data:

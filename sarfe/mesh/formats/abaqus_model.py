@@ -8,7 +8,8 @@ two, S8R: six on its corner and midside nodes) with the isotropic plane-stress s
 
     A = t Q,  D = t³/12 Q,  Q = E/(1 − ν²) [[1, ν, 0], [ν, 1, 0], [0, 0, (1 − ν)/2]],
 
-mass per area ρ t and rotary inertia ρ t³/12 (in the file's units).
+mass per area ρ t and rotary inertia ρ t³/12 (in the file's units). Beams (B31, B32, B32R):
+:mod:`sarfe.mesh.formats.abaqus_beams`.
 """
 from __future__ import annotations
 
@@ -16,6 +17,7 @@ import math
 
 import numpy as np
 
+from sarfe.mesh.formats.abaqus_beams import BEAM_NODES, beam_table
 from sarfe.mesh.formats.deck import DeckError, DeckModel, PointMasses, ShellElements, SpringElements, SupportSet
 
 # nodes per element of the element types read: shells, point elements (springs, masses)
@@ -98,9 +100,10 @@ def build_deck_model(reader) -> DeckModel:
             element_sets[prefix + name] = set_ids(labels, offset)
 
     # elements
-    shell_rows, spring_rows, mass_rows = [], [], []
+    shell_rows, spring_rows, mass_rows, beam_rows = [], [], [], []
     for scope, offset, inst in scoped:
         section_of, spring_of, mass_of = {}, {}, {}
+        beam_of = _beam_sections(scope, reader.materials)
         elsets = {key: {e[1] if isinstance(e, tuple) else e for e in labels}
                   for key, (_, labels) in scope.elsets.items()}
         for elset, material, thickness, where in scope.sections:
@@ -139,7 +142,14 @@ def build_deck_model(reader) -> DeckModel:
         for label, kind, refs, where in scope.elements:
             nodes = [index_of[global_node(r, scope, offset, where)] for r in refs]
             element_id = offset + label
-            if kind in SHELL_NODES:
+            if kind in BEAM_NODES:
+                if label not in beam_of:
+                    raise DeckError(f"{where}: beam element {label} has no *BEAM SECTION")
+                if any(n in nodal_t for n in nodes):
+                    raise DeckError(f"{where}: beam element {label}: *NODAL THICKNESS on a beam's "
+                                    "node (a tapered beam) is not supported")
+                beam_rows.append((element_id, kind, nodes, beam_of[label]))
+            elif kind in SHELL_NODES:
                 if label not in section_of:
                     raise DeckError(f"{where}: shell element {label} has no *SHELL SECTION")
                 section = section_of[label]
@@ -189,11 +199,29 @@ def build_deck_model(reader) -> DeckModel:
     return DeckModel(
         source=deck_path, node_ids=node_ids, points=points,
         displacement_frames=np.broadcast_to(np.eye(3), (len(node_ids), 3, 3)).copy(),
-        shells=_shell_table(shell_rows, points), springs=_spring_table(spring_rows),
+        shells=_shell_table(shell_rows, points), beams=beam_table(beam_rows),
+        springs=_spring_table(spring_rows),
         point_masses=_mass_table(mass_rows), supports=supports, loads=loads,
         node_sets=node_sets, element_sets=element_sets,
         unsupported=dict(reader.unsupported), ignored=dict(reader.ignored),
         unsupported_where=dict(reader.unsupported_where))
+
+
+def _beam_sections(scope, materials):
+    """{element label: (E, ν, ρ, section, dims, direction 1, where)} of a scope's
+    ``*BEAM SECTION`` lines."""
+    elsets = {key: {e[1] if isinstance(e, tuple) else e for e in labels}
+              for key, (_, labels) in scope.elsets.items()}
+    beam_of = {}
+    for elset, material, kind, dims, direction, where in scope.beam_sections:
+        if elset.upper() not in elsets:
+            raise DeckError(f"{where}: no element set {elset!r}")
+        mat = materials.get(material)
+        if mat is None or "E" not in mat or "nu" not in mat:
+            raise DeckError(f"{where}: no *MATERIAL {material!r} with an isotropic *ELASTIC (E, ν)")
+        for label in elsets[elset.upper()]:
+            beam_of[label] = (mat["E"], mat["nu"], mat.get("rho", 0.0), kind, dims, direction, where)
+    return beam_of
 
 
 def _node_reference(ref, node_sets, node_index, where):

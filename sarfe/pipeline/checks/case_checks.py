@@ -49,6 +49,8 @@ from sarfe.pipeline.checks.case_inputs import case_inputs
 from sarfe.pipeline.checks.held_checks import (check_something_free, contact_warnings,
                                                load_warnings)
 from sarfe.pipeline.checks.mesh_checks import check_deck, shared_pair_warnings
+from sarfe.pipeline.checks.run_cost import (ModelSize, contact_rows, plate_bending,
+                                            weyl_mode_density)
 from sarfe.pipeline.model.case_mesh import load_case_mesh
 from sarfe.pipeline.model.contact_pairs import boundary_dofs, node_pairs
 from sarfe.pipeline.model.erp_map import surface_triangles
@@ -67,11 +69,14 @@ HELD_BY = "model.fe.fixed or on no triangle"
 @dataclass(frozen=True)
 class CaseCheck:
     """What :func:`check_case` found: ``info`` for the validate line (nodes, triangles, contact
-    pairs), ``warnings`` (one-line strings), ``output`` (the checked result folder or None)."""
+    pairs), ``warnings`` (one-line strings), ``output`` (the checked result folder or None),
+    ``size`` (what the run's cost depends on: :class:`sarfe.pipeline.checks.run_cost.ModelSize`,
+    None when the mesh checks were skipped)."""
 
     info: dict = field(default_factory=dict)
     warnings: tuple = ()
     output: object = None
+    size: ModelSize | None = None
 
 
 def _excitation_top_hz(case) -> float:
@@ -170,11 +175,12 @@ def check_matrices_held(case) -> None:
     must be regular — else the static (0th harmonic) block of the HBM Jacobian is singular at every
     point. K_0 (n, n) [N/m]; its eigenvalues λ ≤ :data:`RIGID_TOLERANCE`·max λ span the rigid-body
     modes. CaseError naming model.matrices.stiffness and the null-space size. Models above
-    :data:`HELD_MATRIX_LIMIT` DOFs are not checked (a dense eigenvalue problem)."""
+    :data:`HELD_MATRIX_LIMIT` DOFs are not checked (a dense eigenvalue problem). Returns the
+    model's DOF count."""
     stage = build_linear_model(case)
     n = stage.dof_count
     if n > HELD_MATRIX_LIMIT:
-        return
+        return n
     nl = nonlinear_model(case, stage)
     K0 = linearized_stiffness(nl.model, nl.contacts)[0]
     K0 = K0.toarray() if hasattr(K0, "toarray") else np.asarray(K0, dtype=float)
@@ -189,6 +195,7 @@ def check_matrices_held(case) -> None:
                          f"null space of size {count} of {n} DOFs; DOF(s) {shown} move freely); "
                          "add stiffness to ground or a preloaded contact",
                          ("model", "matrices", "stiffness"))
+    return n
 
 
 def bending_resolution_hz(points, triangles, thickness, young, poisson, density) -> np.ndarray:
@@ -344,17 +351,26 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True,
     if not mesh_checks:
         return CaseCheck({}, tuple(range_warnings(case)), output)
     if not case.is_fe:
-        check_matrices_held(case)
-        return CaseCheck({}, tuple(range_warnings(case)), output)
+        dofs = check_matrices_held(case)
+        size = ModelSize(dofs=dofs, radiating_nodes=len(case.config.erp.dofs or ()),
+                         contacts=len(case.config.contacts),
+                         contact_rows=contact_rows(case.config, None))
+        return CaseCheck({}, tuple(range_warnings(case)), output, size)
     config = case.config
     if config.model.fe.is_deck:   # a Nastran/Abaqus deck: its own checks, with ids
         info = check_deck(case, assemble=assemble)
-        return CaseCheck(info, tuple(range_warnings(case)) + tuple(info.pop("warnings")), output)
+        size = ModelSize(dofs=6 * info.pop("free_nodes"), nodes=info["nodes"],
+                         triangles=info["triangles"], radiating_nodes=info.pop("radiating_nodes"),
+                         contacts=len(config.contacts),
+                         contact_rows=contact_rows(config, info["contact_pairs"]),
+                         mode_density_per_hz=info.pop("mode_density_per_hz"), fe=True)
+        return CaseCheck(info, tuple(range_warnings(case)) + tuple(info.pop("warnings")), output,
+                         size)
     mesh = load_case_mesh(case)
     fixed = fixed_nodes(case, mesh)
     held, used = held_nodes(mesh, fixed)
     check_something_free(case, held, used)
-    shell_properties(case, mesh)
+    section = shell_properties(case, mesh)
     check_thickness(case, mesh)
     resolved = resolve_contacts(case, mesh)
     paired = node_pairs(resolved)
@@ -363,7 +379,8 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True,
                   for i, f in enumerate(config.excitation.forces)]
     warned = load_warnings(case, held, load_nodes, HELD_BY)
     warned += contact_warnings(case, paired, held, HELD_BY)
-    surface_triangles(case, mesh)     # erp.surface: an element group, or a node group's triangles
+    # erp.surface: an element group, or a node group's triangles
+    radiating = np.unique(surface_triangles(case, mesh)).size
     joined = [(int(a), int(b)) for p in paired.values() for a, b in zip(p[0], p[1])]
     check_element_quality(case, mesh, joined)
     check_held(case, mesh, fixed)
@@ -373,9 +390,17 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True,
     interior = interior_dof_count(mesh, fixed, np.union1d(
         boundary_dofs(resolved), (6 * loads[:, None] + np.arange(3)).ravel()))
     geometry = tuple(w for r in resolved.values() for w in r.warnings)
+    size = ModelSize(dofs=6 * int(np.count_nonzero(used & ~held)), nodes=mesh.n_nodes,
+                     triangles=mesh.n_triangles, radiating_nodes=int(radiating),
+                     contacts=len(config.contacts),
+                     contact_rows=contact_rows(config, info["contact_pairs"]),
+                     mode_density_per_hz=weyl_mode_density(
+                         mesh.points, mesh.triangles, section.density * section.thickness,
+                         plate_bending(section.thickness, section.young, section.poisson)),
+                     fe=True, generated=config.model.fe.source == "generator")
     return CaseCheck(info, tuple(range_warnings(case, mesh)) + tuple(shared)
                      + tuple(warned) + geometry
-                     + tuple(mode_count_warnings(case, interior)), output)
+                     + tuple(mode_count_warnings(case, interior)), output, size)
 
 
 __all__ = ["CaseCheck", "check_case", "held_nodes", "check_matrices_held", "output_target",

@@ -18,6 +18,7 @@ from sarfe.mesh import quality
 from sarfe.pipeline.model.case_mesh import load_case_mesh
 from sarfe.pipeline.checks.held_checks import (check_something_free, contact_warnings,
                                                load_warnings)
+from sarfe.pipeline.checks.run_cost import weyl_mode_density
 from sarfe.pipeline.model.contact_pairs import node_pairs
 from sarfe.pipeline.model.deck_checks import check_boundary_nodes, connected_parts
 from sarfe.pipeline.model.deck_model import prepare_deck
@@ -150,7 +151,7 @@ def check_deck(case, assemble=True) -> dict:
     held_by = "the supports or model.fe.fixed, or on no element"
     shared += load_warnings(case, held, load_nodes, held_by)
     shared += contact_warnings(case, paired, held, held_by, labels=deck.node_ids)
-    deck_surface_triangles(case, mesh)
+    radiating = np.unique(deck_surface_triangles(case, mesh)).size
     # what solve refuses at assembly (degenerate cells, rigid-element chains, force nodes
     # without stiffness): validate assembles too (no reduction)
     if assemble:
@@ -162,8 +163,23 @@ def check_deck(case, assemble=True) -> dict:
             "contact_pairs": pairs, "ignored_cards": prepared.notes["ignored_cards"],
             "coincident_node_pairs": prepared.notes["coincident_node_pairs"],
             "coincident_nodes": prepared.notes["coincident_nodes"],
+            "free_nodes": int(np.count_nonzero(~held)), "radiating_nodes": int(radiating),
+            "mode_density_per_hz": shell_mode_density(deck),
             "warnings": list(prepared.warnings) + shared
                         + [w for r in resolved.values() for w in r.warnings]}
 
 
-__all__ = ["check_mesh", "check_deck", "shared_pair_warnings", "mesh_quality"]
+def shell_mode_density(deck) -> float | None:
+    """The Weyl modal density [modes/Hz] of a deck's shells (:func:`sarfe.pipeline.checks.
+    run_cost.weyl_mode_density` with each triangle's ρ t + NSM and √(D₁₁ D₂₂)); None without
+    shells."""
+    shells = deck.shells
+    if shells.n_triangles == 0:
+        return None
+    bending = np.sqrt(np.abs(shells.bending[:, 0, 0] * shells.bending[:, 1, 1]))
+    keep = (bending > 0) & (shells.mass_per_area > 0)
+    return weyl_mode_density(deck.points, shells.triangles[keep], shells.mass_per_area[keep],
+                             bending[keep])
+
+
+__all__ = ["check_mesh", "check_deck", "shell_mode_density", "shared_pair_warnings", "mesh_quality"]

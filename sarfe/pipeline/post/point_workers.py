@@ -24,12 +24,25 @@ result is that path's.
 """
 from __future__ import annotations
 
+import numpy as np
+
 from sarfe.case.config import CaseConfig, SolverConfig
+from sarfe.hbm.stability import deferred
+from sarfe.hbm.stability.hill import StabilityResult
 from sarfe.hbm.stability.deferred import pending, stability_of, with_stability
 from sarfe.pipeline.post import records
+from sarfe.pipeline.post.stability_need import seed_jobs, stability_by_need, stability_stride
 from sarfe.pipeline.solve.points import common_samples
 from sarfe.util.progress import bar as progress_bar
 from sarfe.util.workers import Stream, map_points, worker_count
+
+
+def _stability_or_error(job, compute=None):
+    """:func:`stability_of` (or ``compute``) of a job, or the exception it raised (returned)."""
+    try:
+        return (compute or stability_of)(job)
+    except Exception as error:      # the caller solves the sweep again serially
+        return error
 
 
 def point_workers(solver: SolverConfig) -> int:
@@ -40,8 +53,35 @@ def point_workers(solver: SolverConfig) -> int:
 
 def stability_stream() -> Stream:
     """The Hill stability of the sweep's points on one worker while the sweep goes on (the jobs
-    of :func:`sarfe.hbm.stability.deferred.deferred_stability` submitted as they are recorded)."""
+    of :func:`sarfe.hbm.stability.deferred.deferred_stability` submitted as they are recorded,
+    :func:`stream_submit`)."""
     return Stream(stability_of)
+
+
+def stream_submit(stream: Stream, stride: int):
+    """on_job(index, job) for :func:`sarfe.hbm.stability.deferred.deferred_stability`: every
+    ``stride``-th recorded job goes to the stream (the seeds of the stability by need; the others
+    are computed after the sweep where a verdict changes)."""
+    def submit(index, job):
+        if index % stride == 0:
+            stream.submit(index, job)
+    return submit
+
+
+def serial_stability(solutions, jobs, stride: int) -> list:
+    """The solutions of a serial sweep (``workers`` = 1) with their deferred stability by need
+    (:mod:`sarfe.pipeline.post.stability_need`) computed in this process; a failing computation
+    gives verdict None with its error in the note."""
+    indices = pending(solutions)
+    if not indices:
+        return solutions
+    verdicts = stability_by_need(solutions, jobs,
+                                 lambda todo: [_stability_or_error(j, deferred.stability_of)
+                                               for j in todo], stride=stride)
+    results = [StabilityResult(None, float("nan"), f"stability failed: {type(r).__name__}: {r}",
+                               np.zeros(0, complex)) if isinstance(r, Exception) else r
+               for r in (verdicts[i] for i in indices)]
+    return with_stability(solutions, indices, results)
 
 
 def first_estimates(config: CaseConfig, stage, nl, solutions) -> dict:
@@ -76,7 +116,10 @@ def point_work(config: CaseConfig, stage, nl, solutions, jobs, done, first, work
     done = done or {}
     if any(isinstance(done.get(i), Exception) for i in indices):
         return None
-    hill = [i for i in indices if i not in done]
+    # the seeds of the stability by need first (sarfe.pipeline.post.stability_need), with the
+    # estimates; the crossings between differing verdicts after them
+    stride = stability_stride(config.excitation)
+    hill = [i for i in seed_jobs(solutions, stride) if i not in done] if indices else []
     estimates = [i for i in records.estimated_points(config, nl, solutions) if i not in first]
     gridded = common_samples(nl, solutions)      # records at one N; estimates at each point's own
     # two pools: the Hill and estimate items first, then the records on freshly forked workers
@@ -90,10 +133,7 @@ def point_work(config: CaseConfig, stage, nl, solutions, jobs, done, first, work
     def run(task):
         kind, i = task
         if kind == "stability":
-            try:
-                return stability_of(jobs[i])
-            except Exception as error:      # the serial path's sweep is solved instead
-                return error
+            return _stability_or_error(jobs[i])
         if kind == "estimate":
             return records.point_estimate(config, stage, nl, solutions[i])
         return records.point_records(config, stage, nl, [(j, gridded[j], None) for j in i])
@@ -113,6 +153,10 @@ def point_work(config: CaseConfig, stage, nl, solutions, jobs, done, first, work
             bar.close()
     by_task = dict(zip(tasks, results))
     verdicts = {**done, **{i: by_task["stability", i] for i in hill}}
+    if indices:
+        verdicts = stability_by_need(
+            solutions, jobs, lambda todo: map_points(_stability_or_error, todo, workers),
+            done=verdicts, stride=stride)
     if any(isinstance(verdicts[i], Exception) for i in indices):
         return None
     if indices:

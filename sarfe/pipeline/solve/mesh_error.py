@@ -1,16 +1,25 @@
-r"""The mesh term of a run's ± (issue 29 item 4): the loudest point re-solved on a generated mesh
-of twice the element size, Richardson-extrapolated (:mod:`sarfe.accuracy.mesh_refinement`, (1))
+r"""The mesh term of a run's ± (issue 29 item 4): the loudest point re-solved on two generated
+meshes of √2 and 2 times the element size, the three levels L_h, L_√2h, L_2h (dB and dB(A)) turned
+into a grid convergence index (:func:`sarfe.accuracy.mesh_refinement.mesh_gci`, (2) there):
 
-    mesh_db = max(|L_h − L_2h|, |L_A,h − L_A,2h|) / (2^p − 1),   p = MESH_ORDER (stated)
+    monotone, observed p = ln(ε₃₂/ε₂₁)/ln √2 in [1, 2]:  mesh_db = 1.25·|L_√2h − L_h| / (√2^p − 1)
+    monotone, p outside [1, 2] (pre-asymptotic): 1.25·ΔM;       oscillatory: 3·ΔM
 
-One linear stage built on the coarser mesh (the case's reduction rule and cutoff, so the modal
-basis covers the same band) and one Newton solve of the harmonic balance at the loudest point's
-ω, H, N, started from the linear response to the fine point's contact forces (same contact
-rows), else from the linear response. Where the two meshes' contacts are in different states at ω
-(one closes, the other does not: the mesh moved the contact onset, e.g. a rattle near its fold)
-the level change is no Richardson estimate: the term is "not estimated" with that reason. The term is measured at the loudest point and added to every
-estimated point's ERP bound (``error_estimate.mesh_db``, ``erp_db`` includes it): the headline
-carries it where it was measured; elsewhere it stands for the mesh error of the run.
+(ΔM the range of the three levels; Roache's Fs = 1.25 for three meshes, Eça & Hoekstra's 3·ΔM
+where the levels oscillate; the larger of the dB and dB(A) estimates). Where the middle mesh
+fails (or its contacts are on another branch) the two meshes h, 2h give Richardson with p = 1
+stated, |L_h − L_2h| / (2 − 1) ((1) there, method 'two meshes').
+
+Each re-solve: one linear stage built on the coarser mesh (the case's reduction rule and cutoff,
+so the modal basis covers the same band) and one Newton solve of the harmonic balance at the
+loudest point's ω, H, N, started from the linear response to the fine point's contact forces
+(same contact rows), else from the linear response. Where the 2h mesh's contacts are in a
+different state at ω (one closes, the other does not: the mesh moved the contact onset, e.g. a
+rattle near its fold) the level change is no estimate: the term is "not estimated" with that
+reason. The term is measured at the loudest point and added to every estimated point's ERP bound
+(``error_estimate.mesh_db``, ``erp_db`` includes it): the headline carries it where it was
+measured; elsewhere it stands for the mesh error of the run. Cost: the two re-solves (≈ ¼ and ½
+of the fine mesh's DOFs), ``timings_s.mesh_error_s``.
 
 Only generated meshes (``model.fe.generator``) have a coarser mesh to build: for decks, given
 meshes and matrices models the term is "not estimated" and said so (``solver.mesh_error``:
@@ -23,12 +32,14 @@ import warnings
 
 import numpy as np
 
-from sarfe.accuracy.mesh_refinement import MESH_ORDER, MESH_RATIO, mesh_richardson
+from sarfe.accuracy.mesh_refinement import (MESH_GCI_RATIO, MESH_ORDER, mesh_gci,
+                                             mesh_richardson)
 from sarfe.hbm import SolverOptions, solve_frequency
 from sarfe.hbm.time_integration import linear_harmonic_response
 from sarfe.pipeline.model.linear_stage import build_linear_model
 from sarfe.pipeline.model.nonlinear_model import nonlinear_model
 from sarfe.pipeline.post.records import loudest_point, point_erp
+from sarfe.util.workers import map_points, worker_count
 
 
 def mesh_error_reason(case) -> str | None:
@@ -62,15 +73,44 @@ def coarse_start(nl_coarse, solution, H):
     return linear_harmonic_response(nl_coarse.model, F, solution.omega)
 
 
-def mesh_error_term(case, points, solutions, ratio=MESH_RATIO, order=MESH_ORDER) -> dict:
+def resolve_coarser(case, fine, mesh_size_m):
+    """The fine point ``fine`` (a HarmonicSolution) re-solved on a generated mesh of
+    ``mesh_size_m``: one linear stage (the case's reduction rule and cutoff) and one Newton solve at
+    its ω, H, N, warm-started by :func:`coarse_start` → {'mesh_size_m', 'level_db', 'level_dba',
+    'converged', 'touching', 'nodes', 'reason'}. Raises what building the mesh or the model raises."""
+    solver = case.config.solver
+    coarse = case.with_generator(mesh_size_m=mesh_size_m)
+    stage = build_linear_model(coarse)
+    nl = nonlinear_model(coarse, stage)
+    H, N = int(fine.harmonics), int(fine.samples_per_period)
+    options = SolverOptions(tolerance=solver.tolerance, max_iterations=solver.max_iterations,
+                            stability=False, harmonic_set=solver.harmonic_set)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        start = coarse_start(nl, fine, H)
+        s = solve_frequency(nl.model, nl.contacts, nl.excitation, fine.omega, H, N,
+                            initial=start, options=options)
+        if not s.converged and start is not None:
+            s = solve_frequency(nl.model, nl.contacts, nl.excitation, fine.omega, H, N,
+                                options=options)
+    erp, _ = point_erp(case.config.erp, stage, s.displacement, s.omega)
+    return {"mesh_size_m": float(mesh_size_m), "level_db": float(erp.level_total_db),
+            "level_dba": float(erp.level_total_a_db), "converged": bool(s.converged),
+            "touching": touches(s), "nodes": int(stage.info.get("nodes", 0)),
+            "reason": getattr(s, "reason", "")}
+
+
+def mesh_error_term(case, points, solutions, ratio=MESH_GCI_RATIO) -> dict:
     """The mesh term (module docstring) of a solved case: ``points`` the summary's point records,
-    ``solutions`` their HarmonicSolutions → {'estimated', 'reason', 'mesh_db', 'order', 'ratio',
-    'mesh_size_m', 'coarse_mesh_size_m', 'frequency_hz', 'level_db', 'level_dba',
-    'coarse_level_db', 'coarse_level_dba', 'coarse_converged', 'coarse_nodes', 'seconds'}.
-    A failure (coarser mesh not built, Newton not converged) is reported as not estimated, never
-    raised."""
+    ``solutions`` their HarmonicSolutions → {'estimated', 'reason', 'mesh_db', 'method',
+    'convergence', 'order', 'order_used', 'safety_factor', 'ratio', 'mesh_size_m',
+    'coarse_mesh_sizes_m', 'coarse_levels_db', 'coarse_levels_dba', 'coarse_mesh_size_m' (the
+    coarsest), 'coarse_level_db', 'coarse_level_dba', 'coarse_converged', 'coarse_nodes',
+    'frequency_hz', 'level_db', 'level_dba', 'seconds'}. A failure (coarser mesh not built, Newton
+    not converged) is reported as not estimated, never raised; where only the middle mesh fails,
+    the two meshes h, 2h give (1) of :mod:`sarfe.accuracy.mesh_refinement` (method 'two meshes')."""
     clock = time.perf_counter()
-    out = {"estimated": False, "mesh_db": float("nan"), "order": float(order),
+    out = {"estimated": False, "mesh_db": float("nan"), "order": float("nan"),
            "ratio": float(ratio), "reason": mesh_error_reason(case)}
     if out["reason"] is not None:
         return out
@@ -80,48 +120,61 @@ def mesh_error_term(case, points, solutions, ratio=MESH_RATIO, order=MESH_ORDER)
         return out
     fine = solutions[j]
     h = float(case.config.model.fe.generator.mesh_size_m)
-    solver = case.config.solver
-    out.update(mesh_size_m=h, coarse_mesh_size_m=ratio * h, frequency_hz=points[j]["frequency_hz"],
+    out.update(mesh_size_m=h, frequency_hz=points[j]["frequency_hz"],
                level_db=points[j]["erp"]["level_db"], level_dba=points[j]["erp"]["level_dba"])
-    try:
-        coarse = case.with_generator(mesh_size_m=ratio * h)
-        stage = build_linear_model(coarse)
-        nl = nonlinear_model(coarse, stage)
-        H, N = int(fine.harmonics), int(fine.samples_per_period)
-        options = SolverOptions(tolerance=solver.tolerance, max_iterations=solver.max_iterations,
-                                stability=False, harmonic_set=solver.harmonic_set)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            start = coarse_start(nl, fine, H)
-            s = solve_frequency(nl.model, nl.contacts, nl.excitation, fine.omega, H, N,
-                                initial=start, options=options)
-            if not s.converged and start is not None:
-                s = solve_frequency(nl.model, nl.contacts, nl.excitation, fine.omega, H, N,
-                                    options=options)
-    except Exception as error:  # an estimate must not break a solve
-        out.update(reason=f"not estimated (the {1e3 * ratio * h:.3g} mm mesh failed: "
-                   f"{type(error).__name__}: {error})", seconds=time.perf_counter() - clock)
-        return out
-    erp, _ = point_erp(case.config.erp, stage, s.displacement, s.omega)
-    out.update(coarse_level_db=float(erp.level_total_db), coarse_level_dba=float(erp.level_total_a_db),
-               coarse_converged=bool(s.converged), coarse_nodes=int(stage.info.get("nodes", 0)),
+    def run(size):
+        try:
+            return resolve_coarser(case, fine, size)
+        except Exception as error:  # an estimate must not break a solve
+            return {"mesh_size_m": size, "failed": f"{type(error).__name__}: {error}"}
+
+    # the two coarser meshes at once on the case's workers (the coarsest, 2h, decides whether
+    # the middle one is used); one process: the coarsest first, the middle only if it converged
+    sizes = (ratio ** 2 * h, ratio * h)
+    workers = min(worker_count(case.config.solver.workers), len(sizes))
+    runs = dict(zip(sizes, map_points(run, sizes, workers))) if workers > 1 else {}
+    if not runs:
+        runs[sizes[0]] = run(sizes[0])
+        if "failed" not in runs[sizes[0]] and runs[sizes[0]]["converged"]:
+            runs[sizes[1]] = run(sizes[1])
+    coarsest = runs[ratio ** 2 * h]
+    middle = runs.get(ratio * h, {"mesh_size_m": ratio * h, "failed": "not solved"})
+    runs = [middle, coarsest]
+    out.update(coarse_mesh_size_m=coarsest["mesh_size_m"],
+               coarse_mesh_sizes_m=[r["mesh_size_m"] for r in runs],
+               coarse_levels_db=[r.get("level_db") for r in runs],
+               coarse_levels_dba=[r.get("level_dba") for r in runs],
+               coarse_level_db=coarsest.get("level_db"), coarse_level_dba=coarsest.get("level_dba"),
+               coarse_converged=coarsest.get("converged"), coarse_nodes=coarsest.get("nodes"),
                seconds=time.perf_counter() - clock)
-    if not s.converged:
-        out["reason"] = (f"not estimated (the re-solve on the {1e3 * ratio * h:.3g} mm mesh did "
-                         f"not converge: {getattr(s, 'reason', '')})")
+    size_mm = f"{1e3 * coarsest['mesh_size_m']:.3g} mm"
+    if "failed" in coarsest:
+        out["reason"] = f"not estimated (the {size_mm} mesh failed: {coarsest['failed']})"
         return out
-    touching = (touches(fine), touches(s))
-    if touching[0] != touching[1]:      # one mesh's contacts close at ω, the other's do not
-        out["reason"] = (f"not estimated: at {out['frequency_hz']:.2f} Hz the "
-                         f"{1e3 * ratio * h:.3g} mm mesh's contacts "
-                         f"{'do not close' if touching[0] else 'close'} "
-                         f"({out['coarse_level_dba']:.1f} against {out['level_dba']:.1f} dB(A)): "
+    if not coarsest["converged"]:
+        out["reason"] = (f"not estimated (the re-solve on the {size_mm} mesh did not converge: "
+                         f"{coarsest['reason']})")
+        return out
+    fine_touching = touches(fine)
+    if coarsest["touching"] != fine_touching:   # one mesh's contacts close at ω, the other's do not
+        out["reason"] = (f"not estimated: at {out['frequency_hz']:.2f} Hz the {size_mm} mesh's "
+                         f"contacts {'do not close' if fine_touching else 'close'} "
+                         f"({coarsest['level_dba']:.1f} against {out['level_dba']:.1f} dB(A)): "
                          "another branch, its level change is no Richardson estimate (the mesh "
                          "moves the contact onset; refine the mesh or compare the sweeps with "
                          "`sarfe study --knobs mesh`)")
         return out
-    mesh_db = max(mesh_richardson(out["level_db"], out["coarse_level_db"], order, ratio),
-                  mesh_richardson(out["level_dba"], out["coarse_level_dba"], order, ratio))
+    if "failed" in middle or not middle["converged"] or middle["touching"] != fine_touching:
+        mesh_db = max(mesh_richardson(out[k], coarsest[k], MESH_ORDER, ratio ** 2)
+                      for k in ("level_db", "level_dba"))
+        out.update(method="two meshes", order=MESH_ORDER, order_used=MESH_ORDER,
+                   convergence=None, safety_factor=float("nan"),
+                   middle_reason=middle.get("failed") or "not converged or another branch")
+    else:
+        gci = max((mesh_gci([out[k], middle[k], coarsest[k]], ratio)
+                   for k in ("level_db", "level_dba")), key=lambda g: g["mesh_db"])
+        mesh_db = gci["mesh_db"]
+        out.update(method="three meshes", **{k: v for k, v in gci.items() if k != "mesh_db"})
     out.update(estimated=bool(np.isfinite(mesh_db)), mesh_db=float(mesh_db), reason=None)
     return out
 
@@ -159,12 +212,29 @@ def mesh_line(term: dict | None) -> str | None:
         return None
     if not term.get("estimated"):
         return f"mesh error: {term.get('reason') or 'not estimated'}"
-    return (f"mesh error: ±{term['mesh_db']:.2f} dB (in the ±): loudest point {term['frequency_hz']:.2f}"
-            f" Hz re-solved on a {1e3 * term['coarse_mesh_size_m']:.3g} mm mesh: "
-            f"{term['coarse_level_dba']:.1f} dB(A) against {term['level_dba']:.1f} at "
-            f"{1e3 * term['mesh_size_m']:.3g} mm, Richardson with p = {term['order']:g} (stated); "
-            f"{term.get('seconds', 0.0):.1f} s")
+    sizes = " / ".join(f"{1e3 * m:.3g}" for m in term.get("coarse_mesh_sizes_m", [])
+                       if m is not None)
+    levels = " / ".join(f"{v:.1f}" for v in term.get("coarse_levels_dba", []) if v is not None)
+    head = (f"mesh error: ±{term['mesh_db']:.2f} dB (in the ±): loudest point "
+            f"{term['frequency_hz']:.2f} Hz re-solved on {sizes} mm meshes: {levels} dB(A) against "
+            f"{term['level_dba']:.1f} at {1e3 * term['mesh_size_m']:.3g} mm; ")
+    kind = term.get("convergence")
+    if term.get("method") == "two meshes":
+        how = (f"Richardson from the {1e3 * term['coarse_mesh_size_m']:.3g} mm mesh with p = "
+               f"{term['order']:g} (stated; the middle mesh: {term.get('middle_reason')})")
+    elif kind == "monotone":
+        how = f"GCI, monotone, observed p = {term['order']:.2f}, Fs = {term['safety_factor']:g}"
+    elif kind == "pre-asymptotic":
+        how = (f"GCI, monotone but observed p = {term['order']:.2f} not in [1, 2] "
+               "(pre-asymptotic): "
+               f"Fs = {term['safety_factor']:g} × the levels' range {term['range_db']:.2f} dB")
+    elif kind == "oscillatory":
+        how = (f"GCI, the levels oscillate: Fs = {term['safety_factor']:g} × their range "
+               f"{term['range_db']:.2f} dB")
+    else:
+        how = "the three levels agree"
+    return head + how + f"; {term.get('seconds', 0.0):.1f} s"
 
 
-__all__ = ["mesh_error_reason", "touches", "coarse_start", "mesh_error_term", "with_mesh_term",
-           "mesh_checked", "mesh_line"]
+__all__ = ["mesh_error_reason", "touches", "coarse_start", "resolve_coarser", "mesh_error_term",
+           "with_mesh_term", "mesh_checked", "mesh_line"]

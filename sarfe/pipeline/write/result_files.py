@@ -216,53 +216,15 @@ def full_field_every_point(stage, solutions) -> bool:
     return cost <= FULL_FIELD_BUDGET
 
 
-CONSOLE_WIDTH = 80      # the compact console summary fits this many columns
-CONSOLE_ROWS = 12       # … and shows at most this many points (all of them in table.txt)
-
-
-def console_summary(rows, contact_types=None, full_table=None, width=CONSOLE_WIDTH,
-                    max_rows=CONSOLE_ROWS) -> str:
-    """The end-of-run console summary of the points, at most ``width`` characters a line: the
-    compact :func:`results_table` (f, converged, ERP [dB(A)], ±dB and as many contacts as fit) of
-    all points when there are at most ``max_rows``, else of the band's two ends and ``max_rows``
-    − 2 others, the level's peaks loudest first, then points spread over the sweep (in sweep
-    order), with a line saying so and naming ``full_table`` (the file
-    with every point, e.g. 'table.txt'; None: not written)."""
-    rows = list(rows)
-    shown = list(range(len(rows)))
-    if len(rows) > max_rows:
-        levels = np.array([row.get("erp_dba", float("nan")) for row in rows], dtype=float)
-        levels = np.where(np.isfinite(levels), levels, -np.inf)
-        peak = np.r_[False, (levels[1:-1] > levels[:-2]) & (levels[1:-1] >= levels[2:]), False]
-        peaks = [int(i) for i in np.flatnonzero(peak)[np.argsort(-levels[peak])]]
-        spread = [int(i) for i in np.linspace(0, len(rows) - 1, max_rows).round()]
-        chosen = [0, len(rows) - 1]
-        for i in peaks[:max_rows - 2] + spread:     # the peaks loudest first, then spread
-            if len(chosen) < max_rows and i not in chosen:
-                chosen.append(i)
-        shown = sorted(chosen)
-    count = len([k for k in (rows[0] if rows else {}) if k.endswith(".max_penetration_m")])
-    for contacts in range(count, -1, -1):       # as many contact columns as fit the width
-        table = results_table([rows[i] for i in shown], contact_types, max_contacts=contacts,
-                              compact=True)
-        if max(len(line) for line in table.splitlines()) <= width:
-            break
-    if len(shown) < len(rows):
-        where = f"; all in {full_table}" if full_table else ""
-        table += f"\n({len(shown)} of {len(rows)} points: ends, peaks, spread{where})"
-    return table
-
-
-def results_table(rows, contact_types=None, max_contacts=6, compact=False) -> str:
+def results_table(rows, contact_types=None, max_contacts=6) -> str:
     """Console table of the frequency points: convergence, ERP and, per contact (at most
     ``max_contacts``), the indicator its law declares (max penetration, or the slip fraction of a
     friction law: the share of the period in slip, 0…1). The ±dB column is the ERP error bound,
     "~" marking a bound interpolated between estimated points. ``contact_types``: {name: law
-    name} (default: max penetration). ``compact``: frequency, convergence and dB(A) only (no
-    stability, iterations, dB and linear dB columns: :func:`console_summary`)."""
-    columns = (["frequency_hz", "converged", "erp_dba"] if compact else
-               ["frequency_hz", "converged", "stable", "iterations", "erp_db", "erp_dba",
-                "linear_erp_db"])
+    name} (default: max penetration). Every point and contact: table.txt (the console shows a
+    few points, :func:`sarfe.results.console.points_table`)."""
+    columns = ["frequency_hz", "converged", "stable", "iterations", "erp_db", "erp_dba",
+               "linear_erp_db"]
     headers = {"frequency_hz": "f [Hz]", "erp_db": "ERP [dB]", "erp_dba": "ERP [dB(A)]",
                "linear_erp_db": "linear [dB]", "iterations": "iter"}
     formats = {"frequency_hz": ".2f", "erp_db": ".1f", "erp_dba": ".1f", "linear_erp_db": ".1f"}

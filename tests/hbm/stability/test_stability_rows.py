@@ -13,6 +13,7 @@ from sarfe.hbm.residual import Problem, full_residual
 from sarfe.hbm.stability.contact_terms import ContactOperator
 from sarfe.hbm.stability.contour import winding_count
 from sarfe.hbm.stability.determinant import ContactRowDeterminant, structural_exponents
+from sarfe.hbm.stability.perturbation import perturbation_check
 from sarfe.hbm.stability.rows import contact_row_stability
 from tests.hbm.shipped_points import full_hill, shipped_case_points
 
@@ -215,13 +216,21 @@ def test_squeak_rig_rows_equal_full(squeak_rig):
                                   "door_trim", "instrument_panel"])
 def test_shipped_cases_rows_equal_full(name):
     """Shipped cases at their own settings (H ≤ 5): every solved point, the solver's verdict with
-    the count (where it decides) equals the full Hill method's."""
+    the count (where it decides) equals the full Hill method's — or, where the two differ, the
+    time integrator's (its monodromy, shooting converged). The full method's truncated structure
+    leaves edge exponents at |Im s| of a few ω (sarfe.hbm.stability.trust): rattle_rig_deck at
+    32 Hz, H = 5, full +1.00 1/s at Im s = 776.7 = 3.86 ω, where the count says stable and the
+    integrator too (1024 / 2048 steps per period: −23.9 / −14.4 1/s, periodicity 8e-5)."""
     nl, H, points = shipped_case_points(name)
     F = nl.excitation[:2 * H + 1]
     for f, s in points:
         full, rows, _, _ = full_and_rows(nl.model, nl.contacts, F, s)
-        if rows is not None:            # None: handed over to the Ritz method
-            assert rows.stable is full.stable, (f, full, rows)
+        if rows is None or rows.stable is full.stable:    # None: handed over to the Ritz method
+            continue
+        check = perturbation_check(nl.model, nl.contacts, F, s, steps_per_period=1024,
+                                   newton_steps=4)
+        assert check.periodicity < 1e-3, (f, check.periodicity)
+        assert rows.stable is check.stable, (f, full, rows, check.rate)
 
 
 def test_a_ritz_verdict_that_contradicts_the_count_is_reported_uncertain(sweep03, monkeypatch):

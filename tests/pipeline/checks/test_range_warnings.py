@@ -69,6 +69,9 @@ def test_log_gets_one_line_per_stage(far_case, capsys):
     assert main(["solve", str(far_case), "--output", "res"]) == 0
     err = [line for line in capsys.readouterr().err.splitlines()      # (the accuracy check's
            if "warning" not in line and not line.startswith("sarfe: accuracy:")]   # own line)
+    # the run's cost, said once after the checks and before the work (issue 30 item 4)
+    assert [i for i, line in enumerate(err) if line.startswith("sarfe: cost: H ")] == [1]
+    err = [line for line in err if not line.startswith(("sarfe: cost: ", "      "))]
     assert err == ["sarfe: checking the case: mesh, groups, quality …", "sarfe: linear stage: mesh …", "sarfe: linear stage: assembly …",
                    "sarfe: linear stage: reduction …", "sarfe: Craig-Bampton mode blocks …",
                    "sarfe: linear stage: contacts, loads, ERP map …",

@@ -344,3 +344,19 @@ def test_cbush_squeak_contact_takes_axis_and_stiffness_from_the_element(tmp_path
     assert np.allclose(contacts["clip"].frames[0, 0], normal)
     assert contacts["clip"].normal_stiffness.tolist() == [pytest.approx(k_n)]
     assert contacts["clip"].tangential_stiffness.tolist() == [pytest.approx(k_t)]
+
+
+def test_abaqus_beam_stiffener_is_read_into_the_case(tmp_path):
+    """A B31 rib (*BEAM SECTION RECT 4 × 6 mm) along the free edge y = LY of the plate: the
+    case's mass gains ρ A L exactly and the rib stiffens the plate (first mode up)."""
+    nid = lambda i: 1 + i + (NX + 1) * NY                           # noqa: E731
+    rib = "\n".join(["*ELEMENT, TYPE=B31, ELSET=rib",
+                     *[f"{700 + i}, {nid(i)}, {nid(i + 1)}" for i in range(NX)],
+                     "*BEAM SECTION, ELSET=rib, MATERIAL=PP, SECTION=RECT", "4., 6.", "0., 0., 1."])
+    plain = build_linear_model(load_case(write_case(tmp_path, plate_inp()), base_dir=tmp_path))
+    ribbed = build_linear_model(load_case(write_case(tmp_path, plate_inp(extra=rib)),
+                                          base_dir=tmp_path))
+    added = RHO * 1e12 * (4.0 * 6.0 * 1e-6) * (LX * 1e-3)
+    assert ribbed.info["total_mass_kg"] - plain.info["total_mass_kg"] == pytest.approx(added,
+                                                                                      rel=1e-9)
+    assert ribbed.mode_frequencies_hz[0] > plain.mode_frequencies_hz[0]

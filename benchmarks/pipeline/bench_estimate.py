@@ -1,0 +1,156 @@
+"""Issue 30 item 4: the cost ``sarfe validate`` / ``sarfe solve`` state before the run
+(:mod:`sarfe.pipeline.checks.run_cost`) against what the run then costs.
+
+Each case is one whole ``sarfe solve`` process (one BLAS thread, ``nice``); its summary.json
+``cost_estimate`` is the estimate it printed. Measured: CPU s (user + system of the process and
+its workers: on a shared machine the better proxy of a quiet machine's time), wall s, the bytes
+of the result folder per file kind, the points. The table says whether the measured CPU s and
+bytes fall in the estimated range, and the central disk estimate's ratio (the estimate's low end
+for listed frequencies, where low = high).
+
+``python benchmarks/pipeline/bench_estimate.py [case …]`` (default: the small shipped cases;
+door_trim_p1 and instrument_panel_sweep take minutes); writes benchmarks/results/estimate.{json,md},
+replacing the rows of the cases run and keeping the others (each row with its load average).
+"""
+import json
+import os
+import pathlib
+import sys
+import tempfile
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))   # benchmarks/: benchlib
+from benchlib import (ROOT, machine, machine_line, read_results, run_timed,  # noqa: E402
+                      write_results)
+
+CASES = ["squeak_rig", "door_trim", "instrument_panel", "lumped_rattle", "rattle_rig",
+         "rattle_rig_deck"]
+
+
+def file_kind(path: pathlib.Path, folder: pathlib.Path) -> str | None:
+    """The estimate's file kind of a written file (sarfe.pipeline.checks.run_cost.file_bytes)."""
+    rel = path.relative_to(folder)
+    name = rel.name
+    if rel.parts[0] == "animation":
+        return "animation"
+    if rel.parts[0] == "erp" or name == "erp.vtu":
+        return "ERP maps (VTU)"
+    if name.endswith(".png"):
+        return "plots (PNG)"
+    if name.endswith(".wav"):
+        return "sound.wav"
+    if name.startswith(".sarfe"):
+        return None
+    return name
+
+
+def written(folder: pathlib.Path) -> dict:
+    sizes = {}
+    for f in folder.rglob("*"):
+        kind = file_kind(f, folder) if f.is_file() else None
+        if kind is not None:
+            sizes[kind] = sizes.get(kind, 0) + f.stat().st_size
+    return sizes
+
+
+def run(case: str, scratch: pathlib.Path) -> dict:
+    out = scratch / case
+    command = ["nice", "-n", "10", sys.executable, "-m", "sarfe", "solve",
+               str(ROOT / "cases" / f"{case}.yaml"), "--output", str(out), "--force", "--quiet"]
+    wall, cpu, _ = run_timed(command, cwd=str(scratch), ok=(0, 3, 4))
+    summary = json.loads((out / "summary.json").read_text())
+    estimate = summary["cost_estimate"]
+    sizes = written(out)
+    total = sum(sizes.values())
+    low, high = estimate["bytes"]
+    return {"case": case, "wall_s": wall, "cpu_s": cpu, "points": len(summary["points"]),
+            "estimate": estimate, "written_bytes": total, "files": sizes,
+            "cpu_in_range": estimate["cpu_s"][0] <= cpu <= estimate["cpu_s"][1],
+            "bytes_ratio_low": low / total, "bytes_ratio_high": high / total,
+            "bytes_in_range": 0.7 * total <= high and low <= 1.3 * total}
+
+
+def markdown(rows, load_start, load_end) -> list:
+    lines = ["# The cost said before the run vs the run (issue 30 item 4)", "",
+             machine_line(), "",
+             f"Last run: load average at the start {load_start:.2f}, at the end {load_end:.2f} "
+             "(per case: the load column, start–end of its bench run). CPU s = "
+             "user + system of the `sarfe solve` process and its workers. The estimate is the "
+             "line `sarfe validate` and `sarfe solve` print (summary.json `cost_estimate`): a "
+             "range; MB written is the result folder. Ratio = estimate / measured (low end; "
+             "high end for a sweep in brackets).", "",
+             "| case | points est. (run) | CPU s est. | CPU s run | wall s | load | in range | "
+             "MB est. | MB run | ratio | modes est. (run) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        e = r["estimate"]
+        lo, hi = e["bytes"]
+        ratio = f"{r['bytes_ratio_low']:.2f}" + ("" if lo == hi else
+                                                  f" ({r['bytes_ratio_high']:.2f})")
+        mb = f"{lo / 1e6:.2f}" + ("" if lo == hi else f"–{hi / 1e6:.2f}")
+        pts = "–".join(str(p) for p in sorted(set(e["points"])))
+        lines.append(f"| {r['case']} | {pts} ({r['points']}) | {e['cpu_s'][0]:.0f}–"
+                     f"{e['cpu_s'][1]:.0f} | {r['cpu_s']:.1f} | {r['wall_s']:.1f} | "
+                     f"{'–'.join(f'{v:.1f}' for v in r.get('load_average', []))} | "
+                     f"{'yes' if r['cpu_in_range'] else 'NO'} | {mb} | "
+                     f"{r['written_bytes'] / 1e6:.2f} | {ratio} | {e['modes']} "
+                     f"({r.get('modes_run')}) |")
+    lines += NOTES.splitlines()
+    lines += ["", "Per file, MB estimated (low end) / written:", "",
+              "| case | " + " | ".join(FILES) + " |", "|---|" + "---|" * len(FILES)]
+    for r in rows:
+        e = r["estimate"]["files"]
+        cells = [f"{e.get(k, [0])[0] / 1e6:.3f} / {r['files'].get(k, 0) / 1e6:.3f}"
+                 for k in FILES]
+        lines.append(f"| {r['case']} | " + " | ".join(cells) + " |")
+    return lines
+
+
+NOTES = """
+Notes (2026-11-28, by hand):
+- Disk: every listed-frequency case within ±10 % of the folder (squeak rig +10 %, door trim
+  −3 %, instrument panel −1 %); every sweep inside its range. A sweep's range is wide by design:
+  its low end holds N as given, its high end the 16 × N a continuation may raise the contact
+  time histories to (the lumped rattle and the rattle rig were written at N = 4096 = 16 × 256;
+  door_trim_p1 and the rattle rig deck kept N).
+- CPU: inside the stated range for 7 of 8 cases. The instrument_panel_sweep (resolution auto,
+  H = 18 and N = 512 chosen, 410 modes, 400 points) took 656 CPU s against 34–177: its points cost
+  ≈ 1.5 CPU s each here (the model: ≈ 0.3), and the machine ran at load 6–11 (door_trim_p1
+  took 339 CPU s here, 173–192 at load ≈ 2 in stages.md: CPU s under such load is inflated up to
+  ≈ 2×). The lead's issue-30 work on exactly this sweep (its profile runs: 675 → 122 s wall) changes
+  that per-point cost; the constants should be re-measured after it is merged. The table's estimates
+  of door_trim_p1 and instrument_panel_sweep were printed before the sweep's point range was
+  widened from 3.6 to 4 / max_step (their high ends are now 800 and 400 points).
+- Modes (Weyl's leading term against the reduction's count): ×0.4 (rattle rig, few low modes)
+  to ×2.1 (instrument panel at 186 Hz); ×1.07 on the instrument panel sweep's 1500 Hz stage,
+  ×1.33 on door_trim_p1's 1200 Hz.
+"""
+
+FILES = ["summary.json", "table.txt", "response.h5", "ERP maps (VTU)", "animation",
+         "sound.wav", "plots (PNG)", "report.html"]
+
+
+def main(argv) -> None:
+    cases = argv or CASES
+    load_start = os.getloadavg()[0]
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="sarfe-estimate-") as scratch:
+        for case in cases:
+            row = run(case, pathlib.Path(scratch))
+            summary = json.loads((pathlib.Path(scratch) / case / "summary.json").read_text())
+            row["modes_run"] = summary["model"].get("modes")
+            rows.append(row)
+            print(f"{case}: CPU {row['cpu_s']:.1f} s (est. {row['estimate']['cpu_s']}), "
+                  f"{row['written_bytes'] / 1e6:.2f} MB (est. "
+                  f"{[round(b / 1e6, 2) for b in row['estimate']['bytes']]})", flush=True)
+    for row in rows:
+        row["load_average"] = [load_start, os.getloadavg()[0]]
+    done = {row["case"] for row in rows}
+    kept = [row for row in (read_results("estimate") or {}).get("rows", [])
+            if row["case"] not in done]
+    rows = kept + rows
+    write_results("estimate", {"machine": machine(), "rows": rows},
+                  markdown(rows, load_start, os.getloadavg()[0]))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])

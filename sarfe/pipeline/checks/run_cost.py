@@ -1,0 +1,360 @@
+r"""The cost of a run, said before it is paid (issue 30 item 4): H, N, the reduction cutoff, an
+estimated mode count, CPU seconds and bytes written — from what ``sarfe validate`` knows without
+solving (the mesh or matrices, the contacts' node pairs, the case's options).
+
+    model_size(...)  -> ModelSize      DOFs, nodes, triangles, radiating nodes, contact rows,
+                                       the Weyl modal density of the shells [modes/Hz]
+    run_cost(case, size) -> RunCost    points, H, N, cutoff, modes, CPU s (low, high), bytes
+    cost_lines(cost) -> list           the validate/solve line(s), ≤ 80 columns each
+
+**Modes.** The fixed-interface modes below the cutoff f_c, by the leading (Weyl) term of a thin
+plate's eigenvalue count, summed over the triangles (area A_e, D_e = E t³ / (12 (1 − ν²))):
+
+    N(f_c) ≈ Σ_e A_e k_e² / (4π),  k_e² = 2π f_c √(ρ t / D_e)
+           = f_c Σ_e (A_e / 2) √(ρ t / D)_e
+
+Against the reduction's count it is ×1.16 (squeak rig, 4.8 kHz: 25 vs 22), ×1.41 (door trim,
+800 Hz: 298 vs 212), ×2.1 (instrument panel, 186 Hz: 54 vs 26) and ×0.43 (rattle rig, 400 Hz:
+4 vs 10 — the steel strip's few low modes are below the asymptotic regime): a factor of ~2
+either way. The clamped-edge term − Σ L_e k_e / 2π (the exact count of a plate with clamped
+edges) was tried and does not help these models (the rattle rig's count goes below zero); the
+leading term alone is exact to 3 % against a simply supported plate's spectrum once the edge
+term of that boundary is taken off (tests/pipeline/checks/test_run_cost.py). A deck's shells
+count with their own ρ t + NSM and √(D₁₁ D₂₂) (the rattle rig's deck gives its generator's
+density); a matrices model states no mode count.
+
+**Points.** A list of frequencies: its length. A sweep (arc-length continuation): between
+:data:`SWEEP_POINTS_PER_BAND` / max_step (a smooth branch: the door trim, 105 at max_step 0.1,
+204 at 0.05) and :data:`SWEEP_FOLD_FACTOR` × that (folds and contact switches: lumped rattle 234,
+rattle rig 363, instrument panel sweep 400 at 0.1). ``resolution: auto``: H between :data:`AUTO_HARMONICS` (the shipped
+searches chose 14 and 18; the search may go from 3 to 64) and N = max(64, 2^⌈log₂ 16 H⌉).
+
+**Disk** (bytes, the files of ``output.files``): each file from its layout, with the compression
+measured on the shipped cases (LZ4 of the VTU arrays ≈ :data:`VTU_RATIO`, gzip of response.h5's
+contact time histories ≈ :data:`H5_GZIP_RATIO`); summary.json and table.txt by a per-point size
+fitted on the shipped cases; a sweep may raise N up to 16× at its corners
+(:data:`sarfe.hbm.continuation.MAX_SAMPLES_FACTOR`), which the high end of the range holds.
+Measured within ±30 % on the shipped cases (benchmarks/results/estimate.md).
+
+**CPU** [s] (the process tree's user + system: a quiet 2-core machine's wall time is about this
+over 1.5 with the point workers), stage by stage with constants measured on this machine
+(benchmarks/results/point_cost.md, stages.md, large_panel.md, estimate.md):
+
+    start + outputs      T_START + T_OUTPUT (FE: + the report's renders)
+    mesh and assembly    c_a · n_dof
+    Craig–Bampton        c_cb · n_dof · modes^0.71        (block Lanczos with shift-invert)
+    H search (auto)      14 points at the low H (on the sweep's own linear stage)
+    points               n_points · (c_0 + c_1 · (rows (2H+1))^0.55) · (2 for listed frequencies:
+                         a cold start each) — Newton, error estimate, Hill stability, records
+    mesh term            a quarter of the linear stage and a point (generated meshes)
+
+given as a range ×½ … ×2 around that (a sweep: ×1/√2 … ×√2 around its point range's ends):
+an order of magnitude, never a promise (benchmarks/pipeline/bench_estimate.py compares it with
+measured CPU s: benchmarks/results/estimate.md).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from sarfe.case.config import default_samples_per_period
+from sarfe.pipeline.model.cutoff import stage_cutoff_hz
+from sarfe.pipeline.solve.case_accuracy import rule_cutoff_hz
+
+SWEEP_POINTS_PER_BAND = 10.0     # points × max_step of a smooth continuation (door trim)
+SWEEP_FOLD_FACTOR = 4.0          # … × this with folds and contact switches (IP sweep: 400)
+AUTO_HARMONICS = (8, 24)         # the H range the cost of resolution: auto is given for
+SWEEP_SAMPLES_FACTOR = 16        # sarfe.hbm.continuation.MAX_SAMPLES_FACTOR
+
+# disk [bytes]
+VTU_RATIO = 0.55                 # LZ4 of an ERP map's arrays (0.53–0.55 measured)
+ANIMATION_RATIO = 0.6            # … of a deflection frame (0.59–0.63)
+ANIMATION_FRAMES = 24
+H5_GZIP_RATIO = 0.15             # gzip of response.h5's contact time histories (0.10–0.20)
+H5_COMPRESS_MIN = 65536          # sarfe.results.response_h5.COMPRESS_MIN_ENTRIES
+H5_BASE = 40e3                   # response.h5's attributes, names, small datasets
+PNG_BYTES = 300e3                # the plots (7 PNGs, 264–348 kB measured)
+RENDER_BYTES = 300e3             # the report's surface renders (FE; 80–520 kB measured)
+REPORT_BASE = 100e3              # report.html without its embedded files
+SUMMARY_BASE = 15e3              # summary.json without the points
+SUMMARY_POINT = (11.6e3, 2.3e3, 0.29e3)  # bytes per point: a + b · contacts + c · H (fitted
+#                                         on the 6 shipped cases of estimate.md: 0.94–1.06)
+TABLE_POINT = (120.0, 60.0)      # table.txt bytes per point: a + b · contacts
+WAV_HEADER = 138                 # bytes of a sound.wav header; 16-bit mono samples follow
+SAMPLE_RATE_HZ = 44100
+
+# CPU [s]
+T_START = 2.5                    # interpreter, imports, the case checks
+T_OUTPUT = 3.5                   # summary, table, response.h5, plots, sound, report
+T_OUTPUT_FE = 3.0                # … plus the report's renders and the VTU files
+ASSEMBLY_S_PER_DOF = 5e-5        # mesh, checks, assembly (large_panel.md: ≈ 1e-4 at 1 M DOF)
+CB_S = 6e-6                      # c_cb: Craig–Bampton s per DOF per (Weyl) mode^0.71
+CB_MODE_EXPONENT = 0.71
+POINT_S = (0.08, 0.01, 0.55)     # c_0, c_1, exponent of one point's cost
+LISTED_POINT_FACTOR = 2.0        # listed frequencies start cold (no predictor)
+SEARCH_POINTS = 14               # points of the H search: 8 screened, a ladder at the loudest
+RANGE = 2.0                      # the CPU range: central / RANGE … central × RANGE (a sweep:
+#                                  √RANGE around its point range's ends)
+
+
+@dataclass(frozen=True)
+class ModelSize:
+    """What a run's cost depends on, known before solving: ``dofs`` (free DOFs of the FE model,
+    or the matrices' size), ``nodes``, ``triangles``, ``radiating_nodes`` (the ERP surface's
+    nodes, or erp.dofs), ``contacts`` (count), ``contact_rows`` (rows of r = G u: 1 per rattle
+    pair, 3 per FE squeak pair, the given DOFs of a matrices contact), ``friction_rows``,
+    ``mode_density_per_hz`` (Weyl, None unknown), ``fe`` (a mesh model: VTU files)."""
+
+    dofs: int
+    nodes: int = 0
+    triangles: int = 0
+    radiating_nodes: int = 0
+    contacts: int = 0
+    contact_rows: int = 0
+    mode_density_per_hz: float | None = None
+    fe: bool = False
+    generated: bool = False
+
+
+@dataclass(frozen=True)
+class RunCost:
+    """:func:`run_cost`'s answer. ``harmonics`` and ``samples`` (low, high) (equal unless
+    ``resolution: auto``), ``cutoff_hz`` (None: a given mode count or no reduction), ``modes``
+    (None: not estimated), ``points`` (low, high), ``cpu_s`` (low, high) [s], ``bytes``
+    (low, high) written, ``files`` {file: (low, high) bytes}, ``auto`` (H chosen by the search)."""
+
+    harmonics: tuple
+    samples: tuple
+    cutoff_hz: float | None
+    modes: int | None
+    points: tuple
+    cpu_s: tuple
+    bytes: tuple
+    files: dict = field(default_factory=dict)
+    auto: bool = False
+    dofs: int = 0
+
+    def as_dict(self) -> dict:
+        """JSON-ready (summary.json ``cost_estimate``, validate --json)."""
+        return {"harmonics": list(self.harmonics), "samples_per_period": list(self.samples),
+                "cutoff_hz": self.cutoff_hz, "modes": self.modes, "points": list(self.points),
+                "cpu_s": [round(v, 1) for v in self.cpu_s],
+                "bytes": [int(v) for v in self.bytes], "resolution_auto": self.auto,
+                "dofs": self.dofs,
+                "files": {k: [int(a), int(b)] for k, (a, b) in self.files.items()}}
+
+
+def weyl_mode_density(points, triangles, mass_per_area, bending) -> float:
+    """Σ_e (A_e / 2) √(ρ t / D)_e [modes/Hz] (module docstring): points (n, 3) [m], triangles
+    (n_e, 3), per triangle (scalars or (n_e,)) the mass per area ρ t [kg/m²] and the bending
+    stiffness D [N·m] (an orthotropic section: √(D₁₁ D₂₂))."""
+    p = np.asarray(points, dtype=float)[np.asarray(triangles)]
+    area = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+    return float(np.sum(area / 2 * np.sqrt(np.asarray(mass_per_area, dtype=float)
+                                           / np.asarray(bending, dtype=float))))
+
+
+def plate_bending(thickness, young, poisson):
+    """D = E t³ / (12 (1 − ν²)) [N·m] of an isotropic shell (arrays broadcast)."""
+    t = np.asarray(thickness, dtype=float)
+    return np.asarray(young, dtype=float) * t ** 3 / (12 * (1 - np.asarray(poisson) ** 2))
+
+
+def contact_rows(config, pairs: dict | None) -> int:
+    """Rows of r = G u of the case's contacts: per FE node pair 1 (rattle) or 3 (squeak: the
+    normal and two tangents); a matrices contact its given normal_dof and tangential_dofs.
+    ``pairs`` {contact name: node pairs} (FE) or None."""
+    rows = 0
+    for c in config.contacts:
+        if pairs is not None:
+            rows += int(pairs.get(c.name, 1)) * (3 if c.kind == "squeak" else 1)
+        else:
+            rows += (c.normal_dof is not None) + len(c.tangential_dofs or ())
+    return rows
+
+
+def sweep_points(config) -> tuple:
+    """(low, high) reported points: a list's length, or a continuation's range (docstring)."""
+    excitation = config.excitation
+    if excitation.sweep is None:
+        n = len(excitation.frequency_hz)
+        return n, n
+    if not config.contacts:      # a linear sweep: evenly spaced points (initial_step apart)
+        n = min(max(2, int(round(1.0 / config.solver.continuation.initial_step)) + 1), 101)
+        return n, n
+    low = SWEEP_POINTS_PER_BAND / config.solver.continuation.max_step
+    cap = config.solver.continuation.max_points
+    return int(min(round(low), cap)), int(min(round(low * SWEEP_FOLD_FACTOR), cap))
+
+
+def _harmonics(config) -> tuple:
+    solver = config.solver
+    if solver.resolution == "auto" and config.contacts:
+        return AUTO_HARMONICS
+    return solver.harmonics, solver.harmonics
+
+
+def _cutoff(case) -> float | None:
+    config = case.config
+    if not config.model.is_fe:
+        return None
+    if config.solver.resolution == "auto" and config.contacts:
+        cutoff = rule_cutoff_hz(case)
+        if cutoff is not None:
+            return cutoff
+    return stage_cutoff_hz(config)
+
+
+def file_bytes(config, size: ModelSize, points: int, H: int, N: int) -> dict:
+    """{file: bytes} of ``output.files`` for ``points`` reported points at H, N (docstring)."""
+    files = set(config.output.files)
+    out = {}
+    n_c, rows = size.contacts, size.contact_rows
+    if "summary" in files:
+        a, b, c = SUMMARY_POINT
+        out["summary.json"] = SUMMARY_BASE + (points + 1) * (a + b * n_c + c * H)
+    if "table" in files:
+        out["table.txt"] = 500 + points * (TABLE_POINT[0] + TABLE_POINT[1] * n_c)
+    maps = map_count(config, points) if size.fe else 0
+    if "response" in files:
+        harmonic = 2 * (2 * H + 1) * rows * 8                    # displacement_m, force_N
+        history = N * rows * 8 + N * n_c                         # force_time_N, state (int8)
+        ratio = H5_GZIP_RATIO if points * N * rows >= H5_COMPRESS_MIN else 1.0
+        records = 8 * (5 * H + 4 * 14 + 2 * 28 + 40 + n_c * 30)  # erp, bands, audibility, …
+        excitation = 0 if size.fe else 8 * (2 * H + 1) * size.dofs
+        out["response.h5"] = (H5_BASE + points * (harmonic + records + excitation
+                                                  + ratio * history)
+                              + 8 * size.radiating_nodes * (1 + maps))
+    cells = size.triangles * (3 * 8 + 8 + 1 + 4)      # connectivity, offsets, types, part_id
+    if "erp_vtu" in files and size.fe:
+        per_map = size.nodes * (8 * (H + 12) + 2 * 4 + 24) + cells
+        out["ERP maps (VTU)"] = maps * (VTU_RATIO * per_map + 3e3)
+    if "animation" in files and size.fe:
+        frame = size.nodes * (4 + 24 + 8 + 24) + cells
+        out["animation"] = ANIMATION_FRAMES * (ANIMATION_RATIO * frame + 1e3)
+    wav = WAV_HEADER + 2 * SAMPLE_RATE_HZ * config.audibility.sound_duration_s
+    if "sound" in files:
+        out["sound.wav"] = 2 * wav                         # and sound_with_background.wav
+    if "plots" in files:
+        out["plots (PNG)"] = PNG_BYTES
+    if "report" in files:
+        out["report.html"] = REPORT_BASE + 4 / 3 * (PNG_BYTES + 2 * wav + (
+            RENDER_BYTES if size.fe else 0.0))
+    return out
+
+
+def map_count(config, points: int) -> int:
+    """ERP maps written (output.maps: :mod:`sarfe.pipeline.write.map_points`): the loudest, and
+    every N-th point or the listed frequencies (at most ``points``)."""
+    maps = config.output.maps
+    if isinstance(maps, str):
+        return min(1, points)
+    if hasattr(maps, "keys"):
+        return min(points, 1 + math.ceil(points / int(maps["every"])))
+    return min(points, 1 + len(maps))
+
+
+def point_seconds(rows: int, H: int, listed: bool) -> float:
+    """CPU s of one point (Newton, error estimate, Hill stability, records): c_0 + c_1 ·
+    (rows (2H+1))^p, doubled for a listed frequency (docstring)."""
+    c0, c1, p = POINT_S
+    t = c0 + c1 * (max(rows, 1) * (2 * H + 1)) ** p
+    return t * (LISTED_POINT_FACTOR if listed else 1.0)
+
+
+def stage_seconds(dofs: int, modes) -> float:
+    """CPU s of a linear stage: mesh, assembly and the Craig–Bampton modes (docstring)."""
+    modes = 0 if modes is None else modes
+    return ASSEMBLY_S_PER_DOF * dofs + CB_S * dofs * max(modes, 1) ** CB_MODE_EXPONENT
+
+
+def run_cost(case, size: ModelSize) -> RunCost:
+    """The cost of ``sarfe solve`` on ``case`` (a loaded Case) with ``size`` (docstring)."""
+    config = case.config
+    H = _harmonics(config)
+    auto = config.solver.resolution == "auto" and bool(config.contacts)
+    N = tuple(default_samples_per_period(h) for h in H) if auto \
+        else (config.solver.samples_per_period,) * 2
+    cutoff = _cutoff(case)
+    modes = None
+    if size.mode_density_per_hz is not None:
+        if cutoff is not None:
+            modes = int(round(size.mode_density_per_hz * cutoff))
+        elif config.reduction is not None and config.reduction.mode_count is not None:
+            modes = int(config.reduction.mode_count)
+    points = sweep_points(config)
+    listed = config.excitation.sweep is None
+    stage = stage_seconds(size.dofs, modes if modes is not None else 100) if size.fe else 0.0
+    fixed = T_START + T_OUTPUT + (T_OUTPUT_FE if size.fe else 0.0) + stage
+    if auto:
+        fixed += SEARCH_POINTS * point_seconds(size.contact_rows, H[0], True)
+    mesh_term = size.generated and config.solver.error_estimate \
+        and config.solver.mesh_error is not False
+    cpu, written, files = [], [], {}
+    for i, (n, h, samples) in enumerate(((points[0], H[0], N[0]),
+                                         (points[1], H[1], N[1] * (
+                                             SWEEP_SAMPLES_FACTOR if not listed
+                                             and config.contacts else 1)))):
+        t = fixed + n * point_seconds(size.contact_rows, h, listed)
+        if mesh_term:
+            t += 0.25 * stage + point_seconds(size.contact_rows, h, True)
+        spread = RANGE if listed else math.sqrt(RANGE)   # a sweep's points carry the rest
+        cpu.append(t / spread if i == 0 else t * spread)
+        sizes = file_bytes(config, size, n, h, samples)
+        written.append(sum(sizes.values()))
+        for name, value in sizes.items():
+            files.setdefault(name, []).append(value)
+    return RunCost(harmonics=H, samples=N, cutoff_hz=cutoff, modes=modes, points=points,
+                   cpu_s=tuple(cpu), bytes=tuple(written),
+                   files={k: tuple(v) for k, v in files.items()}, auto=auto, dofs=size.dofs)
+
+
+def _span(low, high, fmt) -> str:
+    a, b = fmt(low), fmt(high)
+    return a if a == b else f"{a}–{b}"
+
+
+def _seconds(s) -> str:
+    return f"{s:.2g}" if s < 100 else f"{s:.0f}"
+
+
+def _megabytes(b) -> str:
+    mb = b / 1e6
+    return f"{mb:.2g}" if mb < 100 else f"{mb:.0f}"
+
+
+def cost_lines(cost: RunCost, width: int = 80) -> list:
+    """The validate/solve line, wrapped at ``width`` columns between its items (continuation
+    lines indented by two), e.g.
+
+        cost: H 10, N 64, cutoff 800 Hz, ≈ 298 modes, 31332 DOFs
+          4 points, ≈ 14–54 s CPU, ≈ 14 MB written
+    """
+    H = _span(*cost.harmonics, str) + (" (auto)" if cost.auto else "")
+    model = [f"H {H}", f"N {_span(*cost.samples, str)}"]
+    if cost.cutoff_hz is not None:
+        model.append(f"cutoff {cost.cutoff_hz:.0f} Hz")
+    if cost.modes is not None:
+        model.append(f"≈ {cost.modes} modes")
+    if cost.dofs:
+        model.append(f"{cost.dofs} DOFs")
+    run = [f"{_span(*cost.points, str)} points", f"≈ {_span(*cost.cpu_s, _seconds)} s CPU",
+           f"≈ {_span(*cost.bytes, _megabytes)} MB written"]
+    one = "cost: " + ", ".join(model + run)
+    if len(one) <= width:
+        return [one]
+    lines = ["cost: " + model[0]]
+    for item in model[1:] + run:
+        if item is run[0] or len(lines[-1]) + 2 + len(item) + 1 > width:   # + its comma
+            lines[-1] += ","
+            lines.append("  " + item)      # the run's items start a line of their own
+        else:
+            lines[-1] += ", " + item
+    return lines
+
+
+__all__ = ["ModelSize", "RunCost", "run_cost", "cost_lines", "weyl_mode_density", "plate_bending",
+           "contact_rows", "sweep_points", "file_bytes", "map_count", "point_seconds",
+           "stage_seconds"]

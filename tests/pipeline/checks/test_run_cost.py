@@ -1,0 +1,168 @@
+"""The cost said before the run (issue 30 item 4, :mod:`sarfe.pipeline.checks.run_cost`): the
+Weyl mode count against a closed-form plate spectrum, the disk estimate against the bytes a run
+writes (±30 %), the range growing with the points and H, and the line in validate and solve."""
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sarfe import cli
+from sarfe.case.read import load_case
+from sarfe.pipeline import solve_case
+from sarfe.pipeline.checks.case_checks import check_case
+from sarfe.pipeline.checks.run_cost import (ModelSize, RunCost, cost_lines, plate_bending,
+                                            run_cost, weyl_mode_density)
+from tests.small_cases import TINY, coarse_rig
+
+CASES = Path(__file__).resolve().parents[3] / "cases"
+DISK_TOLERANCE = 0.30       # estimated bytes within ±30 % of the written ones (listed points)
+
+
+def test_weyl_density_counts_a_simply_supported_plate():
+    """Simply supported a × b plate: f_mn = (π/2) √(D/ρt) ((m/a)² + (n/b)²), m, n ≥ 1 — the
+    exact count below f against N ≈ f Σ (A/2) √(ρt/D) (the leading term; the edge term
+    −P k/(4π) of this boundary makes the exact count lower by ≈ that, measured here)."""
+    a, b, t, E, nu, rho = 0.6, 0.4, 2e-3, 2e9, 0.35, 1000.0
+    x, y = np.meshgrid(np.linspace(0, a, 31), np.linspace(0, b, 21), indexing="ij")
+    points = np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)])
+    index = np.arange(x.size).reshape(x.shape)
+    q = np.stack([index[:-1, :-1], index[1:, :-1], index[1:, 1:], index[:-1, 1:]], -1).reshape(-1, 4)
+    triangles = np.vstack([q[:, [0, 1, 2]], q[:, [0, 2, 3]]])
+    D = E * t ** 3 / (12 * (1 - nu ** 2))
+    density = weyl_mode_density(points, triangles, rho * t, plate_bending(t, E, nu))
+    assert density == pytest.approx(a * b / 2 * np.sqrt(rho * t / D), rel=1e-12)
+    m = np.arange(1, 400)
+    f = np.pi / 2 * np.sqrt(D / (rho * t)) * ((m[:, None] / a) ** 2 + (m[None, :] / b) ** 2)
+    f_top = 20e3
+    exact = np.count_nonzero(f <= f_top)
+    k = np.sqrt(2 * np.pi * f_top * np.sqrt(rho * t / D))
+    edge = 2 * (a + b) * k / (4 * np.pi)
+    assert density * f_top - edge == pytest.approx(exact, rel=0.03)
+    assert exact < density * f_top < 1.5 * exact
+
+
+def _written(folder: Path) -> dict:
+    sizes = {}
+    for f in folder.rglob("*"):
+        if f.is_file() and not f.name.startswith(".sarfe"):
+            rel = f.relative_to(folder)
+            kind = ("animation" if rel.parts[0] == "animation" else "ERP maps (VTU)"
+                    if rel.parts[0] == "erp" or f.name == "erp.vtu" else "plots (PNG)"
+                    if f.suffix == ".png" else "sound.wav" if f.suffix == ".wav" else f.name)
+            sizes[kind] = sizes.get(kind, 0) + f.stat().st_size
+    return sizes
+
+
+def test_disk_estimate_matches_a_written_fe_run(tmp_path):
+    """The coarse rattle rig at 2 listed frequencies, every default file (maps, animation,
+    report, sound): the bytes the run writes against the estimate it said — in total and for
+    the files written from their layout (VTU maps, animation frames) within ±30 %."""
+    path = tmp_path / "rig.yaml"
+    path.write_text(coarse_rig([30.0, 33.0], "{harmonics: 5, samples_per_period: 64, "
+                               "error_estimate: false, stability: false, resolution: fixed}"))
+    result = solve_case(path, output_dir=tmp_path / "out")
+    estimate = result.summary["cost_estimate"]
+    sizes = _written(tmp_path / "out")
+    low, high = estimate["bytes"]
+    assert low == high                       # listed frequencies: one number
+    assert low == pytest.approx(sum(sizes.values()), rel=DISK_TOLERANCE)
+    for kind in ("ERP maps (VTU)", "animation", "sound.wav"):
+        assert estimate["files"][kind][0] == pytest.approx(sizes[kind], rel=DISK_TOLERANCE), kind
+    assert estimate["points"] == [2, 2]
+    assert estimate["harmonics"] == [5, 5]
+
+
+def test_disk_estimate_matches_a_written_matrices_run(tmp_path):
+    """The 2-DOF case with every default file of a matrices model: total within ±30 %."""
+    path = tmp_path / "tiny.yaml"
+    path.write_text(TINY.replace("output: {files: [summary, table]}\n", "")
+                    .replace("frequency_hz: [20.0]", "frequency_hz: [15.0, 20.0, 25.0]"))
+    result = solve_case(path, output_dir=tmp_path / "out")
+    estimate = result.summary["cost_estimate"]
+    written = sum(_written(tmp_path / "out").values())
+    assert estimate["bytes"][0] == pytest.approx(written, rel=DISK_TOLERANCE)
+    assert estimate["modes"] is None and estimate["cutoff_hz"] is None
+
+
+def _with(case, **solver):
+    config = case.config
+    return dataclasses.replace(case, config=dataclasses.replace(
+        config, solver=dataclasses.replace(config.solver, **solver)))
+
+
+def test_more_points_or_harmonics_cost_more():
+    """Monotone: 30 listed frequencies cost more CPU and disk than 3; H = 20 more than H = 5."""
+    case = load_case(CASES / "squeak_rig.yaml")
+    size = check_case(case, write=False).size
+    few = run_cost(case, size)
+    config = case.config
+    many = run_cost(dataclasses.replace(case, config=dataclasses.replace(
+        config, excitation=dataclasses.replace(
+            config.excitation, frequency_hz=tuple(np.linspace(50, 150, 30))))), size)
+    assert many.points == (30, 30) and few.points == (3, 3)
+    assert many.cpu_s[0] > few.cpu_s[0] and many.bytes[0] > few.bytes[0]
+    low, high = (run_cost(_with(case, harmonics=h, samples_per_period=256), size)
+                 for h in (5, 20))
+    assert high.cpu_s[0] > low.cpu_s[0] and high.bytes[0] > low.bytes[0]
+    bigger = dataclasses.replace(size, dofs=10 * size.dofs)
+    assert run_cost(case, bigger).cpu_s[0] > few.cpu_s[0]
+
+
+def test_sweep_states_a_range():
+    """A continuation's point count is not known before it runs: a range, and so are CPU s and
+    bytes; resolution auto states the H range the cost is given for."""
+    case = load_case(CASES / "lumped_rattle.yaml")
+    cost = run_cost(case, ModelSize(dofs=3, radiating_nodes=1, contacts=2, contact_rows=2))
+    assert cost.points[0] < 234 < cost.points[1]        # the run's 234 points (estimate.md)
+    assert cost.bytes[0] < cost.bytes[1] and cost.cpu_s[0] < cost.cpu_s[1]
+    auto = run_cost(_with(case, resolution="auto"), ModelSize(dofs=3, contacts=2,
+                                                              contact_rows=2))
+    assert auto.auto and auto.harmonics[0] < auto.harmonics[1]
+    assert "(auto)" in cost_lines(auto)[0]
+
+
+def test_validate_and_solve_print_the_cost(tmp_path, capsys):
+    """validate prints the cost line(s) (≤ 80 columns); solve prints them once on stderr before
+    the work, and not with --quiet."""
+    assert cli.main(["validate", str(CASES / "squeak_rig.yaml"), "-o", str(tmp_path / "v")]) == 0
+    out = capsys.readouterr().out.splitlines()
+    cost = [line for line in out if line.startswith("cost: ")]
+    assert len(cost) == 1 and "H 32, N 256, cutoff 4800 Hz" in cost[0]
+    at = out.index(cost[0])
+    assert all(len(line) <= 80 for line in out[at:])
+    assert "s CPU" in "".join(out[at:]) and "MB written" in "".join(out[at:])
+    path = tmp_path / "tiny.yaml"
+    path.write_text(TINY)
+    assert cli.main(["solve", str(path), "-o", str(tmp_path / "s")]) == 0
+    err = capsys.readouterr().err
+    assert err.count("sarfe: cost: H 3, N ") == 1
+    assert cli.main(["solve", str(path), "-o", str(tmp_path / "q"), "--quiet"]) == 0
+    assert "cost:" not in capsys.readouterr().err
+
+
+def test_deck_and_generator_state_the_same_model_size():
+    """The rattle rig read from its Nastran deck (mm-t-s, PSHELL/MAT1 → ρ t and D per triangle)
+    and generated from its YAML (SI) are one model: the same free DOFs, radiating nodes and
+    Weyl modal density."""
+    generated, deck = (check_case(load_case(CASES / f"{name}.yaml"), write=False).size
+                       for name in ("rattle_rig", "rattle_rig_deck"))
+    assert deck.dofs == generated.dofs and deck.contact_rows == generated.contact_rows == 1
+    assert deck.radiating_nodes == generated.radiating_nodes
+    assert deck.mode_density_per_hz == pytest.approx(generated.mode_density_per_hz, rel=1e-6)
+    assert generated.generated and not deck.generated
+
+
+def test_cost_line_wraps_within_its_width():
+    """A 1 M DOF auto sweep: every line within the width (solve gives 73: after 'sarfe: '),
+    each item whole, the run's items on a line of their own."""
+    cost = RunCost((8, 24), (128, 512), 1500.0, 437, (100, 360), (34, 177), (14e6, 37e6),
+                   auto=True, dofs=1140102)
+    for width in (40, 73, 80):
+        lines = cost_lines(cost, width)
+        assert all(len(line) <= width for line in lines)
+        assert lines[0].startswith("cost: H 8–24 (auto), N 128–512")
+        assert any(line.startswith("  100–360 points") for line in lines)
+        assert "1140102 DOFs" in "".join(lines) and "≈ 14–37 MB written" in lines[-1]
