@@ -183,14 +183,16 @@ def _run_dask(client, groups, output, stats, finish, pipeline_name, write_output
 
     pending = as_completed()
     task_of = {}
+    stages, resubmitted = {}, set()      # a group's stage, to scatter again for a lost variant
 
-    def submit_group(key, stage):
+    def submit_group(key, stage, members=None):
+        stages[key] = stage
         shared = client.scatter(stage, broadcast=True, hash=False)
-        for variant in groups[key]:
+        for variant in groups[key] if members is None else members:
             future = client.submit(solve_variant, variant, shared, pipeline_name,
                                    _variant_output(output, variant, write_outputs),
                                    retries=1, pure=False, key=f"sarfe-variant-{variant.id}-{time.time_ns()}")
-            task_of[future.key] = ("variant", variant)
+            task_of[future.key] = ("variant", variant, key)
             pending.add(future)
 
     for key, members in groups.items():
@@ -201,11 +203,11 @@ def _run_dask(client, groups, output, stats, finish, pipeline_name, write_output
             continue
         future = client.submit(_timed_build, members[0], pipeline_name, retries=1, pure=False,
                                key=f"sarfe-linear-{key[:16]}-{time.time_ns()}")
-        task_of[future.key] = ("linear", key)
+        task_of[future.key] = ("linear", key, key)
         pending.add(future)
 
     for future in pending:
-        kind, item = task_of.pop(future.key)
+        kind, item, group = task_of.pop(future.key)
         transient = False
         try:
             value = future.result()
@@ -225,16 +227,26 @@ def _run_dask(client, groups, output, stats, finish, pipeline_name, write_output
             if cache:
                 store.save_stage(output, item, value)
             submit_group(item, value)
+        elif value is None and transient and item.id not in resubmitted:
+            # a worker died holding the only copy of the scattered stage (a worker restarted
+            # after the broadcast has none): scatter it again and run the variant once more
+            resubmitted.add(item.id)
+            submit_group(group, stages[group], [item])
         else:
             finish(value if value is not None else failed_record(item, f"worker: {message}", transient))
 
 
 def _infrastructure_error(error: BaseException) -> bool:
     """Workers killed or connections lost — not the variant's fault: run it again next time."""
+    from concurrent.futures import CancelledError
+
     from distributed import KilledWorker
     from distributed.comm.core import CommClosedError
 
-    return isinstance(error, (KilledWorker, CommClosedError, TimeoutError, ConnectionError))
+    # CancelledError (distributed's FutureCancelledError): a scattered stage lost with the only
+    # worker that held it (the scheduler forgets the tasks that depend on it)
+    return isinstance(error, (KilledWorker, CommClosedError, TimeoutError, ConnectionError,
+                              CancelledError))
 
 
 def _local_client(workers: int):
