@@ -333,17 +333,11 @@ def condense(model, gap_map, excitation: np.ndarray, omega: float,
             return None
         g = basis.dynamic_receptance(k, omega)              # (m, n_modes)
         # GV, K⁻¹Gᵀ, G K⁻¹ Gᵀ, K⁻¹ f_k and Vᵀ f_k do not depend on ω: once per sweep
-        gap_modes, static, static_compliance = basis.gap_projection(Gd)
+        gap_modes, static, _ = basis.gap_projection(Gd)
         static_forced, modal_forced = basis.load_projection(forces)
         # G y_k = G K⁻¹ f_k + (GV)(q_k ⊙ Vᵀ f_k): O(n_rows n_modes), y_k itself only on demand
         gy = real_product(static_forced, Gd.T) + real_product(g * modal_forced, gap_modes.T)
-        # Σ_j (G v_j)_r q_kj (G v_j)_s as one real product over the orders and rows per part
-        # (Re q, Im q): the scaled rows are formed real, not as a complex array split again
-        # (the same two products as real_product of the complex rows: the same numbers)
-        def part(q):
-            return ((gap_modes[None] * q[:, None, :]).reshape(-1, g.shape[1]) @ gap_modes.T)
-        Ck = static_compliance[None] + (part(g.real) + 1j * part(g.imag)).reshape(
-            k.size, n_rows, n_rows)
+        Ck = basis.row_compliance(Gd, g)                    # (m, n_rows, n_rows)
         factors = dict(modal=ModalCompliance(basis, g, gap_modes, static, static_forced,
                                              modal_forced))
     else:

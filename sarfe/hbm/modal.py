@@ -116,6 +116,20 @@ class ModalBasis:
             return self.static_solve(f.T).T, real_product(f, self.modes)
         return self._projection("load", np.asarray(loads), build)
 
+    def row_compliance(self, gap_map: np.ndarray, receptance: np.ndarray) -> np.ndarray:
+        """C_k = G Z_k⁻¹ Gᵀ = G K⁻¹ Gᵀ + (GV) diag(q_k) (GV)ᵀ (m, n_rows, n_rows) complex [m/N] of
+        a dense gap map G (n_rows, n) and the receptance q (m, n_modes) of
+        :meth:`dynamic_receptance`: Σ_j (G v_j)_r q_kj (G v_j)_s as one real product over the
+        orders and rows per part (Re q, Im q), the scaled rows formed real."""
+        gap_modes, _, static_compliance = self.gap_projection(gap_map)
+        q = np.asarray(receptance)
+
+        def part(x):
+            return (gap_modes[None] * x[:, None, :]).reshape(-1, q.shape[1]) @ gap_modes.T
+        rows = gap_modes.shape[0]
+        return static_compliance[None] + (part(q.real) + 1j * part(q.imag)).reshape(
+            q.shape[0], rows, rows)
+
     def singular(self, orders, omega: float) -> bool:
         """True if some Z_k(ω) is singular to working precision, |1 − a_kj| ≤ 10⁻¹³ max(1, |a_kj|)
         (an undamped resonance (kω)² = ω_j²)."""
@@ -135,12 +149,11 @@ def updated_solve(basis: ModalBasis, gap_map: np.ndarray, row_stiffness: np.ndar
     singular."""
     orders = np.asarray(orders, dtype=float)
     G = np.asarray(gap_map, dtype=float)
-    gap_modes, static, static_compliance = basis.gap_projection(G)
+    gap_modes, static, _ = basis.gap_projection(G)
     q = basis.dynamic_receptance(orders, omega)                            # (m, n_modes)
     y = basis.static_solve(np.asarray(loads).T).T + real_product(
         q * real_product(loads, basis.modes), basis.modes.T)
-    C = static_compliance[None] + ((gap_modes[None] * q.real[:, None, :]) @ gap_modes.T
-                                   + 1j * (gap_modes[None] * q.imag[:, None, :]) @ gap_modes.T)
+    C = basis.row_compliance(G, q)                                         # (m, n_rows, n_rows)
     A = row_stiffness[None, :] + 1j * (orders * omega)[:, None] * row_damping[None, :]
     system = np.eye(G.shape[0])[None] + A[:, :, None] * C
     lam = np.linalg.solve(system, (A * (y @ G.T))[..., None])[..., 0]     # (m, n_rows)
