@@ -130,12 +130,10 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
 
     clock = time.perf_counter()
     workers = point_workers(config.solver)     # processes for the per-point work (1: serial)
-    # with workers, Hill stability is recorded during the sweep and computed on one worker while
-    # the sweep goes on (the stream); after it the points' stability left, their error estimates
-    # and records go to all workers at once (sarfe.pipeline.post.point_workers)
     # Hill stability by need (sarfe.pipeline.post.stability_need): recorded during the sweep,
     # computed at the seeds (with workers: on the stream while the sweep goes on) and where a
-    # verdict changes, inferred between equal verdicts — the same on both paths
+    # verdict changes, inferred between equal verdicts — the same on both paths; after the sweep
+    # the error estimates and records go to all workers at once (sarfe.pipeline.post.point_workers)
     deferring = bool(config.solver.stability)
     parallel, work = {"processes": workers}, None
     streaming = deferring and workers > 1
