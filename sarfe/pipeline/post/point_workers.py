@@ -5,22 +5,24 @@ one. The rest of a point's work reads the converged point only, and runs on work
 forked from the solve (:func:`sarfe.util.workers.map_points`: the reduced model and the points are
 shared copy-on-write, only the results come back):
 
-1. Hill stability — deferred during the sweep (:mod:`sarfe.hbm.stability.deferred`: ``finalize`` records a
-   job per converged point) and computed on one worker while the sweep goes on (:func:`stability_
-   stream`: the sweep holds one core, the stream the other), then the reported points left;
+1. Hill stability by need (:mod:`sarfe.pipeline.post.stability_need`) — deferred during the
+   sweep (:mod:`sarfe.hbm.stability.deferred`: ``finalize`` records a job per converged point),
+   the seeds computed on one worker while the sweep goes on (:func:`stability_stream`,
+   :func:`stream_submit`: the sweep holds one core, the stream the other), then the seeds left
+   and the points between differing verdicts; the rest inferred;
 2. the error estimates (:func:`sarfe.pipeline.post.records.error_estimates`; the first in the
    solving process, :func:`first_estimates`);
 3. the point records: ERP, contact indicators, contributions, linear baseline
    (:func:`sarfe.pipeline.post.records.point_records`, by chunks of points).
 
-After the sweep 1–3 go to the workers in two pools (:func:`point_work`): the Hill points left
-and the estimates, longest first, then the records on freshly forked workers (memory).
+After the sweep 1–3 go to the workers in two pools (:func:`point_work`): the seeds left and the
+estimates, longest first, then the records on freshly forked workers (memory).
 
-``workers`` = 1 is the serial path (stability in place during the sweep, plain loops). The results
-do not depend on ``workers``: every point is computed by the same function from the same inputs.
-An exception of a deferred stability makes the caller solve the sweep again serially — in the
-serial path that exception ends the continuation and the sweep falls back point by point, so the
-result is that path's.
+``workers`` = 1 is the serial path (the same stability by need in this process,
+:func:`serial_stability`; plain loops). The results do not depend on ``workers``: every point is
+computed by the same function from the same inputs. An exception of a deferred stability on a
+worker makes the caller solve the sweep again serially, whose :func:`serial_stability` gives such
+a point verdict None with the error in its note.
 """
 from __future__ import annotations
 
