@@ -209,7 +209,7 @@ def bending_resolution_hz(points, triangles, thickness, young, poisson, density)
     corners = np.asarray(points, dtype=float)[np.asarray(triangles)]
     h = np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=2).max(axis=1)
     t = np.asarray(thickness, dtype=float)
-    bending = np.asarray(young, dtype=float) * t ** 3 / (12 * (1 - np.asarray(poisson) ** 2))
+    bending = plate_bending(t, young, poisson)
     k = 2 * np.pi / (ELEMENTS_PER_WAVELENGTH * h)
     return k ** 2 * np.sqrt(bending / (np.asarray(density, dtype=float) * t)) / (2 * np.pi)
 

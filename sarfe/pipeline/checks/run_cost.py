@@ -60,6 +60,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from sarfe.case.config import default_samples_per_period
+from sarfe.mesh.geometry import triangle_areas
 from sarfe.pipeline.model.cutoff import stage_cutoff_hz
 from sarfe.pipeline.solve.case_accuracy import rule_cutoff_hz
 
@@ -150,8 +151,7 @@ def weyl_mode_density(points, triangles, mass_per_area, bending) -> float:
     """Σ_e (A_e / 2) √(ρ t / D)_e [modes/Hz] (module docstring): points (n, 3) [m], triangles
     (n_e, 3), per triangle (scalars or (n_e,)) the mass per area ρ t [kg/m²] and the bending
     stiffness D [N·m] (an orthotropic section: √(D₁₁ D₂₂))."""
-    p = np.asarray(points, dtype=float)[np.asarray(triangles)]
-    area = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+    area = triangle_areas(points, triangles)
     return float(np.sum(area / 2 * np.sqrt(np.asarray(mass_per_area, dtype=float)
                                            / np.asarray(bending, dtype=float))))
 
