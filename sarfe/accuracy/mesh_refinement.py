@@ -83,5 +83,6 @@ def mesh_gci(levels_db, ratio: float = MESH_GCI_RATIO) -> dict:
     return dict(out, mesh_db=SAFETY_FACTOR * abs(e21) / (ratio ** p - 1.0),
                 convergence="monotone", order_used=p)
 
+
 __all__ = ["MESH_RATIO", "MESH_ORDER", "MESH_GCI_RATIO", "MESH_ORDER_BOUNDS", "SAFETY_FACTOR",
            "SAFETY_FACTOR_OSCILLATING", "mesh_richardson", "mesh_gci"]

@@ -43,14 +43,11 @@ import scipy.sparse as sp
 
 from sarfe.accuracy.correction import newton_correction, newton_step
 from sarfe.accuracy.measures import resize_harmonics, solution_change
+from sarfe.hbm.modal import dense_matrix
 from sarfe.hbm.model import LinearModel
 
 MODE_PROBES = (0.05, 0.2)    # fractions of the fixed-interface modes the two modal probes leave out (5)
 MODE_DECAY = (1.0, 2.5)      # bounds of the fitted decay p of the modal error ∝ m^{−p} (5)
-
-
-def _dense(A) -> np.ndarray:
-    return A.toarray() if hasattr(A, "toarray") else np.asarray(A, dtype=float)
 
 
 def coarser_basis(model, excitation, boundary_count, removed, residual=()):
@@ -71,7 +68,7 @@ def coarser_basis(model, excitation, boundary_count, removed, residual=()):
     keep = np.setdiff1d(np.arange(n), S)
     blocks = [np.eye(n)[:, keep]]
     if residual.size:
-        M, K = _dense(model.mass), _dense(model.stiffness)
+        M, K = dense_matrix(model.mass), dense_matrix(model.stiffness)
         boundary = np.arange(int(boundary_count))
         F = np.asarray(excitation, dtype=float)
         loads = np.column_stack([M[np.ix_(S, boundary)], F[1, S], F[2, S]])
@@ -99,7 +96,7 @@ def rebuilt_modal_damping(model, small):
     and the coarser model of (4) is meant to be the case's reduction with fewer modes."""
     if model.damping is None:
         return small
-    M, K, D = _dense(model.mass), _dense(model.stiffness), _dense(model.damping)
+    M, K, D = dense_matrix(model.mass), dense_matrix(model.stiffness), dense_matrix(model.damping)
     w2, phi = scipy.linalg.eigh(0.5 * (K + K.T), 0.5 * (M + M.T))
     modal = phi.T @ D @ phi
     off = modal - np.diag(np.diag(modal))
@@ -107,7 +104,7 @@ def rebuilt_modal_damping(model, small):
         return small                                   # not modal damping: keep the projection
     omega = np.sqrt(np.clip(w2, 1e-300, None))
     zeta = np.diag(modal) / (2 * omega)
-    Ms, Ks = _dense(small.mass), _dense(small.stiffness)
+    Ms, Ks = dense_matrix(small.mass), dense_matrix(small.stiffness)
     w2s, phis = scipy.linalg.eigh(0.5 * (Ks + Ks.T), 0.5 * (Ms + Ms.T))
     weighted = Ms @ phis
     Ds = (weighted * (2.0 * zeta[:len(w2s)] * np.sqrt(np.clip(w2s, 0.0, None)))) @ weighted.T

@@ -169,7 +169,9 @@ def real_product(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(A.real) @ B + 1j * (np.ascontiguousarray(A.imag) @ B)
 
 
-def _dense(matrix):
+def dense_matrix(matrix) -> np.ndarray:
+    """A dense float array of a sparse or dense matrix (the modal basis and the checks that work
+    on the small reduced model's M, D, K)."""
     return matrix.toarray() if sp.issparse(matrix) else np.asarray(matrix, dtype=float)
 
 
@@ -187,7 +189,7 @@ def modal_basis(model, max_dofs=MODAL_MAX_DOFS, tolerance=MODAL_DAMPING_TOLERANC
     n = model.dof_count
     if n == 0 or n > max_dofs:
         return None
-    M, K, D = (_dense(a) for a in (model.mass, model.stiffness, model.damping))
+    M, K, D = (dense_matrix(a) for a in (model.mass, model.stiffness, model.damping))
     K, M = 0.5 * (K + K.T), 0.5 * (M + M.T)
     try:
         factor = sla.cho_factor(K)                 # K positive definite (no rigid-body mode)

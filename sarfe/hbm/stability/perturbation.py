@@ -42,9 +42,9 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
-import scipy.sparse as sp
 
 from sarfe.hbm.harmonics import time_samples
+from sarfe.hbm.modal import dense_matrix
 from sarfe.hbm.newmark import ContactLaws, initial_sliders, march_periods, state_at_zero
 
 
@@ -76,8 +76,8 @@ def step_resolution(model, vectors, omega, steps_per_period):
     undamped modes ω_k [rad/s] of (K, M) (module docstring); 1 where a vector has no structural
     motion."""
     n = model.dof_count
-    M = _dense(model.mass)
-    w2, modes = sla.eigh(_dense(model.stiffness), M)
+    M = dense_matrix(model.mass)
+    w2, modes = sla.eigh(dense_matrix(model.stiffness), M)
     wk = np.sqrt(np.maximum(w2, 0.0))
     h = 2.0 * np.pi / (omega * steps_per_period)
     projector = modes.T @ M
@@ -87,10 +87,6 @@ def step_resolution(model, vectors, omega, steps_per_period):
     total = energy.sum(axis=0)
     weighted = (1.0 / (1.0 + (0.5 * wk * h) ** 2)) @ energy
     return np.where(total > 0, weighted / np.where(total > 0, total, 1.0), 1.0)
-
-
-def _dense(matrix):
-    return matrix.toarray() if sp.issparse(matrix) else np.asarray(matrix, dtype=float)
 
 
 def perturbation_check(model, contacts, excitation, solution, steps_per_period=512,
