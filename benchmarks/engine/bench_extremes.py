@@ -1,7 +1,8 @@
 """Continuation at the extremes (issue 29 item 5) → results/extremes.md|json.
 
 cases/lumped_rattle.yaml with one parameter pushed — k_n = 10⁹ and 10¹⁰ N/m (panel–bracket), gap
-10⁻⁷ m, modal ζ = 10⁻⁴, k_t = 10⁹ N/m (the seal's stick spring) — swept 30 → 90 Hz by
+10⁻⁷ m, modal ζ = 10⁻⁴, k_t = 10⁹ N/m (the seal's stick spring), k_n = 10¹¹ N/m (beyond the
+issue's 10¹⁰) — swept 30 → 90 Hz by
 ``sarfe solve`` (error estimate and stability off: they do not change the sweep). Reported per
 extreme: whether the sweep completed by continuation (summary.json ``sweep_complete``), its stop
 reason, the points, wall and CPU seconds of the whole process, the exit code, the points where
@@ -27,6 +28,7 @@ EXTREMES = {        # name: (section, index, key, value) changed in lumped_rattl
     "gap1e-7": ("contacts", 0, "gap_m", 1e-7),
     "zeta1e-4": ("damping", None, "modal_zeta", 1e-4),
     "kt1e9": ("contacts", 1, "tangential_stiffness_N_m", 1e9),
+    "kn1e11": ("contacts", 0, "normal_stiffness_N_m", 1e11),
 }
 BEFORE = {          # fork base bf7347e, `sarfe solve` at the defaults: complete?, points, wall s, stop
     "kn1e9": (False, 60, 66.2, "step below min_step at 42.40 Hz; 40 points point by point"),
@@ -34,6 +36,7 @@ BEFORE = {          # fork base bf7347e, `sarfe solve` at the defaults: complete
     "gap1e-7": (False, 636, 563.6, "turned back past 30 Hz; exit code 3"),
     "zeta1e-4": (False, 212, 131.6, "step below min_step at 55.04 Hz; 30 points point by point"),
     "kt1e9": (False, 262, 84.1, "turned back past 30 Hz; 50 points point by point"),
+    "kn1e11": (False, 11, None, "exit code 3, 11 points not converged (issue 29; not timed)"),
 }
 
 

@@ -62,10 +62,7 @@ on cases/lumped_rattle.yaml with one parameter changed, docs/hbm.md "At the extr
 - Stiff contacts: a point whose full residual misses ``full_tolerance`` (≈ k_n ‖R_c‖ / ‖f̃_e‖) is
   tightened at its ω by the fixed-frequency Newton and its polish (:mod:`sarfe.hbm.solve`).
 - Closed loops: a new point within ``RETRACE_SHARE`` of its step of the path through the earlier
-  points, still so when the step is retried ``RETRACE_REFINE`` times at Δs / 4 (the two sides of a
-  sharp peak lie a fixed distance apart, which a shorter step resolves; a point back on the path
-  stays on it; with ζ = 10⁻⁴ the sides of the bracket's 2ω resonance near 55 Hz were taken for
-  loops). Gap 10⁻⁷ m (31.2 Hz), ζ = 10⁻⁴ (54.3 Hz): unchecked, the sweep circles one loop of H = 7
+  points. Gap 10⁻⁷ m (31.2 Hz), ζ = 10⁻⁴ (54.3 Hz): unchecked, the sweep circles one loop of H = 7
   solutions again and again (the time integration is not periodic there). The sweep leaves it
   (≤ ``LOOP_LIMIT`` times) by a new continuation from fixed ω past the farthest ω reached
   (:func:`continuation`'s ``leave_loop``); that point's ``reason`` says so (``LEFT_LOOP``).
@@ -107,7 +104,6 @@ COS_CORNER = 0.2         # ω turns with consecutive secants at more than ~80°:
 CORNER_LIMIT = 12        # corners stepped past within FOLD_DISTANCE of each other: a crawl, stop
 RETRACE_SKIP = 3         # a new point near the path of the earlier points but these: came back
 RETRACE_SHARE = 0.1      # … within this share of its step
-RETRACE_REFINE = 3       # … that persists when the step is retried RETRACE_REFINE times at Δs / 4
 LOOP_LIMIT = 3           # closed loops the sweep leaves by a new start past them (docstring)
 LOOP_EXIT = (0.25, 0.5, 1.0, 2.0)   # … at these shares of initial_step past the loop's farthest ω
 LEFT_LOOP = "left a closed loop of solutions"   # in the reason of the new start past a loop
@@ -189,7 +185,6 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
     physical = False                # a corner stayed after raising N: orientation by secants
     extreme = False                 # a corner was stepped past or N raised for aliasing
     corners_at = []                 # ω of the corners stepped past
-    refined_retrace = 0             # retries of this step with Δs / 4 after it came back
 
     def refine_samples(factor=MAX_SAMPLES_FACTOR):
         """(k, point k re-solved with 2N — 4N, … when that fails) after backing up BACKUP points
@@ -447,9 +442,6 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
         z_new = result.x
         omega_new = z_new[-1] * span
         if retraces(z_new, np.linalg.norm(z_new - z)):
-            if corner is None and refined_retrace < RETRACE_REFINE:   # a sharp peak's other
-                refined_retrace, step = refined_retrace + 1, step / 4   # side, or a loop?
-                continue
             return leave_loop(omega_new) or stop(came_back(omega_new))
         U_new = to_displacement(z_new[:-1] * x_scale, omega_new, result.evaluation)
         if direction * (omega_new - omega_end) >= 0:      # passed the end: solve at ω_end exactly
@@ -511,7 +503,7 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
             return stop(f"max_points {options.max_points} reached")
         if (physical or extreme) and full is None:
             t = (z_new - z) / np.linalg.norm(z_new - z)    # orientation past corners: the secant
-        previous, z, refined_retrace = t, z_new, 0
+        previous, z = t, z_new
         size = np.linalg.norm(z[:-1])
         if not 1.0 / RESCALE <= size <= RESCALE:   # the response left a decade of x_s: x_s ← ‖x‖
             x_scale *= size
