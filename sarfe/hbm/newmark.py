@@ -21,7 +21,10 @@ step reduces to a small semismooth Newton iteration on the contact rows r = G u�
 with the Newmark velocity of the contact rows ṙ₊ = (2/h)(r₊ − r) − ṙ (so ∂ṙ₊/∂r₊ = 2/h),
 
 followed by u₊ = u_lin − B λ. The friction history (slider positions) is updated by the exact
-return map once r has converged. :func:`march_periods` runs periods until the period-end state
+return map once r has converged. A step in which a stiff contact opens or closes (ω_c h >
+SUBSTEP_RESOLUTION, ω_c its contact frequency) is redone in m sub-steps (:class:`_SubSteps`): the
+rule conserves energy only while the law is linear, and an impact under-resolved in the step
+gains energy (k_n = 10¹⁰ N/m, ω_c h ≈ 2: the orbit grows without bound or never settles). :func:`march_periods` runs periods until the period-end state
 (u, v/ω, sliders) repeats to a tolerance, optionally extrapolating the period-start states to the
 periodic orbit (reduced-rank extrapolation).
 

@@ -7,7 +7,7 @@ Equation (the same model as the harmonic balance, see :mod:`sarfe.hbm.contacts`)
 
 integrated by the Newmark average-acceleration scheme with a fixed step h = T/N and the contact
 laws evaluated pointwise in time (:mod:`sarfe.hbm.newmark`: the step, its contact Newton on the
-contact rows, the friction return map). :func:`integrate_time` runs periods until the period-end
+contact rows, the friction return map, sub-steps where a stiff contact opens or closes). :func:`integrate_time` runs periods until the period-end
 state (u, v/ω, sliders) repeats to ``steady_tolerance`` (relative to the response amplitude) and
 Fourier-analyses the last period with the convention of :mod:`sarfe.hbm.harmonics`;
 :func:`integrate_transient` is a free response from a given state.
