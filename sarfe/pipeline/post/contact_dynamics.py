@@ -16,7 +16,9 @@ displacements r(θ_j) = G u and forces λ(θ_j) of the contact rows:
                                for a force non-decreasing in ẇ; 0 for a rate-independent law),
                          D_t = Σ_{j : s_j = slip} λ_t,j · (p_j − p_{j−1})   (Coulomb slip work of
                                the Jenkins slider; the return map moves p along λ_t, so each
-                               term is ≥ 0 exactly).
+                               term is ≥ 0 exactly; on a curved partner λ_t is the tangent
+                               rows' force less the normal force's components −κ q λ_n,
+                               :mod:`sarfe.hbm.laws.curvature`).
                          The elastic parts (penalty spring λ_n(w, 0) and the tangential spring
                          k_t (q − p)) are conservative: their work over a closed period is
                          exactly 0 and is not summed. (Before: Σ_rows ∮ λ ṙ dt by Parseval of
@@ -31,6 +33,7 @@ import numpy as np
 
 from sarfe.hbm import laws
 from sarfe.hbm.harmonics import derivative_matrix, time_samples
+from sarfe.hbm.laws.curvature import friction_force
 
 
 def normal_dissipation(nl, r, rate, omega) -> np.ndarray:
@@ -87,6 +90,11 @@ def contact_dynamics(solution, nl) -> list[dict]:
         slip, slip_work = float("nan"), 0.0
         if valid.any():
             q = r[:, t] * valid
+            kappa = np.stack([np.asarray(cs.partner_curvature_1)[idx],
+                              np.asarray(cs.partner_curvature_2)[idx]], axis=-1)
+            if np.any(kappa != 0.0):   # a curved partner: the rows also carry −κ q λ_n
+                pair_normal = np.where(nr >= 0, force[:, np.maximum(nr, 0)], 0.0)
+                lam_t = friction_force(kappa, q, lam_t, pair_normal) * valid
             stiffness = k_t[idx][None, :, None]
             slider = q - np.divide(lam_t, stiffness, out=np.zeros_like(lam_t),
                                    where=stiffness > 0)
