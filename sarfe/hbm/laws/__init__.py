@@ -2,7 +2,9 @@ r"""Contact laws: one module per law, each a :class:`~.contract.ContactLaw` regi
 line (the contract is in :mod:`sarfe.hbm.laws.contract`; docs/hbm.md explains how to add a law).
 
 Everything outside a law's module reaches it through :func:`law` and the helpers below; nothing
-else tests a law's name.
+else tests a law's name. Shared parts: :mod:`.jenkins` (+ :mod:`.jenkins_march`, its compiled
+kernels) the friction element, :mod:`.curvature` a curved contact partner (the penetration and
+normal force follow the slide; the squeak law's ``partner_radius_m``).
 """
 from __future__ import annotations
 

@@ -110,6 +110,29 @@ def friction_force(kappa, q, tangential_force, normal_force):
     return tangential_force + kappa * q * normal_force[..., None]
 
 
+def friction_rows(contacts, r, force):
+    """The contact-row forces ``force`` (N, n_rows) [N] with the tangent rows of every curved
+    contact replaced by its friction part (:func:`friction_force`; the outputs' friction force,
+    slider and slip work); r (N, n_rows) [m] the contact displacements at the same samples.
+    ``contacts``: a :class:`sarfe.hbm.contacts.ContactSet`. Unchanged (the same array) when no
+    contact is curved."""
+    kappa = np.stack([np.asarray(contacts.partner_curvature_1, dtype=float),
+                      np.asarray(contacts.partner_curvature_2, dtype=float)], axis=-1)
+    normal_row = np.asarray(contacts.normal_row)
+    curved = np.flatnonzero(np.any(kappa != 0.0, axis=1) & (normal_row >= 0))
+    if not curved.size:
+        return force
+    rows = np.asarray(contacts.tangent_rows)[curved]
+    on = rows >= 0
+    safe = np.maximum(rows, 0)
+    q = np.where(on[None], r[:, safe], 0.0)
+    friction = friction_force(kappa[curved], q, np.where(on[None], force[:, safe], 0.0),
+                              force[:, normal_row[curved]])
+    out = np.array(force, dtype=float, copy=True)
+    out[:, rows[on]] = friction[:, on]
+    return out
+
+
 def local_jacobian(kappa, q, force, stiffness, d_tq=None, d_tn=None):
     r"""∂λ/∂(w, q₁, q₂) (n, 3, 3) at one instant of n contacts with a curved partner: the normal
     row, the tangential rows (friction λ_t plus −κ q λ_n). The friction's ∂λ_t/∂q ``d_tq``
@@ -129,4 +152,4 @@ def local_jacobian(kappa, q, force, stiffness, d_tq=None, d_tn=None):
 
 
 __all__ = ["PARAMETERS", "CASE_KEY", "CASE_KEYS", "prepare", "curvatures", "penetration_shift",
-           "effective_normal", "coupling", "friction_force", "local_jacobian"]
+           "effective_normal", "coupling", "friction_force", "friction_rows", "local_jacobian"]

@@ -33,7 +33,7 @@ import numpy as np
 
 from sarfe.hbm import laws
 from sarfe.hbm.harmonics import derivative_matrix, time_samples
-from sarfe.hbm.laws.curvature import friction_force
+from sarfe.hbm.laws.curvature import friction_rows
 
 
 def normal_dissipation(nl, r, rate, omega) -> np.ndarray:
@@ -71,6 +71,7 @@ def contact_dynamics(solution, nl) -> list[dict]:
     H = (R.shape[0] - 1) // 2
     rate = omega * time_samples(derivative_matrix(H) @ R, N) if R.shape[1] else r
     normal_loss = normal_dissipation(nl, r, rate, omega) if R.shape[1] else np.zeros(cs.count)
+    friction = friction_rows(cs, r, force) if R.shape[1] else force   # curved: less −κ q λ_n
     if state.shape[0] != N:  # states sampled differently from the forces: resample by phase
         state = state[(np.arange(N) * state.shape[0]) // N]
     closing = (state != 0) & (np.roll(state, 1, axis=0) == 0)                  # (N, n_c)
@@ -90,11 +91,7 @@ def contact_dynamics(solution, nl) -> list[dict]:
         slip, slip_work = float("nan"), 0.0
         if valid.any():
             q = r[:, t] * valid
-            kappa = np.stack([np.asarray(cs.partner_curvature_1)[idx],
-                              np.asarray(cs.partner_curvature_2)[idx]], axis=-1)
-            if np.any(kappa != 0.0):   # a curved partner: the rows also carry −κ q λ_n
-                pair_normal = np.where(nr >= 0, force[:, np.maximum(nr, 0)], 0.0)
-                lam_t = friction_force(kappa, q, lam_t, pair_normal) * valid
+            lam_t = friction[:, t] * valid
             stiffness = k_t[idx][None, :, None]
             slider = q - np.divide(lam_t, stiffness, out=np.zeros_like(lam_t),
                                    where=stiffness > 0)
