@@ -247,3 +247,75 @@ def test_hill_verdict_matches_the_time_integrators_monodromy(curvature):
     assert s.stable is (curvature < 0)
     if curvature > 0:
         assert full.floquet_exponent == pytest.approx(check.rate, rel=0.4)
+
+
+def test_case_file_partner_radius_reaches_the_solver():
+    """partner_radius_m in a matrices case: the solved point equals the directly built curved model
+    (the key becomes κ = 1/R), its contact indicators report the friction part (|λ_t| ≤ μ λ_n),
+    and a radius on a contact without a normal DOF is an input error naming the key."""
+    from sarfe.case.errors import CaseError
+    from sarfe.pipeline import load_case, solve_case
+
+    H = 12
+    model, contacts, F, omega = curved_squeak_model(H, -0.05)
+    M, K = np.diag([1.0, 0.3, 0.3]), np.array([[2e4, -1e4, 0.0], [-1e4, 1e4, 0.0], [0.0, 0.0, 2e4]])
+    case = {
+        "name": "curved",
+        "model": {"matrices": {"mass": M.tolist(), "stiffness": K.tolist(),
+                               "damping": (2e-4 * K + 2.0 * M).tolist()}},
+        "contacts": [{"name": "pad", "type": "squeak", "normal_dof": 2, "tangential_dofs": [1],
+                      "gap_m": -2e-4, "normal_stiffness_N_m": 4e4,
+                      "tangential_stiffness_N_m": 3e4, "friction_coefficient": 0.4,
+                      "partner_radius_m": -0.05}],
+        "excitation": {"forces": [{"dof": 0, "force_N": 15.0}], "frequency_hz": [12.0]},
+        "solver": {"harmonics": H, "samples_per_period": 512, "error_estimate": False,
+                   "stability": False, "workers": 1},
+        "erp": {"dofs": [2], "areas_m2": [0.01]},
+    }
+    result = solve_case(load_case(case), write=False)
+    direct = solve_frequency(model, contacts, F, omega, H, 512)
+    U = np.asarray(result.solutions[0].displacement)
+    assert np.abs(U - direct.displacement).max() <= 1e-8 * np.abs(direct.displacement).max()
+    (record,) = result.summary["points"][0]["contacts"]
+    # it slips at the normal force's peak: μ λ_n,max (the rows' force there is 2 % above)
+    assert record["peak_friction_force_N"] <= 0.4 * record["peak_normal_force_N"] * (1 + 1e-9)
+    assert record["peak_friction_force_N"] == pytest.approx(0.4 * record["peak_normal_force_N"],
+                                                            rel=1e-3)
+    bad = dict(case, contacts=[dict(case["contacts"][0], preload_N=2.0)])
+    del bad["contacts"][0]["normal_dof"], bad["contacts"][0]["gap_m"]
+    del bad["contacts"][0]["normal_stiffness_N_m"]
+    with pytest.raises(CaseError, match="partner_radius_m"):
+        load_case(bad)
+
+
+@pytest.mark.parametrize("radius", [0.05, -0.05])
+def test_small_motion_is_the_linear_rest_structure(radius):
+    """At a small excitation the contact sticks and the curved partner acts as the tangential
+    spring k_t − κ λ_n,s (the geometric stiffness at the static normal force λ_n,s = k_n δ0
+    shared with the normal DOF's spring 2e4: 8/3 N): the HBM response equals the linearized rest
+    structure (the cold start and the pipeline's linear baseline,
+    :func:`sarfe.hbm.solve.linearized_guess`) and the closed form of the stuck chain to 1e-6."""
+    from sarfe.hbm.solve import linearized_guess, make_problem
+
+    H = 3
+    model, contacts, F, omega = curved_squeak_model(H, radius)
+    F = 1e-3 * F
+    hbm = solve_frequency(model, contacts, F, omega, H, 64)
+    assert hbm.converged and np.all(np.asarray(hbm.contact_state) == 1)
+    linear = linearized_guess(make_problem(model, contacts, F, H, 4 * H + 1), omega)
+    U = np.asarray(hbm.displacement)
+    assert np.abs(U[1:3] - linear[1:3]).max() <= 1e-6 * np.abs(linear[1:3]).max()
+    # closed form: x0, x1 (masses 1, 0.3; K of the chain) with k_t − κ λ_n,s on x1
+    static = 4e4 * 2e-4 * 2e4 / (4e4 + 2e4)
+    K = np.array([[2e4, -1e4], [-1e4, 1e4]])
+    stiffness = K + np.diag([0.0, 3e4 - static / radius])
+    Z = stiffness - omega ** 2 * np.diag([1.0, 0.3]) + 1j * omega * (2e-4 * K + 2.0 * np.diag(
+        [1.0, 0.3]))
+    x = np.linalg.solve(Z, np.array([F[1, 0], 0.0]))               # u_c − i u_s
+    assert np.abs(U[1, :2] - x.real).max() <= 1e-6 * np.abs(x).max()
+    assert np.abs(U[2, :2] + x.imag).max() <= 1e-6 * np.abs(x).max()
+    # the geometric stiffness is seen: without it x1 differs by ~ κ λ_n,s / k_t
+    flat = np.linalg.solve(K + np.diag([0.0, 3e4]) - omega ** 2 * np.diag([1.0, 0.3])
+                           + 1j * omega * (2e-4 * K + 2.0 * np.diag([1.0, 0.3])),
+                           np.array([F[1, 0], 0.0]))
+    assert abs(flat[1] - x[1]) > 1e-3 * abs(x[1])
