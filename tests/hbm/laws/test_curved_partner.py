@@ -16,11 +16,12 @@ from sarfe.hbm.aft import contact_forces, jacobian_matrix
 from sarfe.hbm.contacts import make_contact_set
 from sarfe.hbm.laws import LawInputError, law
 from sarfe.hbm.laws.curvature import prepare
-from sarfe.hbm.model import make_linear_model
 from sarfe.hbm.residual import Problem, full_residual
 from sarfe.hbm.stability.contact_terms import ContactOperator
 from sarfe.hbm.stability.perturbation import perturbation_check
 from sarfe.hbm.time_integration import integrate_time
+from tests.hbm.stability.test_stability import friction_chain
+from tests.hbm.test_hbm_vs_time import squeak_model
 
 K_N, K_T, DELTA0 = 1e4, 5e3, 1e-4          # N/m, N/m, m (static penetration at q = 0)
 
@@ -114,19 +115,34 @@ def test_aft_jacobian_matches_finite_differences(amplitude, mu):
 
 
 def curved_squeak_model(H, radius):
-    """3 DOF: driven mass x0 – spring – part with tangential DOF x1 and normal DOF x2 (the lumped
-    squeak model of tests/hbm/test_hbm_vs_time.py) rubbing on a curved partner of radius R;
-    k_n = 4e4 N/m, 0.2 mm overclosure, k_t = 3e4 N/m, μ = 0.4, 12 Hz: stick–slip."""
-    M = np.diag([1.0, 0.3, 0.3])
-    K = np.array([[2e4, -1e4, 0.0], [-1e4, 1e4, 0.0], [0.0, 0.0, 2e4]])
-    model = make_linear_model(M, 2e-4 * K + 2.0 * M, K)
-    G = sp.csr_matrix([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0]])
-    contacts = make_contact_set(G, ["squeak"], [0], [[1, -1]], gap=-2e-4, normal_stiffness=4e4,
-                                tangential_stiffness=3e4, friction_coefficient=0.4,
+    """The 3-DOF lumped squeak model of tests/hbm/test_hbm_vs_time.py (driven mass x0 – spring –
+    part with tangential DOF x1 and normal DOF x2; k_n = 4e4 N/m, 0.2 mm overclosure,
+    k_t = 3e4 N/m, μ = 0.4, 12 Hz) without the constant load and the normal DOF's shaking,
+    rubbing on a curved partner of radius R: stick–slip."""
+    model, flat, _, omega = squeak_model(H)
+    contacts = make_contact_set(flat.gap_map, ["squeak"], [0], [[1, -1]], gap=-2e-4,
+                                normal_stiffness=4e4, tangential_stiffness=3e4,
+                                friction_coefficient=0.4,
                                 parameters={"partner_curvature_1": 1.0 / radius})
     F = np.zeros((2 * H + 1, 3))
     F[1, 0] = 15.0
-    return model, contacts, F, 2 * np.pi * 12.0
+    return model, contacts, F, omega
+
+
+def curved_chain(two_d, kappa, omega):
+    """The friction chain of tests/hbm/stability/test_stability.py on a curved partner κ (κ₁, κ₂)
+    at ``omega``, H = 7, N = 256: (model, contacts, F, solution, Problem, full residual)."""
+    model, flat = friction_chain(two_d)
+    contacts = make_contact_set(flat.gap_map, ["squeak"], [0], flat.tangent_rows, -0.05, 5.0, 3.0,
+                                0.3, 0.8, parameters={"partner_curvature_1": kappa[0],
+                                                      "partner_curvature_2": kappa[1]})
+    H, N = 7, 256
+    F = np.zeros((2 * H + 1, 4))
+    F[1, 2], F[2, 3] = 0.3, 0.2
+    s = solve_frequency(model, contacts, F, omega, H, N)
+    assert s.converged
+    problem = Problem(model, contacts, F, H, N)
+    return model, contacts, F, s, problem, full_residual(problem, s.displacement.ravel(), omega)
 
 
 @pytest.mark.parametrize("radius, H", [(0.05, 18), (-0.05, 12)])
@@ -158,21 +174,7 @@ def test_hbm_matches_newmark_time_integration(radius, H):
 def test_hill_operator_at_zero_is_the_aft_jacobian(two_d):
     """𝒥(s) → the AFT Jacobian as s → 0 with the curved coupling (normal rows' slide columns,
     the tangential components of λ_n, the slip limit moving with q): the correction vanishes."""
-    n = 4
-    Kc = sp.diags([2.0 * np.ones(n), -np.ones(n - 1), -np.ones(n - 1)], [0, 1, -1]).toarray()
-    model = make_linear_model(np.eye(n), 0.02 * Kc, Kc)
-    G = sp.csr_matrix(np.array([[1.0, 0, 0, 0], [0, 0, 1.0, 0], [0, 0, 0, 1.0]]))
-    contacts = make_contact_set(G, ["squeak"], [0], [[1, 2]] if two_d else [[1, -1]], -0.05,
-                                5.0, 3.0, 0.3, 0.8,
-                                parameters={"partner_curvature_1": 2.0,
-                                            "partner_curvature_2": -1.5})
-    H, N = 7, 256
-    F = np.zeros((2 * H + 1, 4))
-    F[1, 2], F[2, 3] = 0.3, 0.2
-    s = solve_frequency(model, contacts, F, 0.8, H, N)
-    assert s.converged
-    problem = Problem(model, contacts, F, H, N)
-    ev = full_residual(problem, s.displacement.ravel(), s.omega)
+    _, _, _, s, problem, ev = curved_chain(two_d, (2.0, -1.5), 0.8)
     op = ContactOperator(problem, s.displacement, s.omega, ev.forces)
     assert op.has_memory
     assert abs(op.correction(1e-9)).max() < 1e-6 * abs(ev.jacobian).max()
@@ -226,22 +228,12 @@ def test_hill_verdict_matches_the_time_integrators_monodromy(curvature):
     contact, the orbit slips 79 % of the period and is unstable (exponent +0.57, matched);
     concave (κ = −2): stiffer, stuck all period, stable (the integrator's neutral slider
     direction, rate 0, carries no exponent to compare)."""
-    n = 4
-    Kc = sp.diags([2.0 * np.ones(n), -np.ones(n - 1), -np.ones(n - 1)], [0, 1, -1]).toarray()
-    model = make_linear_model(np.eye(n), 0.02 * Kc, Kc)
-    G = sp.csr_matrix(np.array([[1.0, 0, 0, 0], [0, 0, 1.0, 0], [0, 0, 0, 1.0]]))
-    contacts = make_contact_set(G, ["squeak"], [0], [[1, -1]], -0.05, 5.0, 3.0, 0.3, 0.8,
-                                parameters={"partner_curvature_1": curvature})
-    H, N = 7, 256
-    F = np.zeros((2 * H + 1, 4))
-    F[1, 2], F[2, 3] = 0.3, 0.2
-    s = solve_frequency(model, contacts, F, 0.4, H, N)
-    assert s.converged
+    model, contacts, F, s, _, _ = curved_chain(False, (curvature, 0.0), 0.4)
     assert np.mean(np.asarray(s.contact_state) == 2) == pytest.approx(0.79 if curvature > 0 else 0.0,
                                                                       abs=0.02)
     check = perturbation_check(model, contacts, F, s, steps_per_period=256, newton_steps=1)
     assert s.stable is check.stable
-    full = solve_frequency(model, contacts, F, 0.4, H, N, initial=s,
+    full = solve_frequency(model, contacts, F, 0.4, 7, 256, initial=s,
                            options=SolverOptions(stability_method="full"))
     assert full.stable is check.stable
     assert s.stable is (curvature < 0)
