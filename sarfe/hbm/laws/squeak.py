@@ -35,8 +35,10 @@ def static_deflection(p, force):
 
 
 def prune_open(p):
-    """A pair under a constant normal load keeps its slider history: never dropped."""
-    return ~(p["normal_load"] > 0)
+    """A pair under a constant normal load keeps its slider history: never dropped; nor one on a
+    concave partner (κ < 0: the slide closes the gap, which the screen's w alone does not see)."""
+    concave = (p["partner_curvature_1"] < 0) | (p["partner_curvature_2"] < 0)
+    return ~(p["normal_load"] > 0) & ~concave
 
 
 LAW = ContactLaw(

@@ -311,3 +311,25 @@ def test_small_motion_is_the_linear_rest_structure(radius):
                            + 1j * omega * (2e-4 * K + 2.0 * np.diag([1.0, 0.3])),
                            np.array([F[1, 0], 0.0]))
     assert abs(flat[1] - x[1]) > 1e-3 * abs(x[1])
+
+
+def test_pruning_keeps_an_open_contact_that_the_slide_closes():
+    """Open at rest (gap 0.1 mm) on a concave partner: the slide closes it (κ q²/2 > g) although
+    the normal motion alone never would, so the screen keeps it; on a convex partner the slide
+    only opens it further and the screen may drop it (the flat rule)."""
+    from sarfe.hbm.pruning import NONLINEAR, OPEN, screen_contacts
+
+    H = 5
+    decisions = {}
+    for radius in (-0.05, 0.05):
+        model, curved, F, omega = curved_squeak_model(H, radius)
+        contacts = make_contact_set(curved.gap_map, ["squeak"], [0], [[1, -1]], gap=1e-4,
+                                    normal_stiffness=4e4, tangential_stiffness=3e4,
+                                    friction_coefficient=0.4,
+                                    parameters={"partner_curvature_1": 1.0 / radius})
+        (decisions[radius],) = screen_contacts(model, contacts, F, [omega])
+        if radius < 0:
+            s = solve_frequency(model, contacts, F, omega, H, 256)
+            assert s.converged and np.any(np.asarray(s.contact_state) != 0)   # it does close
+    assert decisions[-0.05].decision == NONLINEAR
+    assert decisions[0.05].decision == OPEN
