@@ -333,3 +333,23 @@ def test_pruning_keeps_an_open_contact_that_the_slide_closes():
             assert s.converged and np.any(np.asarray(s.contact_state) != 0)   # it does close
     assert decisions[-0.05].decision == NONLINEAR
     assert decisions[0.05].decision == OPEN
+
+
+@pytest.mark.parametrize("radius", [0.05, -0.05])
+def test_stuck_normal_force_second_harmonic_closed_form(radius):
+    """Dynamic stuck limit of the lumped model: the slide q = a_c cos ωt + a_s sin ωt moves the
+    surface by κq²/2, whose 2nd harmonic S₂ = (κ/2)((a_c² − a_s²)/2 − i a_c a_s) drives the
+    normal DOF (mass 0.3, spring 2e4, damping of the chain) through k_n:
+    λ_n,2 = −k_n S₂ / (1 + k_n / Z_n(2ω)), Z_n(Ω) = 2e4 − 0.3 Ω² + iΩ c — the HBM's 2nd harmonic of
+    the normal force within 1e-6 (measured 4e-8; higher orders in κq)."""
+    H = 6
+    model, contacts, F, omega = curved_squeak_model(H, radius)
+    s = solve_frequency(model, contacts, 0.1 * F, omega, H, 256)
+    assert s.converged and np.all(np.asarray(s.contact_state) == 1)
+    R, L = np.asarray(s.contact_displacement), np.asarray(s.contact_force)
+    a_c, a_s = R[1, 1], R[2, 1]
+    S2 = 0.5 / radius * ((a_c ** 2 - a_s ** 2) / 2 - 1j * a_c * a_s)
+    Omega = 2 * omega
+    Zn = 2e4 - 0.3 * Omega ** 2 + 1j * Omega * (2e-4 * 2e4 + 2.0 * 0.3)
+    closed = -4e4 * S2 / (1 + 4e4 / Zn)
+    assert abs((L[3, 0] - 1j * L[4, 0]) - closed) <= 1e-6 * abs(closed)
