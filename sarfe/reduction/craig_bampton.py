@@ -63,6 +63,8 @@ def residual_modes(stiffness_ii, mass_ii, operator, loads, modes, relative_toler
     n = mass_ii.shape[0]
     if loads.shape[1] == 0:
         return np.empty(0), np.empty((n, 0))
+    if isinstance(static, list):
+        static = static.pop()
     if static is None:
         static = operator(np.asarray(loads, dtype=float))
     mass_static = mass_ii @ static
@@ -70,7 +72,7 @@ def residual_modes(stiffness_ii, mass_ii, operator, loads, modes, relative_toler
     static = static[:, norms > 0] / norms[norms > 0]  # unit M-norm before deflation
     mass_static = mass_static[:, norms > 0] / norms[norms > 0]
     for _ in range(2):  # deflate Φ twice (classical Gram–Schmidt, re-orthogonalized)
-        static = static - modes @ (modes.T @ mass_static)
+        static -= modes @ (modes.T @ mass_static)
         mass_static = mass_ii @ static        # (one sparse product per pass; reused below)
     gram = static.T @ mass_static
     values, vectors = np.linalg.eigh(0.5 * (gram + gram.T))
@@ -78,8 +80,15 @@ def residual_modes(stiffness_ii, mass_ii, operator, loads, modes, relative_toler
     if not keep.any():
         return np.empty(0), np.empty((n, 0))
     transform = vectors[:, keep] / np.sqrt(values[keep])
-    basis, mass_basis = m_orthonormal(static @ transform, mass_ii, mass_static @ transform)
-    basis = basis - modes @ (modes.T @ mass_basis)  # the clean-up against Φ
+    # (each n_i × k array dropped as soon as its successor exists: no three alive at once)
+    block = static @ transform
+    del static
+    mass_block = mass_static @ transform
+    del mass_static
+    basis, mass_basis = m_orthonormal(block, mass_ii, mass_block)
+    del block, mass_block
+    basis -= modes @ (modes.T @ mass_basis)  # the clean-up against Φ
+    del mass_basis
     basis, _ = m_orthonormal(basis, mass_ii)
     if basis.shape[1] == 0:
         return np.empty(0), np.empty((n, 0))
@@ -219,6 +228,7 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
     n_fixed = len(omega2)
     basis = np.empty((len(interior), n_b + n_fixed + (0 if loads is None else loads.shape[1])))
     basis[:, :n_b] = psi
+    psi = basis[:, :n_b]                 # the copy in T serves from here (one n_i × n_b array less)
     column = n_b
     while blocks:
         block = blocks.pop(0)
@@ -227,7 +237,8 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
         del block
     phi = basis[:, n_b:n_b + n_fixed]
     if loads is not None:
-        omega2_r, phi_r = residual_modes(k_ii, m_ii, None, loads, phi, static=static)
+        held_static, static = [static], None    # residual_modes frees it once used
+        omega2_r, phi_r = residual_modes(k_ii, m_ii, None, loads, phi, static=held_static)
     else:
         omega2_r, phi_r = np.empty(0), np.empty((len(interior), 0))
     basis[:, n_b + n_fixed:n_b + n_fixed + phi_r.shape[1]] = phi_r
