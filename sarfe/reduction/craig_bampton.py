@@ -55,18 +55,21 @@ def residual_modes(stiffness_ii, mass_ii, operator, loads, modes, relative_toler
                    static=None):
     """Residual modes Φ_r from interior loads (module docstring): ω_r² (ascending), Φ_r.
 
-    loads: (n_i, k) interior load columns F_i; operator(F) = K_ii⁻¹ F; modes: Φ (n_i, n_m),
+    loads: (n_i, k) interior load columns F_i (not read when ``static`` is given); operator(F) =
+    K_ii⁻¹ F; modes: Φ (n_i, n_m),
     Φᵀ M_ii Φ = I. Directions whose M-norm after deflation is below relative_tolerance × their norm
     before (already in span Φ, or dependent) are dropped. ``static``: K_ii⁻¹ F_i when already
     computed (then ``operator`` is not called).
     """
     n = mass_ii.shape[0]
-    if loads.shape[1] == 0:
-        return np.empty(0), np.empty((n, 0))
     if isinstance(static, list):
         static = static.pop()
     if static is None:
+        if loads.shape[1] == 0:
+            return np.empty(0), np.empty((n, 0))
         static = operator(np.asarray(loads, dtype=float))
+    if static.shape[1] == 0:
+        return np.empty(0), np.empty((n, 0))
     mass_static = mass_ii @ static
     norms = np.sqrt(np.einsum("ij,ij->j", static, mass_static))
     static = static[:, norms > 0] / norms[norms > 0]  # unit M-norm before deflation
@@ -237,8 +240,11 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
         del block
     phi = basis[:, n_b:n_b + n_fixed]
     if loads is not None:
-        held_static, static = [static], None    # residual_modes frees it once used
-        omega2_r, phi_r = residual_modes(k_ii, m_ii, None, loads, phi, static=held_static)
+        # the loads (F_b among them) go before the residual modes' peak: residual_modes frees the
+        # statics once used, and F_b = M_ib + M_ii Ψ is formed again below, the same operations
+        held_static, static = [static], None
+        loads = boundary_load = None
+        omega2_r, phi_r = residual_modes(k_ii, m_ii, None, None, phi, static=held_static)
     else:
         omega2_r, phi_r = np.empty(0), np.empty((len(interior), 0))
     basis[:, n_b + n_fixed:n_b + n_fixed + phi_r.shape[1]] = phi_r
@@ -254,6 +260,9 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
     m_ib = m_ib.toarray()
     m_rbb = m_bb + m_ib.T @ psi + psi.T @ m_ib + psi_m_psi
     del m_ib
+    if boundary_load is None:
+        boundary_load = m_ii @ psi
+        np.add.at(boundary_load, (coo.row, coo.col), coo.data)
     m_rbm = boundary_load.T @ phi
     n_b, n_m = len(boundary), len(omega2)
     stiffness_r = np.zeros((n_b + n_m, n_b + n_m))
