@@ -40,6 +40,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from sarfe.hbm import laws
+from sarfe.hbm.laws import curvature
 
 DENSE_LIMIT = 3000  # models up to this many DOFs use a dense propagator (reduced models)
 #: ω_c h_s, the contact frequency × sub-step a stiff contact switches in (see :class:`_SubSteps`):
@@ -88,6 +89,9 @@ class ContactLaws:
             g = dict(law=law, idx=idx, p=p, gap=contacts.gap[idx], has_normal=nr >= 0,
                      normal_safe=np.maximum(nr, 0))
             g["normal_rows"] = nr[g["has_normal"]]
+            g["kappa"] = curvature.curvatures(p)   # a curved partner: w − ½ Σ κ q², :mod:`curvature`
+            if g["kappa"] is not None:
+                g["all_t"] = contacts.tangent_rows[idx]
             sel = np.flatnonzero(contacts.tangent_rows[idx, 0] >= 0) if law.tangent is not None \
                 else np.zeros(0, int)
             g["tangent"] = sel.size > 0        # the element acts on the contacts with tangent rows
@@ -128,6 +132,9 @@ class ContactLaws:
             has = g["has_normal"]
             w = np.where(has, r[g["normal_safe"]], g["gap"])
             wdot = np.where(has, rdot[g["normal_safe"]], 0.0) if rdot is not None else None
+            if g["kappa"] is not None:
+                q_all = np.where(g["all_t"] >= 0, r[np.maximum(g["all_t"], 0)], 0.0)
+                w = curvature.effective_normal(g["kappa"], w, q_all)
             out = g["law"].normal(g["p"], g["gap"], w, wdot)
             lam[g["normal_rows"]] = out.force[has]
             state[g["idx"]] = out.closed
@@ -141,6 +148,11 @@ class ContactLaws:
                 state[g["idx"][g["t_sel"]]] = fstate
                 slider[g["sliders"]] = new
                 keep.update(d_tq=d_tq, d_tn=d_tn)
+            if g["kappa"] is not None:
+                geometric = curvature.coupling(g["kappa"], q_all, out.force, keep["stiffness"])[0]
+                on = g["all_t"] >= 0
+                np.add.at(lam, g["all_t"][on], geometric[on])
+                keep.update(q=q_all, force=out.force)
             self._last.append(keep)
         return lam, slider, state
 
@@ -153,6 +165,17 @@ class ContactLaws:
             stiffness = keep["stiffness"]
             if keep["damping"] is not None:
                 stiffness = stiffness + rate_factor * keep["damping"]
+            if g["kappa"] is not None:           # the coupled (w, q₁, q₂) block of each contact
+                d_tq, d_tn = np.zeros((has.size, 2, 2)), np.zeros((has.size, 2))
+                if g["tangent"]:
+                    d_tq[g["t_sel"]], d_tn[g["t_sel"]] = keep["d_tq"], keep["d_tn"]
+                local = curvature.local_jacobian(g["kappa"], keep["q"], keep["force"], stiffness,
+                                                 d_tq, d_tn)
+                rows = np.column_stack([np.where(has, g["normal_safe"], -1), g["all_t"]])
+                valid = (rows[:, :, None] >= 0) & (rows[:, None, :] >= 0)
+                np.add.at(jac, (np.broadcast_to(rows[:, :, None], valid.shape)[valid],
+                                np.broadcast_to(rows[:, None, :], valid.shape)[valid]), local[valid])
+                continue
             jac[g["normal_rows"], g["normal_rows"]] = stiffness[has]
             if g["tangent"]:
                 jac[g["pair_rows"], g["pair_cols"]] += keep["d_tq"][g["pair"]]
@@ -173,6 +196,10 @@ def initial_sliders(law, r0, initial_force):
         q = np.where(g["t_mask"], r0[g["t_safe"]], 0.0)
         force = None if initial_force is None else np.where(g["t_mask"],
                                                             initial_force[g["t_safe"]], 0.0)
+        if force is not None and g["kappa"] is not None:   # less the normal force's −κ q λ_n
+            sel = g["t_sel"]
+            normal = np.where(g["has_normal"][sel], initial_force[g["normal_safe"][sel]], 0.0)
+            force = force + g["kappa"][sel] * q * normal[:, None]
         slider[g["sliders"]] = g["law"].tangent.initial_slider(g["p_t"], q, force)
     return slider
 
