@@ -24,7 +24,8 @@ followed by u₊ = u_lin − B λ. The friction history (slider positions) is up
 return map once r has converged. A step in which a stiff contact opens or closes (ω_c h >
 SUBSTEP_RESOLUTION, ω_c its contact frequency) is redone in m sub-steps (:class:`_SubSteps`): the
 rule conserves energy only while the law is linear, and an impact under-resolved in the step
-gains energy (k_n = 10¹⁰ N/m, ω_c h ≈ 2: the orbit grows without bound or never settles). :func:`march_periods` runs periods until the period-end state
+gains energy (k_n = 10¹⁰ N/m, ω_c h ≈ 2: the orbit grows without bound or never settles).
+:func:`march_periods` runs periods until the period-end state
 (u, v/ω, sliders) repeats to a tolerance, optionally extrapolating the period-start states to the
 periodic orbit (reduced-rank extrapolation).
 
@@ -44,7 +45,8 @@ from sarfe.hbm.laws import curvature
 
 DENSE_LIMIT = 3000  # models up to this many DOFs use a dense propagator (reduced models)
 #: ω_c h_s, the contact frequency × sub-step a stiff contact switches in (see :class:`_SubSteps`):
-#: the trapezoidal rule's energy error of one impact is ≤ (ω_c h_s)²/4 of its kinetic energy
+#: the trapezoidal rule's energy error of a closing or an opening is ≤ (ω_c h_s)²/4 of the impact's
+#: kinetic energy (measured: 0.05/0.1/0.2 change the k_n = 10¹⁰ lumped rattle's orbit ≤ 0.2 %)
 SUBSTEP_RESOLUTION = 0.1
 MAX_SUBSTEPS = 256
 
@@ -244,16 +246,19 @@ class _SubSteps:
     trapezoidal rule conserves energy only while the law is linear).
 
     A contact that closes at a fraction α of a step ends it with penetration p ≈ (1 − α) ṙ h; the
-    rule's work Δr·λ̄ exceeds the stored energy ½ k p² by α(1 − α)(ω_c h)² of the impact's
-    kinetic energy (ω_c² = k/m, m the contact's mass): up to 80 % at ω_c h = 1.8 (k_n = 10¹⁰ N/m
-    on the 0.14 kg lumped rattle, N = 2048 at 72 Hz), a gain that grows the orbit without bound.
-    The contact's ρ = ‖C ∂λ/∂r‖∞ ≈ (ω_c h/2)² (C = G K_eff⁻¹ Gᵀ ≈ (h²/4) G M⁻¹ Gᵀ) measures it
-    for any law; a step in which a contact opens or closes (state 0 ↔ not 0; stick ↔ slip keeps
+    rule's work Δr·λ̄ differs from the stored energy ½ k p² by α(1 − α)(ω_c h)² of the impact's
+    kinetic energy (ω_c² = k/m, m the contact's mass). The errors of closing and opening cancel
+    only for an isolated free impact (the rule is time-symmetric); with the springs, the load and
+    a second body in the impact they do not: k_n = 10¹⁰ N/m on the lumped rattle, N = 2048 at
+    71.5 Hz (ω_c h = 1.8), the contact's cyclic work was −36 % of the input and the orbit never
+    settled; a driven 1-DOF impact oscillator grew to 10³⁵ m at N = 256.
+
+    The contact's ρ = ‖C ∂λ/∂r‖∞ ≈ (ω_c h/2)² (C = G K_eff⁻¹ Gᵀ ≈ (h²/4) G M⁻¹ Gᵀ) measures ω_c h
+    for any law. A step in which a contact opens or closes (state 0 ↔ not 0; stick ↔ slip keeps
     the step: friction dissipates) with 2√ρ > SUBSTEP_RESOLUTION (the larger ρ of its start and
-    end) is redone in m = 2^⌈log₂(2√ρ /
-    SUBSTEP_RESOLUTION)⌉ ≤ MAX_SUBSTEPS sub-steps, the load f_e(t) trigonometrically interpolated
-    between the samples. Steps without a stiff switch are untouched (the results of soft contacts
-    are unchanged).
+    end) is redone in m = 2^⌈log₂(2√ρ / SUBSTEP_RESOLUTION)⌉ ≤ MAX_SUBSTEPS sub-steps, the load
+    f_e(t) trigonometrically interpolated between the samples. Contacts the step resolves
+    (ω_c h ≤ SUBSTEP_RESOLUTION at their switches) give the results of the plain rule.
     """
 
     def __init__(self, model, h, gap_map, forcing):

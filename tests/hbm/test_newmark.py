@@ -116,6 +116,7 @@ def test_stiff_impacts_do_no_net_work_and_converge_in_the_step(monkeypatch):
     assert abs(first[256] - first[1024]) < 5e-3 * abs(first[1024])
     for r in runs.values():
         assert abs(r.contact_work[0]) < 1e-2 * r.input_work
+        assert r.substepped_steps >= 1                       # the impact's step(s)
     monkeypatch.setattr(newmark, "SUBSTEP_RESOLUTION", np.inf)   # the plain rule
     plain = integrate_time(model, contacts, F, omega, 3, steps_per_period=256, max_periods=30)
-    assert abs(plain.contact_work[0]) > 0.1 * plain.input_work
+    assert abs(plain.contact_work[0]) > 0.1 * plain.input_work and plain.substepped_steps == 0
