@@ -20,20 +20,13 @@ friction coefficient and normal load follow from one adjoint solve with the conv
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sp
 
 from sarfe.erp.erp import AIR_DENSITY, REFERENCE_POWER, SOUND_SPEED
+from sarfe.erp.reduced import radiation_gram
 from sarfe.erp.weighting import a_weighting_db
 from sarfe.hbm.sensitivity import PARAMETERS, RELATIVE_STEP, adjoint_sensitivities
 
 __all__ = ["a_weighted_level", "level_sensitivities"]
-
-
-def _apply(erp_map, U):
-    """W = U Nᵀ (rows, n_s) for a dense or sparse N (n_s, n)."""
-    if sp.issparse(erp_map):
-        return np.asarray(erp_map @ np.asarray(U).T).T
-    return np.asarray(U) @ np.asarray(erp_map).T
 
 
 def a_weighted_level(displacement, omega, erp_map, areas, density=AIR_DENSITY,
@@ -41,15 +34,20 @@ def a_weighted_level(displacement, omega, erp_map, areas, density=AIR_DENSITY,
                      reference_power=REFERENCE_POWER):
     """(L_A [dB(A)], ∂L_A/∂ũ (2H+1, n) [dB(A)/m]) of displacement harmonics ũ (2H+1, n) [m] at
     ω [rad/s] (module docstring). erp_map N (n_s, n) dense or sparse; areas (n_s,) [m²]. A zero
-    power gives (−inf, NaN gradient)."""
+    power gives (−inf, NaN gradient).
+
+    Evaluated in the reduced coordinates with Q = Nᵀ diag(A) N (:func:`sarfe.erp.reduced.
+    radiation_gram`, cached per map): p_k = (kω)² (ũ_kcᵀ Q ũ_kc + ũ_ksᵀ Q ũ_ks) and
+    ∂L_A/∂ũ_kc = (10/ln 10) · 2 a_k (kω)² (Q ũ_kc) / Σ_j a_j p_j — the nodal sums above without
+    forming W on every radiating node (two (2H+1)·n·n_s products per point on a fine mesh)."""
     U = np.asarray(displacement, dtype=float)
     H = (U.shape[0] - 1) // 2
     omega = float(omega)
-    W = _apply(erp_map, U)                                            # (2H+1, n_s)
-    A = np.asarray(areas, dtype=float)
+    QU = U @ radiation_gram(erp_map, areas)                            # (2H+1, n), Q symmetric
     k_omega2 = (np.arange(1, H + 1) * omega) ** 2
     weight = 10.0 ** (a_weighting_db(np.arange(1, H + 1) * omega / (2.0 * np.pi)) / 10.0)
-    power = k_omega2 * ((W[1::2] ** 2 + W[2::2] ** 2) @ A)           # p_k (H,)
+    rows = np.einsum("rn,rn->r", U[1:], QU[1:])
+    power = k_omega2 * (rows[0::2] + rows[1::2])                       # p_k (H,)
     total = float(weight @ power)
     if not total > 0:
         return -np.inf, np.full(U.shape, np.nan)
@@ -57,10 +55,7 @@ def a_weighted_level(displacement, omega, erp_map, areas, density=AIR_DENSITY,
     level = 10.0 * np.log10(scale * total / reference_power)
     coefficient = np.zeros(2 * H + 1)
     coefficient[1:] = np.repeat(10.0 / np.log(10.0) * 2.0 * weight * k_omega2 / total, 2)
-    dW = coefficient[:, None] * W * A[None, :]
-    gradient = np.asarray(erp_map.T @ dW.T).T if sp.issparse(erp_map) \
-        else dW @ np.asarray(erp_map)
-    return level, gradient
+    return level, coefficient[:, None] * QU
 
 
 def level_sensitivities(model, contacts, excitation, solution, erp_map, areas,

@@ -13,7 +13,10 @@ over all harmonics); it is assembled analytically:
   Fourier coefficients of ∂λ/∂w (∂λ/∂ẇ) up to order 2H with product-to-sum identities (O(H²) per
   contact, :func:`pointwise_jacobian`);
 * a hysteretic tangent element (Jenkins): its own periodic march and Jacobian
-  (:func:`sarfe.hbm.laws.jenkins.periodic_forces`).
+  (:func:`sarfe.hbm.laws.jenkins.periodic_forces`);
+* a curved partner (:mod:`sarfe.hbm.laws.curvature`): the law sees the penetration
+  w − g − ½ Σ κ_i q_i², the tangent rows get −κ_i q_i λ_n, and the pointwise couplings
+  ∂λ/∂(w, q) enter as further E diag(·) Φ blocks (:func:`curvature_blocks`).
 
 Rate-dependent laws also give ∂λ̃/∂ω = E diag(∂λ/∂ẇ) Φ ∇ r̃ (``omega_derivative``) and the blocks
 E diag(∂λ/∂ẇ) Φ of Hill's damping term (``damping_blocks``); for rate-independent laws both are
@@ -33,6 +36,7 @@ import scipy.sparse as sp
 
 from sarfe.hbm import harmonics as hm
 from sarfe.hbm import laws
+from sarfe.hbm.laws import curvature
 
 
 @lru_cache(maxsize=32)
@@ -77,6 +81,32 @@ def pointwise_jacobian(derivative_time: np.ndarray, harmonics: int, kept_rows=No
         keep = np.ix_(kept_rows, kept_rows)
         idx1, idx2, s1, s2 = idx1[keep], idx2[keep], s1[keep], s2[keep]
     return s1 * table[:, idx1] + s2 * table[:, idx2]
+
+
+def tangential_samples(contacts, idx, r):
+    """q (N, n_g, 2) [m] of the contacts ``idx`` at the samples r (N, n_rows); 0 where a contact
+    has no such tangent row."""
+    rows = contacts.tangent_rows[idx]
+    return np.where((rows >= 0)[None], r[:, np.maximum(rows, 0)], 0.0)
+
+
+def curvature_blocks(kappa, q, force, stiffness, harmonics, kept_rows=None):
+    r"""The pointwise curved-partner terms of n contacts in the local layout (h·3 + l; l = 0
+    normal, 1, 2 tangents): E diag(∂λ_n/∂q_i) Φ in the normal rows' tangent columns, the same
+    (symmetric) in the tangent rows' normal columns, E diag(∂λ_q,i/∂q_k) Φ in the tangent rows'
+    tangent columns (:func:`sarfe.hbm.laws.curvature.coupling`). q (N, n, 2), λ_n and ∂λ_n/∂δ
+    (N, n). Returns (n, 3P, 3P) [N/m]; the friction's own terms are not included."""
+    _, slope, hessian = curvature.coupling(kappa, q, force, stiffness)
+    n = force.shape[1]
+    P = 2 * int(harmonics) + 1 if kept_rows is None else len(kept_rows)
+    J = np.zeros((n, 3 * P, 3 * P))
+    for i in range(2):
+        coupled = pointwise_jacobian(slope[..., i], harmonics, kept_rows)
+        J[:, 0::3, i + 1::3] = coupled
+        J[:, i + 1::3, 0::3] = coupled
+        for k in range(2):
+            J[:, i + 1::3, k + 1::3] = pointwise_jacobian(hessian[..., i, k], harmonics, kept_rows)
+    return J
 
 
 @dataclass(frozen=True)
@@ -142,6 +172,10 @@ def contact_forces(contacts, contact_displacement, samples_per_period, slider_st
         gap = contacts.gap[idx]
         safe = np.maximum(normal_rows, 0)
         w = np.where(has_normal, r[:, safe], gap) if not np.all(has_normal) else r[:, normal_rows]
+        kappa = curvature.curvatures(p)
+        if kappa is not None:                  # a curved partner: the slide moves the surface
+            q_all = tangential_samples(contacts, idx, r)
+            w = curvature.effective_normal(kappa, w, q_all)
         wdot = None
         if law.velocity_dependent:
             if omega is None:
@@ -167,6 +201,13 @@ def contact_forces(contacts, contact_displacement, samples_per_period, slider_st
             rate = hm.harmonic_coefficients(damping * hm.time_samples(velocity[0][:, safe], N), H)
             np.add.at(omega_derivative, (slice(None), normal_rows[has_normal]),
                       rate[:, has_normal])
+        slope_q = None
+        if kappa is not None:
+            geometric, slope_q, _ = curvature.coupling(kappa, q_all, out.force, stiffness)
+            t_all = contacts.tangent_rows[idx]
+            for col in range(2):
+                on = t_all[:, col] >= 0
+                np.add.at(lam, (slice(None), t_all[on, col]), geometric[:, on, col])
         normal_jacobian = None
         if jacobian:
             normal_jacobian = pointwise_jacobian(stiffness, H, kept_rows)
@@ -194,7 +235,8 @@ def contact_forces(contacts, contact_displacement, samples_per_period, slider_st
         p_t = p if isinstance(sel, slice) else {k: v[sel] for k, v in p.items()}
         force_t, st, w_end, n_pass, J_t = law.tangent.periodic_forces(
             p_t, q, ~present[:, 1], out.force[:, sel], stiffness[:, sel], slider_start[t_idx], H,
-            N, jacobian, friction_tolerance, friction_pass_cap, rows_k)
+            N, jacobian, friction_tolerance, friction_pass_cap, rows_k,
+            None if slope_q is None else slope_q[:, sel])
         for col in range(2):
             on = present[:, col]
             if np.any(on):
@@ -204,6 +246,9 @@ def contact_forces(contacts, contact_displacement, samples_per_period, slider_st
         passes = max(passes, n_pass)
         if jacobian:
             J_t[:, 0::3, 0::3] = normal_jacobian[sel]
+            if kappa is not None:
+                J_t += curvature_blocks(kappa[sel], q, out.force[:, sel], stiffness[:, sel], H,
+                                        kept_rows)
             normal_t = np.where(has_normal, normal_rows, -1)[sel]
             blocks.append((np.column_stack([normal_t, t_rows]), J_t))
     return ContactForces(hm.harmonic_coefficients(lam, H), lam, state, blocks, slider_end, passes,

@@ -21,7 +21,11 @@ step reduces to a small semismooth Newton iteration on the contact rows r = G u�
 with the Newmark velocity of the contact rows ṙ₊ = (2/h)(r₊ − r) − ṙ (so ∂ṙ₊/∂r₊ = 2/h),
 
 followed by u₊ = u_lin − B λ. The friction history (slider positions) is updated by the exact
-return map once r has converged. :func:`march_periods` runs periods until the period-end state
+return map once r has converged. A step in which a stiff contact opens or closes (ω_c h >
+SUBSTEP_RESOLUTION, ω_c its contact frequency) is redone in m sub-steps (:class:`_SubSteps`): the
+rule conserves energy only while the law is linear, and an impact under-resolved in the step
+gains energy (k_n = 10¹⁰ N/m, ω_c h ≈ 2: the orbit grows without bound or never settles).
+:func:`march_periods` runs periods until the period-end state
 (u, v/ω, sliders) repeats to a tolerance, optionally extrapolating the period-start states to the
 periodic orbit (reduced-rank extrapolation).
 
@@ -37,8 +41,14 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from sarfe.hbm import laws
+from sarfe.hbm.laws import curvature
 
 DENSE_LIMIT = 3000  # models up to this many DOFs use a dense propagator (reduced models)
+#: ω_c h_s, the contact frequency × sub-step a stiff contact switches in (see :class:`_SubSteps`):
+#: the trapezoidal rule's energy error of a closing or an opening is ≤ (ω_c h_s)²/4 of the impact's
+#: kinetic energy (measured: 0.05/0.1/0.2 change the k_n = 10¹⁰ lumped rattle's orbit ≤ 0.2 %)
+SUBSTEP_RESOLUTION = 0.1
+MAX_SUBSTEPS = 256
 
 
 def warped_frequency(frequency, omega, steps_per_period):
@@ -81,6 +91,9 @@ class ContactLaws:
             g = dict(law=law, idx=idx, p=p, gap=contacts.gap[idx], has_normal=nr >= 0,
                      normal_safe=np.maximum(nr, 0))
             g["normal_rows"] = nr[g["has_normal"]]
+            g["kappa"] = curvature.curvatures(p)   # a curved partner: w − ½ Σ κ q², :mod:`curvature`
+            if g["kappa"] is not None:
+                g["all_t"] = contacts.tangent_rows[idx]
             sel = np.flatnonzero(contacts.tangent_rows[idx, 0] >= 0) if law.tangent is not None \
                 else np.zeros(0, int)
             g["tangent"] = sel.size > 0        # the element acts on the contacts with tangent rows
@@ -121,6 +134,9 @@ class ContactLaws:
             has = g["has_normal"]
             w = np.where(has, r[g["normal_safe"]], g["gap"])
             wdot = np.where(has, rdot[g["normal_safe"]], 0.0) if rdot is not None else None
+            if g["kappa"] is not None:
+                q_all = np.where(g["all_t"] >= 0, r[np.maximum(g["all_t"], 0)], 0.0)
+                w = curvature.effective_normal(g["kappa"], w, q_all)
             out = g["law"].normal(g["p"], g["gap"], w, wdot)
             lam[g["normal_rows"]] = out.force[has]
             state[g["idx"]] = out.closed
@@ -134,6 +150,11 @@ class ContactLaws:
                 state[g["idx"][g["t_sel"]]] = fstate
                 slider[g["sliders"]] = new
                 keep.update(d_tq=d_tq, d_tn=d_tn)
+            if g["kappa"] is not None:
+                geometric = curvature.coupling(g["kappa"], q_all, out.force, keep["stiffness"])[0]
+                on = g["all_t"] >= 0
+                np.add.at(lam, g["all_t"][on], geometric[on])
+                keep.update(q=q_all, force=out.force)
             self._last.append(keep)
         return lam, slider, state
 
@@ -146,6 +167,17 @@ class ContactLaws:
             stiffness = keep["stiffness"]
             if keep["damping"] is not None:
                 stiffness = stiffness + rate_factor * keep["damping"]
+            if g["kappa"] is not None:           # the coupled (w, q₁, q₂) block of each contact
+                d_tq, d_tn = np.zeros((has.size, 2, 2)), np.zeros((has.size, 2))
+                if g["tangent"]:
+                    d_tq[g["t_sel"]], d_tn[g["t_sel"]] = keep["d_tq"], keep["d_tn"]
+                local = curvature.local_jacobian(g["kappa"], keep["q"], keep["force"], stiffness,
+                                                 d_tq, d_tn)
+                rows = np.column_stack([np.where(has, g["normal_safe"], -1), g["all_t"]])
+                valid = (rows[:, :, None] >= 0) & (rows[:, None, :] >= 0)
+                np.add.at(jac, (np.broadcast_to(rows[:, :, None], valid.shape)[valid],
+                                np.broadcast_to(rows[:, None, :], valid.shape)[valid]), local[valid])
+                continue
             jac[g["normal_rows"], g["normal_rows"]] = stiffness[has]
             if g["tangent"]:
                 jac[g["pair_rows"], g["pair_cols"]] += keep["d_tq"][g["pair"]]
@@ -166,6 +198,10 @@ def initial_sliders(law, r0, initial_force):
         q = np.where(g["t_mask"], r0[g["t_safe"]], 0.0)
         force = None if initial_force is None else np.where(g["t_mask"],
                                                             initial_force[g["t_safe"]], 0.0)
+        if force is not None and g["kappa"] is not None:   # less the normal force's −κ q λ_n
+            sel = g["t_sel"]
+            normal = np.where(g["has_normal"][sel], initial_force[g["normal_safe"][sel]], 0.0)
+            force = force + g["kappa"][sel] * q * normal[:, None]
         slider[g["sliders"]] = g["law"].tangent.initial_slider(g["p_t"], q, force)
     return slider
 
@@ -188,17 +224,100 @@ class _Propagator:
             lu = spla.splu((Ks + c2 * Ds + c0 * Ms).tocsc())
             solve = lu.solve
             self.M, self.D, self.lu, self.c = Ms, Ds, lu, (c0, c1, c2)
-        self.g = solve(forcing.T).T if forcing.shape[0] else forcing      # K_eff⁻¹ f_j, (N, n)
+        self.solve, self.h = solve, h
+        # K_eff⁻¹ f_j (N, n) at the period's samples; None for a sub-step propagator (f given)
+        self.g = None if forcing is None else solve(forcing.T).T if forcing.shape[0] else forcing
         rows_t = gap_map.T.toarray() if sp.issparse(gap_map) else gap_map.T
         self.B = solve(rows_t) if gap_map.shape[0] else np.zeros((n, 0))
         self.B = self.B.reshape(n, -1)
         self.C = np.asarray(gap_map @ self.B)                             # contact compliance
 
-    def linear(self, u, v, a, j):
+    def linear(self, u, v, a, j, force=None):
+        """u_lin at the end of the step to sample j (or with the load ``force`` (n,) [N])."""
+        load = self.g[j] if force is None else self.solve(force)
         if self.dense:
-            return self.P @ np.concatenate((u, v, a)) + self.g[j]
+            return self.P @ np.concatenate((u, v, a)) + load
         c0, c1, c2 = self.c
-        return self.lu.solve(self.M @ (c0 * u + c1 * v + a) + self.D @ (c2 * u + v)) + self.g[j]
+        return self.lu.solve(self.M @ (c0 * u + c1 * v + a) + self.D @ (c2 * u + v)) + load
+
+
+class _SubSteps:
+    r"""Steps in which a stiff contact opens or closes, redone in m equal sub-steps h_s = h/m (the
+    trapezoidal rule conserves energy only while the law is linear).
+
+    A contact that closes at a fraction α of a step ends it with penetration p ≈ (1 − α) ṙ h; the
+    rule's work Δr·λ̄ differs from the stored energy ½ k p² by α(1 − α)(ω_c h)² of the impact's
+    kinetic energy (ω_c² = k/m, m the contact's mass). The errors of closing and opening cancel
+    only for an isolated free impact (the rule is time-symmetric); with the springs, the load and
+    a second body in the impact they do not: k_n = 10¹⁰ N/m on the lumped rattle, N = 2048 at
+    71.5 Hz (ω_c h = 1.8), the contact's cyclic work was −36 % of the input and the orbit never
+    settled; a driven 1-DOF impact oscillator grew to 10³⁵ m at N = 256.
+
+    The contact's ρ = ‖C ∂λ/∂r‖∞ ≈ (ω_c h/2)² (C = G K_eff⁻¹ Gᵀ ≈ (h²/4) G M⁻¹ Gᵀ) measures ω_c h
+    for any law. A step in which a contact opens or closes (state 0 ↔ not 0; stick ↔ slip keeps
+    the step: friction dissipates) with 2√ρ > SUBSTEP_RESOLUTION (the larger ρ of its start and
+    end) is redone in m = 2^⌈log₂(2√ρ / SUBSTEP_RESOLUTION)⌉ ≤ MAX_SUBSTEPS sub-steps, the load
+    f_e(t) trigonometrically interpolated between the samples. Contacts the step resolves
+    (ω_c h ≤ SUBSTEP_RESOLUTION at their switches) give the results of the plain rule.
+    """
+
+    def __init__(self, model, h, gap_map, forcing):
+        self.model, self.h, self.G = model, h, gap_map
+        self.N = forcing.shape[0]
+        spectrum = np.fft.rfft(forcing, axis=0) / self.N            # f_j = Re Σ_k w_k c_k e^{ikθ_j}
+        size = np.abs(spectrum).max(axis=1)
+        self.k = np.flatnonzero(size > 1e-14 * max(size.max(initial=0.0), 1e-300))
+        weight = np.where((self.k == 0) | (2 * self.k == self.N), 1.0, 2.0)
+        self.c = weight[:, None] * spectrum[self.k]
+        self.forcing, self.props = forcing, {}
+
+    def load(self, position):
+        """f_e at sample position j + s (n,) [N] (exact for a load of fewer than N/2 harmonics)."""
+        phase = np.exp(2j * np.pi * self.k * position / self.N)
+        return (phase @ self.c).real
+
+    def count(self, law, C, state, state_new, r, rdot, slider):
+        """Number of sub-steps m of a step from contact state ``state`` to ``state_new`` (1: keep);
+        called after the step's contact solve (the laws' last evaluation is its end), with the
+        start's contact displacement r, velocity ṙ (None: rate-independent laws) and sliders."""
+        if np.array_equal(state == 0, state_new == 0):     # no contact opened or closed
+            return 1
+        rate = 2.0 / self.h
+        rho = np.abs(C @ law.jacobian(rate)).sum(axis=1).max(initial=0.0)
+        law.forces(r, rdot, slider)                          # the start (a contact that opens)
+        rho = max(rho, np.abs(C @ law.jacobian(rate)).sum(axis=1).max(initial=0.0))
+        ratio = 2.0 * np.sqrt(rho) / SUBSTEP_RESOLUTION
+        if ratio <= 1.0:
+            return 1
+        return int(min(2 ** np.ceil(np.log2(ratio)), MAX_SUBSTEPS))
+
+    def march(self, contact, law, j, m, u, v, a, lam, slider, r):
+        """The step j → j + 1 in m sub-steps from (u, v, a, λ, slider, r); returns the end state
+        (u, v, a, λ, slider, state, r), its work (input, damping, contact rows) and the most
+        contact Newton iterations of a sub-step."""
+        if m not in self.props:
+            self.props[m] = _Propagator(self.model, self.h / m, self.G, None)
+        prop, hs, G, D = self.props[m], self.h / m, self.G, self.model.damping
+        f_prev = self.forcing[j]
+        work_input = work_damping = 0.0
+        work_contact = np.zeros(r.size)
+        worst = 0
+        for i in range(1, m + 1):
+            f = self.forcing[(j + 1) % self.N] if i == m else self.load(j + i / m)
+            u_lin = prop.linear(u, v, a, None, f)
+            r_lin = G @ u_lin
+            lam_new, slider, state, r_new, iterations = contact(
+                r_lin, slider, r_lin - prop.C @ lam, r, G @ v if law.velocity else None, prop)
+            worst = max(worst, iterations)
+            u_new = u_lin - prop.B @ lam_new
+            du = u_new - u
+            work_input += du @ (0.5 * (f_prev + f))
+            work_damping += du @ (D @ du) / hs
+            work_contact += (r_new - r) * 0.5 * (lam + lam_new)
+            a = 4.0 / hs**2 * (du - hs * v) - a
+            v = 2.0 / hs * du - v
+            u, lam, r, f_prev = u_new, lam_new, r_new, f
+        return u, v, a, lam, slider, state, r, (work_input, work_damping, work_contact), worst
 
 
 def _extrapolation_weights(steps):
@@ -249,20 +368,22 @@ def march_periods(model, contacts, forcing, omega, N, u, v, slider, max_periods,
     identity = np.eye(n_rows)
     if law is not None:  # round-off floor of the contact Newton [m]
         length_floor = law.length_floor(contacts.gap)
-    rate = 2.0 / h       # Newmark: ṙ₊ = (2/h)(r₊ − r) − ṙ, ∂ṙ₊/∂r₊ = 2/h
+    # Newmark: ṙ₊ = (2/h)(r₊ − r) − ṙ, ∂ṙ₊/∂r₊ = 2/h
+    fine = _SubSteps(model, h, G, forcing) if law is not None else None
 
-    def contact(r_lin, slider_prev, r_guess, r_start, rdot_start):
-        """Solve r + C λ(r, ṙ(r)) = r_lin (semismooth Newton); returns λ, slider, state, r,
-        iterations."""
+    def contact(r_lin, slider_prev, r_guess, r_start, rdot_start, step_prop=prop):
+        """Solve r + C λ(r, ṙ(r)) = r_lin (semismooth Newton, C and ṙ of the step ``step_prop``);
+        returns λ, slider, state, r, iterations."""
         r = r_guess
+        rate = 2.0 / step_prop.h
         tolerance = 1e-12 * np.abs(r_lin).max() + length_floor
         for it in range(1, 60):
             rdot = rate * (r - r_start) - rdot_start if law.velocity else None
             lam, new_slider, state = law.forces(r, rdot, slider_prev)
-            residual = r + prop.C @ lam - r_lin
+            residual = r + step_prop.C @ lam - r_lin
             if np.abs(residual).max() <= tolerance:
                 break
-            step = np.linalg.solve(identity + prop.C @ law.jacobian(rate), residual)
+            step = np.linalg.solve(identity + step_prop.C @ law.jacobian(rate), residual)
             r = r - (0.5 * step if it > 30 else step)  # damp if cycling between active sets
         return lam, new_slider, state, r, it
 
@@ -294,11 +415,12 @@ def march_periods(model, contacts, forcing, omega, N, u, v, slider, max_periods,
     window = min(2 * n + slider.size, 12)
     history, jumped, failures, wait = [], None, 0, 0
     section_dofs = np.arange(n) if section_dofs is None else section_dofs
-    section = []
+    section, sub_work = [], {}
     while periods < max_periods:
         start = pack(u, v, slider)
         section.append(np.concatenate((u[section_dofs], v[section_dofs] / omega)))
         r_prev = G @ u
+        sub_work = {}     # step j → its work (input, damping, contact rows) summed over sub-steps
         for j in range(N):
             u_samples[j], v_samples[j] = u, v
             r_samples[j], lam_samples[j] = r_prev, lam
@@ -308,9 +430,17 @@ def march_periods(model, contacts, forcing, omega, N, u, v, slider, max_periods,
             if law is not None:
                 r_lin = G @ u_lin
                 guess = r_lin - prop.C @ lam  # predictor: last step's contact force
-                lam_new, slider, state, r_new, iterations = contact(
-                    r_lin, slider, guess, r_prev, G @ v if law.velocity else None)
+                rdot = G @ v if law.velocity else None
+                lam_new, slider_new, state_new, r_new, iterations = contact(
+                    r_lin, slider, guess, r_prev, rdot)
                 worst_iterations = max(worst_iterations, iterations)
+                m = fine.count(law, prop.C, state, state_new, r_prev, rdot, slider)
+                if m > 1:   # a stiff contact switched within the step: redo it in m sub-steps
+                    u, v, a, lam, slider, state, r_prev, sub_work[j], iterations = fine.march(
+                        contact, law, j, m, u, v, a, lam, slider, r_prev)
+                    worst_iterations = max(worst_iterations, iterations)
+                    continue
+                slider, state = slider_new, state_new
                 u_new = u_lin - prop.B @ lam_new
             else:
                 lam_new, r_new, u_new = lam, r_prev, u_lin
@@ -355,11 +485,16 @@ def march_periods(model, contacts, forcing, omega, N, u, v, slider, max_periods,
             history = []
     # work over the last period by the discrete identity of the trapezoidal rule (exact balance):
     # Δu·f̄, Δuᵀ D Δu / h, Δr·λ̄ per step
+    # (a sub-stepped step: the same sums over its sub-steps)
     du = np.diff(np.vstack((u_samples, u)), axis=0)
-    input_work = float(np.sum(du * 0.5 * (forcing + np.roll(forcing, -1, axis=0))))
-    damping_work = float(np.sum(du * (D @ du.T).T) / h)
-    contact_work = np.sum(np.diff(np.vstack((r_samples, r_prev)), axis=0)
-                          * 0.5 * (lam_samples + np.vstack((lam_samples[1:], lam))), axis=0)
+    input_step = np.sum(du * 0.5 * (forcing + np.roll(forcing, -1, axis=0)), axis=1)
+    damping_step = np.sum(du * (D @ du.T).T, axis=1) / h
+    contact_step = (np.diff(np.vstack((r_samples, r_prev)), axis=0)
+                    * 0.5 * (lam_samples + np.vstack((lam_samples[1:], lam))))
+    for j, (step_input, step_damping, step_contact) in sub_work.items():
+        input_step[j], damping_step[j], contact_step[j] = step_input, step_damping, step_contact
+    input_work, damping_work = float(input_step.sum()), float(damping_step.sum())
+    contact_work = contact_step.sum(axis=0)
     per_contact = np.zeros(n_c)
     if n_c:
         owner = np.full(n_rows, -1)
@@ -372,6 +507,6 @@ def march_periods(model, contacts, forcing, omega, N, u, v, slider, max_periods,
         u=u_samples, v=v_samples, r=r_samples, lam=lam_samples, state=state_samples,
         periods=periods, steady=steady, error=error, input_work=input_work,
         damping_work=damping_work, contact_work=per_contact, iterations=worst_iterations,
-        final=(u, v, slider),
+        substeps=len(sub_work), final=(u, v, slider),
         section=np.array(section + [np.concatenate((u[section_dofs], v[section_dofs] / omega))]),
     )

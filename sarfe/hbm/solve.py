@@ -114,10 +114,12 @@ def contact_row_springs(contacts) -> np.ndarray:
     return springs
 
 
-def linearized_rows(contacts):
+def linearized_rows(contacts, normal_force=None):
     """(spring, dashpot [N s/m], preload [N]) per row of G of the contacts linearized at u = 0:
     normal rows of contacts closed at u = 0 carry their law's spring, dashpot and preload (the
-    preload of a contact without a normal row has no row), tangent rows the stuck spring k_t."""
+    preload of a contact without a normal row has no row), tangent rows the stuck spring k_t
+    (less κ λ_n on a curved partner, :func:`sarfe.hbm.laws.tangent_springs`; λ_n the static
+    ``normal_force`` (n_c,) [N] when given, else λ_n(0))."""
     c = contacts
     normal, tangent = laws.linearization(c)
     springs, dashpots, preload = np.zeros(c.row_count), np.zeros(c.row_count), np.zeros(c.row_count)
@@ -126,17 +128,33 @@ def linearized_rows(contacts):
     springs[c.normal_row[closed]] = normal.spring[closed]
     dashpots[c.normal_row[closed]] = normal.dashpot[closed]
     preload[c.normal_row[has_n]] = normal.preload[has_n]
+    tangent_rows = laws.tangent_springs(c, normal, tangent, normal_force)
     for col in range(2):
         present = c.tangent_rows[:, col] >= 0
-        springs[c.tangent_rows[present, col]] = tangent[present]
+        springs[c.tangent_rows[present, col]] = tangent_rows[present, col]
     return springs, dashpots, preload
 
 
 def linearized_guess(problem, omega) -> np.ndarray:
     """ũ of the linear system with the contacts linearized at u = 0 (see module docstring):
-    (S(ω) + (I⊗G)ᵀ (I⊗k + ω∇⊗c) (I⊗G)) ũ = f̃_e − Gᵀ p in row 0."""
-    c, H, n = problem.contacts, problem.harmonics, problem.model.dof_count
+    (S(ω) + (I⊗G)ᵀ (I⊗k + ω∇⊗c) (I⊗G)) ũ = f̃_e − Gᵀ p in row 0. On a curved partner the
+    tangent springs include the geometric stiffness −κ λ_n at the static normal force λ_n
+    (a first pass gives the static state)."""
+    c = problem.contacts
     rows_k, rows_c, preload = linearized_rows(c)
+    if laws.curvatures(c) is None:
+        return _linearized_solve(problem, omega, rows_k, rows_c, preload)
+    U = _linearized_solve(problem, omega, rows_k, rows_c, preload)
+    normal, _ = laws.linearization(c)
+    w0 = np.asarray(c.gap_map @ U[0])[np.maximum(c.normal_row, 0)]
+    static = normal.preload + normal.spring * w0
+    rows_k = linearized_rows(c, static)[0]
+    return _linearized_solve(problem, omega, rows_k, rows_c, preload)
+
+
+def _linearized_solve(problem, omega, rows_k, rows_c, preload):
+    """:func:`linearized_guess` with the given row springs, dashpots and preloads."""
+    c, H, n = problem.contacts, problem.harmonics, problem.model.dof_count
     G = c.gap_map
     if not sp.issparse(problem.model.stiffness):
         return _linearized_guess_dense(problem, omega, rows_k, rows_c, preload)

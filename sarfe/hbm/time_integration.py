@@ -7,10 +7,11 @@ Equation (the same model as the harmonic balance, see :mod:`sarfe.hbm.contacts`)
 
 integrated by the Newmark average-acceleration scheme with a fixed step h = T/N and the contact
 laws evaluated pointwise in time (:mod:`sarfe.hbm.newmark`: the step, its contact Newton on the
-contact rows, the friction return map). :func:`integrate_time` runs periods until the period-end
-state (u, v/ω, sliders) repeats to ``steady_tolerance`` (relative to the response amplitude) and
-Fourier-analyses the last period with the convention of :mod:`sarfe.hbm.harmonics`;
-:func:`integrate_transient` is a free response from a given state.
+contact rows, the friction return map, sub-steps where a stiff contact opens or closes).
+:func:`integrate_time` runs periods until the period-end state (u, v/ω, sliders) repeats to
+``steady_tolerance`` (relative to the response amplitude) and Fourier-analyses the last period
+with the convention of :mod:`sarfe.hbm.harmonics`; :func:`integrate_transient` is a free response
+from a given state.
 
 For a linear system the scheme's periodic response is the exact one at the warped frequencies
 ω'_k = (2/h) tan(kωh/2) (bilinear transform), so its amplitude error is O((ωh)²). The run starts
@@ -63,6 +64,8 @@ class TimeResponse:
                                            spreads (see :func:`section_spread`)
     final_state                            (u, u̇, sliders) at the end: the warm start of the next
                                            frequency (``initial=`` this response)
+    substepped_steps int                   steps of the last period redone in sub-steps (a stiff
+                                           contact opened or closed in them)
     """
 
     omega: float
@@ -86,6 +89,7 @@ class TimeResponse:
     max_contact_iterations: int
     section: np.ndarray | None = None
     final_state: tuple | None = None
+    substepped_steps: int = 0
 
 
 def section_spread(section, tail=None, period=1):
@@ -149,7 +153,8 @@ def integrate_time(model, contacts, excitation, omega, harmonics, steps_per_peri
 
     model: :class:`LinearModel` (n_dof); contacts: :class:`ContactSet` or None; excitation: force
     harmonics F (2H_e+1, n_dof) [N] at ``omega`` [rad/s]; harmonics: H of the returned analysis.
-    steps_per_period: N, fixed step h = T/N (contacts need N ≳ 512 for 0.1 %).
+    steps_per_period: N, fixed step h = T/N (contacts need N ≳ 512 for 0.1 %); a step in which a
+    stiff contact opens or closes is redone in sub-steps (:mod:`sarfe.hbm.newmark`).
     max_periods: cap on integrated periods (``steady`` is False when it is hit).
     steady_tolerance: relative change of the period-end state (u, u̇/ω, sliders) that ends the run.
     initial: start state — None (the scheme's linear periodic solution, contacts ignored), harmonics
@@ -252,6 +257,7 @@ def integrate_time(model, contacts, excitation, omega, harmonics, steps_per_peri
         max_contact_iterations=int(run["iterations"]),
         section=run["section"],
         final_state=run["final"],
+        substepped_steps=int(run["substeps"]),
     )
 
 

@@ -55,22 +55,27 @@ def residual_modes(stiffness_ii, mass_ii, operator, loads, modes, relative_toler
                    static=None):
     """Residual modes Φ_r from interior loads (module docstring): ω_r² (ascending), Φ_r.
 
-    loads: (n_i, k) interior load columns F_i; operator(F) = K_ii⁻¹ F; modes: Φ (n_i, n_m),
+    loads: (n_i, k) interior load columns F_i (not read when ``static`` is given); operator(F) =
+    K_ii⁻¹ F; modes: Φ (n_i, n_m),
     Φᵀ M_ii Φ = I. Directions whose M-norm after deflation is below relative_tolerance × their norm
     before (already in span Φ, or dependent) are dropped. ``static``: K_ii⁻¹ F_i when already
     computed (then ``operator`` is not called).
     """
     n = mass_ii.shape[0]
-    if loads.shape[1] == 0:
-        return np.empty(0), np.empty((n, 0))
+    if isinstance(static, list):
+        static = static.pop()
     if static is None:
+        if loads.shape[1] == 0:
+            return np.empty(0), np.empty((n, 0))
         static = operator(np.asarray(loads, dtype=float))
+    if static.shape[1] == 0:
+        return np.empty(0), np.empty((n, 0))
     mass_static = mass_ii @ static
     norms = np.sqrt(np.einsum("ij,ij->j", static, mass_static))
     static = static[:, norms > 0] / norms[norms > 0]  # unit M-norm before deflation
     mass_static = mass_static[:, norms > 0] / norms[norms > 0]
     for _ in range(2):  # deflate Φ twice (classical Gram–Schmidt, re-orthogonalized)
-        static = static - modes @ (modes.T @ mass_static)
+        static -= modes @ (modes.T @ mass_static)
         mass_static = mass_ii @ static        # (one sparse product per pass; reused below)
     gram = static.T @ mass_static
     values, vectors = np.linalg.eigh(0.5 * (gram + gram.T))
@@ -78,8 +83,15 @@ def residual_modes(stiffness_ii, mass_ii, operator, loads, modes, relative_toler
     if not keep.any():
         return np.empty(0), np.empty((n, 0))
     transform = vectors[:, keep] / np.sqrt(values[keep])
-    basis, mass_basis = m_orthonormal(static @ transform, mass_ii, mass_static @ transform)
-    basis = basis - modes @ (modes.T @ mass_basis)  # the clean-up against Φ
+    # (each n_i × k array dropped as soon as its successor exists: no three alive at once)
+    block = static @ transform
+    del static
+    mass_block = mass_static @ transform
+    del mass_static
+    basis, mass_basis = m_orthonormal(block, mass_ii, mass_block)
+    del block, mass_block
+    basis -= modes @ (modes.T @ mass_basis)  # the clean-up against Φ
+    del mass_basis
     basis, _ = m_orthonormal(basis, mass_ii)
     if basis.shape[1] == 0:
         return np.empty(0), np.empty((n, 0))
@@ -219,6 +231,7 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
     n_fixed = len(omega2)
     basis = np.empty((len(interior), n_b + n_fixed + (0 if loads is None else loads.shape[1])))
     basis[:, :n_b] = psi
+    psi = basis[:, :n_b]                 # the copy in T serves from here (one n_i × n_b array less)
     column = n_b
     while blocks:
         block = blocks.pop(0)
@@ -227,7 +240,11 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
         del block
     phi = basis[:, n_b:n_b + n_fixed]
     if loads is not None:
-        omega2_r, phi_r = residual_modes(k_ii, m_ii, None, loads, phi, static=static)
+        # the loads (F_b among them) go before the residual modes' peak: residual_modes frees the
+        # statics once used, and F_b = M_ib + M_ii Ψ is formed again below, the same operations
+        held_static, static = [static], None
+        loads = boundary_load = None
+        omega2_r, phi_r = residual_modes(k_ii, m_ii, None, None, phi, static=held_static)
     else:
         omega2_r, phi_r = np.empty(0), np.empty((len(interior), 0))
     basis[:, n_b + n_fixed:n_b + n_fixed + phi_r.shape[1]] = phi_r
@@ -243,6 +260,9 @@ def craig_bampton(stiffness, mass, boundary_dofs, mode_count=None, cutoff_hz=Non
     m_ib = m_ib.toarray()
     m_rbb = m_bb + m_ib.T @ psi + psi.T @ m_ib + psi_m_psi
     del m_ib
+    if boundary_load is None:
+        boundary_load = m_ii @ psi
+        np.add.at(boundary_load, (coo.row, coo.col), coo.data)
     m_rbm = boundary_load.T @ phi
     n_b, n_m = len(boundary), len(omega2)
     stiffness_r = np.zeros((n_b + n_m, n_b + n_m))

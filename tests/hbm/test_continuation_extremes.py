@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 from sarfe.case.read import load_case
-from sarfe.hbm.time_integration import integrate_time
+from sarfe.hbm.time_integration import integrate_time, section_spread
 from sarfe.pipeline import solve_case
 from sarfe.pipeline.model.linear_stage import build_linear_model
 from sarfe.pipeline.model.nonlinear_model import nonlinear_model
@@ -163,25 +163,40 @@ def _swept(name):
 
 
 @pytest.mark.slow
-@pytest.mark.timeout(1800)
+@pytest.mark.timeout(900)
 def test_hard_contact_branch_matches_time_integration():
     """k_n = 10¹⁰ N/m, the continued branch at three frequencies on its upper (impacting) part and
     past the jump: each point's first harmonic on all DOFs agrees with an independent Newmark
-    integration (2048 steps per period, Richardson) started from it and run to a periodic state
-    within 2 % (H = 7 truncation of a hard impact: the integrator resolves all harmonics)."""
+    integration (2048 steps per period, Richardson) started from it within 2 %.
+
+    The impacts last 12 µs (1/1200 of a period): the integration sub-steps the steps in which the
+    contact opens or closes (:data:`sarfe.hbm.newmark.SUBSTEP_RESOLUTION`), checked by the energy
+    balance — the elastic contact does no net work over a period (< 1 % of the input; the plain
+    trapezoidal rule: −36 % at 71.5 Hz, an orbit that never settles: the cause of this test's
+    former > 25 min). The impacting orbit keeps a residual jitter of ~0.2 % from period to
+    period (vibro-impact), so 40 periods per run and the spread of the last 10 period-start
+    states (< 0.5 %) stand for ``steady``. Measured (2026-11-28, benchmarks/results/extremes.md):
+    71.5 Hz 17 %, 75.6 Hz 39 %, 90 Hz 0.02 %; N = 2048 vs 4096 agree to 0.08 % and the
+    sub-step resolution 0.05/0.1/0.2 to 0.2 %: the H = 7 branch (its impact a 54 µs, 0.7 kN
+    pulse against the integration's 12 µs, 3 kN) misses the 2 % on the impacting part."""
     points, model, f = _swept("k_n = 1e10 N/m")
     amplitude = np.array([np.hypot(*p.displacement[1:3, 0]) for p in points])
     impacting = np.flatnonzero(amplitude > 1e-4)           # closes the 0.1 mm gap
     chosen = [impacting[len(impacting) // 4], impacting[len(impacting) // 2], len(points) - 1]
+    errors = {}
     for k in chosen:
         point = points[k]
         H = point.displacement.shape[0] // 2
         reference = integrate_time(model.model, model.contacts, model.excitation, point.omega, H,
-                                   steps_per_period=2048, richardson=True, initial=point)
+                                   steps_per_period=2048, richardson=True, initial=point,
+                                   max_periods=40)
+        assert reference.steady or section_spread(reference.section, tail=10) < 5e-3, f[k]
+        rattle = reference.contact_work[0]                   # panel_bracket: elastic, ∮ λ dr = 0
+        assert abs(rattle) < 1e-2 * reference.input_work, (f[k], rattle, reference.input_work)
         a = point.displacement[1] - 1j * point.displacement[2]
         b = reference.displacement_harmonics[1] - 1j * reference.displacement_harmonics[2]
-        error = np.abs(a - b).max() / np.abs(b).max()
-        assert error < 2e-2, (f[k], error)
+        errors[round(float(f[k]), 2)] = float(np.abs(a - b).max() / np.abs(b).max())
+    assert max(errors.values()) < 2e-2, errors
 
 
 @pytest.mark.slow

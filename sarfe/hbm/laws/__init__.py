@@ -2,7 +2,9 @@ r"""Contact laws: one module per law, each a :class:`~.contract.ContactLaw` regi
 line (the contract is in :mod:`sarfe.hbm.laws.contract`; docs/hbm.md explains how to add a law).
 
 Everything outside a law's module reaches it through :func:`law` and the helpers below; nothing
-else tests a law's name.
+else tests a law's name. Shared parts: :mod:`.jenkins` (+ :mod:`.jenkins_march`, its compiled
+kernels) the friction element, :mod:`.curvature` a curved contact partner (the penetration and
+normal force follow the slide; the squeak law's ``partner_radius_m``).
 """
 from __future__ import annotations
 
@@ -83,6 +85,30 @@ def linearization(contacts):
     return Linearization(spring, dashpot, preload, closed), tangent
 
 
+def curvatures(contacts):
+    """κ (n_c, 2) [1/m] of every contact (:mod:`.curvature`), or None when all are flat."""
+    kappa = np.stack([np.asarray(contacts.partner_curvature_1, dtype=float),
+                      np.asarray(contacts.partner_curvature_2, dtype=float)], axis=-1)
+    return kappa if np.any(kappa != 0.0) else None
+
+
+def tangent_springs(contacts, normal=None, tangent=None, normal_force=None):
+    """Per contact and tangent direction (n_c, 2) [N/m]: the stuck spring of its tangent rows,
+    k_t less κ_i λ_n on a curved partner (:mod:`.curvature`: the normal force's tangential
+    component −κ q λ_n, the geometric stiffness of a loaded contact); λ_n = ``normal_force``
+    (n_c,) [N] (the static one), default λ_n(0) of the contacts closed at u = 0.
+    ``normal``, ``tangent``: :func:`linearization` of ``contacts`` when already computed."""
+    if normal is None:
+        normal, tangent = linearization(contacts)
+    springs = np.repeat(np.asarray(tangent, dtype=float)[:, None], 2, axis=1)
+    kappa = curvatures(contacts)
+    if kappa is not None:
+        closed = normal.closed & (contacts.normal_row >= 0)
+        loaded = np.where(closed, normal.preload if normal_force is None else normal_force, 0.0)
+        springs = springs - kappa * np.maximum(loaded, 0.0)[:, None]
+    return springs
+
+
 def velocity_dependent(contacts) -> bool:
     return any(law(k).velocity_dependent for k in dict.fromkeys(np.asarray(contacts.kind)))
 
@@ -119,4 +145,5 @@ def uses_tangent(contact_law, given_keys) -> bool:
 
 __all__ = ["ContactLaw", "LawInputError", "Parameter", "NormalForce", "Linearization", "LAWS",
            "REGISTERED", "register", "law", "names", "all_parameters", "groups", "linearization",
-           "velocity_dependent", "pruning_rules", "table_column", "uses_tangent"]
+           "curvatures", "tangent_springs", "velocity_dependent", "pruning_rules", "table_column",
+           "uses_tangent"]

@@ -183,13 +183,15 @@ def _basis(H: int, N: int):
 
 
 def periodic_forces(p, q, one_d, normal_force, normal_stiffness, slider_start, H, N, jacobian,
-                    tolerance, pass_cap, kept_rows):
+                    tolerance, pass_cap, kept_rows, normal_slope_q=None):
     r"""Periodic tangential forces of n Jenkins elements over one period, and their AFT Jacobian.
 
     p: parameters (tangential_stiffness k_t, friction_coefficient μ; (n,) each); q (N, n, 2) [m]
     tangential displacements, one_d (n,) bool: only the first direction exists; normal_force λ_n (N, n) [N], normal_stiffness ∂λ_n/∂w (N, n) [N/m]; slider_start (n, 2);
     kept_rows: coefficient rows of the Jacobian (P of them). slider_start is not used: the periodic
     state is fixed by the gauge (module docstring), so it is a function of q and λ_n alone.
+    normal_slope_q (N, n, 2) [N/m] or None: ∂λ_n/∂q where the normal force also depends on the
+    slide (a curved partner, :mod:`.curvature`): the slip radius then moves with q as well.
     Returns (λ_t (N, n, 2), state (N, n) int8, slider_end (n, 2), passes, J (n, 3P, 3P) or None)
     with J in the local layout (h·3 + l), l = 0 normal, 1, 2 tangents; its tangential rows only.
     """
@@ -212,12 +214,16 @@ def periodic_forces(p, q, one_d, normal_force, normal_stiffness, slider_start, H
         slider_end[c1, 0] = res["slider_end"]
         passes = max(passes, res["passes"])
         if jacobian:
-            J[c1] = _jacobian_1d(res, mu[c1] * normal_stiffness[:, c1], k_t[c1], H, N, kept_rows)
+            slope_q = None if normal_slope_q is None else mu[c1] * normal_slope_q[:, c1, 0]
+            J[c1] = _jacobian_1d(res, mu[c1] * normal_stiffness[:, c1], k_t[c1], H, N, kept_rows,
+                                 slope_q)
     c2 = np.flatnonzero(~one_d)
     if c2.size:
+        drho_dq = np.zeros((N, c2.size, 2)) if normal_slope_q is None \
+            else (mu[c2] / k_t[c2])[:, None] * normal_slope_q[:, c2]
         force_t, st, w_end, n_pass, J2 = _march_2d(
             q_all[:, c2], rho[:, c2], mu[c2] * normal_stiffness[:, c2] / k_t[c2], k_t[c2],
-            np.zeros((c2.size, 2)), H, N, jacobian, tolerance, pass_cap, kept_rows)
+            np.zeros((c2.size, 2)), H, N, jacobian, tolerance, pass_cap, kept_rows, drho_dq)
         force[:, c2] = force_t
         state[:, c2] = st
         slider_end[c2] = w_end
@@ -227,7 +233,7 @@ def periodic_forces(p, q, one_d, normal_force, normal_stiffness, slider_start, H
     return force, state, slider_end, passes, J
 
 
-def _jacobian_1d(res, mu_dlam, k_t, H, N, kept_rows):
+def _jacobian_1d(res, mu_dlam, k_t, H, N, kept_rows, mu_dlam_q=None):
     """∂λ̃_t/∂(w̃, q̃) of 1-D Jenkins elements in the local (h·3 + l) layout (l = 0 n, 1 t),
     h over the kept coefficient rows.
 
@@ -235,7 +241,8 @@ def _jacobian_1d(res, mu_dlam, k_t, H, N, kept_rows):
     λ_t,i = k_t (q_i − q_j) + s_j μ λ_n,j and ∂λ_t,i/∂X = k_t (Φ_i − Φ_j) + s_j μ ∂λ_n,j/∂w Φ_j
     (s_j = ±1 the slip direction), pushed through one FFT of the gathered rows Φ_{j(i)}; a contact
     sticking the whole period keeps the gauge slider w0 = 0 (module docstring): λ_t = k_t q,
-    ∂w0/∂X = 0."""
+    ∂w0/∂X = 0. ``mu_dlam_q`` (N, n): μ ∂λ_n/∂q where λ_n also depends on the slide (a curved
+    partner): the term s_j μ ∂λ_n,j/∂q Φ_j then joins the tangential columns."""
     P = kept_rows.size
     n = k_t.size
     Phi = _basis(H, N)[:, kept_rows]
@@ -248,10 +255,16 @@ def _jacobian_1d(res, mu_dlam, k_t, H, N, kept_rows):
     eye = np.eye(P)
     J[:, 1::3, 1::3] = k_t[:, None, None] * (eye - np.where(has[:, None, None], memory, 0.0))
     J[:, 1::3, 0::3] = np.where(has[:, None, None], normal, 0.0)
+    if mu_dlam_q is not None:
+        weight_q = np.take_along_axis(res["sign"] * mu_dlam_q, j, axis=0)
+        slide = np.moveaxis(hm.harmonic_coefficients(weight_q[..., None] * gathered, H)[kept_rows],
+                            0, 1)
+        J[:, 1::3, 1::3] += np.where(has[:, None, None], slide, 0.0)
     return J
 
 
-def _march_2d(q, rho, drho_dw, k_t, start, H, N, jacobian, tolerance, pass_cap, kept_rows):
+def _march_2d(q, rho, drho_dw, k_t, start, H, N, jacobian, tolerance, pass_cap, kept_rows,
+              drho_dq):
     r"""2-D Jenkins elements over one period (compiled kernels over contacts × samples,
     :mod:`.jenkins_march`).
 
@@ -278,6 +291,8 @@ def _march_2d(q, rho, drho_dw, k_t, start, H, N, jacobian, tolerance, pass_cap, 
         dw_j = (I − P_j) dq_j + n_j dρ_j + P_j dw_{j−1},
     and the periodicity w_N = w_0 gives ∂w_0/∂X = (I − A)⁻¹ B (A = ∂w_N/∂w_0, B = ∂w_N/∂X at
     fixed w_0).
+    drho_dq (N, n, 2): ∂ρ/∂q (0 unless a curved partner makes λ_n depend on the slide; then
+    dρ_j = ∂ρ/∂w_n dw_n,j + ∂ρ/∂q · dq_j in the formulas above).
     Returns (λ_t (N, n, 2), state (N, n), w_start (n, 2), passes, J (n, 3P, 3P) or None).
     """
     from sarfe.hbm.laws import jenkins_march as march    # numba is imported (and the kernels loaded) on first use
@@ -301,6 +316,7 @@ def _march_2d(q, rho, drho_dw, k_t, start, H, N, jacobian, tolerance, pass_cap, 
         w0, passes = march.periodic_start(qs, rs, np.array(start, dtype=float)[slipping],
                                           tolerance * scale, pass_cap)
         f, st, df, history, dw = march.final_pass(qs, rs, np.ascontiguousarray(drho_dw[:, slipping]),
+                                                  np.ascontiguousarray(drho_dq[:, slipping]),
                                                   k_t[slipping], w0, Phi, jacobian)
         passes += 1
         force[:, slipping], state[:, slipping], w_start[slipping] = f, st, w0
@@ -319,7 +335,7 @@ def _march_2d(q, rho, drho_dw, k_t, start, H, N, jacobian, tolerance, pass_cap, 
         dq[:, :, 0, 1::3] = Phi[:, None, :]
         dq[:, :, 1, 2::3] = Phi[:, None, :]
         dw0 = _stuck_slider_derivative(q[:, held], rho[:, held], drho_dw[:, held], Phi,
-                                       w_start[held], active[held])
+                                       w_start[held], active[held], drho_dq[:, held])
         dforce[:, held] = k_t[None, held, None, None] * (dq - dw0[None])
     coeff = hm.harmonic_coefficients(dforce, H)[kept_rows]  # (P, n, 2, 3P)
     J = np.zeros((n, 3 * P, 3 * P))
@@ -332,9 +348,10 @@ STUCK_TOLERANCE = 1e-10      # a stuck slider may lie outside a disk by this × 
 STUCK_ITERATIONS = 64        # cutting-plane steps of the stuck test (more: treated as slipping)
 
 
-def _stuck_slider_derivative(q, rho, drho_dw, Phi, w, active):
+def _stuck_slider_derivative(q, rho, drho_dw, Phi, w, active, drho_dq):
     r"""∂w₀/∂X (m, 2, 3P) of stuck sliders w₀ (m, 2) with active disks ``active`` (m, 2) (sample
-    indices, −1 none): the formulas of :func:`_march_2d`. q (N, m, 2), ρ, ∂ρ/∂w_n (N, m)."""
+    indices, −1 none): the formulas of :func:`_march_2d`. q (N, m, 2), ρ, ∂ρ/∂w_n (N, m),
+    ∂ρ/∂q (N, m, 2)."""
     m, C = w.shape[0], 3 * Phi.shape[1]
     contacts = np.arange(m)
 
@@ -344,6 +361,8 @@ def _stuck_slider_derivative(q, rho, drho_dw, Phi, w, active):
         dq[:, 1, 2::3] = Phi[j]
         drho = np.zeros((m, C))
         drho[:, 0::3] = drho_dw[j, contacts][:, None] * Phi[j]
+        drho[:, 1::3] = drho_dq[j, contacts, 0][:, None] * Phi[j]
+        drho[:, 2::3] = drho_dq[j, contacts, 1][:, None] * Phi[j]
         return dq, drho
 
     j, k = np.maximum(active[:, 0], 0), np.maximum(active[:, 1], 0)

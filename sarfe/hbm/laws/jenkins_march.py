@@ -93,11 +93,13 @@ def periodic_start(q, rho, start, tolerance, pass_cap):
 
 
 @njit(cache=True)
-def final_pass(q, rho, drho_dw, k_t, start, Phi, jacobian):
+def final_pass(q, rho, drho_dw, drho_dq, k_t, start, Phi, jacobian):
     r"""One period from the periodic start (n, 2): forces, states and the consistent tangent.
 
     λ_t,j = k_t (q_j − w_j); with X the local harmonics (C = 3P columns, Φ (N, P) the kept basis)
-        dw_j = P_j (dw_{j−1} − dq_j) + dq_j + n_j (∂ρ_j/∂w) dw_n,j     (∂ρ/∂w = drho_dw (N, n))
+        dw_j = P_j (dw_{j−1} − dq_j) + dq_j + n_j dρ_j,   dρ_j = (∂ρ/∂w) dw_n,j + (∂ρ/∂q) · dq_j
+    (∂ρ/∂w = drho_dw (N, n); ∂ρ/∂q = drho_dq (N, n, 2), 0 unless a curved partner makes the normal
+    force depend on the slide)
     at fixed w_0, and the history ∂w_j/∂w_0 = P_j ⋯ P_1.
     Returns (λ_t (N, n, 2) [N], state (N, n) int8 (0 separated, 1 stick, 2 slip),
     ∂λ_t,j/∂X at fixed w_0 (N, n, 2, C) [N/m], history (N, n, 2, 2), ∂w_N/∂X (n, 2, C)) — the
@@ -127,6 +129,7 @@ def final_pass(q, rho, drho_dw, k_t, start, Phi, jacobian):
                 continue
             p00, p01, p10, p11, s0, s1 = return_map_derivative(ratio, slipping, u0, u1, separated)
             weight = drho_dw[j, c]
+            slope0, slope1 = drho_dq[j, c, 0], drho_dq[j, c, 1]
             for h in range(P):
                 phi = Phi[j, h]
                 for l in range(3):
@@ -135,8 +138,9 @@ def final_pass(q, rho, drho_dw, k_t, start, Phi, jacobian):
                     dq1 = phi if l == 2 else 0.0
                     dn = phi if l == 0 else 0.0
                     e0, e1 = dw[0, col] - dq0, dw[1, col] - dq1
-                    v0 = p00 * e0 + p01 * e1 + dq0 + s0 * (weight * dn)
-                    v1 = p10 * e0 + p11 * e1 + dq1 + s1 * (weight * dn)
+                    drho = weight * dn + slope0 * dq0 + slope1 * dq1
+                    v0 = p00 * e0 + p01 * e1 + dq0 + s0 * drho
+                    v1 = p10 * e0 + p11 * e1 + dq1 + s1 * drho
                     dw[0, col], dw[1, col] = v0, v1
                     dforce[j, c, 0, col] = k_t[c] * (dq0 - v0)
                     dforce[j, c, 1, col] = k_t[c] * (dq1 - v1)

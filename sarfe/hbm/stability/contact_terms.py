@@ -29,17 +29,22 @@ import scipy.sparse as sp
 
 from sarfe.hbm import harmonics as hm
 from sarfe.hbm import laws
-from sarfe.hbm.aft import jacobian_matrix, pointwise_jacobian
+from sarfe.hbm.aft import curvature_blocks, jacobian_matrix, pointwise_jacobian, tangential_samples
+from sarfe.hbm.laws import curvature
 from sarfe.hbm.laws.jenkins import jenkins_periodic_1d, last_reset_index, slider_update_derivatives
 
 
 def _normal_part(law, p, contacts, idx, R, omega, N):
-    """λ_n (N, n_g), ∂λ_n/∂w (N, n_g) [N/m], ∂λ_n/∂ẇ or None, rows (n_g,) (−1: no normal row)."""
+    """λ_n (N, n_g), ∂λ_n/∂w (N, n_g) [N/m], ∂λ_n/∂ẇ or None, rows (n_g,) (−1: no normal row);
+    at the penetration w − g − ½ Σ κ q² of a curved partner (:mod:`sarfe.hbm.laws.curvature`)."""
     rows = contacts.normal_row[idx]
     has = rows >= 0
     gap = contacts.gap[idx]
     r = hm.time_samples(R, N)
     w = np.where(has, r[:, np.maximum(rows, 0)], gap)
+    kappa = curvature.curvatures(p)
+    if kappa is not None:
+        w = curvature.effective_normal(kappa, w, tangential_samples(contacts, idx, r))
     wdot = None
     if law.velocity_dependent:
         slope = hm.derivative_matrix((R.shape[0] - 1) // 2) @ R
@@ -103,9 +108,10 @@ def _memory_blocks(s, omega, P_march, n_rho_march, drho, k_t, H, N, chunk=2, set
     return out
 
 
-def _memory_setup(omega, P_march, n_rho_march, drho, H, N):
+def _memory_setup(omega, P_march, n_rho_march, drho, H, N, drho_q=None):
     """The s-independent arrays of :func:`_memory_blocks` (once per solution): step P_j
-    (N, n, 2, 2), source b_j = (I − P_j) δq_j + n_j dρ_j δn_j (N, n, 2, 3P), products Π_j
+    (N, n, 2, 2), source b_j = (I − P_j) δq_j + n_j dρ_j (N, n, 2, 3P) with
+    dρ_j = ∂ρ/∂w δn_j (+ ∂ρ/∂q δq_j, ``drho_q`` (N, n, 2), for a curved partner), products Π_j
     (N, n, 2, 2), the DFT matrix E (2H+1, N), E δq (2H+1, 2, 3P), sample spacing h [s], and
     ``stuck`` (n,): contacts stuck at every sample (P_j = I, b_j = 0: no march needed)."""
     from sarfe.hbm.stability.march import step_products   # numba (0.4 s to import): 2-D sliders only
@@ -119,6 +125,9 @@ def _memory_setup(omega, P_march, n_rho_march, drho, H, N):
     step = np.ascontiguousarray(P_march, dtype=float)
     source = (dq[:, None] - np.einsum("jcab,jbx->jcax", step, dq)
               + n_rho_march[..., None] * (drho[:, :, None, None] * dn[:, None, None, :]))
+    if drho_q is not None:
+        slide = np.einsum("jca,jax->jcx", drho_q, dq)                        # ∂ρ/∂q δq_j
+        source = source + n_rho_march[..., None] * slide[:, :, None, :]
     stuck = np.all(step == np.eye(2), axis=(0, 2, 3)) & np.all(source == 0.0, axis=(0, 2, 3))
     return dict(step=step, source=source, products=step_products(step), E=E,
                 Edq=np.einsum("hj,jcx->hcx", E, dq), h=2.0 * np.pi / (omega * N), stuck=stuck)
@@ -156,8 +165,9 @@ def _memory_block_1d(s, omega, P, n_rho, drho, k_t, H, N):
     return _memory_blocks_1d(np.array([s], dtype=complex), omega, P, n_rho, drho, k_t, H, N)[0]
 
 
-def _memory_blocks_1d(s, omega, P, n_rho, drho, k_t, H, N):
-    """:func:`_memory_block_1d` at several exponents s (n_s,): (n_s, P, n, 2, 3P) complex."""
+def _memory_blocks_1d(s, omega, P, n_rho, drho, k_t, H, N, drho_q=None):
+    """:func:`_memory_block_1d` at several exponents s (n_s,): (n_s, P, n, 2, 3P) complex;
+    ``drho_q`` (N, n, 2): ∂ρ/∂q of a curved partner (b_j gains n_j ∂ρ/∂q p̂_j)."""
     s = np.atleast_1d(np.asarray(s, dtype=complex))
     P_count = 2 * H + 1
     Phi = hm.fourier_matrices(H, N)[1]
@@ -175,6 +185,10 @@ def _memory_blocks_1d(s, omega, P, n_rho, drho, k_t, H, N):
                                                            - weight[..., None] * gathered[:, None])
     dforce[:, :, :, 0, 0::3] = -k_t[None, None, :, None] * (weight * slope[:, None])[..., None] \
         * gathered[:, None]
+    if drho_q is not None:
+        slide = np.take_along_axis(n_rho[:, :, 0] * drho_q[:, :, 0], j, axis=0)
+        dforce[:, :, :, 0, 1::3] -= k_t[None, None, :, None] \
+            * (weight * slide[:, None])[..., None] * gathered[:, None]
     coeff = hm.harmonic_coefficients(dforce.real, H) + 1j * hm.harmonic_coefficients(dforce.imag, H)
     return np.moveaxis(coeff, 1, 0)
 
@@ -223,11 +237,16 @@ class ContactOperator:
             start = np.nan_to_num(forces.slider_end[t_idx])
             normal = np.zeros((sel.size, 3 * (2 * H + 1), 3 * (2 * H + 1)))
             normal[:, 0::3, 0::3] = block[sel]
+            kappa = curvature.curvatures({k: v[sel] for k, v in p.items()})
+            drho_q = None
+            if kappa is not None:     # curved partner: pointwise couplings, ρ moves with q too
+                normal += curvature_blocks(kappa, q, force_n, stiff_n, H)
+                drho_q = (mu / k_t)[:, None] * curvature.coupling(kappa, q, force_n, stiff_n)[1]
             one_d = bool(np.all(t_rows[:, 1] < 0))
             march = _slider_march(q, mu * force_n / k_t, start, one_d)
             self.memory.append(dict(rows=np.column_stack([rows[sel], t_rows]), normal=normal,
                                     march=march, drho=mu * stiff_n / k_t, k_t=k_t, N=N,
-                                    one_d=one_d))
+                                    one_d=one_d, drho_q=drho_q))
         self.has_memory = bool(self.memory)
         base = jacobian_matrix(forces.blocks, self.n_rows, H)
         self._fixed = jacobian_matrix(self.static, self.n_rows, H) - base
@@ -252,10 +271,11 @@ class ContactOperator:
         for g in self.memory:
             args = (s, self.omega, *g["march"], g["drho"], g["k_t"], self.H, g["N"])
             if g["one_d"]:
-                out.append((g["rows"], _memory_blocks_1d(*args)))
+                out.append((g["rows"], _memory_blocks_1d(*args, drho_q=g["drho_q"])))
                 continue
             if "setup" not in g:         # the s-independent part, once per solution
-                g["setup"] = _memory_setup(self.omega, *g["march"], g["drho"], self.H, g["N"])
+                g["setup"] = _memory_setup(self.omega, *g["march"], g["drho"], self.H, g["N"],
+                                           g["drho_q"])
             out.append((g["rows"], _memory_blocks(*args, setup=g["setup"])))
         return out
 
@@ -267,6 +287,9 @@ class ContactOperator:
             J = np.broadcast_to(g["normal"], (s.size,) + g["normal"].shape).astype(complex)
             J[:, :, 1::3, :] = np.moveaxis(coeff[:, :, :, 0, :], 1, 2)
             J[:, :, 2::3, :] = np.moveaxis(coeff[:, :, :, 1, :], 1, 2)
+            if g["drho_q"] is not None:          # the normal force's tangential components
+                J[:, :, 1::3, :] += g["normal"][:, 1::3, :]
+                J[:, :, 2::3, :] += g["normal"][:, 2::3, :]
             out.append((rows, J))
         return out
 

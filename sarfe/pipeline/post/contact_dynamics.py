@@ -16,7 +16,9 @@ displacements r(θ_j) = G u and forces λ(θ_j) of the contact rows:
                                for a force non-decreasing in ẇ; 0 for a rate-independent law),
                          D_t = Σ_{j : s_j = slip} λ_t,j · (p_j − p_{j−1})   (Coulomb slip work of
                                the Jenkins slider; the return map moves p along λ_t, so each
-                               term is ≥ 0 exactly).
+                               term is ≥ 0 exactly; on a curved partner λ_t is the tangent
+                               rows' force less the normal force's components −κ q λ_n,
+                               :mod:`sarfe.hbm.laws.curvature`).
                          The elastic parts (penalty spring λ_n(w, 0) and the tangential spring
                          k_t (q − p)) are conservative: their work over a closed period is
                          exactly 0 and is not summed. (Before: Σ_rows ∮ λ ṙ dt by Parseval of
@@ -31,6 +33,7 @@ import numpy as np
 
 from sarfe.hbm import laws
 from sarfe.hbm.harmonics import derivative_matrix, time_samples
+from sarfe.hbm.laws.curvature import friction_rows
 
 
 def normal_dissipation(nl, r, rate, omega) -> np.ndarray:
@@ -68,6 +71,7 @@ def contact_dynamics(solution, nl) -> list[dict]:
     H = (R.shape[0] - 1) // 2
     rate = omega * time_samples(derivative_matrix(H) @ R, N) if R.shape[1] else r
     normal_loss = normal_dissipation(nl, r, rate, omega) if R.shape[1] else np.zeros(cs.count)
+    friction = friction_rows(cs, r, force) if R.shape[1] else force   # curved: less −κ q λ_n
     if state.shape[0] != N:  # states sampled differently from the forces: resample by phase
         state = state[(np.arange(N) * state.shape[0]) // N]
     closing = (state != 0) & (np.roll(state, 1, axis=0) == 0)                  # (N, n_c)
@@ -87,6 +91,7 @@ def contact_dynamics(solution, nl) -> list[dict]:
         slip, slip_work = float("nan"), 0.0
         if valid.any():
             q = r[:, t] * valid
+            lam_t = friction[:, t] * valid
             stiffness = k_t[idx][None, :, None]
             slider = q - np.divide(lam_t, stiffness, out=np.zeros_like(lam_t),
                                    where=stiffness > 0)

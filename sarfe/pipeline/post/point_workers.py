@@ -115,13 +115,18 @@ def point_work(config: CaseConfig, stage, nl, solutions, jobs, done, first, work
     (:func:`sarfe.pipeline.post.records.with_verdict`, ``with_estimate``): the same records as the
     serial path's."""
     indices = pending(solutions) if jobs is not None else []
-    done = done or {}
+    # the seeds of the stability by need first (sarfe.pipeline.post.stability_need), with the
+    # estimates; the crossings between differing verdicts after them. Of the stream's verdicts
+    # only the seeds' are kept: it computed every stride-th job as recorded, and where the sweep
+    # dropped or re-recorded points those are not all seeds — which of them it reached depends on
+    # timing, and a kept extra verdict would turn an inferred neighbour into a computed one from
+    # run to run (measured on lumped_rattle, point 162)
+    stride = stability_stride(config.excitation)
+    seeds = seed_jobs(solutions, stride) if indices else []
+    done = {i: r for i, r in (done or {}).items() if i in set(seeds)}
     if any(isinstance(done.get(i), Exception) for i in indices):
         return None
-    # the seeds of the stability by need first (sarfe.pipeline.post.stability_need), with the
-    # estimates; the crossings between differing verdicts after them
-    stride = stability_stride(config.excitation)
-    hill = [i for i in seed_jobs(solutions, stride) if i not in done] if indices else []
+    hill = [i for i in seeds if i not in done]
     estimates = [i for i in records.estimated_points(config, nl, solutions) if i not in first]
     gridded = common_samples(nl, solutions)      # records at one N; estimates at each point's own
     # two pools: the Hill and estimate items first, then the records on freshly forked workers

@@ -26,6 +26,7 @@ from sarfe.erp.bands import third_octave_levels
 from sarfe.erp.risk import linear_risk_from_contacts
 from sarfe.hbm.onset import rest_rows
 from sarfe.hbm.harmonics import time_samples
+from sarfe.hbm.laws.curvature import friction_rows
 from sarfe.pipeline.model.nonlinear_model import NonlinearModel
 from sarfe.pipeline.post.audibility_records import point_audibility
 from sarfe.pipeline.post.contact_dynamics import contact_dynamics
@@ -81,6 +82,7 @@ def contact_indicators(solution, nl: NonlinearModel) -> list[dict]:
     N = force.shape[0]
     r = time_samples(R, N) if R.shape[1] else np.zeros((N, 0))
     state = np.asarray(solution.contact_state)
+    tangential = friction_rows(cs, r, force) if R.shape[1] else force   # curved: less −κ q λ_n
     out = []
     for name, kind, idx in nl.groups:
         nr = cs.normal_row[idx]
@@ -93,7 +95,7 @@ def contact_indicators(solution, nl: NonlinearModel) -> list[dict]:
         has_tangent = bool(np.any(tr >= 0))        # a law with a tangent (friction) element
         if has_tangent:
             t = np.where(tr >= 0, tr, 0)
-            ft = force[:, t] * (tr >= 0)
+            ft = tangential[:, t] * (tr >= 0)
             friction = np.sqrt((ft ** 2).sum(axis=2)).sum(axis=1)
         st = state[:, idx]
         amplitude_1 = np.hypot(R[1, nr[has]], R[2, nr[has]]).max(initial=0.0) if has.any() else np.nan

@@ -8,6 +8,8 @@ from pathlib import Path
 import numpy as np
 
 from sarfe import results
+from sarfe.hbm.harmonics import time_samples
+from sarfe.hbm.laws.curvature import friction_rows
 from sarfe.results import render
 from sarfe.results.vtk import period_samples
 
@@ -18,6 +20,9 @@ def _squeak_series(nl, solution):
     sticks, else 'open'."""
     cs = nl.contacts
     force = np.asarray(solution.contact_force_time, dtype=float)
+    R = np.asarray(solution.contact_displacement, dtype=float)
+    if R.shape[1]:                  # a curved partner's rows also carry −κ q λ_n: not friction
+        force = friction_rows(cs, time_samples(R, force.shape[0]), force)
     state = np.asarray(solution.contact_state)
     friction, states, names = [], [], []
     for name, _, idx in nl.groups:
