@@ -58,7 +58,7 @@ on cases/lumped_rattle.yaml with one parameter changed, docs/hbm.md "At the extr
   branch climbed to metres at 79.478 Hz, a resonance finer sampling does not have.
 - Scale. x_s follows the response: when ‖x‖ leaves [x_s / ``RESCALE``, ``RESCALE`` x_s] it is
   reset to ‖x‖ (z, t rescaled), so a step is a share of the response also on a resonance that
-  climbs decades (with x_s of the first point the ζ = 10⁻⁴ sweep took 570 points for 1 → 6 mm).
+  climbs decades (with x_s of the first point the ζ = 10⁻⁴ sweep took ~470 points for 1 → 5.5 mm).
 - Stiff contacts: a point whose full residual misses ``full_tolerance`` (≈ k_n ‖R_c‖ / ‖f̃_e‖) is
   tightened at its ω by the fixed-frequency Newton and its polish (:mod:`sarfe.hbm.solve`).
 - Closed loops: a new point within ``RETRACE_SHARE`` of its step of the path through the earlier
