@@ -40,7 +40,7 @@ BEFORE = {          # fork base bf7347e, `sarfe solve` at the defaults: complete
 }
 
 NOTES = [           # measured beside the table (the bare continuation of each extreme)
-    "Rows other than kn1e11 were measured before branch extremes3 (energy error, x_s following |x|);",
+    "Rows other than kn1e11 were measured before branch extremes3 (energy error, x_s from |x|);",
     "with it, measured by the bare continuation (load 4-7), the four stay complete with the same",
     "points: kt1e9 276 (8.2 CPU s), gap1e-7 313 (12.1), kn1e9 376 (46.1), kn1e10 574 (97.9);",
     "zeta1e-4 stops at 56.59 Hz (350 points, 87 CPU s; the bracket's 2w resonance with grazing",

@@ -28,7 +28,7 @@ def rattle():
 
 
 def orbit(X):
-    """r(θ) = X cos θ + 0.3 X cos 2θ + 0.1 X sin 3θ (2H+1, 1) [m]: a closed orbit through the gap."""
+    """r(θ) = X cos θ + 0.3 X cos 2θ + 0.1 X sin 3θ (2H+1, 1) [m]: an orbit through the gap."""
     R = np.zeros((2 * H + 1, 1))
     R[1, 0], R[3, 0], R[6, 0] = X, 0.3 * X, 0.1 * X
     return R
