@@ -19,6 +19,8 @@ Modules (in the order a solve uses them):
     solution           SolverOptions, ContinuationOptions, HarmonicSolution (the result)
     solve              one ω: first guess, homotopies, Newton, polish, finalize (solve_frequency)
     continuation       the sweep: pseudo-arclength continuation in ω through folds
+    arclength          its steps: bordered tangent, hyperplane/sphere corrector, corner step
+    energy_balance     is a point's energy balance resolved by its N samples (the sweep raises N)
     stability/         is the orbit stable? one entry, stability(...) (Hill, contact-row count, …)
     pruning            contact screening: contacts that never switch solved linearly
     linear_points      points where every contact stays open/closed/stuck: the linearized

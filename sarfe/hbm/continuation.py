@@ -41,7 +41,7 @@ on cases/lumped_rattle.yaml with one parameter changed, docs/hbm.md "At the extr
 - Physical corners. Where the panel first touches (grazing) a hard contact turns the branch at
   ~110° within a length no N resolves (10⁹ N/m: 111° at N = 512 … 16384). A stall within
   ``FOLD_DISTANCE`` of a point where N was already raised steps past the corner
-  (:func:`_corner_step`, the point's ``reason`` says so) instead of raising N again; so does a
+  (:func:`sarfe.hbm.arclength.corner_step`, the point's ``reason`` says so) instead of raising N again; so does a
   stall once N is at ``MAX_STALL_FACTOR`` × N. From then on the tangent is oriented along the
   last secant (at a corner crossed within one step, t_i oriented like t_{i−1} points back).
 - Unresolved contact forces. Each accepted point's residual with 2N samples is measured (one AFT
@@ -50,6 +50,15 @@ on cases/lumped_rattle.yaml with one parameter changed, docs/hbm.md "At the extr
   largest values along the shipped sweeps: 2.6·10⁻³ lumped_rattle, 6.3·10⁻³ rattle_rig; 0.075
   with k_n = 10⁹ N/m at N = 256). Stalls (and, once a corner was stepped past or N raised for
   this, turns) raise N up to ``MAX_STALL_FACTOR`` × N.
+- Unresolved energy balance (light damping). The AFT's error in the contacts' work per period
+  grows like k_n ‖r̃‖² / N² (:mod:`sarfe.hbm.energy_balance`); a lightly damped peak is set by
+  the damping's work, so N is raised as above also where the work changes with 2N by more than
+  ``ENERGY_LIMIT`` of the dissipated energy (until ``ENERGY_TARGET``). With modal ζ = 10⁻⁴ at
+  N = 256 the sampled rattle contact's spurious input balanced the damping at any amplitude: the
+  branch climbed to metres at 79.478 Hz, a resonance finer sampling does not have.
+- Scale. x_s follows the response: when ‖x‖ leaves [x_s / ``RESCALE``, ``RESCALE`` x_s] it is
+  reset to ‖x‖ (z, t rescaled), so a step is a share of the response also on a resonance that
+  climbs decades (with x_s of the first point the ζ = 10⁻⁴ sweep took ~470 points for 1 → 5.5 mm).
 - Stiff contacts: a point whose full residual misses ``full_tolerance`` (≈ k_n ‖R_c‖ / ‖f̃_e‖) is
   tightened at its ω by the fixed-frequency Newton and its polish (:mod:`sarfe.hbm.solve`).
 - Closed loops: a new point within ``RETRACE_SHARE`` of its step of the path through the earlier
@@ -75,11 +84,12 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
-import scipy.sparse as sp
 
-from sarfe.hbm.harmonic_set import expand_rows
-from sarfe.hbm.newton import SingularJacobian, newton, solve_linear
-from sarfe.hbm.residual import Evaluation, kept_rows
+from sarfe.hbm.arclength import (band_edge, corner_step, corrector, rescaled, switch_set,
+                                 tangent)
+from sarfe.hbm.energy_balance import energy_error
+from sarfe.hbm.newton import SingularJacobian
+from sarfe.hbm.residual import kept_rows
 from sarfe.hbm.solution import ContinuationOptions
 from sarfe.hbm.solve import (check_omega, finalize, initial_slider, linearized_guess, make_evaluator,
                              make_problem, slider_acceptor, solve_auto, solve_from,
@@ -91,7 +101,6 @@ MAX_STALL_FACTOR = 64    # … and to 64× at stalled steps and unresolved conta
 BACKUP = 3               # points dropped before re-solving with 2N at a corner or turn
 FOLD_DISTANCE = 0.05     # a turn of ω this close (share of the band) to a checked one is a fold
 COS_CORNER = 0.2         # ω turns with consecutive secants at more than ~80°: a corner, checked
-COS_BEHIND = -0.9        # a corner step's point at more than ~154° from t_i: the old piece behind
 CORNER_LIMIT = 12        # corners stepped past within FOLD_DISTANCE of each other: a crawl, stop
 RETRACE_SKIP = 3         # a new point near the path of the earlier points but these: came back
 RETRACE_SHARE = 0.1      # … within this share of its step
@@ -100,45 +109,9 @@ LOOP_EXIT = (0.25, 0.5, 1.0, 2.0)   # … at these shares of initial_step past t
 LEFT_LOOP = "left a closed loop of solutions"   # in the reason of the new start past a loop
 ALIASING_LIMIT = 2e-2    # residual of a point with 2N samples above which N is doubled (docstring)
 ALIASING_TARGET = 5e-3   # … until it is below this (a margin: the contact hardens along the branch)
-
-
-DENSE_BELOW = 500        # a sparse J of fewer rows is bordered and factorized dense (sp.bmat and
-                         # SuperLU cost more than the dense LU there: 1-DOF Jenkins, 15 rows)
-
-
-def _bordered(jacobian, d_omega, x_scale, omega_scale, row, row_scale=1.0):
-    """[[J x_s, ∂R/∂ω ω_s], [row · row_scale]] (sparse like J, dense below DENSE_BELOW rows)."""
-    if sp.issparse(jacobian) and jacobian.shape[0] < DENSE_BELOW:
-        jacobian = jacobian.toarray()
-    if sp.issparse(jacobian):
-        return sp.bmat([[jacobian * x_scale, sp.csc_matrix(d_omega[:, None] * omega_scale)],
-                        [sp.csr_matrix(row[None, :-1] * row_scale),
-                         sp.csr_matrix(row[None, -1:] * row_scale)]], format="csc")
-    # filled in place: np.block's scaled copies took 1.6 ms at 589 rows (P1), this 0.2 ms
-    n = jacobian.shape[0]
-    kind = np.result_type(jacobian, d_omega, row, x_scale, omega_scale, row_scale)
-    out = np.empty((n + 1, n + 1), dtype=kind)
-    np.multiply(jacobian, x_scale, out=out[:n, :n])
-    np.multiply(d_omega, omega_scale, out=out[:n, n])
-    np.multiply(row, row_scale, out=out[n])
-    return out
-
-
-def tangent(evaluation, x_scale, omega_scale, previous):
-    """Unit tangent of the solution curve in scaled unknowns, oriented like ``previous``."""
-    A = _bordered(evaluation.jacobian, evaluation.omega_derivative, x_scale, omega_scale, previous)
-    rhs = np.zeros(A.shape[0])
-    rhs[-1] = 1.0
-    t = solve_linear(A, rhs, evaluation.unit_columns if isinstance(A, np.ndarray) else None)
-    t /= np.linalg.norm(t)
-    return t if t @ previous >= 0 else -t
-
-
-def _switch_set(tangent_z, rows_from, harmonics, width, x_scale_from, x_scale_to):
-    """A tangent in scaled unknowns of a harmonic set → the same direction with all rows."""
-    x = expand_rows(tangent_z[:-1] * x_scale_from, rows_from, harmonics, width).ravel()
-    t = np.append(x / x_scale_to, tangent_z[-1])
-    return t / np.linalg.norm(t)
+ENERGY_LIMIT = 2e-1      # contacts' work error with 2N / dissipated energy above which N is doubled
+ENERGY_TARGET = 5e-2     # … until it is below this (sarfe.hbm.energy_balance, docstring)
+RESCALE = 10.0           # x_s follows ‖x‖ when it leaves [x_s / RESCALE, RESCALE x_s] (docstring)
 
 
 def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
@@ -165,8 +138,9 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
     if harmonic_set is not None:
         so = replace(so, harmonic_set=harmonic_set)
     auto = isinstance(so.harmonic_set, str) and so.harmonic_set == "auto"
-    corrector = replace(so, max_iterations=min(so.max_iterations, options.corrector_iterations),
-                        line_search_steps=min(so.line_search_steps, 3))
+    corrector_options = replace(so, max_iterations=min(so.max_iterations,
+                                                        options.corrector_iterations),
+                                line_search_steps=min(so.line_search_steps, 3))
     full_problem = make_problem(model, contacts, excitation, harmonics, samples_per_period, so,
                                 None if auto else so.harmonic_set)
     check_omega(omega_start, "omega_start")
@@ -232,7 +206,7 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
         return e
 
     def pass_corner(t):
-        """:func:`_corner_step` at z, travelling along the secant from the point before (t_i at
+        """:func:`corner_step` at z, travelling along the secant from the point before (t_i at
         the first point: at a corner crossed within a step, t_i oriented like t_{i−1} may point
         back), with spheres of radius ≤ that secant's length."""
         direction_z, radius = t, options.initial_step
@@ -243,12 +217,13 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
             if size > 0:
                 direction_z, radius = secant / size, min(radius, size)
         for r in (options.initial_step, 4 * options.initial_step):   # across a sawtooth
-            result = _corrector(evaluate_z, z, z + r * direction_z, direction_z, r, x_scale, span,
-                                corrector, accept)
+            result = corrector(evaluate_z, z, z + r * direction_z, direction_z, r, x_scale, span,
+                               corrector_options, accept)
             if result is not None:
                 d = result.x - z
                 return result, float(d @ direction_z / np.linalg.norm(d))
-        return _corner_step(evaluate_z, z, direction_z, radius, x_scale, span, corrector, accept)
+        return corner_step(evaluate_z, z, direction_z, radius, x_scale, span, corrector_options,
+                           accept)
 
     fine_evaluator = {}
 
@@ -263,7 +238,15 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
         with np.errstate(all="ignore"):
             e = fine_evaluator["evaluate"](zz[:-1] * x_scale, zz[-1] * span, False,
                                            state["slider"])
-        return float(np.linalg.norm(e.residual) / e.reference)
+        return float(np.linalg.norm(e.residual) / e.reference), e.forces.force
+
+    def unresolved(N, zz, U, force):
+        """(residual with 2N samples, energy error of the contacts' work with 2N samples, see
+        :func:`sarfe.hbm.energy_balance.energy_error`) of the point zz solved with N samples (its
+        displacement U, contact force λ̃ ``force``)."""
+        aliased, force_fine = aliasing(N, zz)
+        return aliased, energy_error(problem.model, problem.contacts.gap_map, U,
+                                     zz[-1] * span, force, force_fine)
 
     def resolve_aliasing(result):
         """The accepted point re-solved with 2N, 4N, … (≤ MAX_SAMPLES_FACTOR × the requested N)
@@ -279,8 +262,10 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
                 break
             point, U = trial, trial.displacement
             zz = np.append(to_x(U) / x_scale, omega_new / span)
-            if (2 * N_fine > MAX_STALL_FACTOR * samples_per_period
-                    or aliasing(N_fine, zz) <= ALIASING_TARGET):
+            if 2 * N_fine > MAX_STALL_FACTOR * samples_per_period:
+                break
+            aliased, energy = unresolved(N_fine, zz, U, trial.contact_force)
+            if aliased <= ALIASING_TARGET and energy <= ENERGY_TARGET:
                 break
         return point
 
@@ -370,15 +355,16 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
                 continue
             return stop("singular bordered Jacobian (tangent)")
         refined = None                 # point k re-solved with 2N (stalled step or turn of ω)
-        corner = None                  # cosine of a corner stepped past (_corner_step)
+        corner = None                  # cosine of a corner stepped past (corner_step)
         while True:
             predicted = z + step * t
-            result = _corrector(evaluate_z, z, predicted, t, step, x_scale, span, corrector, accept)
+            result = corrector(evaluate_z, z, predicted, t, step, x_scale, span,
+                               corrector_options, accept)
             if result is None and step <= 0.01 * options.initial_step:
                 # a corner of the (nonsmooth) branch: the hyperplane may miss it, the sphere
                 # ‖z − z_i‖ = Δs intersects it
-                result = _corrector(evaluate_z, z, predicted, None, step, x_scale, span,
-                                    corrector, accept)
+                result = corrector(evaluate_z, z, predicted, None, step, x_scale, span,
+                                   corrector_options, accept)
             if result is not None:
                 break
             step *= 0.5
@@ -418,14 +404,19 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
                 k, refined = refine_samples(MAX_STALL_FACTOR if extreme else MAX_SAMPLES_FACTOR)
         why = "a stalled step or a turn of ω, checked with finer AFT sampling"
         if refined is None and problem.samples_per_period < MAX_STALL_FACTOR * samples_per_period:
-            aliased = aliasing(problem.samples_per_period, result.x)
-            if aliased > ALIASING_LIMIT:    # the contact forces are not resolved by N samples
+            aliased, energy = unresolved(
+                problem.samples_per_period, result.x,
+                to_displacement(result.x[:-1] * x_scale, result.x[-1] * span, result.evaluation),
+                result.evaluation.forces.force)
+            if aliased > ALIASING_LIMIT or energy > ENERGY_LIMIT:   # contact forces not resolved
                 refined = resolve_aliasing(result)
                 if refined is not None:
                     k, extreme = len(solutions), True
                     why = (f"with {problem.samples_per_period} samples the residual of this point "
-                           f"at twice as many was {aliased:.2g} > {ALIASING_LIMIT:g}: the contact "
-                           "forces were not resolved")
+                           f"at twice as many was {aliased:.2g} (limit {ALIASING_LIMIT:g}), the "
+                           f"contacts' work per period changed by {energy:.2g} of the dissipated "
+                           f"energy (limit {ENERGY_LIMIT:g}): the contact forces were not "
+                           "resolved")
         if refined is not None:        # continue with 2N from the re-solved point k
             problem = replace(problem, samples_per_period=refined.samples_per_period)
             full_problem = replace(full_problem, samples_per_period=refined.samples_per_period)
@@ -491,7 +482,7 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
             x_scale = max(np.linalg.norm(x), 1e-300)
             if condensed == was_condensed:
                 width = problem.contacts.row_count if condensed else problem.model.dof_count
-                t = _switch_set(t, rows_from, problem.harmonics, width, old_scale, x_scale)
+                t = switch_set(t, rows_from, problem.harmonics, width, old_scale, x_scale)
             else:                      # other unknowns: restart the orientation along ω
                 t = np.zeros(x.size + 1)
                 t[-1] = direction
@@ -499,7 +490,7 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
             point = full
         edge = omega_start if band_start is None else band_start
         if direction * (omega_new - edge) < 0:            # turned back out of the band
-            return _band_edge(problem, solutions, point, edge, so, state["slider"])
+            return band_edge(problem, solutions, point, edge, so, state["slider"])
         if full is not None or np.linalg.norm(z_new - z) >= REPORT_DISTANCE:
             solutions.append(point)     # (a step shrunk to a corner adds no reported point)
         else:
@@ -513,88 +504,12 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
         if (physical or extreme) and full is None:
             t = (z_new - z) / np.linalg.norm(z_new - z)    # orientation past corners: the secant
         previous, z = t, z_new
+        size = np.linalg.norm(z[:-1])
+        if not 1.0 / RESCALE <= size <= RESCALE:   # the response left a decade of x_s: x_s ← ‖x‖
+            x_scale *= size
+            z, previous = rescaled(z, size), rescaled(previous, size)
+            previous /= np.linalg.norm(previous)
         if result.iterations <= options.target_iterations:
             step = min(step * options.step_growth, options.max_step)
         else:
             step = max(step * 0.5, options.min_step)
-
-
-def _band_edge(problem, solutions, point, omega_start, options, slider):
-    """The branch turned back past ω_start at ``point``: solved at exactly ω_start instead (start:
-    the secant between the last reported point and ``point``) and the sweep stops there, saying so."""
-    last = solutions[-1]
-    fraction = (omega_start - last.omega) / (point.omega - last.omega)
-    guess = last.displacement + fraction * (point.displacement - last.displacement)
-    edge = solve_from(problem, omega_start, guess, options, slider)
-    reason = (f"the branch turned back past the start of the band ({omega_start:.6g} rad/s): "
-              "sweep stopped at the band edge")
-    solutions.append(replace(edge, reason=f"{edge.reason}; sweep stopped: {reason}"))
-    return solutions
-
-
-def _corrector(evaluate_z, z, predicted, t, step, x_scale, span, options, accept, travel=None,
-               cos_min=0.0):
-    """Newton on R(z) = 0 with t·(z − z_p) = 0 (hyperplane), or ‖z − z_i‖² = Δs² when t is None
-    (sphere). Returns the converged NewtonResult within 3 Δs of z_i, or None. A sphere point must
-    lie ahead: cos(z − z_i, d) > ``cos_min`` with d = ``travel`` (default z_p − z_i)."""
-    def augmented(zz, jacobian):
-        e = evaluate_z(zz, jacobian)
-        if t is not None:
-            extra, row = t @ (zz - predicted), t
-        else:
-            d = zz - z
-            extra, row = (d @ d - step**2) / (2 * step), d / step
-        residual = np.append(e.residual, e.reference * extra)
-        J = (_bordered(e.jacobian, e.omega_derivative, x_scale, span, row, e.reference)
-             if jacobian else None)
-        return Evaluation(residual, J, None, e.forces, e.reference,
-                          e.unit_columns if isinstance(J, np.ndarray) else None)
-
-    try:
-        result = newton(augmented, predicted, options, x_scale=1.0, accept=accept)
-    except SingularJacobian:
-        return None
-    if result.converged and np.linalg.norm(result.x - z) <= 3 * step:
-        ahead = predicted - z if travel is None else travel
-        if t is None and (result.x - z) @ ahead <= cos_min * np.linalg.norm(
-                result.x - z) * np.linalg.norm(ahead):
-            return None          # the sphere's backward intersection
-        return result
-    return None
-
-
-def _corner_step(evaluate_z, z, t, radius, x_scale, span, options, accept):
-    r"""A step past a corner of the branch just ahead of z_i, where the correctors stall: the
-    piece ahead leaves at an angle to t_i (the direction of travel: the secant from z_{i−1}) that
-    no hyperplane t_iᵀ(z − z_p) = 0 meets near z_i, and whose sphere point the plain sphere
-    corrector rejects as lying 'behind' (more than 90° from t_i).
-
-    A sphere ‖z − z_i‖ = r meets the branch twice: on the piece behind z_i and on the piece
-    ahead. The point behind is found first (Newton on the sphere from z_i − r t_i); the piece
-    ahead is then sought from z_i + r t_B, z_i − r t_B and z_i + r t_i, where t_B is the tangent at
-    z_i + (r/8) t_i (past the corner: the contact state of the piece ahead holds there), and the
-    first converged point that is not the point behind (farther than 10⁻³ r from it; where the
-    point behind was not found: cos(z − z_i, t_i) > ``COS_BEHIND``) is taken, for r = ``radius``,
-    r/8, r/64. The test by position, not angle, also passes a fold at a corner, whose piece ahead
-    returns almost antiparallel to t_i. Measured on cases/lumped_rattle.yaml with k_n = 10⁹ N/m,
-    where the panel first touches the bracket (42.4 Hz): the piece ahead at 110° from t_i, found
-    from z_i − r t_B in 5 Newton iterations for r = 10⁻³ … 0.02.
-    Returns (NewtonResult, cosine of z − z_i with t_i) or None."""
-    for r in (radius, radius / 8, radius / 64):
-        behind = _corrector(evaluate_z, z, z - r * t, None, r, x_scale, span, options, accept,
-                            cos_min=-2.0)
-        try:
-            beyond = tangent(evaluate_z(z + r / 8 * t, True), x_scale, span, t)
-        except SingularJacobian:
-            beyond = t
-        for start in (z + r * beyond, z - r * beyond, z + r * t):
-            result = _corrector(evaluate_z, z, start, None, r, x_scale, span, options, accept,
-                                cos_min=-2.0)
-            if result is None:
-                continue
-            d = result.x - z
-            cosine = float(d @ t / np.linalg.norm(d))
-            if (np.linalg.norm(result.x - behind.x) > 1e-3 * r if behind is not None
-                    else cosine > COS_BEHIND):
-                return result, cosine
-    return None
