@@ -282,11 +282,13 @@ class _SubSteps:
         start's contact displacement r, velocity ṙ (None: rate-independent laws) and sliders."""
         if np.array_equal(state == 0, state_new == 0):     # no contact opened or closed
             return 1
-        rate = 2.0 / self.h
-        rho = np.abs(C @ law.jacobian(rate)).sum(axis=1).max(initial=0.0)
+
+        def rho():         # ‖C ∂λ/∂r‖∞ at the laws' last evaluation
+            return np.abs(C @ law.jacobian(2.0 / self.h)).sum(axis=1).max(initial=0.0)
+
+        at_end = rho()
         law.forces(r, rdot, slider)                          # the start (a contact that opens)
-        rho = max(rho, np.abs(C @ law.jacobian(rate)).sum(axis=1).max(initial=0.0))
-        ratio = 2.0 * np.sqrt(rho) / SUBSTEP_RESOLUTION
+        ratio = 2.0 * np.sqrt(max(at_end, rho())) / SUBSTEP_RESOLUTION
         if ratio <= 1.0:
             return 1
         return int(min(2 ** np.ceil(np.log2(ratio)), MAX_SUBSTEPS))

@@ -12,6 +12,7 @@ from importlib import import_module
 
 import numpy as np
 
+from sarfe.hbm.laws import curvature
 from sarfe.hbm.laws.contract import ContactLaw, LawInputError, Linearization, NormalForce, Parameter
 
 LAWS = {}
@@ -87,8 +88,7 @@ def linearization(contacts):
 
 def curvatures(contacts):
     """κ (n_c, 2) [1/m] of every contact (:mod:`.curvature`), or None when all are flat."""
-    kappa = np.stack([np.asarray(contacts.partner_curvature_1, dtype=float),
-                      np.asarray(contacts.partner_curvature_2, dtype=float)], axis=-1)
+    kappa = curvature.contact_curvatures(contacts)
     return kappa if np.any(kappa != 0.0) else None
 
 

@@ -78,6 +78,12 @@ def curvatures(p):
     return kappa if np.any(kappa != 0.0) else None
 
 
+def contact_curvatures(contacts) -> np.ndarray:
+    """κ (n_c, 2) [1/m] of every contact of a :class:`sarfe.hbm.contacts.ContactSet` (0: flat)."""
+    return np.stack([np.asarray(contacts.partner_curvature_1, dtype=float),
+                     np.asarray(contacts.partner_curvature_2, dtype=float)], axis=-1)
+
+
 def penetration_shift(kappa, q):
     """½ Σ_i κ_i q_i² (...) [m]: w − g − shift is the penetration. q (..., 2), κ broadcast."""
     return 0.5 * np.einsum("...i,...i->...", kappa, q * q)
@@ -116,8 +122,7 @@ def friction_rows(contacts, r, force):
     slider and slip work); r (N, n_rows) [m] the contact displacements at the same samples.
     ``contacts``: a :class:`sarfe.hbm.contacts.ContactSet`. Unchanged (the same array) when no
     contact is curved."""
-    kappa = np.stack([np.asarray(contacts.partner_curvature_1, dtype=float),
-                      np.asarray(contacts.partner_curvature_2, dtype=float)], axis=-1)
+    kappa = contact_curvatures(contacts)
     normal_row = np.asarray(contacts.normal_row)
     curved = np.flatnonzero(np.any(kappa != 0.0, axis=1) & (normal_row >= 0))
     if not curved.size:
@@ -151,5 +156,6 @@ def local_jacobian(kappa, q, force, stiffness, d_tq=None, d_tn=None):
     return J
 
 
-__all__ = ["PARAMETERS", "CASE_KEY", "CASE_KEYS", "prepare", "curvatures", "penetration_shift",
+__all__ = ["PARAMETERS", "CASE_KEY", "CASE_KEYS", "prepare", "curvatures", "contact_curvatures",
+           "penetration_shift",
            "effective_normal", "coupling", "friction_force", "friction_rows", "local_jacobian"]

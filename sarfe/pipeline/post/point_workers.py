@@ -123,7 +123,8 @@ def point_work(config: CaseConfig, stage, nl, solutions, jobs, done, first, work
     # run to run (measured on lumped_rattle, point 162)
     stride = stability_stride(config.excitation)
     seeds = seed_jobs(solutions, stride) if indices else []
-    done = {i: r for i, r in (done or {}).items() if i in set(seeds)}
+    seed_set = set(seeds)
+    done = {i: r for i, r in (done or {}).items() if i in seed_set}
     if any(isinstance(done.get(i), Exception) for i in indices):
         return None
     hill = [i for i in seeds if i not in done]
