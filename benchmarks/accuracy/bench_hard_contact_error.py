@@ -127,7 +127,7 @@ def main():
         lines.append(f"| {c['frequency_hz']:.2f} | {100 * c['error_vs_newmark']:.3g} % | {shown} "
                      f"| {c['rho']:.3g} |")
     check = hard["impact_check"]
-    if check:
+    if check and "failed" not in check:
         lines += ["", f"Headline: {hard['worst']['erp_level_dba']:.1f} ± "
                   f"{hard['worst']['erp_error_db']:.2f} dB(A) at {check['frequency_hz']:.2f} Hz "
                   f"({hard['worst']['error_note']}): first harmonic {100 * check['amplitude_rel']:.3g} %"

@@ -64,14 +64,19 @@ class ContactResolution:
                 f"{self.contact_frequency_hz:.3g} Hz), far shorter than the "
                 f"{1e6 * self.resolved_duration_s:.3g} µs that H' = {self.harmonics} harmonics "
                 f"resolve (ρ = {self.ratio:.3g} > {RESOLUTION_LIMIT:g}): the change to H' does "
-                "not bound the error (raise solver.harmonics, soften the contact, or check the "
-                "point with `sarfe verify`)")
+                f"not bound the error; a bound needs H' ≥ {self.needed_harmonics()} (raise "
+                "solver.harmonics) or a softer contact")
+
+    def needed_harmonics(self) -> int:
+        """The H' at which (7) would hold, ⌈H' √(ρ / RESOLUTION_LIMIT)⌉ (mass-like compliance)."""
+        return int(np.ceil(self.harmonics * np.sqrt(max(self.ratio, 0.0) / RESOLUTION_LIMIT)))
 
     def as_dict(self) -> dict:
         return {"harmonics": self.harmonics, "ratio": self.ratio, "contact": self.contact,
                 "contact_frequency_hz": self.contact_frequency_hz,
                 "impact_duration_s": self.impact_duration_s,
-                "resolved_duration_s": self.resolved_duration_s, "resolved": self.resolved}
+                "resolved_duration_s": self.resolved_duration_s, "resolved": self.resolved,
+                "needed_harmonics": self.needed_harmonics()}
 
 
 def impact_stiffness(contacts, contact_displacement, samples_per_period, omega):

@@ -8,7 +8,7 @@ from sarfe.results.summary import headline_notes
 
 RESOLUTION = {"harmonics": 14, "ratio": 1780.0, "contact": "panel_bracket",
               "contact_frequency_hz": 42000.0, "impact_duration_s": 1.18e-5,
-              "resolved_duration_s": 5.0e-4, "resolved": False}
+              "resolved_duration_s": 5.0e-4, "resolved": False, "needed_harmonics": 296}
 
 
 def point(frequency_hz, resolution=None):
@@ -22,7 +22,7 @@ def test_unresolved_impacts_are_named_with_their_duration():
     text = unknown_text([point(71.5, RESOLUTION), point(75.6, RESOLUTION), point(50.0)])
     assert text.startswith("no error bound at 2 points (71.50–75.60 Hz): the impact of "
                            "panel_bracket lasts ≈ 11.8 µs")
-    assert "500 µs H' = 14 resolves" in text
+    assert "500 µs H' = 14 resolves" in text and "needs H' ≥ 296" in text
     assert text.endswith("no error estimate at 50.00 Hz (its re-solve at more harmonics or "
                          "samples did not converge)")
 

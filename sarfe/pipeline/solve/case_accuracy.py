@@ -270,8 +270,8 @@ def unknown_text(points) -> str:
             f"no error bound at {len(impacts)} points ({min(f):.2f}–{max(f):.2f} Hz): the impact "
             f"of {r['contact']} lasts ≈ {1e6 * r['impact_duration_s']:.3g} µs, far shorter than "
             f"the {1e6 * r['resolved_duration_s']:.3g} µs H' = {r['harmonics']} resolves, so no "
-            "change of H bounds the error there (raise solver.harmonics, soften the contact, or "
-            "check a point with `sarfe verify`)")
+            f"change of H bounds the error there (a bound needs H' ≥ {r['needed_harmonics']}: "
+            "raise solver.harmonics, or soften the contact)")
     if failed:
         parts.append(f"no error estimate at {where(failed)} (its re-solve at more harmonics or "
                      "samples did not converge)")

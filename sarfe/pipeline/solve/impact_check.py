@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from sarfe.accuracy.time_check import time_integration_error
 from sarfe.pipeline.post.records import loudest_point
 
@@ -35,8 +37,14 @@ def impact_time_check(stage, nl, points, rows, solutions, j) -> dict:
     point = points[j]
     estimate = point["error_estimate"]
     index = point["index"]
-    check = time_integration_error(solutions[index], nl.model, nl.contacts, nl.excitation,
-                                   stage.erp_map, stage.erp_areas)
+    try:        # a check must not break a solve: a failure is said, the point keeps no bound
+        check = time_integration_error(solutions[index], nl.model, nl.contacts, nl.excitation,
+                                       stage.erp_map, stage.erp_areas)
+    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as error:
+        estimate["notes"] = list(estimate.get("notes") or []) + [
+            f"time-integration check failed: {type(error).__name__}: {error}"]
+        return {"index": index, "frequency_hz": point["frequency_hz"],
+                "failed": f"{type(error).__name__}: {error}"}
     estimate = dict(estimate, amplitude_rel=check["amplitude_rel"],
                     erp_db=check["erp_db"] + float(estimate.get("mesh_db", 0.0) or 0.0),
                     time_check=check, interpolated=False,
