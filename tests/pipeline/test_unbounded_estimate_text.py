@@ -4,6 +4,7 @@ headline's note; a re-solve that did not converge keeps its own wording (the shi
 from __future__ import annotations
 
 from sarfe.pipeline.solve.case_accuracy import unknown_text
+from sarfe.pipeline.solve.impact_check import impact_check_point
 from sarfe.results.summary import headline_notes
 
 RESOLUTION = {"harmonics": 14, "ratio": 1780.0, "contact": "panel_bracket",
@@ -38,3 +39,18 @@ def test_headline_says_why_it_has_no_bound():
              "error_note": "no error bound: impact not resolved by H"}
     assert headline_notes(worst) == ["no error bound: impact not resolved by H"]
     assert headline_notes({"erp_error_db": None, "error_estimated": True}) == ["error unknown"]
+
+
+def test_only_a_loudest_point_without_a_bound_for_its_impact_is_time_checked():
+    """The time-integration check (sarfe.pipeline.solve.impact_check) runs at the loudest point
+    only, and only when its estimate has no bound because of an unresolved impact — never on a
+    point with a bound or whose re-solve alone failed (the shipped cases)."""
+    def record(index, level, resolution=None, bound=float("inf")):
+        p = point(60.0 + index, resolution)
+        p["error_estimate"]["amplitude_rel"] = bound
+        return dict(p, index=index, converged=True, stable=None, erp={"level_dba": level})
+
+    flagged = [record(0, 80.0), record(1, 95.0, RESOLUTION), record(2, 90.0, RESOLUTION)]
+    assert impact_check_point(flagged) == 1
+    assert impact_check_point([record(0, 80.0), record(1, 95.0)]) is None           # re-solve
+    assert impact_check_point([record(0, 99.0, bound=0.01), record(1, 95.0, RESOLUTION)]) is None

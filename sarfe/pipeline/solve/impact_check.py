@@ -50,7 +50,8 @@ def impact_time_check(stage, nl, points, rows, solutions, j) -> dict:
                     time_check=check, interpolated=False,
                     notes=list(estimate.get("notes") or []) + [
                         f"± measured against the time integration from this point "
-                        f"({check['periods']} periods, N = {check['steps_per_period']}): "
+                        f"(N = {check['steps_per_period']} and {2 * check['steps_per_period']} "
+                        f"steps a period, Richardson; {check['periods']} periods in all): "
                         f"first harmonic {100 * check['amplitude_rel']:.3g} %, ERP "
                         f"{check['erp_db']:.3g} dB" + (f"; {check['note']}" if check['note']
                                                        else "")])
