@@ -32,6 +32,14 @@ from sarfe.pipeline.solve.points import solver_options  # noqa: E402
 CASE = benchlib.CASES / "lumped_rattle.yaml"
 
 
+def near_frequencies(solutions, closes, frequencies_hz):
+    """Per frequency [Hz], the point of ``closes`` nearest to it up to the branch's fold."""
+    f = np.array([s.omega / (2 * np.pi) for s in solutions])
+    fold = max(closes, key=lambda k: f[k])
+    upper = [k for k in closes if k <= fold]
+    return [min(upper, key=lambda k: abs(f[k] - target)) for target in frequencies_hz]
+
+
 def case_data(normal_stiffness):
     data = load_case(CASE).data
     data["contacts"][0]["normal_stiffness_N_m"] = float(normal_stiffness)
@@ -74,14 +82,12 @@ def hard_case() -> dict:
     summary, solutions = result.summary, result.solutions
     case = load_case(data, base_dir=CASE.parent)
     nl = nonlinear_model(case, build_linear_model(case))
-    amplitude = np.array([np.hypot(*s.displacement[1:3, 0]) for s in solutions])
-    impacting = np.flatnonzero(amplitude > 1e-4)          # (as the test of the extremes)
     force = [np.asarray(s.contact_force_time)[:, 0] for s in solutions]    # panel_bracket
     closes = [k for k, s in enumerate(solutions)
               if s.converged and force[k].max() > 0 and force[k].min() == 0]
     estimates = [summary["points"][k]["error_estimate"] for k in closes]
     compared = []
-    for k in (impacting[len(impacting) // 4], impacting[len(impacting) // 2]):
+    for k in near_frequencies(solutions, closes, (71.54, 75.56)):
         point, e = solutions[k], summary["points"][k]["error_estimate"]
         ref = integrate_time(nl.model, nl.contacts, nl.excitation, point.omega, point.harmonics,
                              steps_per_period=2048, richardson=True, initial=point,
