@@ -33,6 +33,7 @@ from sarfe.pipeline.post.stability_need import stability_stride
 from sarfe.pipeline.solve.by_need import erp_measure
 from sarfe.pipeline.solve.case_accuracy import (accuracy_check, case_resolution, resolution_line,
                                                 resolved_case)
+from sarfe.pipeline.solve.impact_check import impact_check_point, impact_time_check
 from sarfe.pipeline.solve.mesh_error import (mesh_checked, mesh_error_term, mesh_line,
                                              with_mesh_term)
 from sarfe.pipeline.solve.points import common_samples, sweep_status
@@ -200,6 +201,18 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
     with_mesh_term(points, rows, mesh_term)
     mesh_term["line"] = mesh_line(mesh_term)
     timings["mesh_error_s"] = time.perf_counter() - clock
+    # the headline's ± where H cannot give one (an unresolved impact): time integration, issue 29
+    impact_check, loudest = None, impact_check_point(points)
+    if loudest is not None:
+        bar = progress_bar(progress, "the loudest point's error by time integration (its impact "
+                                     "is not resolved by H)", None)
+        try:
+            clock = time.perf_counter()
+            impact_check = impact_time_check(stage, nl, points, rows, solutions, loudest)
+            timings["impact_check_s"] = time.perf_counter() - clock
+        finally:
+            if bar is not None:
+                bar.close()
     not_converged = [p["index"] for p in points if not p["converged"]]
     # None entries without a sweep
     sweep = sweep_status(config.excitation, config.solver.continuation, solutions)
@@ -238,6 +251,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         "accuracy": accuracy,                    # None unless solver.accuracy was given
         "accuracy_check": mesh_checked(accuracy_check(config.solver, points), mesh_term, case),
         "mesh_error": mesh_term,                 # the ± mesh term (sarfe.pipeline.solve.mesh_error)
+        **({} if impact_check is None else {"impact_check": impact_check}),   # (impact_check.py)
         "warnings": warnings,                    # inputs far outside the model's range
         "timings_s": timings,
         "cost_estimate": None if cost is None else cost.as_dict(),   # said before the run
