@@ -33,7 +33,11 @@ meshes and matrices models the term is "not estimated" and said so (``solver.mes
 from __future__ import annotations
 
 import contextlib
+import ctypes
+import ctypes.util
+import dataclasses
 import functools
+import gc
 import time
 import warnings
 
@@ -130,6 +134,23 @@ def coarse_sizes(case, ratio=MESH_GCI_RATIO) -> tuple:
     return (ratio ** 2 * h, ratio * h)
 
 
+def slim_stage(stage):
+    """``stage`` with what :func:`resolve_on` reads after :func:`coarse_model` (the ERP map and
+    areas, ``info``) and without the mesh and the reduction basis (the full-space Craig–Bampton
+    shapes, n_full × n_r: the bulk of a stage), for a background process that holds it."""
+    return dataclasses.replace(stage, mesh=None, reduced=None)
+
+
+def release_memory():
+    """Collect garbage and hand the heap's free pages back to the system (glibc ``malloc_trim``;
+    nothing where there is none)."""
+    gc.collect()
+    try:
+        ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6").malloc_trim(0)
+    except (OSError, AttributeError):
+        pass
+
+
 def start_coarse_levels(case, ratio=MESH_GCI_RATIO):
     """Start building the mesh term's coarser models now, on one background process
     (:class:`sarfe.util.workers.Background`), or None where the term is not due (error estimate
@@ -150,10 +171,12 @@ def start_coarse_levels(case, ratio=MESH_GCI_RATIO):
         for size in sizes:
             clock = time.perf_counter()
             try:
-                built[size] = coarse_model(case, size)
+                stage, nl = coarse_model(case, size)
+                built[size] = (slim_stage(stage), nl)
             except Exception as error:  # an estimate must not break a solve
                 built[size] = error
             built[size, "build_s"] = time.perf_counter() - clock
+        release_memory()     # it waits through the sweep: hold the models, not the build's heap
         return built
 
     return Background(prepare, functools.partial(_resolve_built, case))
@@ -331,6 +354,6 @@ def mesh_line(term: dict | None) -> str | None:
     return head + how + f"; {term.get('seconds', 0.0):.1f} s"
 
 
-__all__ = ["mesh_error_reason", "touches", "coarse_start", "coarse_model", "resolve_on",
+__all__ = ["mesh_error_reason", "touches", "coarse_start", "coarse_model", "resolve_on", "slim_stage",
            "resolve_coarser", "failed_run", "coarse_sizes", "start_coarse_levels", "mesh_error_term",
            "with_mesh_term", "mesh_checked", "mesh_line"]
