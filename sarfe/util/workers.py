@@ -368,6 +368,11 @@ class Background:
     def alive(self) -> bool:
         return self._process is not None and self._process.is_alive()
 
+    @property
+    def pid(self) -> int | None:
+        """The worker's process id (None once closed)."""
+        return None if self._process is None else self._process.pid
+
     def ask(self, message):
         """``respond(state, message)`` computed by the worker (after ``prepare`` is done), or None
         where the worker is gone."""

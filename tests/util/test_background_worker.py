@@ -35,7 +35,7 @@ def test_background_prepares_once_elsewhere_and_answers_from_its_state():
         return {"pid": os.getpid(), "base": 10}
 
     with workers.Background(prepare, lambda state, x: (state["pid"], state["base"] + x)) as b:
-        pid = b._process.pid
+        pid = b.pid
         answers = [b.ask(x) for x in range(3)]
     assert [a[1] for a in answers] == [10, 11, 12]
     assert {a[0] for a in answers} == {pid} and pid != os.getpid()
@@ -57,7 +57,7 @@ def test_background_errors_and_a_dead_worker():
     with workers.Background(lambda: 1 / 0, respond) as b:
         assert isinstance(b.ask(1), ZeroDivisionError)    # prepare's error is every answer
     with workers.Background(lambda: None, respond) as b:
-        os.kill(b._process.pid, signal.SIGKILL)
+        os.kill(b.pid, signal.SIGKILL)
         assert b.ask(1) is None and not b.alive()
 
 
@@ -65,9 +65,7 @@ def test_a_dropped_background_ends_its_worker():
     """The parent's end of the pipe closed (the object collected, e.g. a solve that raised before
     the mesh term): the worker's recv ends and it exits."""
     b = workers.Background(lambda: None, lambda state, x: x)
-    pid = b._process.pid
-    process = b._process
+    pid = b.pid
     del b
     gc.collect()
     assert _gone(pid)
-    process.join(timeout=5)

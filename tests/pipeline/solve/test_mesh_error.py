@@ -9,6 +9,9 @@ With two workers the coarser models are built in the background from the start o
 (issue 30) and give the serial path's term within 1e-12, also when that worker died."""
 import json
 import math
+import os
+import signal
+import time
 from pathlib import Path
 
 import pytest
@@ -119,8 +122,9 @@ def _term(workers, monkeypatch=None, kill=False):
             background = mesh_error.start_coarse_levels(case)
             started.append(background)
             if kill and background is not None:
-                background._process.kill()
-                background._process.join()
+                os.kill(background.pid, signal.SIGKILL)
+                while background.alive():
+                    time.sleep(0.01)
             return background
         monkeypatch.setattr(pipeline_run, "start_coarse_levels", start)
     result = solve_case(load_case(data), write=False)
