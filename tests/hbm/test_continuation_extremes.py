@@ -167,8 +167,9 @@ def _swept(name):
 @pytest.mark.timeout(900)
 @pytest.mark.xfail(strict=True, reason="issue 29, measured 2026-11-28: the H = 7 branch of the "
                    "k_n = 1e10 contact is 17 % (71.5 Hz) and 39 % (75.6 Hz) off the sub-stepped "
-                   "Newmark orbit on its impacting part (0.02 % past the jump); its reported "
-                   "amplitude ± there is 9 %: not covered. Higher-H Newton does not converge "
+                   "Newmark orbit on its impacting part (0.02 % past the jump); the run reports "
+                   "no bound there (its impact is not resolved by H': sarfe.accuracy."
+                   "contact_resolution; before: ± 9 %). Higher-H Newton does not converge "
                    "from either orbit (benchmarks/results/extremes.md)")
 def test_hard_contact_branch_matches_time_integration():
     """k_n = 10¹⁰ N/m, the continued branch at three frequencies on its upper (impacting) part and
