@@ -11,6 +11,8 @@ Modules:
   block of every estimate (engine entry point :func:`sarfe.hbm.solve.newton_from`);
 - harmonic_truncation: the H → H' and N → 2N parts of an estimate, Richardson factors;
 - modal_truncation: the Craig–Bampton mode-truncation part (coarser models, two probes, decay);
+- contact_resolution: whether H' resolves a contact's impacts at all (ρ = k_c |C_{H'}|, the
+  impact's duration against T/(2H')); where not, the point has no bound;
 - estimate: the per-point estimate combining them (:func:`estimate_errors`,
   :class:`EstimateProblem`, :func:`problem_error_estimate`);
 - resolve: a sweep's accuracy target → H, N (:func:`resolve_accuracy`);

@@ -10,6 +10,12 @@ the ERP level), from three sources, each a change of ũ re-solved by Newton
   (:mod:`sarfe.accuracy.modal_truncation`, (4)–(5));
 - spectral tails (2) of the contact displacements and forces, reported only.
 
+Before any re-solve, the indicator (6)–(7) of :mod:`sarfe.accuracy.contact_resolution` asks
+whether H' reaches the decay of the contacts' impacts at all; where it does not (a stiff contact's
+impact far shorter than T / (2H')), the change to H' bounds nothing: the point gets no bound
+(``amplitude_rel``, ``erp_db`` inf, the reason in ``notes``, ρ and the impact's duration in
+``contact_resolution``) and no re-solve is made.
+
 ``amplitude_rel`` = (3)·harmonics_rel + 2·aliasing_rel + modal_rel + AMPLITUDE_FLOOR, likewise
 ``erp_db`` (+ ERP_FLOOR_DB) (triangle inequality over the three sources; harmonics_rel,
 aliasing_rel are the raw changes, modal_rel already includes its factor; the floors, only where a
@@ -25,6 +31,7 @@ from dataclasses import asdict, dataclass, field, replace
 import numpy as np
 import scipy.linalg
 
+from sarfe.accuracy.contact_resolution import contact_resolution
 from sarfe.accuracy.harmonic_truncation import (RICHARDSON, aliasing_change, extended_harmonics,
                                                 harmonics_richardson, reach_harmonics,
                                                 truncation_change)
@@ -50,6 +57,9 @@ class ErrorEstimate:
     harmonics of the H' re-solve above it are answered by the residual vectors, whose Ritz
     frequencies sit just above it — there the reduced model's own error enters the harmonics
     change (:func:`basis_limited_extension`).
+    contact_resolution: :meth:`sarfe.accuracy.contact_resolution.ContactResolution.as_dict` of
+    the point (None: not asked); when not ``resolved`` the point has no bound (inf), and only
+    then is it in :meth:`as_dict`.
     """
 
     harmonics: int
@@ -68,10 +78,13 @@ class ErrorEstimate:
     seconds: float = 0.0
     notes: tuple = field(default=())
     basis_top_hz: float = float("nan")
+    contact_resolution: dict | None = None
 
     def as_dict(self) -> dict:
         data = asdict(self)
         data["notes"] = list(self.notes)
+        if self.contact_resolution is None or self.contact_resolution["resolved"]:
+            data.pop("contact_resolution")     # said only where it withholds the bound
         return data
 
 
@@ -103,6 +116,16 @@ def estimate_errors(solution, model, contacts, excitation, *, erp_map=None, erp_
     nan = float("nan")
     h_rel = h_db = a_rel = a_db = nan
     H_ext = int(harmonics_extension or extended_harmonics(H))
+    resolution = contact_resolution(solution, model, contacts, excitation, H_ext) \
+        if truncation and contacts.count else None
+    if resolution is not None and not resolution.resolved:    # no bound: nothing to re-solve
+        inf = float("inf")
+        return ErrorEstimate(
+            harmonics=H, samples_per_period=N, extended_harmonics=H_ext, harmonics_rel=nan,
+            harmonics_db=nan, aliasing_rel=nan, aliasing_db=nan, modal_rel=nan, modal_db=nan,
+            displacement_tail=disp_tail, force_tail=force_tail, amplitude_rel=inf, erp_db=inf,
+            seconds=time.perf_counter() - clock, notes=(resolution.note(),),
+            contact_resolution=resolution.as_dict())
     if truncation:
         h_rel, h_db, H_ext, more = truncation_change(solution, model, contacts, excitation, H_ext,
                                                      **common)
@@ -133,7 +156,8 @@ def estimate_errors(solution, model, contacts, excitation, *, erp_map=None, erp_
         modal_rel=m_rel, modal_db=m_db, displacement_tail=disp_tail, force_tail=force_tail,
         amplitude_rel=float(sum(parts_rel)) if parts_rel else nan,
         erp_db=float(sum(parts_db)) if parts_db else nan,
-        seconds=time.perf_counter() - clock, notes=tuple(notes))
+        seconds=time.perf_counter() - clock, notes=tuple(notes),
+        contact_resolution=None if resolution is None else resolution.as_dict())
 
 
 @dataclass(frozen=True)

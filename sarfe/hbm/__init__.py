@@ -21,6 +21,7 @@ Modules (in the order a solve uses them):
     continuation       the sweep: pseudo-arclength continuation in ω through folds
     arclength          its steps: bordered tangent, hyperplane/sphere corrector, corner step
     energy_balance     is a point's energy balance resolved by its N samples (the sweep raises N)
+    sampled_folds      turns of ω the AFT sampling makes: the sweep steps over them at fixed ω
     stability/         is the orbit stable? one entry, stability(...) (Hill, contact-row count, …)
     pruning            contact screening: contacts that never switch solved linearly
     linear_points      points where every contact stays open/closed/stuck: the linearized

@@ -33,8 +33,9 @@ from sarfe.pipeline.post.stability_need import stability_stride
 from sarfe.pipeline.solve.by_need import erp_measure
 from sarfe.pipeline.solve.case_accuracy import (accuracy_check, case_resolution, resolution_line,
                                                 resolved_case)
+from sarfe.pipeline.solve.impact_check import impact_check_point, impact_time_check
 from sarfe.pipeline.solve.mesh_error import (mesh_checked, mesh_error_term, mesh_line,
-                                             with_mesh_term)
+                                             start_coarse_levels, with_mesh_term)
 from sarfe.pipeline.solve.points import common_samples, sweep_status
 from sarfe.pipeline.solve.pruned_points import solve_points_pruned
 from sarfe.pipeline.write.result_files import write_outputs
@@ -114,6 +115,8 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         linear_stage = next((s for s in (linear_stage, searched)
                              if s is not None and s.key == linear_model_key(case)), None)
         timings["accuracy_s"] = time.perf_counter() - clock
+    # the ± mesh term's coarser models, built on the other core from now on (this process small)
+    coarse_levels = start_coarse_levels(case)
     if linear_stage is None:
         linear_stage = build_linear_model(case, progress=progress)
         timings.update(linear_stage.timings)
@@ -195,11 +198,25 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         else ([], [], [], [])
     # the ± mesh term: the loudest point re-solved on a 2× coarser generated mesh (issue 29 item 4)
     clock = time.perf_counter()
-    mesh_term = mesh_error_term(case, points, solutions) if config.solver.error_estimate \
+    mesh_term = mesh_error_term(case, points, solutions, background=coarse_levels) \
+        if config.solver.error_estimate \
         else {"estimated": False, "reason": "not estimated (solver.error_estimate: false)"}
+    timings.update(mesh_term.pop("timings_s", {}))    # the coarser models' background seconds
     with_mesh_term(points, rows, mesh_term)
     mesh_term["line"] = mesh_line(mesh_term)
     timings["mesh_error_s"] = time.perf_counter() - clock
+    # the headline's ± where H cannot give one (an unresolved impact): time integration, issue 29
+    impact_check, loudest = None, impact_check_point(points)
+    if loudest is not None:
+        bar = progress_bar(progress, "the loudest point's error by time integration (its impact "
+                                     "is not resolved by H)", None)
+        try:
+            clock = time.perf_counter()
+            impact_check = impact_time_check(stage, nl, points, rows, solutions, loudest)
+            timings["impact_check_s"] = time.perf_counter() - clock
+        finally:
+            if bar is not None:
+                bar.close()
     not_converged = [p["index"] for p in points if not p["converged"]]
     # None entries without a sweep
     sweep = sweep_status(config.excitation, config.solver.continuation, solutions)
@@ -238,6 +255,7 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         "accuracy": accuracy,                    # None unless solver.accuracy was given
         "accuracy_check": mesh_checked(accuracy_check(config.solver, points), mesh_term, case),
         "mesh_error": mesh_term,                 # the ± mesh term (sarfe.pipeline.solve.mesh_error)
+        **({} if impact_check is None else {"impact_check": impact_check}),   # (impact_check.py)
         "warnings": warnings,                    # inputs far outside the model's range
         "timings_s": timings,
         "cost_estimate": None if cost is None else cost.as_dict(),   # said before the run

@@ -240,14 +240,17 @@ def headline_notes(worst: dict) -> list[str]:
     """What the headline level of summary.json's ``worst`` does not carry: 'stability not
     assessed' (``stable`` None: the loudest point is the loudest one not found unstable),
     'error interpolated' (its error bound is the larger of two estimated neighbours'),
-    'error unknown' (its estimate's re-solve failed), 'error not estimated' (none asked or no
+    'error unknown' (its estimate's re-solve failed), ``error_note`` when given (no bound: a
+    contact's impact the harmonics do not resolve), 'error not estimated' (none asked or no
     contacts). Keys absent (older summaries): no note."""
     notes = []
     if "stable" in worst and worst["stable"] is None:
         notes.append("stability not assessed")
     if worst.get("error_interpolated"):
         notes.append("error interpolated")
-    if "erp_error_db" in worst and worst["erp_error_db"] is None:
+    if worst.get("error_note"):        # no bound, and why (an impact H does not resolve)
+        notes.append(worst["error_note"])
+    elif "erp_error_db" in worst and worst["erp_error_db"] is None:
         notes.append("error unknown" if worst.get("error_estimated") else "error not estimated")
     return notes
 

@@ -25,6 +25,9 @@ process. This module imports only :mod:`sarfe.util.parent_watch`, so every layer
   order), so a caller whose items are of different sizes can weigh them.
 
 :func:`worker_count` turns the case's ``solver.workers`` (``auto`` | n) into a process count.
+:class:`Stream` computes items that arrive one at a time on one worker; :class:`Background`
+prepares a state on one worker forked at once (before this process builds its own large arrays)
+and answers questions on it later (the mesh term's coarser models, built while the sweep runs).
 """
 from __future__ import annotations
 
@@ -316,6 +319,110 @@ def _stream_worker(function, batch, connection, parent_pid):
                 result = error
             connection.send((key, result))
         connection.send(None)
+    except (BrokenPipeError, EOFError, OSError):
+        pass
+    finally:
+        connection.close()
+
+
+class Background:
+    r"""``prepare()`` on one process forked now, then ``respond(state, message)`` there for each
+    :meth:`ask`: work whose costly part does not depend on what this process is about to compute
+    (the mesh term's coarser linear stages, :mod:`sarfe.pipeline.solve.mesh_error`, built while
+    this process builds its own stage and sweeps).
+
+        background = Background(prepare, respond)   # forks at once; prepare() runs there
+        …
+        answer = background.ask(message)            # respond(state, message), waited for
+        background.close()
+
+    Fork it early, before this process holds large arrays: the worker inherits the parent's pages
+    copy-on-write, and only ``message`` and the answers are pickled. ``ask`` returns None where
+    the worker died (killed, out of memory) or is closed: the caller then computes the answer
+    itself. An exception raised by ``prepare`` or ``respond`` comes back as the answer (the caller
+    decides). The worker keeps one BLAS / OpenMP thread and ignores SIGINT, dies with this process
+    (SIGKILL included: :func:`sarfe.util.parent_watch.die_with_parent`), ends when its pipe closes
+    (:meth:`close`, this object collected) and is a daemon (ended at this interpreter's exit).
+    """
+
+    def __init__(self, prepare, respond):
+        from threadpoolctl import threadpool_limits
+
+        context = multiprocessing.get_context("fork")
+        parent, child = context.Pipe()
+        with threadpool_limits(limits=1):
+            process = context.Process(target=_background_worker,
+                                      args=(prepare, respond, child, parent, os.getpid()),
+                                      daemon=True)
+            process.start()
+        child.close()
+        self._process, self._connection = process, parent
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+    def alive(self) -> bool:
+        return self._process is not None and self._process.is_alive()
+
+    @property
+    def pid(self) -> int | None:
+        """The worker's process id (None once closed)."""
+        return None if self._process is None else self._process.pid
+
+    def ask(self, message):
+        """``respond(state, message)`` computed by the worker (after ``prepare`` is done), or None
+        where the worker is gone."""
+        if self._process is None:
+            return None
+        try:
+            self._connection.send(message)
+            return self._connection.recv()
+        except (EOFError, OSError):
+            self.close()
+            return None
+
+    def close(self):
+        """End the worker (it is told to stop; ended by force after 5 s)."""
+        process, self._process = self._process, None
+        if process is None:
+            return
+        try:
+            self._connection.send(None)
+        except OSError:
+            pass
+        process.join(timeout=5)
+        if process.is_alive():
+            process.terminate()
+            process.join(timeout=5)
+        self._connection.close()
+
+
+def _background_worker(prepare, respond, connection, parent_end, parent_pid):
+    """Body of a :class:`Background` worker: prepare, then answer each message until None (or
+    until the parent's end of the pipe closes: this copy of it is closed first)."""
+    parent_end.close()
+    _start_worker(parent_pid)
+    try:
+        try:
+            state, failed = prepare(), None
+        except Exception as error:           # every answer is that error (the caller decides)
+            state, failed = None, error
+        while True:
+            message = connection.recv()
+            if message is None:
+                break
+            if failed is not None:
+                answer = failed
+            else:
+                try:
+                    answer = respond(state, message)
+                except Exception as error:
+                    answer = error
+            connection.send(answer)
     except (BrokenPipeError, EOFError, OSError):
         pass
     finally:

@@ -3,7 +3,7 @@
 Before: SIGKILL of `sarfe solve` during a parallel stage left its 2 pool workers alive (150 MB
 each, blocked on their task pipe, still there after 4 min), 5 times out of 5. Now the kernel's
 parent-death signal (Linux) and a watchdog thread end every child within a few seconds: the
-process-pool workers and the stream worker of sarfe.util.workers, and the pyvista render child
+process-pool workers, the stream worker and the background worker of sarfe.util.workers, and the pyvista render child
 of sarfe.results.render. (The Dask workers of `sarfe batch` already died with it, within 1 s.)
 """
 from __future__ import annotations
@@ -85,7 +85,20 @@ with workers.Stream(forever) as stream:
 """
 
 
-@pytest.mark.parametrize("script", [BLOCKED_POOL, BLOCKED_STREAM], ids=["pool", "stream"])
+BLOCKED_BACKGROUND = """
+import time
+from sarfe.util import workers
+
+def forever():
+    time.sleep(3600)
+
+background = workers.Background(forever, lambda state, message: state)
+time.sleep(3600)
+"""
+
+
+@pytest.mark.parametrize("script", [BLOCKED_POOL, BLOCKED_STREAM, BLOCKED_BACKGROUND],
+                         ids=["pool", "stream", "background"])
 def test_pool_and_stream_workers_die_with_a_killed_parent(script):
     parent = subprocess.Popen([sys.executable, "-c", script], env=ENV, stderr=subprocess.PIPE)
     children = wait_for_children(parent, 2 if script is BLOCKED_POOL else 1, timeout_s=60)

@@ -299,7 +299,9 @@ def error_estimates(config: CaseConfig, stage, nl, solutions, stride=ESTIMATE_ST
     ``stride``-th converged point, the first and last, and the point with the largest first-harmonic
     contact amplitude (the resonance, where the error peaks). The error of a harmonic-balance
     solution varies smoothly along a branch between those points, so the subset costs 1/stride of
-    the per-point estimates; benchmarks/results/accuracy.md measures cost and bracketing."""
+    the per-point estimates; benchmarks/results/accuracy.md measures cost and bracketing. A
+    neighbour whose impact the harmonics do not resolve (no bound,
+    :mod:`sarfe.accuracy.contact_resolution`) leaves the point without one (inf, its notes)."""
     n = len(solutions)
     solver = config.solver
     if not solver.error_estimate or not nl.contacts.count:
@@ -311,8 +313,13 @@ def error_estimates(config: CaseConfig, stage, nl, solutions, stride=ESTIMATE_ST
                                                         chosen[:1] and [0], workers)))
     if len(chosen) == sum(s.converged for s in solutions):      # every converged point
         return [computed.get(i) if s.converged else None for i, s in enumerate(solutions)]
+    # a point whose impact the harmonics do not resolve (no bound, contact_resolution) counts
+    # too — a property of the branch there: a neighbour between it and a bounded point takes the
+    # larger, no bound, not one from bounded points further along; a point whose re-solve alone
+    # did not converge (inf) is that point's alone (as before: its neighbours keep theirs)
     usable = [i for i in sorted(computed) if computed[i] is not None and "failed" not in computed[i]
-              and np.isfinite(computed[i]["amplitude_rel"])]    # (unknown: that point alone)
+              and (np.isfinite(computed[i]["amplitude_rel"])
+                   or "contact_resolution" in computed[i])]
     out = []
     for i, s in enumerate(solutions):
         if i in computed or not s.converged or not usable:
@@ -326,6 +333,12 @@ def error_estimates(config: CaseConfig, stage, nl, solutions, stride=ESTIMATE_ST
             if isinstance(value, (int, float)) and not isinstance(value, bool):
                 values = [computed[j][key] for j in near if not np.isnan(computed[j][key])]
                 merged[key] = max(values) if values else float("nan")
+        for j in near:      # why a neighbour has no bound: said at this point too
+            if not np.isfinite(computed[j]["amplitude_rel"]):
+                merged["notes"] = list(computed[j].get("notes") or [])
+                if "contact_resolution" in computed[j]:
+                    merged["contact_resolution"] = computed[j]["contact_resolution"]
+                break
         merged["seconds"] = 0.0
         out.append(merged)
     return out
@@ -544,6 +557,10 @@ def worst_of(points):
                  "excitation": None if excitation is None else {
                      "level_dba": excitation["level_dba"], "share_a": excitation["share_a"]},
                  "bands": p.get("bands"), "contacts": {}, **loudest_review(p)}
+        if (estimate.get("contact_resolution") or {}).get("resolved") is False:   # why: notes
+            worst["error_note"] = ("± by time integration: impact not resolved by H"
+                                   if "time_check" in estimate
+                                   else "no error bound: impact not resolved by H")
     for c_index, c in enumerate(points[0]["contacts"]):
         pen = [p["contacts"][c_index]["max_penetration_m"] for p in points]
         force = [p["contacts"][c_index]["peak_normal_force_N"] for p in points]

@@ -240,19 +240,44 @@ def accuracy_check(solver: SolverConfig, points) -> dict | None:
                         f"the reduced basis' top mode at {e['basis_top_hz']:.0f} Hz, where the "
                         "reduced model's own error enters the change: if a higher "
                         "reduction.cutoff_margin lowers it, it was the basis')")
-    if unknown:     # an estimate whose re-solve did not converge: unknown, said, not hidden
-        where = ", ".join(f"{p['frequency_hz']:.2f}" for p in unknown[:3])
-        more = f" and {len(unknown) - 3} more" if len(unknown) > 3 else ""
+    if unknown:     # no bound (re-solve not converged, impact not resolved): said, not hidden
         met = False
-        warning = (warning + "; " if warning else "accuracy: ") + (
-            f"no error estimate at {where}{more} Hz (its re-solve at more harmonics or samples "
-            "did not converge)")
+        warning = (warning + "; " if warning else "accuracy: ") + unknown_text(unknown)
     return {"met": bool(met), "target": target.name, "point": worst["index"],
             "unknown_points": [p["index"] for p in unknown],
             "frequency_hz": worst["frequency_hz"], "amplitude_rel": float(e["amplitude_rel"]),
             "erp_db": float(e["erp_db"]), "knob": KNOBS[knob], "warning": warning}
 
 
-__all__ = ["accuracy_check", "resolved_case", "with_cutoff", "stage_modal_coordinates", "accuracy_problem", "stage_error_estimate", "sweep_grid_hz",
+def unknown_text(points) -> str:
+    """What the run says of its points without an error bound (summary.json points with an
+    ``error_estimate`` whose amplitude_rel is inf): where the harmonics do not resolve a contact's
+    impact (``contact_resolution``, :mod:`sarfe.accuracy.contact_resolution`) the count, the
+    frequency range and why; the others' re-solve did not converge."""
+    def where(group):
+        shown = ", ".join(f"{p['frequency_hz']:.2f}" for p in group[:3])
+        return shown + (f" and {len(group) - 3} more" if len(group) > 3 else "") + " Hz"
+
+    impacts = [p for p in points if (p["error_estimate"].get("contact_resolution") or {})
+               .get("resolved") is False]
+    failed = [p for p in points if p not in impacts]
+    parts = []
+    if impacts:
+        r = max((p["error_estimate"]["contact_resolution"] for p in impacts),
+                key=lambda r: r["ratio"])
+        f = [p["frequency_hz"] for p in impacts]
+        parts.append(
+            f"no error bound at {len(impacts)} points ({min(f):.2f}–{max(f):.2f} Hz): the impact "
+            f"of {r['contact']} lasts ≈ {1e6 * r['impact_duration_s']:.3g} µs, far shorter than "
+            f"the {1e6 * r['resolved_duration_s']:.3g} µs H' = {r['harmonics']} resolves, so no "
+            f"change of H bounds the error there (a bound needs H' ≥ {r['needed_harmonics']}: "
+            "raise solver.harmonics, or soften the contact)")
+    if failed:
+        parts.append(f"no error estimate at {where(failed)} (its re-solve at more harmonics or "
+                     "samples did not converge)")
+    return "; ".join(parts)
+
+
+__all__ = ["unknown_text", "accuracy_check", "resolved_case", "with_cutoff", "stage_modal_coordinates", "accuracy_problem", "stage_error_estimate", "sweep_grid_hz",
            "resolve_case_accuracy", "case_resolution", "resolution_line", "rule_cutoff_hz",
            "search_margin", "NEWTON_FLOOR_HZ", "NEWTON_HARMONICS"]

@@ -19,7 +19,12 @@ rattle near its fold) the level change is no estimate: the term is "not estimate
 reason. The term is measured at the loudest point and added to every estimated point's ERP bound
 (``error_estimate.mesh_db``, ``erp_db`` includes it): the headline carries it where it was
 measured; elsewhere it stands for the mesh error of the run. Cost: the two re-solves (≈ ¼ and ½
-of the fine mesh's DOFs), ``timings_s.mesh_error_s``.
+of the fine mesh's DOFs), ``timings_s.mesh_error_s``. Their linear stages do not depend on the
+loudest point: with two or more workers (``solver.workers``) :func:`start_coarse_levels` builds
+them on one background process forked before the fine linear stage, on the core the fine stage
+and the one-core sweep leave idle, and only the two Newton solves are left after the sweep
+(``timings_s.mesh_error_build_s`` / ``mesh_error_solve_s``: the background's seconds); with one
+worker they are built after the sweep in this process. Both paths compute the same numbers.
 
 Only generated meshes (``model.fe.generator``) have a coarser mesh to build: for decks, given
 meshes and matrices models the term is "not estimated" and said so (``solver.mesh_error``:
@@ -27,6 +32,12 @@ meshes and matrices models the term is "not estimated" and said so (``solver.mes
 """
 from __future__ import annotations
 
+import contextlib
+import ctypes
+import ctypes.util
+import dataclasses
+import functools
+import gc
 import time
 import warnings
 
@@ -39,7 +50,7 @@ from sarfe.hbm.time_integration import linear_harmonic_response
 from sarfe.pipeline.model.linear_stage import build_linear_model
 from sarfe.pipeline.model.nonlinear_model import nonlinear_model
 from sarfe.pipeline.post.records import loudest_point, point_erp
-from sarfe.util.workers import map_points, worker_count
+from sarfe.util.workers import Background, map_points, worker_count
 
 
 def mesh_error_reason(case) -> str | None:
@@ -73,15 +84,20 @@ def coarse_start(nl_coarse, solution, H):
     return linear_harmonic_response(nl_coarse.model, F, solution.omega)
 
 
-def resolve_coarser(case, fine, mesh_size_m):
-    """The fine point ``fine`` (a HarmonicSolution) re-solved on a generated mesh of
-    ``mesh_size_m``: one linear stage (the case's reduction rule and cutoff) and one Newton solve at
-    its ω, H, N, warm-started by :func:`coarse_start` → {'mesh_size_m', 'level_db', 'level_dba',
-    'converged', 'touching', 'nodes', 'reason'}. Raises what building the mesh or the model raises."""
-    solver = case.config.solver
+def coarse_model(case, mesh_size_m):
+    """The linear stage and nonlinear model of ``case`` on a generated mesh of ``mesh_size_m``
+    (the case's reduction rule and cutoff) → (stage, nl). Raises what building them raises."""
     coarse = case.with_generator(mesh_size_m=mesh_size_m)
     stage = build_linear_model(coarse)
-    nl = nonlinear_model(coarse, stage)
+    return stage, nonlinear_model(coarse, stage)
+
+
+def resolve_on(case, stage, nl, fine, mesh_size_m):
+    """The fine point ``fine`` (a HarmonicSolution) re-solved on the coarser model ``stage``,
+    ``nl`` (:func:`coarse_model` of ``mesh_size_m``): one Newton solve at its ω, H, N,
+    warm-started by :func:`coarse_start` → {'mesh_size_m', 'level_db', 'level_dba',
+    'converged', 'touching', 'nodes', 'reason'}."""
+    solver = case.config.solver
     H, N = int(fine.harmonics), int(fine.samples_per_period)
     options = SolverOptions(tolerance=solver.tolerance, max_iterations=solver.max_iterations,
                             stability=False, harmonic_set=solver.harmonic_set)
@@ -100,7 +116,95 @@ def resolve_coarser(case, fine, mesh_size_m):
             "reason": getattr(s, "reason", "")}
 
 
-def mesh_error_term(case, points, solutions, ratio=MESH_GCI_RATIO) -> dict:
+def resolve_coarser(case, fine, mesh_size_m):
+    """The fine point ``fine`` re-solved on a generated mesh of ``mesh_size_m``: one linear stage
+    (:func:`coarse_model`) and one Newton solve (:func:`resolve_on`). Raises what building the
+    mesh or the model raises."""
+    return resolve_on(case, *coarse_model(case, mesh_size_m), fine, mesh_size_m)
+
+
+def failed_run(mesh_size_m, error) -> dict:
+    """The record of a coarser level that could not be built or solved."""
+    return {"mesh_size_m": mesh_size_m, "failed": f"{type(error).__name__}: {error}"}
+
+
+def coarse_sizes(case, ratio=MESH_GCI_RATIO) -> tuple:
+    """The coarser mesh sizes (r²h, r·h) [m] of the mesh term, the coarsest first."""
+    h = float(case.config.model.fe.generator.mesh_size_m)
+    return (ratio ** 2 * h, ratio * h)
+
+
+def slim_stage(stage):
+    """``stage`` with what :func:`resolve_on` reads after :func:`coarse_model` (the ERP map and
+    areas, ``info``) and without the mesh and the reduction basis (the full-space Craig–Bampton
+    shapes, n_full × n_r: the bulk of a stage), for a background process that holds it."""
+    return dataclasses.replace(stage, mesh=None, reduced=None)
+
+
+def release_memory():
+    """Collect garbage and hand the heap's free pages back to the system (glibc ``malloc_trim``;
+    nothing where there is none)."""
+    gc.collect()
+    try:
+        ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6").malloc_trim(0)
+    except (OSError, AttributeError):
+        pass
+
+
+def start_coarse_levels(case, ratio=MESH_GCI_RATIO):
+    """Start building the mesh term's coarser models now, on one background process
+    (:class:`sarfe.util.workers.Background`), or None where the term is not due (error estimate
+    or mesh term off, no generated mesh) or the case has one worker (``solver.workers``: the
+    serial path builds them after the sweep). The coarser linear stages do not depend on the
+    sweep: started before the fine linear stage (this process still small at the fork), they are
+    built on the core the fine stage and the one-core sweep leave idle; after the sweep
+    :func:`mesh_error_term` sends the loudest point there and gets the re-solves back (the same
+    computation as on the serial path: same models, same start, one BLAS thread)."""
+    solver = case.config.solver
+    if not solver.error_estimate or mesh_error_reason(case) is not None \
+            or worker_count(solver.workers) < 2:
+        return None
+    sizes = coarse_sizes(case, ratio)
+
+    def prepare():          # the coarsest first: it decides whether the middle one is used
+        built = {}
+        for size in sizes:
+            clock = time.perf_counter()
+            try:
+                stage, nl = coarse_model(case, size)
+                built[size] = (slim_stage(stage), nl)
+            except Exception as error:  # an estimate must not break a solve
+                built[size] = error
+            built[size, "build_s"] = time.perf_counter() - clock
+        release_memory()     # it waits through the sweep: hold the models, not the build's heap
+        return built
+
+    return Background(prepare, functools.partial(_resolve_built, case))
+
+
+def _resolve_built(case, built, message):
+    """A :class:`Background` answer: the fine point re-solved on each prepared coarser model
+    ({size: run record}, :func:`resolve_on`; a size not prepared is built here), each record with
+    the seconds its model took to build ('build_s', in the background) and to solve ('solve_s')."""
+    sizes, fine = message
+    runs = {}
+    for size in sizes:
+        clock = time.perf_counter()
+        try:
+            model = built.get(size)
+            if model is None:
+                model = coarse_model(case, size)
+            if isinstance(model, Exception):
+                raise model
+            runs[size] = resolve_on(case, *model, fine, size)
+        except Exception as error:      # an estimate must not break a solve
+            runs[size] = failed_run(size, error)
+        runs[size].update(build_s=built.get((size, "build_s"), 0.0),
+                          solve_s=time.perf_counter() - clock)
+    return runs
+
+
+def mesh_error_term(case, points, solutions, ratio=MESH_GCI_RATIO, background=None) -> dict:
     """The mesh term (module docstring) of a solved case: ``points`` the summary's point records,
     ``solutions`` their HarmonicSolutions → {'estimated', 'reason', 'mesh_db', 'method',
     'convergence', 'order', 'order_used', 'safety_factor', 'ratio', 'mesh_size_m',
@@ -108,7 +212,14 @@ def mesh_error_term(case, points, solutions, ratio=MESH_GCI_RATIO) -> dict:
     coarsest), 'coarse_level_db', 'coarse_level_dba', 'coarse_converged', 'coarse_nodes',
     'frequency_hz', 'level_db', 'level_dba', 'seconds'}. A failure (coarser mesh not built, Newton
     not converged) is reported as not estimated, never raised; where only the middle mesh fails,
-    the two meshes h, 2h give (1) of :mod:`sarfe.accuracy.mesh_refinement` (method 'two meshes')."""
+    the two meshes h, 2h give (1) of :mod:`sarfe.accuracy.mesh_refinement` (method 'two meshes').
+    ``background``: :func:`start_coarse_levels` of this case (its coarser models already built
+    there; closed here), else the levels are built now."""
+    with background if background is not None else contextlib.nullcontext():
+        return _mesh_error_term(case, points, solutions, ratio, background)
+
+
+def _mesh_error_term(case, points, solutions, ratio, background):
     clock = time.perf_counter()
     out = {"estimated": False, "mesh_db": float("nan"), "order": float("nan"),
            "ratio": float(ratio), "reason": mesh_error_reason(case)}
@@ -126,13 +237,17 @@ def mesh_error_term(case, points, solutions, ratio=MESH_GCI_RATIO) -> dict:
         try:
             return resolve_coarser(case, fine, size)
         except Exception as error:  # an estimate must not break a solve
-            return {"mesh_size_m": size, "failed": f"{type(error).__name__}: {error}"}
+            return failed_run(size, error)
 
+    # the coarser models built in the background during the sweep (start_coarse_levels), else
     # the two coarser meshes at once on the case's workers (the coarsest, 2h, decides whether
     # the middle one is used); one process: the coarsest first, the middle only if it converged
-    sizes = (ratio ** 2 * h, ratio * h)
-    workers = min(worker_count(case.config.solver.workers), len(sizes))
-    runs = dict(zip(sizes, map_points(run, sizes, workers))) if workers > 1 else {}
+    sizes = coarse_sizes(case, ratio)
+    runs = background.ask((sizes, fine)) if background is not None else None
+    answered = isinstance(runs, dict)
+    if not answered:                         # no background, or its worker died
+        workers = min(worker_count(case.config.solver.workers), len(sizes))
+        runs = dict(zip(sizes, map_points(run, sizes, workers))) if workers > 1 else {}
     if not runs:
         runs[sizes[0]] = run(sizes[0])
         if "failed" not in runs[sizes[0]] and runs[sizes[0]]["converged"]:
@@ -140,6 +255,9 @@ def mesh_error_term(case, points, solutions, ratio=MESH_GCI_RATIO) -> dict:
     coarsest = runs[ratio ** 2 * h]
     middle = runs.get(ratio * h, {"mesh_size_m": ratio * h, "failed": "not solved"})
     runs = [middle, coarsest]
+    if answered:     # timings_s (popped by the caller): the background's seconds
+        out["timings_s"] = {f"mesh_error_{k}": sum(r.get(k, 0.0) for r in runs)
+                            for k in ("build_s", "solve_s")}
     out.update(coarse_mesh_size_m=coarsest["mesh_size_m"],
                coarse_mesh_sizes_m=[r["mesh_size_m"] for r in runs],
                coarse_levels_db=[r.get("level_db") for r in runs],
@@ -236,5 +354,6 @@ def mesh_line(term: dict | None) -> str | None:
     return head + how + f"; {term.get('seconds', 0.0):.1f} s"
 
 
-__all__ = ["mesh_error_reason", "touches", "coarse_start", "resolve_coarser", "mesh_error_term",
+__all__ = ["mesh_error_reason", "touches", "coarse_start", "coarse_model", "resolve_on", "slim_stage",
+           "resolve_coarser", "failed_run", "coarse_sizes", "start_coarse_levels", "mesh_error_term",
            "with_mesh_term", "mesh_checked", "mesh_line"]

@@ -13,6 +13,7 @@ from sarfe.accuracy.target import parse_accuracy
 from sarfe.case.config import ContinuationConfig, ExcitationConfig, SolverConfig
 from sarfe.hbm import ContinuationOptions, SolverOptions, continuation, solve_frequency
 from sarfe.hbm.continuation import LEFT_LOOP
+from sarfe.hbm.sampled_folds import STEPPED_FOLD
 from sarfe.hbm.harmonics import harmonic_coefficients
 from sarfe.hbm.residual import nonlinear_force
 from sarfe.hbm.solution import HarmonicSolution
@@ -172,7 +173,8 @@ def sweep_status(excitation: ExcitationConfig, continuation: ContinuationConfig,
     frequencies are the band's ends (10⁻³ of its width) and no gap between neighbouring converged
     frequencies is wider than the continuation's largest step (``max_step`` of the band).
     reason: one line saying what happened (None when complete).
-    note: one line naming the closed loops of solutions the continuation left (None if none)."""
+    note: one line naming the closed loops of solutions the continuation left and the folds of
+    the sampled branch it stepped over (None if none)."""
     if excitation.sweep is None:
         return {"complete": None, "reason": None, "covered": None, "note": None}
     start, end = excitation.sweep.start_hz, excitation.sweep.end_hz
@@ -190,6 +192,14 @@ def sweep_status(excitation: ExcitationConfig, continuation: ContinuationConfig,
     note = (f"the continuation {LEFT_LOOP} (H = {solutions[0].harmonics} truncation) "
             f"{len(left)} time(s) and went on from a point solved at fixed frequency past it, at "
             f"{', '.join(left)} Hz (see those points' reason)") if left else None
+    stepped = [f"{float(s.omega) / (2 * np.pi):.2f}" for s in solutions
+               if STEPPED_FOLD in str(s.reason)]
+    if stepped:                 # zig-zags of the sampled branch (sarfe.hbm.sampled_folds)
+        over = (f"the continuation {STEPPED_FOLD} {len(stepped)} time(s) (a turn of ω that the AFT "
+                f"sampling makes, the branch going on past it; the zig-zag is not reported), "
+                f"going on from a point solved at fixed frequency at {', '.join(stepped[:6])}"
+                + (f" and {len(stepped) - 6} more" if len(stepped) > 6 else "") + " Hz")
+        note = over if note is None else f"{note}; {over}"
     if stopped is None and not fallback and reached:
         return {"complete": True, "reason": None, "covered": covered, "note": note}
     if any(CONTINUATION_FAILED in r for r in reasons):

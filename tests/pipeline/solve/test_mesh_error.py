@@ -4,8 +4,14 @@ converges with the mesh (contacts from the geometry, issue 29 items 1-3) — the
 50 Hz — the ± with the term (the loudest point re-solved on √2 and 2 times the element size, a grid
 convergence index of the three levels) covers the difference to a converged fine mesh (the stored references of tests/cases/data/
 mesh_convergence_reference.json, how each was made written in it); the ± shown (console,
-table.txt, report, summary.json) includes it; decks and given meshes say "not estimated"."""
+table.txt, report, summary.json) includes it; decks and given meshes say "not estimated".
+With two workers the coarser models are built in the background from the start of the run
+(issue 30) and give the serial path's term within 1e-12, also when that worker died."""
 import json
+import math
+import os
+import signal
+import time
 from pathlib import Path
 
 import pytest
@@ -13,6 +19,8 @@ import pytest
 from sarfe.case.errors import CaseError
 from sarfe.cli import main
 from sarfe.pipeline import load_case, solve_case
+from sarfe.pipeline import run as pipeline_run
+from sarfe.pipeline.solve import mesh_error
 from sarfe.pipeline.solve.mesh_error import mesh_error_reason
 from sarfe.results.report import render_report_html
 
@@ -99,3 +107,53 @@ def test_decks_and_given_meshes_say_not_estimated():
     data["solver"]["mesh_error"] = True
     with pytest.raises(CaseError, match="mesh_error"):
         load_case(data, base_dir=CASES)
+
+
+# ---- the coarser models built in the background (issue 30: door_trim_p1 41 s → the solves)
+FIELDS = ("mesh_db", "level_db", "level_dba", "coarse_level_db", "coarse_level_dba", "order")
+
+
+def _term(workers, monkeypatch=None, kill=False):
+    data = one_point("rattle_rig", 31.0, 0.02, stability=False, workers=workers)
+    data["model"]["fe"]["generator"].pop("path", None)
+    started = []
+    if monkeypatch is not None:
+        def start(case):
+            background = mesh_error.start_coarse_levels(case)
+            started.append(background)
+            if kill and background is not None:
+                os.kill(background.pid, signal.SIGKILL)
+                while background.alive():
+                    time.sleep(0.01)
+            return background
+        monkeypatch.setattr(pipeline_run, "start_coarse_levels", start)
+    result = solve_case(load_case(data), write=False)
+    return result.summary["mesh_error"], result.summary["timings_s"], started
+
+
+def _same(a, b):
+    for key in FIELDS:
+        x, y = float(a[key]), float(b[key])
+        assert (math.isnan(x) and math.isnan(y)) or abs(x - y) <= 1e-12 * max(1.0, abs(x)), key
+    assert a["coarse_levels_dba"] == pytest.approx(b["coarse_levels_dba"], rel=1e-12, abs=0)
+    assert (a["method"], a.get("convergence")) == (b["method"], b.get("convergence"))
+
+
+@pytest.mark.timeout(300)
+def test_background_levels_give_the_serial_term(monkeypatch):
+    serial, serial_times, _ = _term(1)
+    assert serial["estimated"] and "mesh_error_build_s" not in serial_times
+    background, times, started = _term(2, monkeypatch)
+    assert started and started[0] is not None and not started[0].alive()   # used, then closed
+    assert times["mesh_error_build_s"] > 0 and times["mesh_error_solve_s"] > 0
+    _same(serial, background)
+    died, died_times, started = _term(2, monkeypatch, kill=True)
+    assert started[0] is not None and "mesh_error_build_s" not in died_times
+    _same(serial, died)
+
+
+def test_no_background_where_the_term_is_not_due():
+    case = load_case(one_point("squeak_rig", 50.0))
+    assert mesh_error.start_coarse_levels(case.with_solver(workers=1)) is None
+    assert mesh_error.start_coarse_levels(case.with_solver(mesh_error=False, workers=2)) is None
+    assert mesh_error.start_coarse_levels(case.with_solver(error_estimate=False, workers=2)) is None
