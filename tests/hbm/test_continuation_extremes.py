@@ -132,7 +132,7 @@ def test_extreme_sweeps_complete_or_stop_naming_the_knob(name):
 
 
 @pytest.mark.slow
-@pytest.mark.timeout(1800)
+@pytest.mark.timeout(3600)   # measured 1243 s wall, 658 CPU s at load 5-8
 def test_stiffest_contact_sweep_completes_with_more_samples():
     """k_n = 10¹¹ N/m (beyond the item's 10¹⁰) completes 30 → 90 Hz by continuation at the
     defaults. Past the first impact the contact force is a ~1 kN pulse of a few µs: at 66.3 Hz
