@@ -42,14 +42,19 @@ on cases/lumped_rattle.yaml with one parameter changed, docs/hbm.md "At the extr
   ~110° within a length no N resolves (10⁹ N/m: 111° at N = 512 … 16384). A stall within
   ``FOLD_DISTANCE`` of a point where N was already raised steps past the corner
   (:func:`sarfe.hbm.arclength.corner_step`, the point's ``reason`` says so) instead of raising N again; so does a
-  stall once N is at ``MAX_STALL_FACTOR`` × N. From then on the tangent is oriented along the
+  stall once N is at :func:`most_samples`. From then on the tangent is oriented along the
   last secant (at a corner crossed within one step, t_i oriented like t_{i−1} points back).
 - Unresolved contact forces. Each accepted point's residual with 2N samples is measured (one AFT
   evaluation); above ``ALIASING_LIMIT`` the point is re-solved with 2N, 4N, … until it is below
-  ``ALIASING_TARGET`` (≤ ``MAX_STALL_FACTOR`` × N) and the sweep goes on with that N (measured
+  ``ALIASING_TARGET`` (≤ :func:`most_samples`) and the sweep goes on with that N (measured
   largest values along the shipped sweeps: 2.6·10⁻³ lumped_rattle, 6.3·10⁻³ rattle_rig; 0.075
   with k_n = 10⁹ N/m at N = 256). Stalls (and, once a corner was stepped past or N raised for
-  this, turns) raise N up to ``MAX_STALL_FACTOR`` × N.
+  this, turns) raise N up to :func:`most_samples`: ``MAX_STALL_FACTOR`` × N, or more while
+  N × (contact rows) ≤ ``SAMPLE_BUDGET`` (an AFT evaluation costs ∝ N × rows: 13, 41, 85 ms
+  with its Jacobian at N = 2¹⁴, 2¹⁶, 2¹⁷ on lumped_rattle's 2 rows, H = 7). So a lumped model
+  may go to 2¹⁶ samples while an FE case with many contacts keeps 64 × N. k_n = 10¹¹ N/m on
+  lumped_rattle needs N = 2¹⁵ past 66 Hz (at 2¹⁴ each sample entering a 1 kN impact of 27
+  samples turns the branch by ~92° and the sweep crawled from corner to corner at 68.7 Hz).
 - Unresolved energy balance (light damping). The AFT's error in the contacts' work per period
   grows like k_n ‖r̃‖² / N² (:mod:`sarfe.hbm.energy_balance`); a lightly damped peak is set by
   the damping's work, so N is raised as above also where the work changes with 2N by more than
@@ -73,7 +78,7 @@ on cases/lumped_rattle.yaml with one parameter changed, docs/hbm.md "At the extr
   reason); else it follows the fold. ζ = 10⁻⁴: turns at 55.22 Hz (N = 2048) … 79.4 Hz.
 - Stops that name the knob: more than ``CORNER_LIMIT`` corners within ``FOLD_DISTANCE`` (raise
   solver.samples_per_period), or a loop that cannot be left (raise solver.harmonics; at
-  ``MAX_STALL_FACTOR`` × N: the contact is not resolved).
+  :func:`most_samples`: the contact is not resolved).
 
 Band edge. A branch that turns back past ω_start is stopped there: the last point is solved at
 exactly ω_start and its ``reason`` says why (no points outside the band).
@@ -103,7 +108,8 @@ from sarfe.hbm.solve import (check_omega, finalize, initial_slider, linearized_g
 
 REPORT_DISTANCE = 1e-4   # scaled arclength below which a new point replaces the last one reported
 MAX_SAMPLES_FACTOR = 16  # N may be raised to 16× the requested one at turns of ω (docstring)
-MAX_STALL_FACTOR = 64    # … and to 64× at stalled steps and unresolved contact forces
+MAX_STALL_FACTOR = 64    # … and to 64× at stalled steps and unresolved contact forces,
+SAMPLE_BUDGET = 2 ** 17  # … or further while N × contact rows stays within this (most_samples)
 BACKUP = 3               # points dropped before re-solving with 2N at a corner or turn
 FOLD_DISTANCE = 0.05     # a turn of ω this close (share of the band) to a checked one is a fold
 COS_CORNER = 0.2         # ω turns with consecutive secants at more than ~80°: a corner, checked
@@ -118,6 +124,16 @@ ALIASING_TARGET = 5e-3   # … until it is below this (a margin: the contact har
 ENERGY_LIMIT = 2e-1      # contacts' work error with 2N / dissipated energy above which N is doubled
 ENERGY_TARGET = 5e-2     # … until it is below this (sarfe.hbm.energy_balance, docstring)
 RESCALE = 10.0           # x_s follows ‖x‖ when it leaves [x_s / RESCALE, RESCALE x_s] (docstring)
+
+
+def most_samples(samples_per_period, row_count):
+    """The most AFT samples per period a sweep raises N to at stalled steps and unresolved
+    contact forces: N · 2^k, the larger of ``MAX_STALL_FACTOR`` × N and the most with
+    N · 2^k × ``row_count`` ≤ ``SAMPLE_BUDGET`` (the AFT's cost, ∝ samples × contact rows)."""
+    N = int(samples_per_period) * MAX_STALL_FACTOR
+    while 2 * N * max(int(row_count), 1) <= SAMPLE_BUDGET:
+        N *= 2
+    return N
 
 
 def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
@@ -186,6 +202,7 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
     previous[-1] = direction
     step = options.initial_step
 
+    most = most_samples(samples_per_period, problem.contacts.row_count)
     inner = {}
     refined_at = []                 # ω where a turn was checked with 2N
     physical = False                # a corner stayed after raising N: orientation by secants
@@ -193,11 +210,11 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
     corners_at = []                 # ω of the corners stepped past
     light = False                   # N was raised for the energy balance: sampled folds checked
 
-    def refine_samples(factor=MAX_SAMPLES_FACTOR):
+    def refine_samples(limit):
         """(k, point k re-solved with 2N — 4N, … when that fails) after backing up BACKUP points
-        (or none), or (0, None) when no re-solve up to ``factor`` × the requested N converges."""
+        (or none), or (0, None) when no re-solve up to ``limit`` samples converges."""
         N_fine = 2 * problem.samples_per_period
-        while N_fine <= factor * samples_per_period:
+        while N_fine <= limit:
             fine = replace(problem, samples_per_period=N_fine)
             for k in dict.fromkeys((max(0, len(solutions) - 1 - BACKUP), len(solutions) - 1)):
                 point = solve_from(fine, solutions[k].omega, solutions[k].displacement, so, None)
@@ -256,12 +273,12 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
                                      zz[-1] * span, force, force_fine)
 
     def resolve_aliasing(result):
-        """The accepted point re-solved with 2N, 4N, … (≤ MAX_SAMPLES_FACTOR × the requested N)
+        """The accepted point re-solved with 2N, 4N, … (≤ most_samples)
         until its residual with twice its N is ≤ ALIASING_TARGET (or the cap), or None."""
         omega_new = result.x[-1] * span
         U = to_displacement(result.x[:-1] * x_scale, omega_new, result.evaluation)
         N_fine, point = problem.samples_per_period, None
-        while 2 * N_fine <= MAX_STALL_FACTOR * samples_per_period:
+        while 2 * N_fine <= most:
             N_fine *= 2
             fine = replace(problem, samples_per_period=N_fine)
             trial = solve_from(fine, omega_new, U, so, None)
@@ -269,7 +286,7 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
                 break
             point, U = trial, trial.displacement
             zz = np.append(to_x(U) / x_scale, omega_new / span)
-            if 2 * N_fine > MAX_STALL_FACTOR * samples_per_period:
+            if 2 * N_fine > most:
                 break
             aliased, energy = unresolved(N_fine, zz, U, trial.contact_force)
             if aliased <= ALIASING_TARGET and energy <= ENERGY_TARGET:
@@ -322,10 +339,10 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
     def came_back(omega):
         """The stop reason of a sweep that came back onto its own branch, naming the knob."""
         N, H = problem.samples_per_period, problem.harmonics
-        if 2 * N > MAX_STALL_FACTOR * samples_per_period:
+        if 2 * N > most:
             return (f"the branch came back onto itself near {omega / (2 * np.pi):.5g} Hz at "
-                    f"N = {N}, the most samples the sweep raises N to ({MAX_STALL_FACTOR} × "
-                    "solver.samples_per_period): the contact forces are not resolved — raise "
+                    f"N = {N}, the most samples the sweep raises N to ({most // samples_per_period}"
+                    " × solver.samples_per_period): the contact forces are not resolved — raise "
                     "solver.samples_per_period, or soften the contact (its stiffness)")
         return (f"the branch came back onto itself near {omega / (2 * np.pi):.5g} Hz (a closed "
                 f"loop of solutions at H = {H}, N = {N}): raise solver.harmonics")
@@ -333,11 +350,12 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
     def crawling(omega):
         """The stop reason of a sweep that meets a corner every few steps, naming the knob."""
         N = problem.samples_per_period
-        capped = 2 * N > MAX_STALL_FACTOR * samples_per_period
+        capped = 2 * N > most
         return (f"more than {CORNER_LIMIT} corners of the branch within "
                 f"{FOLD_DISTANCE * span / (2 * np.pi):.3g} Hz of {omega / (2 * np.pi):.5g} Hz "
-                f"at N = {N}" + (f", the most samples the sweep raises N to ({MAX_STALL_FACTOR} × "
-                                 "solver.samples_per_period)" if capped else "")
+                f"at N = {N}" + (f", the most samples the sweep raises N to ("
+                                 f"{most // samples_per_period} × solver.samples_per_period)"
+                                 if capped else "")
                 + " (the sampled contact forces switch a sample at a time): raise "
                 "solver.samples_per_period" + (", or soften the contact (its stiffness)"
                                                if capped else ""))
@@ -405,7 +423,7 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
                     passed = pass_corner(t)
                 if passed is None:
                     refined_at.append(omega_i)
-                    k, refined = refine_samples(MAX_STALL_FACTOR)
+                    k, refined = refine_samples(most)
                     if refined is None and not persists:
                         passed = pass_corner(t)
                 if passed is not None:
@@ -444,9 +462,10 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
             turned = behind[-1] * ahead[-1] < 0 and (sharp or refined_at)
             if turned and not any(abs(omega_i - w) < FOLD_DISTANCE * span for w in refined_at):
                 refined_at.append(omega_i)      # ω turns at a corner: checked with 2N
-                k, refined = refine_samples(MAX_STALL_FACTOR if extreme else MAX_SAMPLES_FACTOR)
+                k, refined = refine_samples(most if extreme else
+                                            MAX_SAMPLES_FACTOR * samples_per_period)
         why = "a stalled step or a turn of ω, checked with finer AFT sampling"
-        if refined is None and problem.samples_per_period < MAX_STALL_FACTOR * samples_per_period:
+        if refined is None and problem.samples_per_period < most:
             aliased, energy = unresolved(
                 problem.samples_per_period, result.x,
                 to_displacement(result.x[:-1] * x_scale, result.x[-1] * span, result.evaluation),
