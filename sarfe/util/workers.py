@@ -28,9 +28,13 @@ process. This module imports only :mod:`sarfe.util.parent_watch`, so every layer
 :class:`Stream` computes items that arrive one at a time on one worker; :class:`Background`
 prepares a state on one worker forked at once (before this process builds its own large arrays)
 and answers questions on it later (the mesh term's coarser models, built while the sweep runs).
+Both fork their one worker by :func:`fork_worker`; :func:`release_memory` hands a waiting
+worker's freed heap back to the system.
 """
 from __future__ import annotations
 
+import ctypes
+import ctypes.util
 import gc
 import multiprocessing
 import os
@@ -262,17 +266,8 @@ class Stream:
         return self.done
 
     def _start(self):
-        from threadpoolctl import threadpool_limits
-
         batch, self.pending = self.pending, []
-        parent, child = multiprocessing.get_context("fork").Pipe()
-        with threadpool_limits(limits=1):
-            process = multiprocessing.get_context("fork").Process(
-                target=_stream_worker, args=(self.function, batch, child, os.getpid()),
-                daemon=True)
-            process.start()
-        child.close()
-        self._process, self._connection = process, parent
+        self._process, self._connection = fork_worker(_stream_worker, self.function, batch)
         self.forks += 1
 
     def _collect(self, wait=False):
@@ -304,9 +299,38 @@ class Stream:
         self._connection = None
 
 
-def _stream_worker(function, batch, connection, parent_pid):
+def fork_worker(target, *args):
+    """One worker process forked now (daemon, one BLAS / OpenMP thread at the fork) running
+    ``target(*args, connection, parent_end, parent_pid)``: ``connection`` its end of a pipe,
+    ``parent_end`` this process's end (inherited: the worker closes it first, so that the pipe
+    closes when this process's copy does) → (process, this process's end of the pipe)."""
+    from threadpoolctl import threadpool_limits
+
+    context = multiprocessing.get_context("fork")
+    parent, child = context.Pipe()
+    with threadpool_limits(limits=1):
+        process = context.Process(target=target, args=(*args, child, parent, os.getpid()),
+                                  daemon=True)
+        process.start()
+    child.close()
+    return process, parent
+
+
+def release_memory():
+    """Collect garbage and hand the heap's free pages back to the system (glibc ``malloc_trim``;
+    nothing where there is none): for a worker that holds a small result of a large build while
+    it waits."""
+    gc.collect()
+    try:
+        ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6").malloc_trim(0)
+    except (OSError, AttributeError):
+        pass
+
+
+def _stream_worker(function, batch, connection, parent_end, parent_pid):
     """Body of a :class:`Stream` worker: the batch in order, each result sent as soon as it is
     computed, until the parent says stop; then the sentinel None."""
+    parent_end.close()
     _start_worker(parent_pid)
     gc.freeze()       # this process's collections leave the inherited objects (and pages) alone
     try:
@@ -346,17 +370,7 @@ class Background:
     """
 
     def __init__(self, prepare, respond):
-        from threadpoolctl import threadpool_limits
-
-        context = multiprocessing.get_context("fork")
-        parent, child = context.Pipe()
-        with threadpool_limits(limits=1):
-            process = context.Process(target=_background_worker,
-                                      args=(prepare, respond, child, parent, os.getpid()),
-                                      daemon=True)
-            process.start()
-        child.close()
-        self._process, self._connection = process, parent
+        self._process, self._connection = fork_worker(_background_worker, prepare, respond)
 
     def __enter__(self):
         return self

@@ -33,11 +33,8 @@ meshes and matrices models the term is "not estimated" and said so (``solver.mes
 from __future__ import annotations
 
 import contextlib
-import ctypes
-import ctypes.util
 import dataclasses
 import functools
-import gc
 import time
 import warnings
 
@@ -50,7 +47,7 @@ from sarfe.hbm.time_integration import linear_harmonic_response
 from sarfe.pipeline.model.linear_stage import build_linear_model
 from sarfe.pipeline.model.nonlinear_model import nonlinear_model
 from sarfe.pipeline.post.records import loudest_point, point_erp
-from sarfe.util.workers import Background, map_points, worker_count
+from sarfe.util.workers import Background, map_points, release_memory, worker_count
 
 
 def mesh_error_reason(case) -> str | None:
@@ -139,16 +136,6 @@ def slim_stage(stage):
     areas, ``info``) and without the mesh and the reduction basis (the full-space Craig–Bampton
     shapes, n_full × n_r: the bulk of a stage), for a background process that holds it."""
     return dataclasses.replace(stage, mesh=None, reduced=None)
-
-
-def release_memory():
-    """Collect garbage and hand the heap's free pages back to the system (glibc ``malloc_trim``;
-    nothing where there is none)."""
-    gc.collect()
-    try:
-        ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6").malloc_trim(0)
-    except (OSError, AttributeError):
-        pass
 
 
 def start_coarse_levels(case, ratio=MESH_GCI_RATIO):
