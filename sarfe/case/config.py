@@ -177,8 +177,9 @@ class DampingConfig:
 # -------------------------------------------------------------------------------------- reduction
 @dataclass(frozen=True)
 class ReductionConfig:
-    """reduction (FE cases): mode_count or cutoff_hz (or neither: cutoff from the excitation),
-    cutoff_margin × H × f_max, at least min_mode_count modes, static residual vectors.
+    """reduction (FE cases): mode_count or cutoff_hz (or neither: cutoff from the excitation,
+    min(cutoff_margin × H × f_max, the Newton cutoff): sarfe.pipeline.model.cutoff), at least
+    min_mode_count modes, static residual vectors.
 
     cutoff_margin 1.0 (was 1.25, before that 1.5): door trim, 12 contact pairs, H = 15, 40–80 Hz,
     15, 10 and 5 mm (benchmarks/results/cutoff.md): the cutoff H f_max changes the contact-row

@@ -8,11 +8,13 @@ import numpy as np
 from sarfe.accuracy.estimate import (EstimateProblem, basis_limited_extension,
                                      highest_natural_frequency_hz, problem_error_estimate)
 from sarfe.accuracy.harmonic_truncation import RICHARDSON, harmonics_richardson
-from sarfe.accuracy.resolve import LADDER_FACTOR, resolve_accuracy
+from sarfe.accuracy.resolve import resolve_accuracy
 from sarfe.accuracy.target import parse_accuracy
 from sarfe.case.config import ExcitationConfig, SolverConfig
 from sarfe.case.read import load_case
 from sarfe.hbm import SolverOptions
+from sarfe.pipeline.model.cutoff import (NEWTON_FLOOR_HZ, NEWTON_HARMONICS, newton_cutoff_hz,
+                                         newton_margin)
 from sarfe.pipeline.model.linear_stage import build_linear_model
 from sarfe.pipeline.model.nonlinear_model import nonlinear_model
 from sarfe.util.progress import bar as progress_bar
@@ -53,25 +55,14 @@ def sweep_grid_hz(excitation: ExcitationConfig, points=8) -> np.ndarray:
     return np.linspace(excitation.sweep.start_hz, excitation.sweep.end_hz, int(points))
 
 
-NEWTON_FLOOR_HZ = 1000.0    # f_floor of :func:`rule_cutoff_hz` [Hz]
-NEWTON_HARMONICS = 5        # H_dyn of :func:`rule_cutoff_hz` (solver.harmonics' default)
-
-
 def rule_cutoff_hz(case) -> float | None:
-    """The accuracy search's (and so the sweep's) Craig–Bampton cutoff: a cutoff for the Newton,
-    not for the spectrum (issue 30),
-
-        c = max(f_floor, m · H_dyn · f_max)  [Hz]
-
-    with f_floor = NEWTON_FLOOR_HZ (1 kHz), H_dyn = NEWTON_HARMONICS (5), m = max(cutoff_margin,
-    LADDER_FACTOR) (1.5 by default), f_max the highest excitation frequency — for an FE case whose
-    reduction gives neither cutoff_hz nor mode_count; None otherwise (a matrices model, or the
-    user's reduction, which the search keeps). It does not grow with the H the search chooses:
-    the harmonics above c meet no kept mode and are
-    answered quasi-statically — the Craig–Bampton constraint modes give the exact static
-    response of the contact (boundary) DOFs, the residual vectors (reduction.residual_vectors,
-    on by default) that of the loads — and the error of that is measured per point by the
-    estimate's modal term (:mod:`sarfe.accuracy.modal_truncation`, in the ±).
+    """The accuracy search's (and so the sweep's) Craig–Bampton cutoff: the Newton cutoff
+    :func:`sarfe.pipeline.model.cutoff.newton_cutoff_hz`, max(1 kHz, max(cutoff_margin, 1.5) · 5 ·
+    f_max), for an FE case whose reduction gives neither cutoff_hz nor mode_count; None otherwise
+    (a matrices model, or the user's reduction, which the search keeps). It does not grow with
+    the H the search chooses: the harmonics above it meet no kept mode and are answered
+    quasi-statically, and the error of that is measured per point by the estimate's modal term
+    (:mod:`sarfe.accuracy.modal_truncation`, in the ±).
 
     The floor, measured: door trim 10 mm, 67 Hz (benchmarks/results/audible.md), the dB(A) on a
     1005 Hz stage is within 0.011 dB of the 4020 Hz stage for every H from 3 to 60, on 2010 Hz
@@ -84,13 +75,7 @@ def rule_cutoff_hz(case) -> float | None:
     reduction = case.config.reduction
     if reduction is None or reduction.cutoff_hz is not None or reduction.mode_count is not None:
         return None
-    return float(max(NEWTON_FLOOR_HZ, search_margin(case) * NEWTON_HARMONICS
-                     * case.config.excitation.max_frequency_hz))
-
-
-def search_margin(case) -> float:
-    """m of :func:`rule_cutoff_hz`: max(reduction.cutoff_margin, LADDER_FACTOR)."""
-    return float(max(case.config.reduction.cutoff_margin, LADDER_FACTOR))
+    return newton_cutoff_hz(case)
 
 
 def with_cutoff(case, cutoff_hz):
@@ -153,7 +138,7 @@ def case_resolution(case, target, points=8, start_harmonics=3, start_samples=64,
     report["text"] += (f"\n  searched on one linear stage ({modes} modes)" + (
         "" if cutoff is None else
         f"; Newton cutoff {cutoff:.0f} Hz = max({NEWTON_FLOOR_HZ:.0f} Hz, "
-        f"{search_margin(case):g} · {NEWTON_HARMONICS} · f_max), not H f_max "
+        f"{newton_margin(case):g} · {NEWTON_HARMONICS} · f_max), not H f_max "
         f"({report['harmonics'] * case.config.excitation.max_frequency_hz:.0f} Hz at "
         f"H = {report['harmonics']}): harmonics above it answer quasi-statically"))
     return report, stage
@@ -279,5 +264,4 @@ def unknown_text(points) -> str:
 
 
 __all__ = ["unknown_text", "accuracy_check", "resolved_case", "with_cutoff", "stage_modal_coordinates", "accuracy_problem", "stage_error_estimate", "sweep_grid_hz",
-           "resolve_case_accuracy", "case_resolution", "resolution_line", "rule_cutoff_hz",
-           "search_margin", "NEWTON_FLOOR_HZ", "NEWTON_HARMONICS"]
+           "resolve_case_accuracy", "case_resolution", "resolution_line", "rule_cutoff_hz"]

@@ -130,7 +130,7 @@ def test_validate_and_solve_print_the_cost(tmp_path, capsys):
     assert cli.main(["validate", str(CASES / "squeak_rig.yaml"), "-o", str(tmp_path / "v")]) == 0
     out = capsys.readouterr().out.splitlines()
     cost = [line for line in out if line.startswith("cost: ")]
-    assert len(cost) == 1 and "H 32, N 256, cutoff 4800 Hz" in cost[0]
+    assert len(cost) == 1 and "H 32, N 256, cutoff 1125 Hz" in cost[0]
     at = out.index(cost[0])
     assert all(len(line) <= 80 for line in out[at:])
     assert "s CPU" in "".join(out[at:]) and "MB written" in "".join(out[at:])

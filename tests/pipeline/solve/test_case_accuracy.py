@@ -115,8 +115,8 @@ def test_newton_cutoff_does_not_follow_H():
     """The search's Craig–Bampton cutoff (rule_cutoff_hz) is max(1 kHz, m · 5 · f_max), the same
     for every H (issue 30: m · H · f_max took the instrument panel, H = 18, to 5.4 kHz), follows
     f_max and the margin, and leaves a cutoff or mode count the user gave alone."""
-    from sarfe.pipeline.solve.case_accuracy import (NEWTON_FLOOR_HZ, rule_cutoff_hz,
-                                                    search_margin)
+    from sarfe.pipeline.model.cutoff import NEWTON_FLOOR_HZ, newton_margin
+    from sarfe.pipeline.solve.case_accuracy import rule_cutoff_hz
 
     case = load_case(Path(CASE).parent / "instrument_panel_sweep.yaml")
     assert case.config.excitation.max_frequency_hz == pytest.approx(200.0)
@@ -126,7 +126,7 @@ def test_newton_cutoff_does_not_follow_H():
         assert rule_cutoff_hz(case.with_solver(harmonics=H, samples_per_period=256)) == pytest.approx(rule)
     assert rule_cutoff_hz(case.with_reduction(cutoff_margin=2.0)) == pytest.approx(2.0 * 5 * 200.0)
     low = load_case(Path(CASE).parent / "rattle_rig.yaml")      # f_max = 40 Hz: the floor
-    assert search_margin(low) * 5 * 40.0 < NEWTON_FLOOR_HZ
+    assert newton_margin(low) * 5 * 40.0 < NEWTON_FLOOR_HZ
     assert rule_cutoff_hz(low) == pytest.approx(NEWTON_FLOOR_HZ)
     assert rule_cutoff_hz(case.with_reduction(cutoff_hz=700.0)) is None
     assert rule_cutoff_hz(load_case(CASE)) is None              # a matrices model
