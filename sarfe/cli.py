@@ -48,7 +48,9 @@ def cmd_solve(args) -> int:
     case = load_case(args.case)
     output_target(case, args.output, args.force)   # before any work (solve_case checks it all)
     clock = time.perf_counter()
-    _say(args, f"sarfe {__version__}: solving {case.name} ({args.case})")
+    _say(args, textwrap.fill(f"sarfe {__version__}: solving {case.name} ({args.case})", WIDTH,
+                             subsequent_indent="  ", break_long_words=False,
+                             break_on_hyphens=False))
     result = solve_case(case, output_dir=args.output, progress=not args.quiet, force=args.force,
                         warn=_warn)
     summary = result.summary

@@ -134,10 +134,14 @@ def test_validate_and_solve_print_the_cost(tmp_path, capsys):
     at = out.index(cost[0])
     assert all(len(line) <= 80 for line in out[at:])
     assert "s CPU" in "".join(out[at:]) and "MB written" in "".join(out[at:])
-    path = tmp_path / "tiny.yaml"
+    path = tmp_path / ("a_case_folder_whose_name_is_long_" * 2) / "tiny.yaml"  # > 80 columns
+    path.parent.mkdir()
     path.write_text(TINY)
     assert cli.main(["solve", str(path), "-o", str(tmp_path / "s")]) == 0
-    err = capsys.readouterr().err
+    out, err = capsys.readouterr()
+    lines = out.splitlines()       # 80 columns; a path longer than that gets a line of its own
+    assert all(len(line) <= 80 for line in lines if str(tmp_path) not in line)
+    assert lines[0].endswith("solving tiny") and lines[1].strip() == f"({path})"
     assert err.count("sarfe: cost: H 3, N ") == 1
     assert cli.main(["solve", str(path), "-o", str(tmp_path / "q"), "--quiet"]) == 0
     assert "cost:" not in capsys.readouterr().err
