@@ -194,7 +194,9 @@ class ContactRowDeterminant:
         lam = s[:, None] + 1j * self.omega * m                                  # (n_s, 2H+1)
         a = lam[..., None] * self.delta + lam[..., None] ** 2 * self.mu
         q = (-a / (1.0 + a)).reshape(-1, self.mu.size)                         # (n_s (2H+1), n)
-        pairs = q.real @ self._pairs.T + 1j * (q.imag @ self._pairs.T)         # (…, n_pairs)
+        pairs = np.empty((q.shape[0], self._pairs.shape[0]), complex)           # (…, n_pairs)
+        pairs.real = np.ascontiguousarray(q.real) @ self._pairs.T     # the parts written in place
+        pairs.imag = np.ascontiguousarray(q.imag) @ self._pairs.T
         width = self.rows.size
         A = np.empty((q.shape[0], width, width), complex)
         i, j = self._upper
