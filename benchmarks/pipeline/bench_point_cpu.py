@@ -33,6 +33,7 @@ NOTES = "## Where the CPU goes (cProfile, hand-written)"
 
 STAGES = {        # stage name: (module, function) wrapped in sarfe.pipeline.run's namespace
     "sweep": "solve_points_pruned",
+    "Hill stability": "serial_stability",       # by need, after a serial sweep (workers 1)
     "error estimates": "error_estimates",
     "point records": "point_records",
     "result files": "write_outputs",

@@ -276,7 +276,7 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
         """The accepted point re-solved with 2N, 4N, … (≤ most_samples)
         until its residual with twice its N is ≤ ALIASING_TARGET (or the cap), or None."""
         omega_new = result.x[-1] * span
-        U = to_displacement(result.x[:-1] * x_scale, omega_new, result.evaluation)
+        U = displacement_of(result)
         N_fine, point = problem.samples_per_period, None
         while 2 * N_fine <= most:
             N_fine *= 2
@@ -315,6 +315,17 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
         return d
 
     trail = {}
+    recovered = {}
+
+    def displacement_of(result):
+        """ũ (2H+1, n) of an accepted corrector ``result``, recovered once: the aliasing check,
+        its re-solve and the reported point share it (condensed: one modal recovery, not two)."""
+        key = recovered.get("key", (None, None, None))
+        if key[0] is not result or key[1] is not to_displacement or key[2] != x_scale:
+            recovered["key"] = (result, to_displacement, x_scale)
+            recovered["U"] = to_displacement(result.x[:-1] * x_scale, result.x[-1] * span,
+                                             result.evaluation)
+        return recovered["U"]
 
     def retraces(zz, length):
         """Does zz lie within RETRACE_SHARE × the step ``length`` of the path through the reported
@@ -327,8 +338,10 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
         if trail.get("key") != key:
             trail.clear()
             trail["key"] = key
-        Z = np.array([trail.setdefault(id(s), np.append(to_x(s.displacement) / x_scale,
-                                                         s.omega / span)) for s in earlier])
+        for s in earlier:       # z of each reported point once (not each call: O(points²));
+            if trail.get(id(s), (None,))[0] is not s:      # the point held: its id stays its own
+                trail[id(s)] = (s, np.append(to_x(s.displacement) / x_scale, s.omega / span))
+        Z = np.array([trail[id(s)][1] for s in earlier])
         a, b = Z[:-1], Z[1:]
         ab = b - a
         share = np.clip(np.einsum("ij,ij->i", zz - a, ab)
@@ -468,7 +481,7 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
         if refined is None and problem.samples_per_period < most:
             aliased, energy = unresolved(
                 problem.samples_per_period, result.x,
-                to_displacement(result.x[:-1] * x_scale, result.x[-1] * span, result.evaluation),
+                displacement_of(result),
                 result.evaluation.forces.force)
             if aliased > ALIASING_LIMIT or energy > ENERGY_LIMIT:   # contact forces not resolved
                 refined = resolve_aliasing(result)
@@ -506,7 +519,7 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
         omega_new = z_new[-1] * span
         if retraces(z_new, np.linalg.norm(z_new - z)):
             return leave_loop(omega_new) or stop(came_back(omega_new))
-        U_new = to_displacement(z_new[:-1] * x_scale, omega_new, result.evaluation)
+        U_new = displacement_of(result)
         if direction * (omega_new - omega_end) >= 0:      # passed the end: solve at ω_end exactly
             fraction = (omega_end - z[-1] * span) / (omega_new - z[-1] * span)
             U_prev = solutions[-1].displacement

@@ -184,10 +184,6 @@ def _linearized_guess_dense(problem, omega, rows_k, rows_c, preload):
     Gᵀ diag(c) G; orders without excitation (or not kept) are zero. Zero where singular."""
     H, n = problem.harmonics, problem.model.dof_count
     G = sp.csr_matrix(problem.contacts.gap_map)
-    dense = (lambda a: a.toarray() if sp.issparse(a) else np.asarray(a, dtype=float))  # noqa: E731
-    K = dense(problem.model.stiffness) + dense(G.T @ sp.diags(rows_k) @ G)
-    D = dense(problem.model.damping) + dense(G.T @ sp.diags(rows_c) @ G)
-    M = dense(problem.model.mass)
     F = problem.excitation.copy()
     F[0] -= G.T @ preload
     rows = kept_rows(problem)
@@ -208,6 +204,11 @@ def _linearized_guess_dense(problem, omega, rows_k, rows_c, preload):
                 return from_complex(z)
         except np.linalg.LinAlgError:
             pass
+    # the dense K_l, D_l, M only here (the modal path above needs none: 3 n² copies a call)
+    dense = (lambda a: a.toarray() if sp.issparse(a) else np.asarray(a, dtype=float))  # noqa: E731
+    K = dense(problem.model.stiffness) + dense(G.T @ sp.diags(rows_k) @ G)
+    D = dense(problem.model.damping) + dense(G.T @ sp.diags(rows_c) @ G)
+    M = dense(problem.model.mass)
     try:
         if kept[0] and np.any(F[0]):
             U[0] = np.linalg.solve(K, F[0])

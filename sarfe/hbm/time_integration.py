@@ -25,6 +25,7 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
@@ -114,7 +115,9 @@ def linear_harmonic_response(model, excitation, omega, steps_per_period=None):
     Per harmonic k: (K − ω_k² M + i ω_k D) Û_k = F_kc − i F_ks, u_kc = Re Û_k, u_ks = −Im Û_k, with
     ω_k = kω (exact), or ω_k = (2/h) tan(kωh/2), h = 2π/(ωN), when ``steps_per_period`` N is given:
     the exact periodic solution of the Newmark average-acceleration scheme. A singular K (a DOF held
-    only by contacts) gets the least-squares mean u0.
+    only by contacts) gets the least-squares mean u0. Dense: one LU per harmonic
+    (:func:`_dense_solve`; the SVD-based least squares only for a singular or ill-conditioned
+    matrix: ≈ 10× cheaper for a Craig–Bampton model of 600 DOFs, the same solution).
     """
     F = np.asarray(excitation, dtype=float)
     H = (F.shape[0] - 1) // 2
@@ -132,7 +135,7 @@ def linear_harmonic_response(model, excitation, omega, steps_per_period=None):
             continue
         S = K - w * w * M + 1j * w * D
         if dense:
-            Uk = np.linalg.lstsq(np.asarray(S, dtype=complex), rhs, rcond=None)[0]
+            Uk = _dense_solve(np.asarray(S, dtype=complex), rhs)
         else:
             with warnings.catch_warnings():  # singular K (DOFs held by contacts only): zero mean
                 warnings.simplefilter("ignore", spla.MatrixRankWarning)
@@ -144,6 +147,26 @@ def linear_harmonic_response(model, excitation, omega, steps_per_period=None):
         else:
             U[2 * k - 1], U[2 * k] = Uk.real, -Uk.imag
     return U
+
+
+def _dense_solve(S, rhs):
+    """S⁻¹ b (S (n, n) dense complex) by LU where that is the least-squares solution
+    np.linalg.lstsq(S, b, rcond=None) gives: S regular with σ_min/σ_max > n ε (lstsq truncates
+    no singular value), which holds when LAPACK's 1-norm estimate rcond₁ > n² ε
+    (σ_min/σ_max ≥ rcond₁/n). Otherwise (singular or ill-conditioned, or a non-finite LU result)
+    the least squares itself."""
+    n = S.shape[0]
+    lu, piv, info = _getrf(S)
+    if info == 0:
+        rcond, info = _gecon(lu, np.abs(S).sum(axis=0).max(), norm="1")
+        if info == 0 and rcond > n * n * np.finfo(float).eps:
+            x, info = _getrs(lu, piv, rhs)
+            if info == 0 and np.all(np.isfinite(x)):
+                return x
+    return np.linalg.lstsq(S, rhs, rcond=None)[0]
+
+
+_getrf, _gecon, _getrs = sla.get_lapack_funcs(("getrf", "gecon", "getrs"), dtype=complex)
 
 
 def integrate_time(model, contacts, excitation, omega, harmonics, steps_per_period=512,

@@ -97,6 +97,25 @@ def test_linear_two_dof_multi_harmonic_from_rest():
     assert np.abs(r.displacement[:, 0] - samples).max() < 1e-6 * scale
 
 
+def test_linear_response_of_a_free_floating_pair():
+    """Two masses joined by one spring, nothing holding them (K singular: the rigid mode): a
+    self-equilibrated static load ±f stretches the spring by f/k about the centre of mass at rest
+    (the least-squares mean, u0 = ±f/(2k)); the first harmonic is the regular closed form. The
+    dense path solves the regular harmonics by LU and falls back to least squares for K."""
+    m, k, f = 1.0, 4e4, 3.0
+    K = k * np.array([[1.0, -1.0], [-1.0, 1.0]])
+    M = m * np.eye(2)
+    model = make_linear_model(M, 1e-4 * K, K)
+    F = np.zeros((3, 2))
+    F[0] = [f, -f]
+    F[1] = [1.0, 0.0]
+    omega = 2 * np.pi * 15.0
+    U = linear_harmonic_response(model, F, omega)
+    assert U[0] == pytest.approx([f / (2 * k), -f / (2 * k)], rel=1e-12)
+    exact = np.linalg.solve(K - omega**2 * M + 1j * omega * 1e-4 * K, F[1] - 1j * F[2])
+    assert np.allclose(U[1] - 1j * U[2], exact.real + 1j * exact.imag, rtol=1e-12, atol=0)
+
+
 def test_period_cap_is_flagged():
     model = two_dof()
     F = np.zeros((3, 2))
