@@ -9,8 +9,10 @@ response_h5.py (response.h5), vtk.py (VTU/PVD arrays), plots.py (PNGs), console.
     write_response_h5(path, solutions, *, contacts=None, excitation=None, excitation_dofs=None,
                       boundary_dofs=None, mode_frequencies_hz=None, erp=None, radiating_nodes=None,
                       store_displacement=False, store_erp_density_per_harmonic=False,
-                      extra_groups=None, attributes=None) -> Path
+                      density_points=None, base_samples_per_period=None, extra_groups=None,
+                      attributes=None) -> Path
     read_response_h5(path) -> dict
+    record_samples(H, N, base_samples=None) -> int   N_rec, response.h5's stored time samples
     write_erp_vtu(path, points, triangles, point_data: dict, field_data=None, active_vectors=None,
                   parts=None) -> Path
     part_ids(n_triangles, element_groups) -> (ids (n_tri,) int32, names)   (cell data part_id)
@@ -48,6 +50,7 @@ _EXPORTS = {
     "plot_audibility": ".plots",
     "write_report_html": ".report",
     "read_response_h5": ".response_h5", "write_response_h5": ".response_h5",
+    "record_samples": ".response_h5",
     "console_table": ".summary", "to_jsonable": ".summary", "write_summary_json": ".summary",
     "contact_markers": ".vtk", "erp_point_data": ".vtk", "period_samples": ".vtk",
     "write_deflection_animation": ".vtk", "write_erp_sweep": ".vtk", "write_erp_vtu": ".vtk",
@@ -57,6 +60,7 @@ __getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
 
 __all__ = [
     "write_summary_json", "console_table", "to_jsonable", "write_response_h5", "read_response_h5",
+    "record_samples",
     "write_erp_vtu", "erp_point_data", "contact_markers", "write_pvd", "write_erp_sweep",
     "start_erp_sweep", "part_ids",
     "write_deflection_animation", "period_samples", "plot_erp_sweep", "plot_contact_forces",

@@ -3,10 +3,13 @@ r"""``response.h5``: everything needed to re-plot a run without re-solving.
 Layout (n_f frequency points, H harmonics, N samples per period, n_rows contact rows r = G u,
 n_c contacts, n_e excitation DOFs, n_r radiating nodes). Harmonic axes follow the sarfe Fourier
 convention (``/`` attribute ``fourier_convention``): index 0 = static term u0, 2k−1 = cos kθ,
-2k = sin kθ, θ = ωt; time axes hold θ_j = 2πj/N, j = 0 … N−1.
+2k = sin kθ, θ = ωt; time axes hold the record's N_rec samples θ_j = 2πj/N_rec, j = 0 … N_rec−1
+(N_rec = :func:`record_samples`, the ``record_samples_per_period`` attribute; not the solve's N).
 
-    /                               attrs: format="sarfe-response", format_version=1, harmonics=H,
-                                    samples_per_period=N, fourier_convention, units, sarfe_version,
+    /                               attrs: format="sarfe-response", format_version=3, harmonics=H,
+                                    samples_per_period=N (the solve's AFT samples),
+                                    record_samples_per_period=N_rec, record_decimation=N/N_rec,
+                                    fourier_convention, units, sarfe_version,
                                     created_utc, + caller attributes (case name, model key, …)
     /frequency_hz                   (n_f,)  excitation (fundamental) frequency ω/2π [Hz]
     /omega_rad_s                    (n_f,)  ω [rad/s]
@@ -24,8 +27,14 @@ convention (``/`` attribute ``fourier_convention``): index 0 = static term u0, 2
               normal_load_N         (n_c,)
     /contacts/displacement_m        (n_f, 2H+1, n_rows) harmonics of the relative displacements r [m]
     /contacts/force_N               (n_f, 2H+1, n_rows) harmonics of the contact forces λ [N]
-    /contacts/force_time_N          (n_f, N, n_rows)    λ(θ_j) over one period [N]
-    /contacts/state                 (n_f, N, n_c) int8  0 open, 1 closed/stick, 2 slip
+    /contacts/force_time_N          (n_f, N_rec, n_rows) λ(θ_j) over one period [N]: the solve's
+                                    AFT samples, every (N/N_rec)-th (a decimation, exact values)
+    /contacts/force_peak_N          (n_f, N_rec, n_rows) per bin j (the N/N_rec AFT samples from
+                                    θ_j on) the force of largest magnitude, signed [N]: its
+                                    maximum over j is the full-N peak (impact) force exactly
+                                    (N_rec = N: a hard link to force_time_N)
+    /contacts/state                 (n_f, N_rec, n_c) int8 per bin the highest state reached:
+                                    0 open throughout, 1 closed/stick at some time, 2 slipped
     /excitation/dofs                (n_e,)  kept-DOF indices that carry excitation
     /excitation/force_N             (2H+1, n_e) force harmonics f̃_e at those DOFs [N]
     /excitation/displacement_m      (n_f, 2H+1, n_e) response harmonics at those DOFs [m]
@@ -47,10 +56,28 @@ convention (``/`` attribute ``fourier_convention``): index 0 = static term u0, 2
                                     baseline), each array with its own ``units`` attribute if given
 
 Levels of zero power are stored as −inf. Datasets with a unit carry a ``units`` attribute.
+
+**The record's time grid** (issue 30 item 3: the file ∝ points × contacts × H, never × N). A
+sweep raises N for hard contacts up to ``sarfe.hbm.continuation.most_samples`` (N × rows ≤ 2^17:
+N = 32768 for a stiff lumped rattle), which would make the time histories — not the harmonics —
+the bulk of the file (670 MB for 1280 points). The time axes therefore hold N_rec =
+:func:`record_samples` (H, N, N_case) = min(N, max(N_case, 64, 2^⌈log₂ 16H⌉)) samples: the
+case's own N before the sweep raised it (``solver.samples_per_period``; a run that did not raise
+N stores exactly what it solved), and at least the solver's default N for H
+(``sarfe.case.config.default_samples_per_period``): 16 samples per period of the highest
+harmonic, 8× the 2H+1 that the harmonics need. Above it, the stored force is a *decimation* (every (N/N_rec)-th AFT sample), not a
+synthesis of the harmonics: a synthesis would only repeat /contacts/force_N (stored exactly) with
+Gibbs ripple (negative "contact forces" while open), while the AFT samples are the nonlinear law's
+own values. What a decimation misses — the short impact peak between two stored samples, a
+contact closing for less than a bin — is kept by the per-bin extremes force_peak_N and state.
+What a user loses: the force's shape inside a bin (N/N_rec AFT samples), i.e. the contact's
+time resolution beyond 16 samples per period of the H-th harmonic; not the harmonics, not the
+peak force, not whether/when (to a bin, 2π/N_rec) the contact closed or slipped.
 """
 from __future__ import annotations
 
 import datetime as _dt
+import math
 from pathlib import Path
 
 import h5py
@@ -58,13 +85,19 @@ import numpy as np
 
 from sarfe import __version__
 
-__all__ = ["write_response_h5", "read_response_h5", "FOURIER_CONVENTION", "FORMAT_VERSION"]
+__all__ = ["write_response_h5", "read_response_h5", "record_samples", "record_histories",
+           "FOURIER_CONVENTION", "FORMAT_VERSION", "RECORD_SAMPLES_PER_HARMONIC",
+           "RECORD_MIN_SAMPLES"]
 
-FORMAT_VERSION = 2      # 2: /erp/density_total_W_m2 at /erp/density_point_index (issue 30)
+FORMAT_VERSION = 3      # 2: /erp/density_total_W_m2 at /erp/density_point_index (issue 30)
+#                         3: contact time histories at N_rec ≤ N, force_peak_N (issue 30 item 3)
+RECORD_SAMPLES_PER_HARMONIC = 16   # N_rec = max(RECORD_MIN_SAMPLES, 2^⌈log₂ 16 H⌉), ≤ N
+RECORD_MIN_SAMPLES = 64
 FOURIER_CONVENTION = (
     "u(theta) = u0 + sum_{k=1..H} (u_kc cos k theta + u_ks sin k theta), theta = omega t; "
     "harmonic axis of length 2H+1 stores [u0, u1c, u1s, ..., uHc, uHs] (u0 not halved); "
-    "time axis of length N stores theta_j = 2 pi j / N, j = 0..N-1"
+    "time axis of length N_rec (attribute record_samples_per_period) stores "
+    "theta_j = 2 pi j / N_rec, j = 0..N_rec-1"
 )
 UNITS = ("SI: m, N, s, Hz, rad/s, W, W/m^2; levels in dB re 1e-12 W, A-weighted per IEC 61672-1; "
          "dataset suffixes _m, _N, _hz, _rad_s, _W, _W_m2, _db, _1_s give the unit")
@@ -95,6 +128,40 @@ def _put(group, name, data, units=None, compress=False, text=False):
     return ds
 
 
+def record_samples(harmonics: int, samples_per_period: int, base_samples: int | None = None
+                   ) -> int:
+    """N_rec, the time samples per period stored (module docstring): N / s with s the smallest
+    decimation dividing N such that N / s ≤ max(RECORD_MIN_SAMPLES, 2^⌈log₂ 16 H⌉,
+    ``base_samples``) (the case's solver.samples_per_period, before a sweep raised N: a run at
+    its own N stores all of it; a power-of-two N gives that bound exactly)."""
+    N = int(samples_per_period)
+    target = max(RECORD_MIN_SAMPLES, int(base_samples or 0),
+                 2 ** math.ceil(math.log2(RECORD_SAMPLES_PER_HARMONIC * max(int(harmonics), 1))))
+    step = max(1, -(-N // target))
+    while N % step:
+        step += 1
+    return N // step
+
+
+def record_histories(force_time, state, record: int) -> tuple:
+    """The stored time histories of one point at N_rec = ``record`` samples per period, from
+    the solve's λ(θ_j) ``force_time`` (N, n_rows) [N] and ``state`` (N, n_c) (either None):
+    (decimated force (N_rec, n_rows), per-bin force of largest magnitude (N_rec, n_rows),
+    per-bin highest state (N_rec, n_c) int8); bin j holds AFT samples j s … j s + s − 1,
+    s = N / N_rec."""
+    out = [None, None, None]
+    if force_time is not None:
+        F = np.asarray(force_time, dtype=float)
+        bins = F.reshape(record, F.shape[0] // record, *F.shape[1:])
+        out[0] = bins[:, 0]
+        where = np.argmax(np.abs(bins), axis=1)[:, None]
+        out[1] = np.take_along_axis(bins, where, axis=1)[:, 0]
+    if state is not None:
+        S = np.asarray(state, dtype=np.int8)
+        out[2] = S.reshape(record, S.shape[0] // record, *S.shape[1:]).max(axis=1)
+    return tuple(out)
+
+
 def _stack(solutions, name, dtype=float):
     return np.stack([np.asarray(getattr(s, name), dtype=dtype) for s in solutions])
 
@@ -113,6 +180,7 @@ def write_response_h5(
     store_displacement: bool = False,
     store_erp_density_per_harmonic: bool = False,
     density_points=None,
+    base_samples_per_period: int | None = None,
     extra_groups: dict | None = None,
     attributes: dict | None = None,
 ) -> Path:
@@ -133,6 +201,8 @@ def write_response_h5(
     store_displacement : also store all kept DOFs' harmonics (can be large).
     store_erp_density_per_harmonic : also store /erp/density_W_m2 (n_f, H, n_r).
     density_points : indices of the points whose ERP density is stored (default: all).
+    base_samples_per_period : the case's N before a sweep raised it (bounds the stored time grid,
+        :func:`record_samples`; None: only H does).
     extra_groups : {group: {name: array | (array, units)}}, e.g. the linear baseline.
     attributes : extra root attributes (str/number), e.g. {"case": name, "model_key": key}.
     """
@@ -144,6 +214,7 @@ def write_response_h5(
     if len(H) != 1 or len(N) != 1:
         raise ValueError(f"all solutions must share H and N, got H={sorted(H)}, N={sorted(N)}")
     H, N = H.pop(), N.pop()
+    N_rec = record_samples(H, N, base_samples_per_period)
     omega = np.array([float(s.omega) for s in solutions])
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -152,6 +223,8 @@ def write_response_h5(
         f.attrs["format_version"] = FORMAT_VERSION
         f.attrs["harmonics"] = H
         f.attrs["samples_per_period"] = N
+        f.attrs["record_samples_per_period"] = N_rec
+        f.attrs["record_decimation"] = N // N_rec
         f.attrs["fourier_convention"] = FOURIER_CONVENTION
         f.attrs["units"] = UNITS
         f.attrs["sarfe_version"] = __version__
@@ -190,11 +263,23 @@ def write_response_h5(
             _put(group, "displacement_m", _stack(solutions, "contact_displacement"), "m", True)
         if getattr(solutions[0], "contact_force", None) is not None:
             _put(group, "force_N", _stack(solutions, "contact_force"), "N", True)
-        if getattr(solutions[0], "contact_force_time", None) is not None:
-            _put(group, "force_time_N", _stack(solutions, "contact_force_time"), "N", True)
-        if getattr(solutions[0], "contact_state", None) is not None:
-            _put(group, "state", _stack(solutions, "contact_state", np.int8), None, True
-                 ).attrs["dtype_note"] = "0 open/separated, 1 closed or stick, 2 slip"
+        # reduced point by point: n_f × N × rows never held at once (module docstring)
+        histories = [record_histories(getattr(s, "contact_force_time", None),
+                                      getattr(s, "contact_state", None), N_rec) for s in solutions]
+        if histories[0][0] is not None:
+            _put(group, "force_time_N", np.stack([h[0] for h in histories]), "N", True
+                 ).attrs["sampling"] = f"every {N // N_rec}-th of the solve's N = {N} AFT samples"
+            if N_rec == N:     # bins of one sample: the same data (a hard link, no bytes)
+                group["force_peak_N"] = group["force_time_N"]
+            else:
+                _put(group, "force_peak_N", np.stack([h[1] for h in histories]), "N", True
+                     ).attrs["sampling"] = (f"per bin of {N // N_rec} AFT samples: the force of "
+                                            "largest magnitude (signed)")
+        if histories[0][2] is not None:
+            ds = _put(group, "state", np.stack([h[2] for h in histories]), None, True)
+            ds.attrs["dtype_note"] = "0 open/separated, 1 closed or stick, 2 slip"
+            ds.attrs["sampling"] = (f"per bin of {N // N_rec} AFT samples: the highest state "
+                                    "reached in the bin")
 
         group = f.create_group("excitation")
         if excitation is not None or excitation_dofs is not None:

@@ -64,7 +64,7 @@ def test_round_trip(tmp_path):
         attributes={"case": "unit", "model_key": "abc123"})
     data = read_response_h5(path)
     attrs = data["attrs"]
-    assert attrs["format"] == "sarfe-response" and attrs["format_version"] == 2
+    assert attrs["format"] == "sarfe-response" and attrs["format_version"] == 3
     assert attrs["harmonics"] == H and attrs["samples_per_period"] == N
     assert "u0" in attrs["fourier_convention"] and attrs["case"] == "unit"
     np.testing.assert_allclose(data["frequency_hz"], [50, 60, 70, 80])

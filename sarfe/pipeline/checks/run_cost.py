@@ -32,8 +32,12 @@ searches chose 14 and 18; the search may go from 3 to 64) and N = max(64, 2^⌈l
 **Disk** (bytes, the files of ``output.files``): each file from its layout, with the compression
 measured on the shipped cases (LZ4 of the VTU arrays ≈ :data:`VTU_RATIO`, gzip of response.h5's
 contact time histories ≈ :data:`H5_GZIP_RATIO`); summary.json and table.txt by a per-point size
-fitted on the shipped cases; a sweep may raise N up to 16× at its corners
-(:data:`sarfe.hbm.continuation.MAX_SAMPLES_FACTOR`), which the high end of the range holds.
+fitted on the shipped cases. A sweep with contacts may raise N up to
+:func:`sarfe.hbm.continuation.most_samples` (N, contact rows) (64 N or more: N × rows ≤ 2^17),
+which the high end of N holds; response.h5 stores the contact time histories at
+:func:`sarfe.results.response_h5.record_samples` (H, N, the case's N) ≤ max(the case's N, 64,
+2^⌈log₂ 16 H⌉) samples (the decimated force, its per-bin peak and the per-bin state), so its size
+is bounded by the case's N and H, not by the raised N.
 Measured within ±30 % on the shipped cases (benchmarks/results/estimate.md).
 
 **CPU** [s] (the process tree's user + system: a quiet 2-core machine's wall time is about this
@@ -60,21 +64,21 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from sarfe.case.config import default_samples_per_period
+from sarfe.hbm.continuation import most_samples
 from sarfe.mesh.geometry import triangle_areas
 from sarfe.pipeline.model.cutoff import stage_cutoff_hz
 from sarfe.pipeline.solve.case_accuracy import rule_cutoff_hz
+from sarfe.results.response_h5 import COMPRESS_MIN_ENTRIES, record_samples
 
 SWEEP_POINTS_PER_BAND = 10.0     # points × max_step of a smooth continuation (door trim)
 SWEEP_FOLD_FACTOR = 4.0          # … × this with folds and contact switches (IP sweep: 400)
 AUTO_HARMONICS = (8, 24)         # the H range the cost of resolution: auto is given for
-SWEEP_SAMPLES_FACTOR = 16        # sarfe.hbm.continuation.MAX_SAMPLES_FACTOR
 
 # disk [bytes]
 VTU_RATIO = 0.55                 # LZ4 of an ERP map's arrays (0.53–0.55 measured)
 ANIMATION_RATIO = 0.6            # … of a deflection frame (0.59–0.63)
 ANIMATION_FRAMES = 24
 H5_GZIP_RATIO = 0.15             # gzip of response.h5's contact time histories (0.10–0.20)
-H5_COMPRESS_MIN = 65536          # sarfe.results.response_h5.COMPRESS_MIN_ENTRIES
 H5_BASE = 40e3                   # response.h5's attributes, names, small datasets
 PNG_BYTES = 300e3                # the plots (7 PNGs, 264–348 kB measured)
 RENDER_BYTES = 300e3             # the report's surface renders (FE; 80–520 kB measured)
@@ -207,8 +211,10 @@ def _cutoff(case) -> float | None:
     return stage_cutoff_hz(config)
 
 
-def file_bytes(config, size: ModelSize, points: int, H: int, N: int) -> dict:
-    """{file: bytes} of ``output.files`` for ``points`` reported points at H, N (docstring)."""
+def file_bytes(config, size: ModelSize, points: int, H: int, N: int, base_N: int | None = None
+               ) -> dict:
+    """{file: bytes} of ``output.files`` for ``points`` reported points at H, N (``base_N``:
+    the case's N before a sweep raised it to N; docstring)."""
     files = set(config.output.files)
     out = {}
     n_c, rows = size.contacts, size.contact_rows
@@ -220,8 +226,10 @@ def file_bytes(config, size: ModelSize, points: int, H: int, N: int) -> dict:
     maps = map_count(config, points) if size.fe else 0
     if "response" in files:
         harmonic = 2 * (2 * H + 1) * rows * 8                    # displacement_m, force_N
-        history = N * rows * 8 + N * n_c                         # force_time_N, state (int8)
-        ratio = H5_GZIP_RATIO if points * N * rows >= H5_COMPRESS_MIN else 1.0
+        n = record_samples(H, N, base_N)                         # the stored time grid ≤ N
+        history = 2 * n * rows * 8 + n * n_c                     # force_time_N, force_peak_N,
+        #                                                          state (int8)
+        ratio = H5_GZIP_RATIO if points * n * rows >= COMPRESS_MIN_ENTRIES else 1.0
         records = 8 * (5 * H + 4 * 14 + 2 * 28 + 40 + n_c * 30)  # erp, bands, audibility, …
         excitation = 0 if size.fe else 8 * (2 * H + 1) * size.dofs
         out["response.h5"] = (H5_BASE + points * (harmonic + records + excitation
@@ -293,16 +301,16 @@ def run_cost(case, size: ModelSize) -> RunCost:
     mesh_term = size.generated and config.solver.error_estimate \
         and config.solver.mesh_error is not False
     cpu, written, files = [], [], {}
-    for i, (n, h, samples) in enumerate(((points[0], H[0], N[0]),
-                                         (points[1], H[1], N[1] * (
-                                             SWEEP_SAMPLES_FACTOR if not listed
-                                             and config.contacts else 1)))):
+    base = N
+    if not listed and config.contacts:    # the sweep's cap on raising N (module docstring)
+        N = (N[0], most_samples(N[1], size.contact_rows))
+    for i, (n, h, samples) in enumerate(((points[0], H[0], N[0]), (points[1], H[1], N[1]))):
         t = fixed + n * point_seconds(size.contact_rows, h, listed)
         if mesh_term:
             t += 0.25 * stage + point_seconds(size.contact_rows, h, True)
         spread = RANGE if listed else math.sqrt(RANGE)   # a sweep's points carry the rest
         cpu.append(t / spread if i == 0 else t * spread)
-        sizes = file_bytes(config, size, n, h, samples)
+        sizes = file_bytes(config, size, n, h, samples, base[i])
         written.append(sum(sizes.values()))
         for name, value in sizes.items():
             files.setdefault(name, []).append(value)

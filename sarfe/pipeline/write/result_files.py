@@ -157,6 +157,7 @@ def _write_outputs(config, stage, nl, summary, rows, solutions, erps, fields, di
             excitation_dofs=np.zeros(0, dtype=int) if reduced is not None
             and config.excitation.base_acceleration is not None else None,
             density_points=selected if stage.kind == "fe" else None,
+            base_samples_per_period=config.solver.samples_per_period,   # N before raised
             boundary_dofs=getattr(stage.reduced, "boundary_dofs", None),
             mode_frequencies_hz=stage.mode_frequencies_hz, erp=erps,
             radiating_nodes=stage.erp_nodes if stage.erp_map.shape[0] else None,
