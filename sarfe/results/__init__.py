@@ -50,7 +50,7 @@ _EXPORTS = {
     "plot_audibility": ".plots",
     "write_report_html": ".report",
     "read_response_h5": ".response_h5", "write_response_h5": ".response_h5",
-    "record_samples": ".response_h5",
+    "record_samples": ".record_grid",
     "console_table": ".summary", "to_jsonable": ".summary", "write_summary_json": ".summary",
     "contact_markers": ".vtk", "erp_point_data": ".vtk", "period_samples": ".vtk",
     "write_deflection_animation": ".vtk", "write_erp_sweep": ".vtk", "write_erp_vtu": ".vtk",

@@ -77,13 +77,15 @@ peak force, not whether/when (to a bin, 2π/N_rec) the contact closed or slipped
 from __future__ import annotations
 
 import datetime as _dt
-import math
 from pathlib import Path
 
 import h5py
 import numpy as np
 
 from sarfe import __version__
+from sarfe.results.record_grid import (COMPRESS_MIN_ENTRIES, RECORD_MIN_SAMPLES,
+                                       RECORD_SAMPLES_PER_HARMONIC, record_histories,
+                                       record_samples)
 
 __all__ = ["write_response_h5", "read_response_h5", "record_samples", "record_histories",
            "FOURIER_CONVENTION", "FORMAT_VERSION", "RECORD_SAMPLES_PER_HARMONIC",
@@ -91,8 +93,6 @@ __all__ = ["write_response_h5", "read_response_h5", "record_samples", "record_hi
 
 FORMAT_VERSION = 3      # 2: /erp/density_total_W_m2 at /erp/density_point_index (issue 30)
 #                         3: contact time histories at N_rec ≤ N, force_peak_N (issue 30 item 3)
-RECORD_SAMPLES_PER_HARMONIC = 16   # N_rec = max(RECORD_MIN_SAMPLES, 2^⌈log₂ 16 H⌉), ≤ N
-RECORD_MIN_SAMPLES = 64
 FOURIER_CONVENTION = (
     "u(theta) = u0 + sum_{k=1..H} (u_kc cos k theta + u_ks sin k theta), theta = omega t; "
     "harmonic axis of length 2H+1 stores [u0, u1c, u1s, ..., uHc, uHs] (u0 not halved); "
@@ -105,9 +105,6 @@ UNITS = ("SI: m, N, s, Hz, rad/s, W, W/m^2; levels in dB re 1e-12 W, A-weighted 
 _STR = h5py.string_dtype("utf-8")
 
 
-# gzip (level 4, shuffled) only from this many entries: below it a dataset is stored whole
-# (contiguous), its chunk index and filter calls costing more than the bytes saved
-COMPRESS_MIN_ENTRIES = 65536
 
 
 def _put(group, name, data, units=None, compress=False, text=False):
@@ -126,40 +123,6 @@ def _put(group, name, data, units=None, compress=False, text=False):
     if units:
         ds.attrs["units"] = units
     return ds
-
-
-def record_samples(harmonics: int, samples_per_period: int, base_samples: int | None = None
-                   ) -> int:
-    """N_rec, the time samples per period stored (module docstring): N / s with s the smallest
-    decimation dividing N such that N / s ≤ max(RECORD_MIN_SAMPLES, 2^⌈log₂ 16 H⌉,
-    ``base_samples``) (the case's solver.samples_per_period, before a sweep raised N: a run at
-    its own N stores all of it; a power-of-two N gives that bound exactly)."""
-    N = int(samples_per_period)
-    target = max(RECORD_MIN_SAMPLES, int(base_samples or 0),
-                 2 ** math.ceil(math.log2(RECORD_SAMPLES_PER_HARMONIC * max(int(harmonics), 1))))
-    step = max(1, -(-N // target))
-    while N % step:
-        step += 1
-    return N // step
-
-
-def record_histories(force_time, state, record: int) -> tuple:
-    """The stored time histories of one point at N_rec = ``record`` samples per period, from
-    the solve's λ(θ_j) ``force_time`` (N, n_rows) [N] and ``state`` (N, n_c) (either None):
-    (decimated force (N_rec, n_rows), per-bin force of largest magnitude (N_rec, n_rows),
-    per-bin highest state (N_rec, n_c) int8); bin j holds AFT samples j s … j s + s − 1,
-    s = N / N_rec."""
-    out = [None, None, None]
-    if force_time is not None:
-        F = np.asarray(force_time, dtype=float)
-        bins = F.reshape(record, F.shape[0] // record, *F.shape[1:])
-        out[0] = bins[:, 0]
-        where = np.argmax(np.abs(bins), axis=1)[:, None]
-        out[1] = np.take_along_axis(bins, where, axis=1)[:, 0]
-    if state is not None:
-        S = np.asarray(state, dtype=np.int8)
-        out[2] = S.reshape(record, S.shape[0] // record, *S.shape[1:]).max(axis=1)
-    return tuple(out)
 
 
 def _stack(solutions, name, dtype=float):

@@ -35,7 +35,7 @@ contact time histories ≈ :data:`H5_GZIP_RATIO`); summary.json and table.txt by
 fitted on the shipped cases. A sweep with contacts may raise N up to
 :func:`sarfe.hbm.continuation.most_samples` (N, contact rows) (64 N or more: N × rows ≤ 2^17),
 which the high end of N holds; response.h5 stores the contact time histories at
-:func:`sarfe.results.response_h5.record_samples` (H, N, the case's N) ≤ max(the case's N, 64,
+:func:`sarfe.results.record_grid.record_samples` (H, N, the case's N) ≤ max(the case's N, 64,
 2^⌈log₂ 16 H⌉) samples (the decimated force, its per-bin peak and the per-bin state), so its size
 is bounded by the case's N and H, not by the raised N.
 Measured within ±30 % on the shipped cases (benchmarks/results/estimate.md).
@@ -68,7 +68,7 @@ from sarfe.hbm.continuation import most_samples
 from sarfe.mesh.geometry import triangle_areas
 from sarfe.pipeline.model.cutoff import stage_cutoff_hz
 from sarfe.pipeline.solve.case_accuracy import rule_cutoff_hz
-from sarfe.results.response_h5 import COMPRESS_MIN_ENTRIES, record_samples
+from sarfe.results.record_grid import COMPRESS_MIN_ENTRIES, record_samples
 
 SWEEP_POINTS_PER_BAND = 10.0     # points × max_step of a smooth continuation (door trim)
 SWEEP_FOLD_FACTOR = 4.0          # … × this with folds and contact switches (IP sweep: 400)
