@@ -293,26 +293,26 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
                 break
         return point
 
-    def solve_past(omega):
-        """The point solved at fixed ω (≤ ω_end) from the last one, and its z."""
+    def solve_past(omega, base):
+        """The point solved at fixed ω (≤ ω_end) from the last one, started on the secant from
+        the earlier point ``base`` (at a fold ∂R/∂x is singular), and its z."""
         omega = omega_end if direction * (omega - omega_end) > 0 else omega
-        last, base = solutions[-1], state["base"]      # start: the secant of the travel (at a
-        reach = (omega - last.omega) / (last.omega - base.omega)   # fold, ∂R/∂x is singular)
+        last = solutions[-1]
+        reach = (omega - last.omega) / (last.omega - base.omega)
         point = solve_from(problem, omega, last.displacement + reach * (last.displacement
                                                                         - base.displacement),
                            so, state["slider"])
         return point, np.append(to_x(point.displacement) / x_scale, omega / span)
 
     def travel():
-        """z_i − z_k for the latest earlier point k at least TRAVEL_BASE away (or the farthest of
-        the last TRAVEL_POINTS): the direction of travel beyond the last micro-steps."""
-        d = np.zeros_like(z)
-        for s in reversed(solutions[-TRAVEL_POINTS:-1]):
-            d = z - np.append(to_x(s.displacement) / x_scale, s.omega / span)
-            state["base"] = s
+        """(z_i − z_k, point k) for the latest earlier point k at least TRAVEL_BASE away (or the
+        farthest of the last TRAVEL_POINTS): the direction of travel beyond the last micro-steps."""
+        d, base = np.zeros_like(z), None
+        for base in reversed(solutions[-TRAVEL_POINTS:-1]):
+            d = z - np.append(to_x(base.displacement) / x_scale, base.omega / span)
             if np.linalg.norm(d) >= TRAVEL_BASE:
                 break
-        return d
+        return d, base
 
     trail = {}
     recovered = {}
@@ -454,7 +454,8 @@ def continuation(model, contacts, excitation, omega_start, omega_end, harmonics,
         if (light and refined is None and len(solutions) > 1
                 and direction * (result.x[-1] - z[-1]) < 0):
             far = direction * max(direction * s.omega for s in solutions[-TRAVEL_POINTS:]) / span
-            over = step_over(solve_past, z, travel(), span, direction, far)  # ω turns: sampling's?
+            d, base = travel()                                    # ω turns: the sampling's?
+            over = step_over(lambda omega: solve_past(omega, base), z, d, span, direction, far)
             if over is not None:
                 point, z_over, share = over
                 solutions.append(replace(point, reason=point.reason + stepped_note(
