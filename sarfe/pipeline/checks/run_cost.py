@@ -305,9 +305,7 @@ def run_cost(case, size: ModelSize) -> RunCost:
     N = tuple(default_samples_per_period(h) for h in H) if auto \
         else (config.solver.samples_per_period,) * 2
     cutoff = _cutoff(case)
-    modes = None
-    if size.mode_density_per_hz is not None:
-        modes = reduction_modes(config, size, cutoff)
+    modes = reduction_modes(config, size, cutoff)
     points = sweep_points(config)
     listed = config.excitation.sweep is None
     stage = stage_seconds(size.dofs, modes if modes is not None else 100) if size.fe else 0.0
