@@ -47,3 +47,14 @@ def dask_client(fake_log_file):
     client.close()
     cluster.close()
     del distributed
+
+
+@pytest.fixture
+def no_batch_plots(monkeypatch):
+    """The batch report without its PNGs, for tests that assert the table, the summary, the gate
+    or the run bookkeeping (not the plots): matplotlib's layout and PNG encoding cost 0.2 s a
+    figure, up to five figures a report, seconds a test. The plots themselves are asserted by
+    test_lumped_study.py::test_table_outputs and test_report_confidence.py."""
+    import sarfe.batch.batch_report as batch_report
+
+    monkeypatch.setattr(batch_report, "_plots", lambda levels, output: [])

@@ -80,7 +80,7 @@ def test_same_table_on_one_and_two_workers(in_process, tmp_path, dask_client):
     pd.testing.assert_frame_equal(one, table)
 
 
-def test_gate_on_the_shipped_study(in_process, capsys):
+def test_gate_on_the_shipped_study(in_process, capsys, no_batch_plots):
     table, out, _ = in_process
     levels = table.groupby("variant_id")["erp_db"].max()
     threshold = float(levels.quantile(0.7))

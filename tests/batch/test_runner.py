@@ -18,6 +18,8 @@ from sarfe.batch.cli import main, register
 
 HERE = pathlib.Path(__file__).resolve().parent
 FAKE = "batch_fake_pipeline"   # tests/batch/batch_fake_pipeline.py, on sys.path (conftest.py)
+# none of these tests asserts the report's plots (conftest.py: no_batch_plots)
+pytestmark = pytest.mark.usefixtures("no_batch_plots")
 
 
 def study(tmp_path, variations, extra=""):

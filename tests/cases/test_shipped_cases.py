@@ -130,10 +130,11 @@ def assert_case_delivers(summary, exit_code):
     assert check["met"] is True and not check["unknown_points"], check["warning"]
 
 
-def test_squeak_rig_meets_its_budget_and_a_finer_model(tmp_path):
+def test_squeak_rig_meets_its_budget_and_a_finer_model():
     """The shipped squeak rig (6 mm, H = 32): converged, exit 0, estimate inside 'balanced' (0.5 dB), and
-    each point's dB(A) within its own error bound (and 0.5 dB) of the finer model."""
-    result = solve_case(load_case(CASES / "squeak_rig.yaml"), output_dir=tmp_path / "squeak")
+    each point's dB(A) within its own error bound (and 0.5 dB) of the finer model. Only the
+    summary is asserted, so nothing is written (the result files and figures cost 4 s)."""
+    result = solve_case(load_case(CASES / "squeak_rig.yaml"), write=False)
     summary = result.summary
     # the ± carries the 6 mm mesh's own error (issue 29 item 4: ±1.84 dB at 150 Hz, 8.5 / 12 mm
     # re-solves): the case is screening grade (its file says why); the budget is met but for it

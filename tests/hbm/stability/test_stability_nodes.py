@@ -69,10 +69,19 @@ def test_the_count_on_these_nodes_finds_the_zeros_between_the_poles():
         return (np.log(s - zeros).sum(axis=1) - np.log(s - far).sum(axis=1)
                 + np.log(s - partners).sum(axis=1) - np.log(s - poles).sum(axis=1))
 
+    above, below = np.concatenate([zeros, partners]), np.concatenate([far, poles])
+
+    def arg_det(s):
+        """arg f(s) = Im log f(s) mod 2π from the product of the factors, by chunks of ~1000
+        points: one complex angle per point instead of 2 × 883 logs (the dense check's 42,003
+        points took 6 s and 0.6 GB temporaries); the wrapped steps below are the same (6e-13)."""
+        return np.concatenate([np.angle(np.prod((c[:, None] - above) / (c[:, None] - below), axis=1))
+                               for c in np.array_split(np.asarray(s), max(1, len(s) // 1000))])
+
     nodes = upper_contour(epsilon, X, top, poles)
     count, _ = winding_count(log_det, nodes)
     assert abs(count - 2.0) < 1e-6
     fine = np.concatenate([X + 1j * np.linspace(0.0, top, 2001),
                            np.geomspace(X + epsilon, 1e-3, 20001) - epsilon + 1j * top,
                            -epsilon + 1j * np.linspace(top, 0.0, 20001)])
-    assert abs(np.angle(np.exp(1j * np.diff(log_det(fine).imag))).sum() / np.pi - 2.0) < 1e-6
+    assert abs(np.angle(np.exp(1j * np.diff(arg_det(fine)))).sum() / np.pi - 2.0) < 1e-6
