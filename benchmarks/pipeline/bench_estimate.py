@@ -123,6 +123,16 @@ Notes (2026-11-28, by hand):
 - Modes (Weyl's leading term against the reduction's count): ×0.4 (rattle rig, few low modes)
   to ×2.1 (instrument panel at 186 Hz); ×1.07 on the instrument panel sweep's 1500 Hz stage,
   ×1.33 on door_trim_p1's 1200 Hz.
+- Stiff contacts (runcost3, 2026-11-28, measured, not yet used by the estimate): `sarfe solve`
+  with error_estimate and stability off, output summary only, nice 10, load 0.1–2.3. Points
+  (CPU s) against the contact normal stiffness k_n [N/m]; the estimate said 100–400 for all:
+  lumped_rattle 1e6 (shipped) 234, 1e7 261 (18), 1e8 297 (35), 1e9 376, 1e10 574,
+  1e11 1280–1306 (the last three from extremes.md); rattle_rig 2e5 (shipped) 363, 1e6 335 (20),
+  1e7 402 (31), 1e8 494 (65), 1e9 715 (339), 1e11 130 points in 1510 CPU s (incomplete run, exit
+  3; 1e10 not finished inside its 3000 s). The high end (4 / max_step = 400) is exceeded from
+  k_n ≈ 1e7 (rattle rig) / 1e10 (lumped) on; the points grow about like κ^0.15 with
+  κ = k_n / (static stiffness at the contact row) (lumped: κ = 55 … 5.5e6 gives 234 … 1280).
+  A rule from this was not built in time (report of runcost3).
 """
 
 FILES = ["summary.json", "table.txt", "response.h5", "ERP maps (VTU)", "animation",

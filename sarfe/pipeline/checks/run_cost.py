@@ -21,7 +21,9 @@ edges) was tried and does not help these models (the rattle rig's count goes bel
 leading term alone is exact to 3 % against a simply supported plate's spectrum once the edge
 term of that boundary is taken off (tests/pipeline/checks/test_run_cost.py). A deck's shells
 count with their own ρ t + NSM and √(D₁₁ D₂₂) (the rattle rig's deck gives its generator's
-density); a matrices model states no mode count.
+density); a matrices model states no mode count. The stated count follows the reduction's
+rule (:func:`reduction_modes`): at least ``reduction.min_mode_count`` (10), so the rattle rig
+says 10 (its run: 10), not Weyl's 4.
 
 **Points.** A list of frequencies: its length. A sweep (arc-length continuation): between
 :data:`SWEEP_POINTS_PER_BAND` / max_step (a smooth branch: the door trim, 105 at max_step 0.1,
@@ -278,6 +280,23 @@ def stage_seconds(dofs: int, modes) -> float:
     return ASSEMBLY_S_PER_DOF * dofs + CB_S * dofs * max(modes, 1) ** CB_MODE_EXPONENT
 
 
+def reduction_modes(config, size: ModelSize, cutoff_hz) -> int | None:
+    """The mode count the reduction keeps (sarfe.pipeline.model.fe_stage.reduce_model's rule):
+    reduction.mode_count when given, else the Weyl count below the cutoff raised to
+    reduction.min_mode_count (capped by the DOFs: the reduction's len(free) − len(boundary) − 1,
+    here dofs − contact rows − 1). None without a Weyl density or a reduction."""
+    reduction = config.reduction
+    if size.mode_density_per_hz is None or reduction is None:
+        return None
+    if reduction.mode_count is not None:
+        return int(reduction.mode_count)
+    if cutoff_hz is None:
+        return None
+    weyl = int(round(size.mode_density_per_hz * cutoff_hz))
+    floor = min(int(reduction.min_mode_count), max(size.dofs - size.contact_rows - 1, 0))
+    return max(weyl, floor)
+
+
 def run_cost(case, size: ModelSize) -> RunCost:
     """The cost of ``sarfe solve`` on ``case`` (a loaded Case) with ``size`` (docstring)."""
     config = case.config
@@ -286,12 +305,7 @@ def run_cost(case, size: ModelSize) -> RunCost:
     N = tuple(default_samples_per_period(h) for h in H) if auto \
         else (config.solver.samples_per_period,) * 2
     cutoff = _cutoff(case)
-    modes = None
-    if size.mode_density_per_hz is not None:
-        if cutoff is not None:
-            modes = int(round(size.mode_density_per_hz * cutoff))
-        elif config.reduction is not None and config.reduction.mode_count is not None:
-            modes = int(config.reduction.mode_count)
+    modes = reduction_modes(config, size, cutoff)
     points = sweep_points(config)
     listed = config.excitation.sweep is None
     stage = stage_seconds(size.dofs, modes if modes is not None else 100) if size.fe else 0.0
@@ -365,4 +379,4 @@ def cost_lines(cost: RunCost, width: int = 80) -> list:
 
 __all__ = ["ModelSize", "RunCost", "run_cost", "cost_lines", "weyl_mode_density", "plate_bending",
            "contact_rows", "sweep_points", "file_bytes", "map_count", "point_seconds",
-           "stage_seconds"]
+           "stage_seconds", "reduction_modes"]

@@ -170,3 +170,14 @@ def test_cost_line_wraps_within_its_width():
         assert lines[0].startswith("cost: H 8–24 (auto), N 128–512")
         assert any(line.startswith("  100–360 points") for line in lines)
         assert "1140102 DOFs" in "".join(lines) and "≈ 14–37 MB written" in lines[-1]
+
+
+def test_mode_estimate_keeps_the_reductions_minimum(tmp_path):
+    """The rattle rig's 400 Hz cutoff holds ≈ 4 Weyl modes; the reduction keeps
+    reduction.min_mode_count = 10 (its solve's summary: 10 modes, benchmarks/results/estimate.md),
+    and the estimate says the same rule's count."""
+    case = load_case(CASES / "rattle_rig.yaml")
+    size = check_case(case, write=False).size
+    cost = run_cost(case, size)
+    assert size.mode_density_per_hz * cost.cutoff_hz < case.config.reduction.min_mode_count
+    assert cost.modes == case.config.reduction.min_mode_count == 10
