@@ -108,7 +108,9 @@ class HarmonicSolution:
     the orders outside the set (outside the odd set, for an 'auto' solution that used all orders)
     carry, see :func:`sarfe.hbm.harmonic_set.dropped_content` (nan if not computed).
     Residual_norm and stability: residual of the kept rows; Hill stability of the full set.
-    stability_note: why ``stable`` is None although stability was computed ('' otherwise).
+    stability_note: why ``stable`` is None although stability was computed, or how the verdict was
+    reached without a located leading exponent (``floquet_exponent`` NaN with the bound the
+    contact-row count gives, a linear point, a verdict inferred from neighbours; '' otherwise).
     method: how the point was obtained — 'harmonic balance' (the Newton solve), 'linear' (exact
     solution without nonlinear contacts) or 'time integration' (the stand-in for a point whose
     engine call raised: iterations = periods integrated, residual_norm = periodicity error).

@@ -7,9 +7,17 @@ from its modal basis (:mod:`sarfe.hbm.stability.determinant`). The zeros in the 
 Ω = {−ε < Re s < X, |Im s| < 1.01 ω/2}, ε = uncertain_band·ω, are counted by the change of
 arg det F along its boundary (:mod:`sarfe.hbm.stability.contour`).
 
-No zero in Ω: stable, and no exponent is within the uncertain band; the leading exponent reported
-is the least damped exponent of the structure (max Re of μ s² + δ s + 1 = 0; the coupled
-exponents left of −ε are not located). One zero in Ω: it is real (a fold's exponent), located on
+No zero in Ω: stable, and every exponent has Re s < −ε. The count locates none of them: the
+leading exponent is reported as not located (NaN) with a note stating the bound Re s < −ε
+(:func:`not_located`). (It used to report the least damped exponent of the structure, max Re of
+μ s² + δ s + 1 = 0, which is not the orbit's where a contact row is loaded: on the squeak rig at
+50 / 100 / 150 Hz, H = 5, it said −3.95 1/s where the full Hill method's leading exponent is
+−25.8 / −13.8 / −14.2 1/s; the contacts damp and stiffen the coupled modes, so the orbit's leading
+exponent lay left of the structure's at every measured point (lumped_rattle at 45 Hz: −9.49
+against −15.85 1/s; door trim at 40 / 52 Hz: −6.25 against −6.65 / −6.43 1/s);
+tests/hbm/stability/test_stability_rows.py checks the bound against the full method.) Where no contact row is
+loaded (every contact open all period) F = I, Hill's operator is the structure's and its least
+damped exponent is the orbit's, reported as such. One zero in Ω: it is real (a fold's exponent), located on
 the real axis by the sign of det F (:func:`sarfe.hbm.stability.zeros.real_zero`), and decides the
 verdict (:func:`contact_row_stability`). Two or more: all of them are located from the count's
 samples (:func:`sarfe.hbm.stability.zeros.located_zeros`) and the leading one decides. A pole near
@@ -60,7 +68,8 @@ def contact_row_counts(model, contacts, omega, harmonics, forces, operator=None,
     H bounds every exponent at H' too, ‖𝒥'‖ ≤ ‖𝒥‖ being a leading block). The result when the
     count decides it, else None.
 
-    No zero of det F right of −ε: stable (for every stability tolerance ≥ 0 of the full method).
+    No zero of det F right of −ε: stable (for every stability tolerance ≥ 0 of the full method),
+    the leading exponent not located (NaN, :func:`not_located`) where a contact row is loaded.
     Exactly one: it is real (zeros off the real axis come in conjugate pairs) and it is the leading
     exponent s*; :func:`real_zero` locates it and the verdict is the full method's rule: uncertain
     (None, with a note) when |s*| ≤ ``uncertain_band``·ω, else stable iff s* ≤ ``tolerance``·ω —
@@ -89,9 +98,10 @@ def contact_row_counts(model, contacts, omega, harmonics, forces, operator=None,
     J = jacobian_matrix(forces.blocks, n_rows, H)
     Jd = jacobian_matrix(forces.damping_blocks, n_rows, H) if forces.damping_blocks else None
     det = ContactRowDeterminant(basis, contacts.gap_map, omega, H, J, Jd, operator)
-    stable = StabilityResult(True, least_damped, "", structure)
-    if det.loaded.size == 0:
-        return stable, 0, None if coarse is None else 0
+    if det.loaded.size == 0:                    # F = I: the orbit's exponents are the structure's
+        return (StabilityResult(True, least_damped, "", structure), 0,
+                None if coarse is None else 0)
+    stable = not_located(epsilon)
     # ‖𝒥(s)‖₂ for Re s ≥ 0: twice its largest value at s = 0, ω, 10ω (the memory factors e^{−shd}
     # have modulus ≤ 1 there; the pointwise part does not depend on s), each bounded above by the
     # Frobenius norm (‖·‖₂ ≤ ‖·‖_F: X only grows, the contour still encloses every exponent)
@@ -127,6 +137,15 @@ def contact_row_counts(model, contacts, omega, harmonics, forces, operator=None,
     lead = float(exponents.real.max())
     return verdict(lead, np.concatenate([exponents, structure]), omega, tolerance,
                    uncertain_band), zeros, coarse_zeros
+
+
+def not_located(epsilon):
+    """The StabilityResult of a count with no zero right of −ε (``epsilon`` [1/s]) and a loaded
+    contact row: stable, leading exponent NaN (not located: the count bounds the exponents, it
+    does not find them), exponents empty, and a note that states the bound Re s < −ε."""
+    return StabilityResult(True, float("nan"), (
+        f"leading Floquet exponent not located: the contact-row count finds none right of "
+        f"−1e-4·ω, every exponent has Re s < {-epsilon:.3g} 1/s"), np.zeros(0, complex))
 
 
 def leading_zeros(log_det, samples, zeros, epsilon, top, X, poles=()):

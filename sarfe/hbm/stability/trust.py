@@ -39,6 +39,8 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+import numpy as np
+
 from sarfe.hbm.residual import Problem
 from sarfe.hbm.stability.contact_terms import ContactOperator
 from sarfe.hbm.stability.rows import contact_row_count, stability_basis
@@ -98,6 +100,6 @@ def checked(result, zeros, coarse, problem):
     if (result.stable is True and coarse > 0) or (result.stable is False and coarse == 0):
         return replace(result, stable=None, note=(
             f"not resolved in H: {zeros} Floquet exponent(s) right of −1e-4·ω with the contact "
-            f"coupling at H = {problem.harmonics}, {coarse} at H = {H_coarse} (leading "
-            f"{result.leading:.3g} 1/s)"))
+            f"coupling at H = {problem.harmonics}, {coarse} at H = {H_coarse}" + (
+                f" (leading {result.leading:.3g} 1/s)" if np.isfinite(result.leading) else "")))
     return result

@@ -307,3 +307,26 @@ def test_shared_contour_counts_equal_separate_counts_friction(squeak_rig):
         assert (zeros, coarse) == (alone, separate) == (0, 0)
         full, _, _ = full_hill(nl.model, nl.contacts, nl.excitation, s)
         assert result.stable is full.stable is True
+
+
+def test_a_count_without_zeros_bounds_the_leading_exponent(squeak_rig, sweep03):
+    """No zero right of −ε with a loaded contact row: the count does not locate the leading
+    exponent — it reports NaN and a note with the bound Re s < −ε, and the full Hill method's
+    leading exponent is left of that bound (squeak rig at 50 and 150 Hz, where the structure's
+    least-damped exponent, which the count used to report, is not the orbit's). Where no row is
+    loaded (NLvib 03 before its contact closes) the structure's exponent is the orbit's and equals
+    the full method's."""
+    nl, sols = squeak_rig
+    for s in sols:
+        full, rows, _, _ = full_and_rows(nl.model, nl.contacts, nl.excitation, s)
+        epsilon = 1e-4 * s.omega
+        assert rows.stable is True and np.isnan(rows.leading), (s.omega, rows)
+        assert "not located" in rows.note and f"{-epsilon:.3g} 1/s" in rows.note
+        assert full.leading < -epsilon, (s.omega, full.leading)
+    model, contacts, F, sweep = sweep03
+    open_points = [s for s in sweep if np.max(np.abs(s.contact_force_time)) == 0.0]
+    assert open_points
+    for s in open_points[:2]:
+        full, rows, _, _ = full_and_rows(model, contacts, F, s)
+        assert rows.stable is True and full.stable is True
+        assert rows.leading == pytest.approx(full.leading, rel=1e-6)
