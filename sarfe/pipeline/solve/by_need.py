@@ -171,6 +171,9 @@ def sweep_by_need(nl, start, end, H, N, options, cont_options, grid, margin, nat
                              and p.method != TIME_INTEGRATION), previous)
 
     for a, b in nonlinear_stretches(linear):
+        if not ahead(grid[b]):
+            continue        # the last branch went on past this stretch (a hardening branch
+            #                 reaches beyond the linearized screen's next linear grid point)
         begin = grid[a] if ahead(grid[a]) else at
         if a > 0 and ahead(begin):
             add_linear(begin, False)
