@@ -30,7 +30,7 @@ from sarfe.pipeline.post.audibility_records import background_record
 from sarfe.pipeline.post.records import error_estimates, worst_of
 from sarfe.pipeline.post.review import target_check
 from sarfe.pipeline.post.stability_need import stability_stride
-from sarfe.pipeline.solve.by_need import erp_measure
+from sarfe.pipeline.solve.by_need import erp_measure, fallback_warning
 from sarfe.pipeline.solve.case_accuracy import (accuracy_check, case_resolution, resolution_line,
                                                 resolved_case)
 from sarfe.pipeline.solve.impact_check import impact_check_point, impact_time_check
@@ -217,6 +217,11 @@ def solve_case(case, linear_stage=None, output_dir=None, progress=False, write=T
         finally:
             if bar is not None:
                 bar.close()
+    fallback = fallback_warning(solutions)      # the sweep by need raised: said, not only in reasons
+    if fallback is not None:
+        warnings.append(fallback)
+        if warn is not None:
+            warn(fallback)
     not_converged = [p["index"] for p in points if not p["converged"]]
     # None entries without a sweep
     sweep = sweep_status(config.excitation, config.solver.continuation, solutions)

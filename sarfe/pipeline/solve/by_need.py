@@ -126,6 +126,18 @@ def points_by_need(solver: SolverConfig, excitation: ExcitationConfig, nl: Nonli
     return in_band(solutions, start, end)
 
 
+def fallback_warning(solutions) -> str | None:
+    """One warning line when the sweep by need raised and the band was solved as one whole-band
+    continuation instead (:func:`points_by_need`: the error is in every point's reason), else
+    None. The points solve the same equations; the walk's time was spent for nothing."""
+    reason = next((str(s.reason) for s in solutions if BY_NEED_FAILED in str(s.reason)), None)
+    if reason is None:
+        return None
+    cause = reason[reason.index(BY_NEED_FAILED):-1]        # the reason ends "(<cause>)"
+    return (f"{cause}: the band was solved as one whole-band continuation instead (the same "
+            "equations, without the linear stretches: slower); please report it")
+
+
 def sweep_by_need(nl, start, end, H, N, options, cont_options, grid, margin, natural=(),
                   measure=None, progress=None):
     """HarmonicSolutions of a sweep from ω ``start`` to ``end`` [rad/s] by need (module
@@ -270,5 +282,5 @@ def _peak(nl, w0, w1, measure) -> float:
     return float(found.x)
 
 
-__all__ = ["LEVEL_STEP_DB", "REFINE_DEPTH", "PEAK_XTOL", "BY_NEED_FAILED", "nonlinear_stretches",
+__all__ = ["LEVEL_STEP_DB", "REFINE_DEPTH", "PEAK_XTOL", "BY_NEED_FAILED", "fallback_warning", "nonlinear_stretches",
            "default_measure", "erp_measure", "points_by_need", "sweep_by_need", "linear_stretch"]
