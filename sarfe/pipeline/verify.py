@@ -94,8 +94,10 @@ def verify_point(solver: SolverConfig, erp: ErpConfig, stage, nl, omega, toleran
                                    steps_per_period=max(512, 4 * N))
         verdict = {True: "stable", False: "unstable", None: "uncertain"}[hbm.stable]
         note = getattr(hbm, "stability_note", "")
+        exponent = (f"{hbm.floquet_exponent:.3g} 1/s" if np.isfinite(hbm.floquet_exponent)
+                    else "not located")     # a stable count bounds it: the note says where
         rows.append(Comparison(
-            f"stability (Hill {hbm.floquet_exponent:.3g} 1/s vs time int. {check.rate:.3g} 1/s)"
+            f"stability (Hill {exponent} vs time int. {check.rate:.3g} 1/s)"
             + (f" [{note}]" if note else ""), verdict, "stable" if check.stable else "unstable",
             None, None, "", hbm.stable is None or hbm.stable == check.stable))
     return hbm, tim, check, rows
