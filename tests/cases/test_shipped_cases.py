@@ -123,9 +123,11 @@ def shipped_case_params():
 
 
 def assert_case_delivers(summary, exit_code):
-    """What every shipped case must achieve: all points converged, exit 0, and its own error
-    estimate inside its accuracy budget with no point left unestimated."""
+    """What every shipped case must achieve: all points converged, exit 0, its own error
+    estimate inside its accuracy budget with no point left unestimated, and a sweep by need that
+    did not fall back to the whole-band continuation (door_trim_p1 did, unseen, until 2026-11-29)."""
     assert exit_code == 0 and summary["all_converged"], summary["non_converged_points"]
+    assert not [w for w in summary["warnings"] if "sweep by need failed" in w], summary["warnings"]
     check = summary["accuracy_check"]
     assert check["met"] is True and not check["unknown_points"], check["warning"]
 
