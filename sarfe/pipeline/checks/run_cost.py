@@ -52,7 +52,10 @@ over 1.5 with the point workers), stage by stage with constants measured on this
     H search (auto)      14 points at the low H (on the sweep's own linear stage)
     points               n_points · (c_0 + c_1 · (rows (2H+1))^0.55) · (2 for listed frequencies:
                          a cold start each) — Newton, error estimate, Hill stability, records
-    mesh term            a quarter of the linear stage and a point (generated meshes)
+    mesh term            the linear stages of the two coarser meshes (√2 h, 2 h: ½ + ¼ of the
+                         DOFs at the same modes, ¾ of the fine stage) and a point on each
+                         (generated meshes; measured on door_trim_p1: 41.8 CPU s against the
+                         fine linear stage's ≈ 51, benchmarks/results/door_trim.md)
 
 given as a range ×½ … ×2 around that (a sweep: ×1/√2 … ×√2 around its point range's ends):
 an order of magnitude, never a promise (benchmarks/pipeline/bench_estimate.py compares it with
@@ -70,6 +73,7 @@ from sarfe.hbm.continuation import most_samples
 from sarfe.mesh.geometry import triangle_areas
 from sarfe.pipeline.model.cutoff import stage_cutoff_hz
 from sarfe.pipeline.solve.case_accuracy import rule_cutoff_hz
+from sarfe.pipeline.solve.mesh_error import coarse_sizes
 from sarfe.results.record_grid import COMPRESS_MIN_ENTRIES, record_samples
 
 SWEEP_POINTS_PER_BAND = 10.0     # points × max_step of a smooth continuation (door trim)
@@ -314,6 +318,9 @@ def run_cost(case, size: ModelSize) -> RunCost:
         fixed += SEARCH_POINTS * point_seconds(size.contact_rows, H[0], True)
     mesh_term = size.generated and config.solver.error_estimate \
         and config.solver.mesh_error is not False
+    # the coarser meshes' DOF shares (h / h_c)² of a shell mesh; their stages keep the cutoff
+    shares = [(config.model.fe.generator.mesh_size_m / h_c) ** 2
+              for h_c in coarse_sizes(case)] if mesh_term else []
     cpu, written, files = [], [], {}
     base = N
     if not listed and config.contacts:    # the sweep's cap on raising N (module docstring)
@@ -321,7 +328,7 @@ def run_cost(case, size: ModelSize) -> RunCost:
     for i, (n, h, samples) in enumerate(((points[0], H[0], N[0]), (points[1], H[1], N[1]))):
         t = fixed + n * point_seconds(size.contact_rows, h, listed)
         if mesh_term:
-            t += 0.25 * stage + point_seconds(size.contact_rows, h, True)
+            t += sum(shares) * stage + len(shares) * point_seconds(size.contact_rows, h, True)
         spread = RANGE if listed else math.sqrt(RANGE)   # a sweep's points carry the rest
         cpu.append(t / spread if i == 0 else t * spread)
         sizes = file_bytes(config, size, n, h, samples, base[i])
