@@ -15,10 +15,10 @@ leading exponent is reported as not located (NaN) with a note stating the bound 
 −25.8 / −13.8 / −14.2 1/s; the contacts damp and stiffen the coupled modes, so the orbit's leading
 exponent lay left of the structure's at every measured point (lumped_rattle at 45 Hz: −9.49
 against −15.85 1/s; door trim at 40 / 52 Hz: −6.25 against −6.65 / −6.43 1/s);
-tests/hbm/stability/test_stability_rows.py checks the bound against the full method.) Where no contact row is
-loaded (every contact open all period) F = I, Hill's operator is the structure's and its least
-damped exponent is the orbit's, reported as such. One zero in Ω: it is real (a fold's exponent), located on
-the real axis by the sign of det F (:func:`sarfe.hbm.stability.zeros.real_zero`), and decides the
+tests/hbm/stability/test_stability_rows.py checks the bound against the full method.) Where no
+contact row is loaded (every contact open all period) F = I, Hill's operator is the structure's
+and its least damped exponent is the orbit's, reported as such. One zero in Ω: it is real (a
+fold's exponent), located on the real axis by the sign of det F (:func:`sarfe.hbm.stability.zeros.real_zero`), and decides the
 verdict (:func:`contact_row_stability`). Two or more: all of them are located from the count's
 samples (:func:`sarfe.hbm.stability.zeros.located_zeros`) and the leading one decides. A pole near
 the contour, a model without a modal basis, a contour that does not close on a multiple of π, or
