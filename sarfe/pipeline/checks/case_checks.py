@@ -397,7 +397,7 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True,
                      mode_density_per_hz=weyl_mode_density(
                          mesh.points, mesh.triangles, section.density * section.thickness,
                          plate_bending(section.thickness, section.young, section.poisson)),
-                     fe=True, generated=config.model.fe.source == "generator")
+                     fe=True)
     return CaseCheck(info, tuple(range_warnings(case, mesh)) + tuple(shared)
                      + tuple(warned) + geometry
                      + tuple(mode_count_warnings(case, interior)), output, size)

@@ -73,7 +73,7 @@ from sarfe.hbm.continuation import most_samples
 from sarfe.mesh.geometry import triangle_areas
 from sarfe.pipeline.model.cutoff import stage_cutoff_hz
 from sarfe.pipeline.solve.case_accuracy import rule_cutoff_hz
-from sarfe.pipeline.solve.mesh_error import coarse_sizes
+from sarfe.pipeline.solve.mesh_error import coarse_sizes, mesh_error_reason
 from sarfe.results.record_grid import COMPRESS_MIN_ENTRIES, record_samples
 
 SWEEP_POINTS_PER_BAND = 10.0     # points × max_step of a smooth continuation (door trim)
@@ -126,7 +126,6 @@ class ModelSize:
     contact_rows: int = 0
     mode_density_per_hz: float | None = None
     fe: bool = False
-    generated: bool = False
 
 
 @dataclass(frozen=True)
@@ -316,19 +315,17 @@ def run_cost(case, size: ModelSize) -> RunCost:
     fixed = T_START + T_OUTPUT + (T_OUTPUT_FE if size.fe else 0.0) + stage
     if auto:
         fixed += SEARCH_POINTS * point_seconds(size.contact_rows, H[0], True)
-    mesh_term = size.generated and config.solver.error_estimate \
-        and config.solver.mesh_error is not False
-    # the coarser meshes' DOF shares (h / h_c)² of a shell mesh; their stages keep the cutoff
-    shares = [(config.model.fe.generator.mesh_size_m / h_c) ** 2
-              for h_c in coarse_sizes(case)] if mesh_term else []
+    # the mesh term's coarser meshes (where it is due: mesh_error_reason's rule), their DOF
+    # shares (h / h_c)² of a shell mesh; their stages keep the cutoff
+    shares = [(config.model.fe.generator.mesh_size_m / h_c) ** 2 for h_c in coarse_sizes(case)] \
+        if config.solver.error_estimate and mesh_error_reason(case) is None else []
     cpu, written, files = [], [], {}
     base = N
     if not listed and config.contacts:    # the sweep's cap on raising N (module docstring)
         N = (N[0], most_samples(N[1], size.contact_rows))
     for i, (n, h, samples) in enumerate(((points[0], H[0], N[0]), (points[1], H[1], N[1]))):
-        t = fixed + n * point_seconds(size.contact_rows, h, listed)
-        if mesh_term:
-            t += sum(shares) * stage + len(shares) * point_seconds(size.contact_rows, h, True)
+        t = fixed + n * point_seconds(size.contact_rows, h, listed) \
+            + sum(shares) * stage + len(shares) * point_seconds(size.contact_rows, h, True)
         spread = RANGE if listed else math.sqrt(RANGE)   # a sweep's points carry the rest
         cpu.append(t / spread if i == 0 else t * spread)
         sizes = file_bytes(config, size, n, h, samples, base[i])

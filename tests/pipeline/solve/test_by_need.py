@@ -6,9 +6,13 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+import yaml
+from small_cases import TINY
 
 from sarfe.hbm import continuation, solve_frequency
 from sarfe.hbm.solution import ContinuationOptions, SolverOptions
+from sarfe.pipeline import solve_case
+from sarfe.pipeline.solve import by_need
 from sarfe.pipeline.solve.by_need import sweep_by_need
 from sarfe.pipeline.solve.pruned_points import linearized_natural_frequencies
 
@@ -103,12 +107,6 @@ def test_a_failed_walk_is_said_in_the_warnings(monkeypatch):
     """Where the sweep by need raises, the run solves the band as one continuation and says so
     in one warning line (it was only in the points' reasons, and door_trim_p1 fell back unseen on
     every run): :data:`small_cases.TINY` swept 15 → 25 Hz with the walk made to raise."""
-    import yaml
-    from small_cases import TINY
-
-    from sarfe.pipeline import solve_case
-    from sarfe.pipeline.solve import by_need
-
     def broken(*args, **kwargs):
         raise RuntimeError("walk broke")
 
