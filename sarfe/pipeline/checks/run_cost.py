@@ -38,8 +38,8 @@ fitted on the shipped cases. A sweep with contacts may raise N up to
 :func:`sarfe.hbm.continuation.most_samples` (N, contact rows) (64 N or more: N × rows ≤ 2^17);
 the high end of N is the rule's N_hi ≤ that (Stiff contacts, below); response.h5 stores the
 contact time histories at :func:`sarfe.results.record_grid.record_samples` (H, N, the case's N)
-≤ max(the case's N, 64, 2^⌈log₂ 16 H⌉) samples (the decimated force, its per-bin peak and the per-bin state), so its size
-is bounded by the case's N and H, not by the raised N.
+≤ max(the case's N, 64, 2^⌈log₂ 16 H⌉) samples (the decimated force, its per-bin peak and the
+per-bin state), so its size is bounded by the case's N and H, not by the raised N.
 Measured within ±30 % on the shipped cases (benchmarks/results/estimate.md).
 
 **CPU** [s] (the process tree's user + system: a quiet 2-core machine's wall time is about this
@@ -76,12 +76,18 @@ and plate 6.2 g, ρ₁ = 1.4e3; the shipped listed cases ρ₁ ≤ 3.2e3; a deck
 Three terms grow with it, each measured (runs of this branch, nice 10, estimate.md):
 
 - N. A sweep raises N at the turns of ω to 16 N (the shipped sweeps; c_0, c_1 were measured on
-  them), and further where the aliasing check asks an impact for :data:`SAMPLES_PER_IMPACT`
-  samples: N_hi = min(most_samples, max(16 N, 2^⌈log₂ 16 √ρ₁⌉)) (T / τ_c = 2 √ρ₁; lumped at
-  1e11 needed 2^15 past 66 Hz, continuation.py). Each point's Newton Jacobians, aliasing check
-  and estimate re-solve (E = :data:`POINT_ITERATIONS` of them) cost c_J rows (2H+1) N each
-  (c_J = :data:`AFT_S`: 9, 22, 61 ms an iteration at N = 2^10, 2^12, 2^14, 2 rows, H = 7); the
-  high end takes every point at N_hi, over the 16 N the base rule holds.
+  them), a hard one (ρ₁ > HARD_RATIO) to 64 N at its stalled corners, and further where the
+  aliasing check asks an impact for samples: N_hi = min(most_samples, max(16 N or 64 N,
+  2^⌈log₂ 8 · 2√ρ₁⌉)) (T / τ_c = 2 √ρ₁ at the band's lowest f). Reached: lumped 4096 (k_n 1e6,
+  1e7), 16384 (1e9), 32768 (1e10, 1e11; the rule 65536 there); rattle rig 4096 (2e5), 16384
+  (1e7) — each the rule's N_hi but at 1e11.
+  Each point's Newton Jacobians, aliasing checks and estimate re-solves (E =
+  :data:`POINT_ITERATIONS`) cost c_J rows (2H+1) N each (c_J = :data:`AFT_S`: 9, 22, 61 ms an
+  iteration at N = 2^10, 2^12, 2^14, 2 rows, H = 7). E = 14: the lumped rattle's points cost
+  c_0 + c_1 (…)^0.55 + c_J E rows (2H+1) (N_hi − 16 N) with E = 14.8 at both 1e9 (344 CPU s,
+  395 points — sweep 110 s, estimates and stability 185, impact check 44) and 1e10 (911 CPU s,
+  555 points — 263, 596, 46); their points' mean N is 0.58 and 0.61 N_hi. The rattle rig 1e7's
+  points are cheaper (E ≈ 3 on the same reading): its high end is ~8× its run.
 - Points: × max(1, ρ₁ / :data:`HARD_RATIO`)^0.15 at both ends (measured: lumped 234 → 1280
   points over k_n 1e6 → 1e11, rattle rig 363 → 715 over 2e5 → 1e9; shipped sweeps: factor 1).
 - The impact check (:mod:`sarfe.pipeline.solve.impact_check`: the loudest point integrated in
@@ -99,7 +105,7 @@ import numpy as np
 from sarfe.case.config import default_samples_per_period
 from sarfe.accuracy.contact_resolution import RESOLUTION_LIMIT
 from sarfe.accuracy.harmonic_truncation import extended_harmonics
-from sarfe.hbm.continuation import MAX_SAMPLES_FACTOR, most_samples
+from sarfe.hbm.continuation import MAX_SAMPLES_FACTOR, MAX_STALL_FACTOR, most_samples
 from sarfe.mesh.geometry import triangle_areas
 from sarfe.pipeline.model.cutoff import stage_cutoff_hz
 from sarfe.pipeline.solve.case_accuracy import rule_cutoff_hz
@@ -139,9 +145,9 @@ SEARCH_POINTS = 14               # points of the H search: 8 screened, a ladder 
 # stiff contacts (module docstring, "Stiff contacts")
 HARD_RATIO = 5e3                 # ρ₁ = (ω_c / ω)² above which a sweep takes more points …
 POINTS_EXPONENT = 0.15           # … ∝ (ρ₁ / HARD_RATIO)^this (lumped: 234 → 1280, k_n 1e6 → 1e11)
-SAMPLES_PER_IMPACT = 8           # AFT samples an impact τ_c = π / ω_c is raised to (1e11: 2^15)
+SAMPLES_PER_IMPACT = 8           # N ≥ this × T / τ_c at the band's lowest f (τ_c = π / ω_c)
 AFT_S = 1.1e-7                   # c_J: s per sample × contact row × column (2H+1) of a Newton step
-POINT_ITERATIONS = 8             # E: AFT Jacobians a reported point (corrector, aliasing, estimate)
+POINT_ITERATIONS = 14            # E: AFT Jacobians a reported point (sweep ≈ 5, estimates ≈ 9)
 PART_SHARE = 33 / 140            # m_c of an FE side: this share of its part's mass (cantilever tip)
 IMPACT_CHECK_S = (19.0, 57.0)    # the time-integration check of an unresolved impact (rattle rig
 #                                  k_n = 1e7; lumped rattle 1e10), CPU s
@@ -316,13 +322,15 @@ def sweep_points(config, size: ModelSize | None = None) -> tuple:
 
 
 def raised_samples(config, size: ModelSize, N: int) -> int:
-    """The most AFT samples a sweep with contacts is taken to reach: 16 N (turns of ω, the
-    shipped sweeps), or more where an impact τ_c = π / ω_c at the band's lowest frequency needs
-    :data:`SAMPLES_PER_IMPACT` samples (N ≥ 8 T / τ_c = 16 √ρ₁, a power of 2), at most
-    :func:`sarfe.hbm.continuation.most_samples`."""
-    impact = SAMPLES_PER_IMPACT * 2 * math.sqrt(stiffness_ratio(config, size))
+    """The most AFT samples a sweep with contacts is taken to reach (docstring): 16 N (turns of
+    ω, the shipped sweeps); 64 N (stalls at corners) with a hard contact (ρ₁ > HARD_RATIO); and
+    at least :data:`SAMPLES_PER_IMPACT` × T / τ_c = 2 √ρ₁ (a power of 2: the aliasing check on
+    an impact τ_c = π / ω_c); at most :func:`sarfe.hbm.continuation.most_samples`."""
+    rho = stiffness_ratio(config, size)
+    impact = SAMPLES_PER_IMPACT * 2 * math.sqrt(rho)
     need = 2 ** math.ceil(math.log2(impact)) if impact > 1 else 1
-    return int(min(most_samples(N, size.contact_rows), max(MAX_SAMPLES_FACTOR * N, need)))
+    turns = (MAX_STALL_FACTOR if rho > HARD_RATIO else MAX_SAMPLES_FACTOR) * N
+    return int(min(most_samples(N, size.contact_rows), max(turns, need)))
 
 
 def impact_check_seconds(config, size: ModelSize, H: int) -> tuple:

@@ -15,7 +15,7 @@ from sarfe.case.read import load_case
 from sarfe.pipeline import solve_case
 from sarfe.pipeline.checks.case_checks import check_case
 from sarfe.accuracy.harmonic_truncation import extended_harmonics
-from sarfe.hbm.continuation import MAX_SAMPLES_FACTOR, most_samples
+from sarfe.hbm.continuation import MAX_SAMPLES_FACTOR, MAX_STALL_FACTOR, most_samples
 from sarfe.pipeline.checks.run_cost import (HARD_RATIO, POINTS_EXPONENT, SAMPLES_PER_IMPACT,
                                             ModelSize, RunCost, contact_frequency, cost_lines,
                                             impact_check_seconds, plate_bending, run_cost,
@@ -220,9 +220,9 @@ def test_contact_mass_is_the_normal_rows_mass():
 
 def test_stiff_contacts_raise_the_sweeps_cost():
     """The sweep's range against k_n (lumped_rattle, 1e6 … 1e12 N/m): the shipped stiffness keeps
-    the 16 N turns and the base rule's points; harder contacts raise N as 16 √ρ₁ samples a period
-    (a power of 2) up to most_samples, the points as (ρ₁ / HARD_RATIO)^0.15, and the CPU range's
-    ends never fall; the time-integration check of an unresolved impact enters the high end when
+    the 16 N turns and the base rule's points; harder contacts raise N to 64 N (ρ₁ > HARD_RATIO)
+    or 8 · 2√ρ₁ samples a period (a power of 2) up to most_samples, the points as
+    (ρ₁ / HARD_RATIO)^0.15, and the CPU range's ends never fall; the time-integration check of an unresolved impact enters the high end when
     ρ(H') > 4 at the band's lowest frequency and the low end when at its highest too."""
     case = load_case(CASES / "lumped_rattle.yaml")
     size = check_case(case, write=False).size
@@ -237,7 +237,8 @@ def test_stiff_contacts_raise_the_sweeps_cost():
         cost = run_cost(stiff, size)
         rho = stiffness_ratio(stiff.config, size)
         need = 2 ** int(np.ceil(np.log2(SAMPLES_PER_IMPACT * 2 * np.sqrt(rho))))
-        assert cost.samples[1] == min(most_samples(N, 2), max(MAX_SAMPLES_FACTOR * N, need))
+        turns = (MAX_STALL_FACTOR if rho > HARD_RATIO else MAX_SAMPLES_FACTOR) * N
+        assert cost.samples[1] == min(most_samples(N, 2), max(turns, need))
         hard = max(1.0, rho / HARD_RATIO) ** POINTS_EXPONENT
         assert cost.points[1] == pytest.approx(min(400 * hard, 2000), abs=1)
         assert cost.cpu_s[0] >= previous.cpu_s[0] and cost.cpu_s[1] > previous.cpu_s[1]
