@@ -247,7 +247,10 @@ def matrices_contact_mass(mass, config) -> tuple:
             g[i, ref.dof] = ref.sign
             if not isinstance(ref.relative_to, str):
                 g[i, ref.relative_to] = -ref.sign
-    flexibility = np.einsum("ij,ji->i", g, np.linalg.solve(mass, g.T))
+    try:
+        flexibility = np.einsum("ij,ji->i", g, np.linalg.solve(mass, g.T))
+    except np.linalg.LinAlgError:       # a singular M (massless DOFs): m_c not stated
+        return tuple(math.nan for _ in rows)
     return tuple(float(1 / f) if r is not None and f > 0 else math.nan
                  for r, f in zip(rows, flexibility))
 
@@ -268,9 +271,13 @@ def fe_contact_mass(config, pairs: dict, triangles, part_of_triangle, triangle_m
         if a.size == 0:
             out.append(math.nan)
             continue
-        flexibility = sum(np.where(side >= 0, 1 / (PART_SHARE * parts[node_part[side]]), 0.0)
-                          for side in (a, b))
-        out.append(float(1 / np.max(flexibility)))
+        flexibility = np.zeros(a.size)
+        for side in (a, b):
+            known = (side >= 0) & (side < node_part.size)
+            part = np.where(known, node_part[np.where(known, side, 0)], -1)
+            mass = np.where(part >= 0, PART_SHARE * parts[np.maximum(part, 0)], np.inf)
+            flexibility += 1 / np.where(mass > 0, mass, np.inf)     # ground, no part: none
+        out.append(float(1 / np.max(flexibility)) if np.max(flexibility) > 0 else math.nan)
     return tuple(out)
 
 
