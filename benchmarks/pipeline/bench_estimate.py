@@ -123,7 +123,7 @@ Notes (2026-11-28, by hand):
 - Modes (Weyl's leading term against the reduction's count): ×0.4 (rattle rig, few low modes)
   to ×2.1 (instrument panel at 186 Hz); ×1.07 on the instrument panel sweep's 1500 Hz stage,
   ×1.33 on door_trim_p1's 1200 Hz.
-- Stiff contacts (runcost3, 2026-11-28, measured, not yet used by the estimate): `sarfe solve`
+- Stiff contacts (runcost3, 2026-11-28, measured; bare continuation): `sarfe solve`
   with error_estimate and stability off, output summary only, nice 10, load 0.1–2.3. Points
   (CPU s) against the contact normal stiffness k_n [N/m]; the estimate said 100–400 for all:
   lumped_rattle 1e6 (shipped) 234, 1e7 261 (18), 1e8 297 (35), 1e9 376, 1e10 574,
@@ -132,7 +132,38 @@ Notes (2026-11-28, by hand):
   3; 1e10 not finished inside its 3000 s). The high end (4 / max_step = 400) is exceeded from
   k_n ≈ 1e7 (rattle rig) / 1e10 (lumped) on; the points grow about like κ^0.15 with
   κ = k_n / (static stiffness at the contact row) (lumped: κ = 55 … 5.5e6 gives 234 … 1280).
-  A rule from this was not built in time (report of runcost3).
+  The rule built from it: the next note.
+- Stiff contacts (stiffcost, 2026-11-29; the rule: run_cost's docstring "Stiff contacts"). Full
+  `sarfe solve` at the defaults (estimates, stability, files), nice 10, load 1.2–4.3, tree CPU s
+  (/tmp driver of stage_cpu's sampling, runs ≤ 150 s wall unless said); "before" is main's line
+  (dd8516d), "after" this branch's. k_n [N/m]; N = the largest N the sweep reached.
+
+  | case | k_n | ρ₁ | points run | N run | CPU s before | CPU s after | CPU s run | in (after) |
+  |---|---|---|---|---|---|---|---|---|
+  | lumped_rattle | 1e6 (shipped) | 197 | 234 | 4096 | 14–90 | 14–90 | 43.1 | yes |
+  | lumped_rattle | 1e7 | 1.97e3 | 261 | 4096 | 14–90 | 14–147 | 58.6 | yes |
+  | lumped_rattle | 1e9 | 1.97e5 | 395 | 16384 | 14–90 | 41–765 | 344.1 (342 s wall, limit raised) | yes (before: 3.8× its high end) |
+  | lumped_rattle | 1e10 | 1.97e6 | 555 | 32768 | 14–90 | 48–2102 | 910.6 (547 s wall, limit raised) | yes (before: 10×) |
+  | lumped_rattle | 1e11 | 1.97e7 | (1280) | (32768) | 14–90 | 59–5909 | > 203 (stopped at 150 s wall, in the sweep) | — |
+  | rattle_rig | 2e5 (shipped) | 1.42e3 | 363 | 4096 | 16–89 | 16–89 | 41.2 | yes |
+  | rattle_rig | 1e7 | 7.1e4 | 402 | 16384 | 16–89 | 40–518 | 65.4 | yes |
+  | rattle_rig | 1e9 | 7.1e6 | (715) | — | 16–89 | 54–3636 | > 97.6 (stopped at 150 s wall, in the sweep) | — |
+
+  Bracketed points/N: the bare continuation's (extremes.md; runcost3 above). Where the CPU s goes
+  (lumped 1e9 / 1e10): sweep 110 / 263, ERP + error estimates + Hill stability 185 / 596, the
+  impact check's time integration 44 / 46, start and writing 5; the points' mean N 0.58 / 0.61
+  N_hi (rattle rig 1e7: 0.56). The old rule's per-point cost c_0 + c_1 (rows (2H+1))^0.55
+  (0.145 s) does not grow with N; the lumped points cost 0.75 / 1.55 s each: the raised N's AFT
+  Jacobians (E = 14.8 of them a point at N_hi on both), more than a points undercount (395
+  inside 100–400; 555 above it). The impact check (19–57 CPU s) was not in the rule at all. The
+  new high ends are 2.2–2.3× the lumped runs. The rattle rig 1e7's points are cheaper (≈ 0.1 s
+  at mean N 9108; its estimates re-solve cheaply), so its stated range is ~8× wide above its
+  run. The shipped listed cases' and the shipped sweeps' CPU ranges are unchanged (door_trim
+  17–68, door_trim_p1 182–724, squeak_rig 6.1–24, instrument_panel 9.2–37, lumped_rattle 14–90,
+  rattle_rig 16–89, instrument_panel_sweep 39–202); the sweeps' printed N high end is now the
+  16 N they reach (4096; the instrument panel sweep 8192) instead of most_samples. A deck
+  (rattle_rig_deck) states no m_c: its contacts are taken soft. Not run (≫ 2 min): rattle rig
+  1e10/1e11 (runcost3: 1e11 130 points in 1510 CPU s, incomplete; after: 66–10138, 82–12063).
 """
 
 FILES = ["summary.json", "table.txt", "response.h5", "ERP maps (VTU)", "animation",

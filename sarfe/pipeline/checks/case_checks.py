@@ -49,7 +49,9 @@ from sarfe.pipeline.checks.case_inputs import case_inputs
 from sarfe.pipeline.checks.held_checks import (check_something_free, contact_warnings,
                                                load_warnings)
 from sarfe.pipeline.checks.mesh_checks import check_deck, shared_pair_warnings
-from sarfe.pipeline.checks.run_cost import (ModelSize, contact_rows, plate_bending,
+from sarfe.mesh.geometry import triangle_areas
+from sarfe.pipeline.checks.run_cost import (ModelSize, contact_rows, fe_contact_mass,
+                                            matrices_contact_mass, plate_bending,
                                             weyl_mode_density)
 from sarfe.pipeline.model.case_mesh import load_case_mesh
 from sarfe.pipeline.model.contact_pairs import boundary_dofs, node_pairs
@@ -164,7 +166,7 @@ HELD_MATRIX_LIMIT = 3000        # DOFs: a dense eigenvalue check above costs mor
 RIGID_TOLERANCE = 1e-10         # eigenvalue ≤ this × the largest: a rigid-body (null-space) mode
 
 
-def check_matrices_held(case) -> None:
+def check_matrices_held(case, stage=None) -> int:
     r"""A ``model.matrices`` model is held at rest, as :func:`check_held` asks of a mesh: the static
     stiffness with the contacts linearized at u = 0 (their preload state: :func:`sarfe.hbm.pruning.
     linearized_stiffness`),
@@ -175,9 +177,9 @@ def check_matrices_held(case) -> None:
     must be regular — else the static (0th harmonic) block of the HBM Jacobian is singular at every
     point. K_0 (n, n) [N/m]; its eigenvalues λ ≤ :data:`RIGID_TOLERANCE`·max λ span the rigid-body
     modes. CaseError naming model.matrices.stiffness and the null-space size. Models above
-    :data:`HELD_MATRIX_LIMIT` DOFs are not checked (a dense eigenvalue problem). Returns the
-    model's DOF count."""
-    stage = build_linear_model(case)
+    :data:`HELD_MATRIX_LIMIT` DOFs are not checked (a dense eigenvalue problem). ``stage``: the
+    case's linear model when built already. Returns the model's DOF count."""
+    stage = build_linear_model(case) if stage is None else stage
     n = stage.dof_count
     if n > HELD_MATRIX_LIMIT:
         return n
@@ -341,6 +343,17 @@ def output_target(case, output_dir=None, force=False):
     return check_output_folder(target, force=force, protected=case_inputs(case))
 
 
+def part_contact_mass(config, mesh, paired, section) -> tuple:
+    """m_c per contact from the parts' masses (:func:`sarfe.pipeline.checks.run_cost.
+    fe_contact_mass`): each triangle's part (its ``part_*`` group; one part without groups) and
+    its mass ρ t A [kg]."""
+    part = np.zeros(mesh.n_triangles, dtype=int)
+    for i, name in enumerate(n for n in sorted(mesh.element_groups) if n.startswith("part_")):
+        part[np.asarray(mesh.element_groups[name], dtype=int)] = i + 1
+    mass = section.density * section.thickness * triangle_areas(mesh.points, mesh.triangles)
+    return fe_contact_mass(config, paired, mesh.triangles, part, mass)
+
+
 def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True,
                assemble=True) -> CaseCheck:
     """All checks of the module docstring. Raises CaseError at the first problem. ``assemble``
@@ -351,10 +364,13 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True,
     if not mesh_checks:
         return CaseCheck({}, tuple(range_warnings(case)), output)
     if not case.is_fe:
-        dofs = check_matrices_held(case)
+        stage = build_linear_model(case)
+        dofs = check_matrices_held(case, stage)
+        masses = matrices_contact_mass(stage.mass, case.config) \
+            if case.config.contacts and dofs <= HELD_MATRIX_LIMIT else ()
         size = ModelSize(dofs=dofs, radiating_nodes=len(case.config.erp.dofs or ()),
                          contacts=len(case.config.contacts),
-                         contact_rows=contact_rows(case.config, None))
+                         contact_rows=contact_rows(case.config, None), contact_mass_kg=masses)
         return CaseCheck({}, tuple(range_warnings(case)), output, size)
     config = case.config
     if config.model.fe.is_deck:   # a Nastran/Abaqus deck: its own checks, with ids
@@ -397,7 +413,7 @@ def check_case(case, output_dir=None, force=False, write=True, mesh_checks=True,
                      mode_density_per_hz=weyl_mode_density(
                          mesh.points, mesh.triangles, section.density * section.thickness,
                          plate_bending(section.thickness, section.young, section.poisson)),
-                     fe=True)
+                     fe=True, contact_mass_kg=part_contact_mass(config, mesh, paired, section))
     return CaseCheck(info, tuple(range_warnings(case, mesh)) + tuple(shared)
                      + tuple(warned) + geometry
                      + tuple(mode_count_warnings(case, interior)), output, size)

@@ -35,11 +35,11 @@ searches chose 14 and 18; the search may go from 3 to 64) and N = max(64, 2^⌈l
 measured on the shipped cases (LZ4 of the VTU arrays ≈ :data:`VTU_RATIO`, gzip of response.h5's
 contact time histories ≈ :data:`H5_GZIP_RATIO`); summary.json and table.txt by a per-point size
 fitted on the shipped cases. A sweep with contacts may raise N up to
-:func:`sarfe.hbm.continuation.most_samples` (N, contact rows) (64 N or more: N × rows ≤ 2^17),
-which the high end of N holds; response.h5 stores the contact time histories at
-:func:`sarfe.results.record_grid.record_samples` (H, N, the case's N) ≤ max(the case's N, 64,
-2^⌈log₂ 16 H⌉) samples (the decimated force, its per-bin peak and the per-bin state), so its size
-is bounded by the case's N and H, not by the raised N.
+:func:`sarfe.hbm.continuation.most_samples` (N, contact rows) (64 N or more: N × rows ≤ 2^17);
+the high end of N is the rule's N_hi ≤ that (Stiff contacts, below); response.h5 stores the
+contact time histories at :func:`sarfe.results.record_grid.record_samples` (H, N, the case's N)
+≤ max(the case's N, 64, 2^⌈log₂ 16 H⌉) samples (the decimated force, its per-bin peak and the
+per-bin state), so its size is bounded by the case's N and H, not by the raised N.
 Measured within ±30 % on the shipped cases (benchmarks/results/estimate.md).
 
 **CPU** [s] (the process tree's user + system: a quiet 2-core machine's wall time is about this
@@ -56,10 +56,44 @@ over 1.5 with the point workers), stage by stage with constants measured on this
                          DOFs at the same modes, ¾ of the fine stage) and a point on each
                          (generated meshes; measured on door_trim_p1: 41.8 CPU s against the
                          fine linear stage's ≈ 51, benchmarks/results/door_trim.md)
+    hard contacts        a sweep's raised N: + c_J E rows (2H+1) (N_hi − 16 N) a point, and the
+                         points × max(1, ρ₁ / HARD_RATIO)^0.15; the impact check (below)
 
 given as a range ×½ … ×2 around that (a sweep: ×1/√2 … ×√2 around its point range's ends):
 an order of magnitude, never a promise (benchmarks/pipeline/bench_estimate.py compares it with
 measured CPU s: benchmarks/results/estimate.md).
+
+**Stiff contacts** (issue 30 item 4: at k_n ≥ 1e9 N/m the lumped and FE rattles took 2–3× the
+old high end). How hard a contact is, is its own frequency against the excitation's:
+
+    ω_c = max_c √(k_n,c / m_c),   ρ(k, f) = (ω_c / (2π k f))²   (ρ₁ = ρ(1, the band's lowest f))
+
+the mass-line form of :mod:`sarfe.accuracy.contact_resolution`'s (6) (an impact lasts
+τ_c = π / ω_c). m_c, the mass the normal row moves: a matrices model's 1 / (g M⁻¹ gᵀ) (exact;
+lumped_rattle 0.143 kg: ρ₁ = 197 at its 1e6 N/m); an FE side moves :data:`PART_SHARE` = 33/140
+of its part's mass (a cantilever tip's static shape), the two sides in series (rattle rig: strip
+and plate 6.2 g, ρ₁ = 1.4e3; the shipped listed cases ρ₁ ≤ 3.2e3; a deck: unknown, not said).
+Three terms grow with it, each measured (runs of this branch, nice 10, estimate.md):
+
+- N. A sweep raises N at the turns of ω to 16 N (the shipped sweeps; c_0, c_1 were measured on
+  them), a hard one (ρ₁ > HARD_RATIO) to 64 N at its stalled corners, and further where the
+  aliasing check asks an impact for samples: N_hi = min(most_samples, max(16 N or 64 N,
+  2^⌈log₂ 8 · 2√ρ₁⌉)) (T / τ_c = 2 √ρ₁ at the band's lowest f). Reached: lumped 4096 (k_n 1e6,
+  1e7), 16384 (1e9), 32768 (1e10, 1e11; the rule 65536 there); rattle rig 4096 (2e5), 16384
+  (1e7) — each the rule's N_hi but at 1e11.
+  Each point's Newton Jacobians, aliasing checks and estimate re-solves (E =
+  :data:`POINT_ITERATIONS`) cost c_J rows (2H+1) N each (c_J = :data:`AFT_S`: 9, 22, 61 ms an
+  iteration at N = 2^10, 2^12, 2^14, 2 rows, H = 7). E = 14: the lumped rattle's points cost
+  c_0 + c_1 (…)^0.55 + c_J E rows (2H+1) (N_hi − 16 N) with E = 14.8 at both 1e9 (344 CPU s,
+  395 points — sweep 110 s, estimates and stability 185, impact check 44) and 1e10 (911 CPU s,
+  555 points — 263, 596, 46); their points' mean N is 0.58 and 0.61 N_hi. The rattle rig 1e7's
+  points are cheaper (E ≈ 3 on the same reading): its high end is ~8× its run.
+- Points: × max(1, ρ₁ / :data:`HARD_RATIO`)^0.15 at both ends (measured: lumped 234 → 1280
+  points over k_n 1e6 → 1e11, rattle rig 363 → 715 over 2e5 → 1e9; shipped sweeps: factor 1).
+- The impact check (:mod:`sarfe.pipeline.solve.impact_check`: the loudest point integrated in
+  time when ρ(H') > 4, H' = :func:`sarfe.accuracy.harmonic_truncation.extended_harmonics`):
+  :data:`IMPACT_CHECK_S` (19 CPU s rattle rig 1e7, 57 lumped 1e10) in the high end when ρ(H') > 4
+  at the band's lowest frequency, in the low end when also at its highest.
 """
 from __future__ import annotations
 
@@ -69,7 +103,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from sarfe.case.config import default_samples_per_period
-from sarfe.hbm.continuation import most_samples
+from sarfe.accuracy.contact_resolution import RESOLUTION_LIMIT
+from sarfe.accuracy.harmonic_truncation import extended_harmonics
+from sarfe.hbm.continuation import MAX_SAMPLES_FACTOR, MAX_STALL_FACTOR, most_samples
 from sarfe.mesh.geometry import triangle_areas
 from sarfe.pipeline.model.cutoff import stage_cutoff_hz
 from sarfe.pipeline.solve.case_accuracy import rule_cutoff_hz
@@ -106,6 +142,15 @@ CB_MODE_EXPONENT = 0.71
 POINT_S = (0.08, 0.01, 0.55)     # c_0, c_1, exponent of one point's cost
 LISTED_POINT_FACTOR = 2.0        # listed frequencies start cold (no predictor)
 SEARCH_POINTS = 14               # points of the H search: 8 screened, a ladder at the loudest
+# stiff contacts (module docstring, "Stiff contacts")
+HARD_RATIO = 5e3                 # ρ₁ = (ω_c / ω)² above which a sweep takes more points …
+POINTS_EXPONENT = 0.15           # … ∝ (ρ₁ / HARD_RATIO)^this (lumped: 234 → 1280, k_n 1e6 → 1e11)
+SAMPLES_PER_IMPACT = 8           # N ≥ this × T / τ_c at the band's lowest f (τ_c = π / ω_c)
+AFT_S = 1.1e-7                   # c_J: s per sample × contact row × column (2H+1) of a Newton step
+POINT_ITERATIONS = 14            # E: AFT Jacobians a reported point (sweep ≈ 5, estimates ≈ 9)
+PART_SHARE = 33 / 140            # m_c of an FE side: this share of its part's mass (cantilever tip)
+IMPACT_CHECK_S = (19.0, 57.0)    # the time-integration check of an unresolved impact (rattle rig
+#                                  k_n = 1e7; lumped rattle 1e10), CPU s
 RANGE = 2.0                      # the CPU range: central / RANGE … central × RANGE (a sweep:
 #                                  √RANGE around its point range's ends)
 
@@ -116,7 +161,10 @@ class ModelSize:
     or the matrices' size), ``nodes``, ``triangles``, ``radiating_nodes`` (the ERP surface's
     nodes, or erp.dofs), ``contacts`` (count), ``contact_rows`` (rows of r = G u: 1 per rattle
     pair, 3 per FE squeak pair, the given DOFs of a matrices contact), ``friction_rows``,
-    ``mode_density_per_hz`` (Weyl, None unknown), ``fe`` (a mesh model: VTU files)."""
+    ``mode_density_per_hz`` (Weyl, None unknown), ``fe`` (a mesh model: VTU files),
+    ``contact_mass_kg`` (per contact, in the case's order: the mass m_c its normal row moves,
+    :func:`matrices_contact_mass` / :func:`fe_contact_mass`; nan without a normal row; ()
+    unknown)."""
 
     dofs: int
     nodes: int = 0
@@ -126,6 +174,7 @@ class ModelSize:
     contact_rows: int = 0
     mode_density_per_hz: float | None = None
     fe: bool = False
+    contact_mass_kg: tuple = ()
 
 
 @dataclass(frozen=True)
@@ -184,8 +233,87 @@ def contact_rows(config, pairs: dict | None) -> int:
     return rows
 
 
-def sweep_points(config) -> tuple:
-    """(low, high) reported points: a list's length, or a continuation's range (docstring)."""
+def matrices_contact_mass(mass, config) -> tuple:
+    """m_c = 1 / (g M⁻¹ gᵀ) [kg] per contact of a matrices model: the mass its normal row
+    r = g u moves (g: ±1 at ``normal_dof`` and −sign at ``relative_to``); nan without a normal
+    row. ``mass`` (n, n) dense or sparse [kg]."""
+    rows = [c.normal_dof for c in config.contacts]
+    if not any(r is not None for r in rows):
+        return tuple(math.nan for _ in rows)
+    mass = mass.toarray() if hasattr(mass, "toarray") else np.asarray(mass, dtype=float)
+    g = np.zeros((len(rows), mass.shape[0]))
+    for i, ref in enumerate(rows):
+        if ref is not None:
+            g[i, ref.dof] = ref.sign
+            if not isinstance(ref.relative_to, str):
+                g[i, ref.relative_to] = -ref.sign
+    try:
+        flexibility = np.einsum("ij,ji->i", g, np.linalg.solve(mass, g.T))
+    except np.linalg.LinAlgError:       # a singular M (massless DOFs): m_c not stated
+        return tuple(math.nan for _ in rows)
+    return tuple(float(1 / f) if r is not None and f > 0 else math.nan
+                 for r, f in zip(rows, flexibility))
+
+
+def fe_contact_mass(config, pairs: dict, triangles, part_of_triangle, triangle_mass) -> tuple:
+    """m_c [kg] per FE contact: each side's node moves :data:`PART_SHARE` of the mass of its part
+    (the part of a triangle holding it; a cantilever's tip: 33/140 of the strip, the static
+    deflection's mass), the two sides in series (a ground side adds none); the lightest pair.
+    ``pairs`` {name: (nodes_a, nodes_b)} (−1: ground), triangles (n_e, 3), part_of_triangle
+    (n_e,) int, triangle_mass (n_e,) [kg]."""
+    parts = np.bincount(part_of_triangle, weights=triangle_mass)
+    node_part = np.full(int(np.max(triangles)) + 1, -1)
+    for k in range(3):
+        node_part[triangles[:, k]] = part_of_triangle
+    out = []
+    for c in config.contacts:
+        a, b = (np.asarray(side, dtype=int) for side in pairs.get(c.name, ((), ())))
+        if a.size == 0:
+            out.append(math.nan)
+            continue
+        flexibility = np.zeros(a.size)
+        for side in (a, b):
+            known = (side >= 0) & (side < node_part.size)
+            part = np.where(known, node_part[np.where(known, side, 0)], -1)
+            mass = np.where(part >= 0, PART_SHARE * parts[np.maximum(part, 0)], np.inf)
+            flexibility += 1 / np.where(mass > 0, mass, np.inf)     # ground, no part: none
+        out.append(float(1 / np.max(flexibility)) if np.max(flexibility) > 0 else math.nan)
+    return tuple(out)
+
+
+def contact_frequency(config, size: ModelSize) -> float | None:
+    """ω_c = max over contacts of √(k_n / m_c) [rad/s] (the contact's own frequency; an impact
+    lasts τ_c = π / ω_c): None without a normal stiffness or a known m_c."""
+    masses = size.contact_mass_kg
+    if len(masses) != len(config.contacts):
+        return None
+    found = [math.sqrt(c.params["normal_stiffness_N_m"] / m)
+             for c, m in zip(config.contacts, masses)
+             if c.params.get("normal_stiffness_N_m") and math.isfinite(m) and m > 0]
+    return max(found) if found else None
+
+
+def band_hz(config) -> tuple:
+    """(lowest, highest) excitation frequency [Hz]: the sweep's band or the listed ones."""
+    sweep = config.excitation.sweep
+    if sweep is not None:
+        return min(sweep.start_hz, sweep.end_hz), max(sweep.start_hz, sweep.end_hz)
+    f = config.excitation.frequency_hz
+    return min(f), max(f)
+
+
+def stiffness_ratio(config, size: ModelSize, harmonic: int = 1, at: int = 0) -> float:
+    """ρ(k) = (ω_c / (k ω))² at the band's lowest (``at`` 0) or highest (1) frequency (the mass-
+    line form of :mod:`sarfe.accuracy.contact_resolution`'s (6)); 0 without ω_c."""
+    omega_c = contact_frequency(config, size)
+    if omega_c is None:
+        return 0.0
+    return (omega_c / (harmonic * 2 * math.pi * band_hz(config)[at])) ** 2
+
+
+def sweep_points(config, size: ModelSize | None = None) -> tuple:
+    """(low, high) reported points: a list's length, or a continuation's range, × the hard
+    contacts' factor max(1, ρ₁ / HARD_RATIO)^POINTS_EXPONENT (docstring)."""
     excitation = config.excitation
     if excitation.sweep is None:
         n = len(excitation.frequency_hz)
@@ -193,9 +321,36 @@ def sweep_points(config) -> tuple:
     if not config.contacts:      # a linear sweep: evenly spaced points (initial_step apart)
         n = min(max(2, int(round(1.0 / config.solver.continuation.initial_step)) + 1), 101)
         return n, n
-    low = SWEEP_POINTS_PER_BAND / config.solver.continuation.max_step
+    hard = 1.0 if size is None else \
+        max(1.0, stiffness_ratio(config, size) / HARD_RATIO) ** POINTS_EXPONENT
+    low = SWEEP_POINTS_PER_BAND / config.solver.continuation.max_step * hard
     cap = config.solver.continuation.max_points
     return int(min(round(low), cap)), int(min(round(low * SWEEP_FOLD_FACTOR), cap))
+
+
+def raised_samples(config, size: ModelSize, N: int) -> int:
+    """The most AFT samples a sweep with contacts is taken to reach (docstring): 16 N (turns of
+    ω, the shipped sweeps); 64 N (stalls at corners) with a hard contact (ρ₁ > HARD_RATIO); and
+    at least :data:`SAMPLES_PER_IMPACT` × T / τ_c = 2 √ρ₁ (a power of 2: the aliasing check on
+    an impact τ_c = π / ω_c); at most :func:`sarfe.hbm.continuation.most_samples`."""
+    rho = stiffness_ratio(config, size)
+    impact = SAMPLES_PER_IMPACT * 2 * math.sqrt(rho)
+    need = 2 ** math.ceil(math.log2(impact)) if impact > 1 else 1
+    turns = (MAX_STALL_FACTOR if rho > HARD_RATIO else MAX_SAMPLES_FACTOR) * N
+    return int(min(most_samples(N, size.contact_rows), max(turns, need)))
+
+
+def impact_check_seconds(config, size: ModelSize, H: int) -> tuple:
+    """(low, high) CPU s of the time-integration check of the loudest point
+    (:mod:`sarfe.pipeline.solve.impact_check`): run when its impact is not resolved by the
+    estimate's H' (ρ(H') > RESOLUTION_LIMIT, (7)) — said in the high end when that holds at the
+    band's lowest frequency, in the low end when it holds at its highest too; none without the
+    error estimate."""
+    if not config.solver.error_estimate or not config.contacts:
+        return 0.0, 0.0
+    extended = extended_harmonics(H)
+    return tuple(IMPACT_CHECK_S[i] if stiffness_ratio(config, size, extended, at) >
+                 RESOLUTION_LIMIT else 0.0 for i, at in ((0, 1), (1, 0)))
 
 
 def _harmonics(config) -> tuple:
@@ -269,12 +424,15 @@ def map_count(config, points: int) -> int:
     return min(points, 1 + len(maps))
 
 
-def point_seconds(rows: int, H: int, listed: bool) -> float:
+def point_seconds(rows: int, H: int, listed: bool, extra_samples: int = 0) -> float:
     """CPU s of one point (Newton, error estimate, Hill stability, records): c_0 + c_1 ·
-    (rows (2H+1))^p, doubled for a listed frequency (docstring)."""
+    (rows (2H+1))^p, doubled for a listed frequency, + c_J E rows (2H+1) ΔN for ``extra_samples``
+    ΔN AFT samples above the 16 N the shipped sweeps reach (a hard contact's raised N;
+    docstring)."""
     c0, c1, p = POINT_S
     t = c0 + c1 * (max(rows, 1) * (2 * H + 1)) ** p
-    return t * (LISTED_POINT_FACTOR if listed else 1.0)
+    aft = AFT_S * POINT_ITERATIONS * max(rows, 1) * (2 * H + 1) * max(extra_samples, 0)
+    return t * (LISTED_POINT_FACTOR if listed else 1.0) + aft
 
 
 def stage_seconds(dofs: int, modes) -> float:
@@ -309,7 +467,7 @@ def run_cost(case, size: ModelSize) -> RunCost:
         else (config.solver.samples_per_period,) * 2
     cutoff = _cutoff(case)
     modes = reduction_modes(config, size, cutoff)
-    points = sweep_points(config)
+    points = sweep_points(config, size)
     listed = config.excitation.sweep is None
     stage = stage_seconds(size.dofs, modes if modes is not None else 100) if size.fe else 0.0
     fixed = T_START + T_OUTPUT + (T_OUTPUT_FE if size.fe else 0.0) + stage
@@ -321,13 +479,16 @@ def run_cost(case, size: ModelSize) -> RunCost:
         if config.solver.error_estimate and mesh_error_reason(case) is None else []
     cpu, written, files = [], [], {}
     base = N
-    if not listed and config.contacts:    # the sweep's cap on raising N (module docstring)
-        N = (N[0], most_samples(N[1], size.contact_rows))
+    if not listed and config.contacts:    # the N a sweep raises to (raised_samples)
+        N = (N[0], raised_samples(config, size, N[1]))
+    impact = impact_check_seconds(config, size, H[1])
     for i, (n, h, samples) in enumerate(((points[0], H[0], N[0]), (points[1], H[1], N[1]))):
-        t = fixed + n * point_seconds(size.contact_rows, h, listed) \
+        # c_0, c_1 were measured on sweeps that reach 16 N: the AFT term counts what is above
+        t = fixed + n * point_seconds(size.contact_rows, h, listed,
+                                      samples - MAX_SAMPLES_FACTOR * base[i]) \
             + sum(shares) * stage + len(shares) * point_seconds(size.contact_rows, h, True)
         spread = RANGE if listed else math.sqrt(RANGE)   # a sweep's points carry the rest
-        cpu.append(t / spread if i == 0 else t * spread)
+        cpu.append(t / spread + impact[0] if i == 0 else t * spread + impact[1])
         sizes = file_bytes(config, size, n, h, samples, base[i])
         written.append(sum(sizes.values()))
         for name, value in sizes.items():
@@ -383,4 +544,6 @@ def cost_lines(cost: RunCost, width: int = 80) -> list:
 
 __all__ = ["ModelSize", "RunCost", "run_cost", "cost_lines", "weyl_mode_density", "plate_bending",
            "contact_rows", "sweep_points", "file_bytes", "map_count", "point_seconds",
-           "stage_seconds", "reduction_modes"]
+           "stage_seconds", "reduction_modes", "matrices_contact_mass", "fe_contact_mass",
+           "contact_frequency", "band_hz", "stiffness_ratio", "raised_samples",
+           "impact_check_seconds"]

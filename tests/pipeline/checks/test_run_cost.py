@@ -1,6 +1,7 @@
 """The cost said before the run (issue 30 item 4, :mod:`sarfe.pipeline.checks.run_cost`): the
 Weyl mode count against a closed-form plate spectrum, the disk estimate against the bytes a run
-writes (±30 %), the range growing with the points and H, and the line in validate and solve."""
+writes (±30 %), the range growing with the points and H and with a stiff contact's own frequency
+(the raised N, the points, the impact check), and the line in validate and solve."""
 from __future__ import annotations
 
 import dataclasses
@@ -13,8 +14,12 @@ from sarfe import cli
 from sarfe.case.read import load_case
 from sarfe.pipeline import solve_case
 from sarfe.pipeline.checks.case_checks import check_case
-from sarfe.pipeline.checks.run_cost import (ModelSize, RunCost, cost_lines, plate_bending,
-                                            run_cost, weyl_mode_density)
+from sarfe.accuracy.harmonic_truncation import extended_harmonics
+from sarfe.hbm.continuation import MAX_SAMPLES_FACTOR, MAX_STALL_FACTOR, most_samples
+from sarfe.pipeline.checks.run_cost import (HARD_RATIO, POINTS_EXPONENT, SAMPLES_PER_IMPACT,
+                                            ModelSize, RunCost, contact_frequency, cost_lines,
+                                            impact_check_seconds, plate_bending, run_cost,
+                                            stiffness_ratio, weyl_mode_density)
 from sarfe.pipeline.solve.mesh_error import mesh_error_reason
 from tests.small_cases import TINY, coarse_rig
 
@@ -183,3 +188,79 @@ def test_mode_estimate_keeps_the_reductions_minimum(tmp_path):
     cost = run_cost(case, size)
     assert size.mode_density_per_hz * cost.cutoff_hz < case.config.reduction.min_mode_count
     assert cost.modes == case.config.reduction.min_mode_count == 10
+
+
+def _stiff(case, k_n):
+    config = case.config
+    contacts = tuple(dataclasses.replace(c, params=dict(c.params, normal_stiffness_N_m=k_n))
+                     if c.params.get("normal_stiffness_N_m") else c for c in config.contacts)
+    return dataclasses.replace(case, config=dataclasses.replace(config, contacts=contacts))
+
+
+def test_contact_mass_is_the_normal_rows_mass():
+    """lumped_rattle's rattle row w = u0 − u1 between 0.2 and 0.5 kg: m_c = 1 / (g M⁻¹ gᵀ) is the
+    two masses in series (0.2 · 0.5 / 0.7 kg), so ω_c = √(k_n / m_c) and ρ₁ = (ω_c / 2π f)² at
+    the band's lowest f (30 Hz); the seal (no normal row) has none. An FE rattle side moves
+    33/140 of its part (rattle rig: the steel strip ρ t L w in series with the ABS plate)."""
+    case = load_case(CASES / "lumped_rattle.yaml")
+    size = check_case(case, write=False).size
+    m_c = 0.2 * 0.5 / 0.7
+    assert size.contact_mass_kg[0] == pytest.approx(m_c, rel=1e-12)
+    assert np.isnan(size.contact_mass_kg[1])
+    assert contact_frequency(case.config, size) == pytest.approx(np.sqrt(1e6 / m_c), rel=1e-12)
+    assert stiffness_ratio(case.config, size) == pytest.approx(
+        1e6 / m_c / (2 * np.pi * 30.0) ** 2, rel=1e-12)
+    rig = load_case(CASES / "rattle_rig.yaml")
+    strip = 7850 * 1.5e-3 * 0.2 * 0.02              # the strip's own mass, 47 g
+    plate = 1050 * 2.5e-3 * 0.15 * 0.15             # the plate's, 59 g
+    share = 33 / 140
+    expected = 1 / (1 / (share * strip) + 1 / (share * plate))
+    assert check_case(rig, write=False).size.contact_mass_kg[0] == pytest.approx(expected, rel=0.1)
+
+
+def test_stiff_contacts_raise_the_sweeps_cost():
+    """The sweep's range against k_n (lumped_rattle, 1e6 … 1e12 N/m): the shipped stiffness keeps
+    the 16 N turns and the base rule's points; harder contacts raise N to 64 N (ρ₁ > HARD_RATIO)
+    or 8 · 2√ρ₁ samples a period (a power of 2) up to most_samples, the points as
+    (ρ₁ / HARD_RATIO)^0.15, and the CPU range's ends never fall; the time-integration check of an unresolved impact enters the high end when
+    ρ(H') > 4 at the band's lowest frequency and the low end when at its highest too."""
+    case = load_case(CASES / "lumped_rattle.yaml")
+    size = check_case(case, write=False).size
+    N = case.config.solver.samples_per_period
+    shipped = run_cost(case, size)
+    soft = run_cost(case, dataclasses.replace(size, contact_mass_kg=()))    # m_c unknown
+    assert shipped.samples == (N, MAX_SAMPLES_FACTOR * N) == soft.samples
+    assert shipped.points == soft.points and shipped.cpu_s == soft.cpu_s
+    previous = shipped
+    for k_n in (1e7, 1e8, 1e9, 1e10, 1e11, 1e12):
+        stiff = _stiff(case, k_n)
+        cost = run_cost(stiff, size)
+        rho = stiffness_ratio(stiff.config, size)
+        need = 2 ** int(np.ceil(np.log2(SAMPLES_PER_IMPACT * 2 * np.sqrt(rho))))
+        turns = (MAX_STALL_FACTOR if rho > HARD_RATIO else MAX_SAMPLES_FACTOR) * N
+        assert cost.samples[1] == min(most_samples(N, 2), max(turns, need))
+        hard = max(1.0, rho / HARD_RATIO) ** POINTS_EXPONENT
+        assert cost.points[1] == pytest.approx(min(400 * hard, 2000), abs=1)
+        assert cost.cpu_s[0] >= previous.cpu_s[0] and cost.cpu_s[1] > previous.cpu_s[1]
+        assert cost.samples[1] >= previous.samples[1] and cost.points[1] >= previous.points[1]
+        H_ext = extended_harmonics(case.config.solver.harmonics)
+        low, high = impact_check_seconds(stiff.config, size, case.config.solver.harmonics)
+        assert (high > 0) == (stiffness_ratio(stiff.config, size, H_ext, 0) > 4)
+        assert (low > 0) == (stiffness_ratio(stiff.config, size, H_ext, 1) > 4)
+        previous = cost
+    assert previous.samples[1] == most_samples(N, 2)          # the cap: N × rows ≤ 2^17
+
+
+def test_listed_frequencies_keep_their_cost_and_validate_says_the_raised_N(tmp_path, capsys):
+    """A listed case does not raise N: its range is the base rule's at any k_n below the impact
+    check (squeak rig); validate prints a stiff sweep's raised N and points."""
+    case = load_case(CASES / "squeak_rig.yaml")
+    size = check_case(case, write=False).size
+    assert run_cost(case, size).cpu_s == run_cost(case, dataclasses.replace(
+        size, contact_mass_kg=())).cpu_s
+    path = tmp_path / "stiff.yaml"
+    path.write_text((CASES / "lumped_rattle.yaml").read_text().replace(
+        "normal_stiffness_N_m: 1.0e6", "normal_stiffness_N_m: 1.0e11"))
+    assert cli.main(["validate", str(path), "-o", str(tmp_path / "v")]) == 0
+    text = " ".join(line.strip() for line in capsys.readouterr().out.splitlines())
+    assert "N 256–65536" in text and "346–1385 points" in text
