@@ -294,6 +294,13 @@ class ExcitationConfig:
             return max(self.sweep.start_hz, self.sweep.end_hz)
         return max(self.frequency_hz)
 
+    @property
+    def min_frequency_hz(self) -> float:
+        """Lowest excitation frequency [Hz] (sweep start or smallest listed frequency)."""
+        if self.sweep is not None:
+            return min(self.sweep.start_hz, self.sweep.end_hz)
+        return min(self.frequency_hz)
+
 
 # ----------------------------------------------------------------------------------------- solver
 @dataclass(frozen=True)

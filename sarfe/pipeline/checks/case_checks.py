@@ -44,12 +44,12 @@ from sarfe.case.plausibility import THICKNESS_RANGE, plausibility_warnings
 from sarfe.case.read import load_case
 from sarfe.hbm.pruning import linearized_stiffness
 from sarfe.mesh import connected_components
+from sarfe.mesh.geometry import triangle_areas
 from sarfe.mesh.quality import coincident_nodes, degenerate_elements, duplicate_elements
 from sarfe.pipeline.checks.case_inputs import case_inputs
 from sarfe.pipeline.checks.held_checks import (check_something_free, contact_warnings,
                                                load_warnings)
 from sarfe.pipeline.checks.mesh_checks import check_deck, shared_pair_warnings
-from sarfe.mesh.geometry import triangle_areas
 from sarfe.pipeline.checks.run_cost import (ModelSize, contact_rows, fe_contact_mass,
                                             matrices_contact_mass, plate_bending,
                                             weyl_mode_density)
@@ -61,6 +61,7 @@ from sarfe.pipeline.model.groups import fixed_nodes, resolve_node_group, shell_p
 from sarfe.pipeline.model.linear_stage import build_linear_model
 from sarfe.pipeline.model.nonlinear_model import nonlinear_model
 from sarfe.results.folder import check_output_folder
+from sarfe.results.vtk import part_ids
 
 ELEMENTS_PER_WAVELENGTH = 6
 COINCIDENT_TOLERANCE = 1e-7      # × model size: nodes closer than this are at the same place
@@ -347,9 +348,9 @@ def part_contact_mass(config, mesh, paired, section) -> tuple:
     """m_c per contact from the parts' masses (:func:`sarfe.pipeline.checks.run_cost.
     fe_contact_mass`): each triangle's part (its ``part_*`` group; one part without groups) and
     its mass ρ t A [kg]."""
-    part = np.zeros(mesh.n_triangles, dtype=int)
-    for i, name in enumerate(n for n in sorted(mesh.element_groups) if n.startswith("part_")):
-        part[np.asarray(mesh.element_groups[name], dtype=int)] = i + 1
+    part, _ = part_ids(mesh.n_triangles, {name: triangles for name, triangles
+                                           in mesh.element_groups.items()
+                                           if name.startswith("part_")})
     mass = section.density * section.thickness * triangle_areas(mesh.points, mesh.triangles)
     return fe_contact_mass(config, paired, mesh.triangles, part, mass)
 

@@ -293,22 +293,15 @@ def contact_frequency(config, size: ModelSize) -> float | None:
     return max(found) if found else None
 
 
-def band_hz(config) -> tuple:
-    """(lowest, highest) excitation frequency [Hz]: the sweep's band or the listed ones."""
-    sweep = config.excitation.sweep
-    if sweep is not None:
-        return min(sweep.start_hz, sweep.end_hz), max(sweep.start_hz, sweep.end_hz)
-    f = config.excitation.frequency_hz
-    return min(f), max(f)
-
-
 def stiffness_ratio(config, size: ModelSize, harmonic: int = 1, at: int = 0) -> float:
     """ρ(k) = (ω_c / (k ω))² at the band's lowest (``at`` 0) or highest (1) frequency (the mass-
     line form of :mod:`sarfe.accuracy.contact_resolution`'s (6)); 0 without ω_c."""
     omega_c = contact_frequency(config, size)
     if omega_c is None:
         return 0.0
-    return (omega_c / (harmonic * 2 * math.pi * band_hz(config)[at])) ** 2
+    excitation = config.excitation
+    f = excitation.max_frequency_hz if at else excitation.min_frequency_hz
+    return (omega_c / (harmonic * 2 * math.pi * f)) ** 2
 
 
 def sweep_points(config, size: ModelSize | None = None) -> tuple:
@@ -545,5 +538,5 @@ def cost_lines(cost: RunCost, width: int = 80) -> list:
 __all__ = ["ModelSize", "RunCost", "run_cost", "cost_lines", "weyl_mode_density", "plate_bending",
            "contact_rows", "sweep_points", "file_bytes", "map_count", "point_seconds",
            "stage_seconds", "reduction_modes", "matrices_contact_mass", "fe_contact_mass",
-           "contact_frequency", "band_hz", "stiffness_ratio", "raised_samples",
+           "contact_frequency", "stiffness_ratio", "raised_samples",
            "impact_check_seconds"]
