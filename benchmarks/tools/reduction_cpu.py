@@ -54,9 +54,9 @@ def main(argv) -> int:
                          for size in coarse_sizes(case)}
     for name, level in [("fine", out["fine"])] + list(out.get("coarse", {}).items()):
         parts = ", ".join(f"{p} {s:.1f}" for p, s in level["parts_cpu_s"].items())
-        print(f"{name}: {level['dofs']} DOFs, {level['modes']} modes, wall {level['wall_s']:.1f} s, "
-              f"CPU {level['cpu_s']:.1f} s + slicing worker {level['slicing_worker_cpu_s']:.1f} s "
-              f"(reduction: {parts})")
+        print(f"{name}: {level['dofs']} DOFs, {level['modes']} modes, "
+              f"wall {level['wall_s']:.1f} s, CPU {level['cpu_s']:.1f} s "
+              f"+ slicing worker {level['slicing_worker_cpu_s']:.1f} s (reduction: {parts})")
     if len(args) > 1:
         pathlib.Path(args[1]).write_text(json.dumps(out, indent=1))
     return 0

@@ -283,4 +283,5 @@ def _peak(nl, w0, w1, measure) -> float:
 
 
 __all__ = ["LEVEL_STEP_DB", "REFINE_DEPTH", "PEAK_XTOL", "BY_NEED_FAILED", "fallback_warning",
-           "nonlinear_stretches", "default_measure", "erp_measure", "points_by_need", "sweep_by_need", "linear_stretch"]
+           "nonlinear_stretches", "default_measure", "erp_measure", "points_by_need",
+           "sweep_by_need", "linear_stretch"]
